@@ -1,0 +1,76 @@
+"""Helpers shared by the subcommands: output, paths, progress."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["emit", "add_json_flag", "check_output_path", "to_jsonable"]
+
+
+def add_json_flag(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--json", action="store_true", help="print a machine-readable JSON object instead of text"
+    )
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays and paths inside ``obj`` to plain JSON types."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating):
+        return float(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
+    """Print ``result`` as JSON if ``--json`` was given, else ``text``; return exit code 0."""
+    if getattr(args, "json", False):
+        json.dump(to_jsonable(result), sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        sys.stdout.write(text.rstrip("\n") + "\n")
+    return 0
+
+
+def check_output_path(out: str | Path, *inputs: str | Path | None) -> Path:
+    """Refuse an output path equal to an input path, or in a missing/unwritable folder."""
+    out_p = Path(out)
+    for inp in inputs:
+        if inp is None:
+            continue
+        in_p = Path(inp)
+        if in_p.exists() and out_p.exists() and out_p.resolve() == in_p.resolve():
+            raise ParameterError(
+                f"output path {str(out)!r} is the same file as input {str(inp)!r}; "
+                "beatsync never overwrites its input: choose another output name"
+            )
+        if out_p.resolve() == in_p.resolve():
+            raise ParameterError(
+                f"output path {str(out)!r} is the same as input {str(inp)!r}; choose another name"
+            )
+    parent = out_p.resolve().parent
+    if not parent.is_dir():
+        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
+    import os
+
+    if not os.access(parent, os.W_OK):
+        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    return out_p

@@ -1,0 +1,171 @@
+"""Time bases and validation shared by every stage.
+
+Data contract
+-------------
+- Event times (beats, period boundaries, motion beats) are 1-D ``float64`` arrays in
+  seconds, strictly increasing.
+- Frames appear only inside a stage or at I/O; every conversion between frames and
+  seconds goes through :func:`frames_to_time` and :func:`time_to_frames`.
+- A frame rate ``fps`` is a finite number > 0 [Hz].
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .errors import ParameterError
+
+__all__ = [
+    "frames_to_time",
+    "time_to_frames",
+    "check_fps",
+    "check_times",
+    "check_finite",
+    "check_range",
+]
+
+
+def check_fps(fps: Any, *, name: str = "fps") -> float:
+    """Return ``fps`` as a float after checking it is finite and > 0 [Hz].
+
+    Raises
+    ------
+    ParameterError
+        If ``fps`` is not a finite positive number.
+    """
+    try:
+        value = float(fps)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={fps!r} is not a number; give a frame rate in Hz") from None
+    if not np.isfinite(value) or value <= 0:
+        raise ParameterError(
+            f"{name}={fps!r} must be a finite frame rate > 0 [Hz] "
+            "(did you pass a frame period in seconds, or zero?)"
+        )
+    return value
+
+
+def frames_to_time(frames: Any, *, fps: float) -> np.ndarray:
+    """Convert frame indices to times in seconds: ``t = frames / fps``.
+
+    Parameters
+    ----------
+    frames : array_like [frames]
+    fps : float > 0 [Hz]
+
+    Returns
+    -------
+    times : np.ndarray [s], float64
+
+    Examples
+    --------
+    >>> frames_to_time([0, 30, 60], fps=60.0)
+    array([0. , 0.5, 1. ])
+    """
+    fps = check_fps(fps)
+    return np.asarray(frames, dtype=np.float64) / fps
+
+
+def time_to_frames(times: Any, *, fps: float, round_to_int: bool = True) -> np.ndarray:
+    """Convert times in seconds to frame indices: ``frames = round(t * fps)``.
+
+    Parameters
+    ----------
+    times : array_like [s]
+    fps : float > 0 [Hz]
+    round_to_int : bool
+        Round to the nearest integer frame (``int64``); otherwise return fractional
+        frames (``float64``).
+
+    Examples
+    --------
+    >>> time_to_frames([0.0, 0.5, 1.0], fps=60.0)
+    array([ 0, 30, 60])
+    """
+    fps = check_fps(fps)
+    frames = np.asarray(times, dtype=np.float64) * fps
+    if round_to_int:
+        return np.rint(frames).astype(np.int64)
+    return frames
+
+
+def check_finite(values: Any, *, name: str) -> np.ndarray:
+    """Return ``values`` as a float64 array, refusing NaN or infinite entries."""
+    arr = np.asarray(values, dtype=np.float64)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        idx = np.argwhere(bad)[0]
+        raise ParameterError(
+            f"{name} contains {int(bad.sum())} NaN or infinite value(s) "
+            f"(first at index {tuple(int(i) for i in idx)}); "
+            "fill gaps (e.g. interpolate missing markers) before calling"
+        )
+    return arr
+
+
+def check_times(
+    times: Any,
+    *,
+    name: str = "times",
+    allow_empty: bool = True,
+    duration: float | None = None,
+) -> np.ndarray:
+    """Validate event times: 1-D, finite, >= 0, strictly increasing, in seconds.
+
+    Parameters
+    ----------
+    times : array_like [s]
+    name : str
+        Used in error messages.
+    allow_empty : bool
+    duration : float, optional [s]
+        If given, times beyond it are refused (a hint that frames were passed).
+
+    Raises
+    ------
+    ParameterError
+        With the likely mistake: frames instead of seconds, milliseconds, unsorted.
+    """
+    arr = np.asarray(times, dtype=np.float64)
+    if arr.ndim != 1:
+        raise ParameterError(f"{name} must be a 1-D array of times in seconds, got shape {arr.shape}")
+    if arr.size == 0:
+        if not allow_empty:
+            raise ParameterError(f"{name} is empty: at least one event time [s] is needed")
+        return arr
+    arr = check_finite(arr, name=name)
+    if arr[0] < 0:
+        raise ParameterError(f"{name} has a negative time {arr[0]!r}; times are seconds from the start")
+    diffs = np.diff(arr)
+    if np.any(diffs <= 0):
+        i = int(np.argmax(diffs <= 0))
+        raise ParameterError(
+            f"{name} must be strictly increasing, but {name}[{i + 1}]={arr[i + 1]!r} "
+            f"<= {name}[{i}]={arr[i]!r}; sort them and drop duplicates"
+        )
+    if duration is not None and arr[-1] > duration + 1e-9:
+        hint = ""
+        if arr[-1] > 30 * duration:
+            hint = " (these look like frame indices or milliseconds, not seconds)"
+        raise ParameterError(
+            f"{name} ends at {arr[-1]!r} s, after the signal's duration {duration:.3f} s{hint}"
+        )
+    return arr
+
+
+def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float]:
+    """Validate an interval ``lo < hi``, both finite and > 0, in ``unit``."""
+    try:
+        lo_f, hi_f = float(lo), float(hi)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}=({lo!r}, {hi!r}) must be two numbers [{unit}]") from None
+    if not (np.isfinite(lo_f) and np.isfinite(hi_f)) or lo_f <= 0 or hi_f <= 0:
+        raise ParameterError(f"{name}=({lo!r}, {hi!r}) must be finite and > 0 [{unit}]")
+    if lo_f >= hi_f:
+        raise ParameterError(
+            f"{name}=({lo!r}, {hi!r}) is reversed or empty: the lower bound must be "
+            f"smaller than the upper bound [{unit}]"
+        )
+    return lo_f, hi_f
