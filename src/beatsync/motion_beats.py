@@ -1,0 +1,472 @@
+"""Motion beats and motion intensity of dance clips (paper B, section 3.1).
+
+Paper B (Xu, Takagi, Kawada) builds its weighted motion graph on the *beat frames*
+of every clip of a motion library, and weights the forward edge between two
+successive beat frames by the *motion intensity* of that interval.
+
+Definitions used here
+---------------------
+- **Kinematic beats** (``method="speed"``, the default): local minima of the mean
+  joint speed, smoothed with a Gaussian of standard deviation ``smooth`` [s]. Dancers
+  mark the beat by stopping or reversing a movement, so the whole body slows down on
+  the beat (Shiratori et al. 2004, Kim et al. 2003). Minima closer than
+  ``min_interval`` [s] are thinned (the deeper one is kept), and minima whose
+  prominence is below ``rel_prominence`` times the median smoothed speed are dropped
+  (flat plateaus give spurious minima).
+- **PCA beats** (``method="pca"``, paper B's earlier work and Kim et al. 2003): a
+  short-term principal component analysis of root-relative joint positions over a
+  sliding window of ``window`` [s]; the projection of each frame on the first
+  principal axis (sign kept consistent between neighbouring windows) is smoothed
+  and its extrema (both minima and maxima: the turning points of the dominant
+  movement) are the beats.
+- **Motion intensity** of a beat interval: the mean kinetic energy of the joints,
+  ``0.5 * mean_j |v_j|^2`` (unit mass per joint), averaged over the frames of the
+  interval ``[beat_i, beat_{i+1})`` [(position unit)^2 / s^2].
+
+Data contract
+-------------
+- Input: a :class:`beatsync.motion.Motion` with a skeleton (world joint positions by
+  forward kinematics, :meth:`Motion.positions`) or a marker table whose channels are
+  ``<marker>_x/_y/_z`` triples. The array-level functions take positions
+  ``(n_frames, n_joints, 3)`` and ``fps`` [Hz] directly.
+- Output: beat times, 1-D float64 seconds, strictly increasing, always on frame
+  times (``frame / fps``); intensities one per interval between successive beats.
+
+Notebook: ``notebooks/tab01_speed_motion_graph.ipynb``; paper B section 3.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+from scipy.ndimage import gaussian_filter1d
+from scipy.signal import find_peaks
+
+from .errors import BeatsyncWarning, ParameterError
+from .units import check_finite, check_fps, check_times, frames_to_time, time_to_frames
+
+__all__ = [
+    "kinematic_beats",
+    "kinematic_beat_frames",
+    "beat_interval_intensity",
+    "interval_intensity",
+    "speed_curve",
+    "pca_curve",
+    "kinetic_energy",
+    "motion_positions",
+    "zscore",
+]
+
+_METHODS = ("speed", "pca")
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
+    """World joint positions of a motion, ``(n_frames, n_joints, 3)`` [position unit].
+
+    Uses forward kinematics (:meth:`Motion.positions`) when the motion has a skeleton;
+    a marker table (channels ``<name>_x``, ``<name>_y``, ``<name>_z``) is reshaped.
+
+    Parameters
+    ----------
+    motion : Motion
+    joints : sequence of str or int, optional
+        Joint (or marker) names or indices to keep; default all (end sites included).
+
+    Raises
+    ------
+    ParameterError
+        No skeleton and no marker triples, unknown joint names, NaN gaps.
+    """
+    if getattr(motion, "skeleton", None) is not None:
+        pos = np.asarray(motion.positions(), dtype=np.float64)
+        names = list(getattr(motion, "joint_names", []))
+    else:
+        channels = list(getattr(motion, "channels", ()))
+        vals = np.asarray(getattr(motion, "values", np.empty((0, 0))), dtype=np.float64)
+        if len(channels) == 0 or len(channels) % 3 != 0:
+            raise ParameterError(
+                f"motion {getattr(motion, 'name', '')!r} has no skeleton and its "
+                f"{len(channels)} channels are not <marker>_x/_y/_z triples: joint "
+                "positions are needed (read a BVH, or a marker table)"
+            )
+        names = []
+        for i in range(0, len(channels), 3):
+            trio = channels[i : i + 3]
+            stems = {c.rsplit("_", 1)[0] for c in trio}
+            axes = [c.rsplit("_", 1)[-1].lower() for c in trio]
+            if len(stems) != 1 or axes != ["x", "y", "z"]:
+                raise ParameterError(
+                    f"channels {trio} are not a <marker>_x/_y/_z triple; motion beats need "
+                    "joint positions (a BVH with a skeleton, or marker positions)"
+                )
+            names.append(stems.pop())
+        pos = vals.reshape(vals.shape[0], -1, 3)
+    if joints is not None:
+        idx = []
+        for j in joints:
+            if isinstance(j, (int, np.integer)):
+                if not 0 <= int(j) < pos.shape[1]:
+                    raise ParameterError(f"joint index {j} out of range 0..{pos.shape[1] - 1}")
+                idx.append(int(j))
+            else:
+                if j not in names:
+                    raise ParameterError(
+                        f"joint {j!r} not in the motion; known joints: {', '.join(names[:12])}"
+                        + (" ..." if len(names) > 12 else "")
+                    )
+                idx.append(names.index(j))
+        if not idx:
+            raise ParameterError("joints is empty: give at least one joint name or None for all")
+        pos = pos[:, idx, :]
+    return check_finite(pos, name="joint positions")
+
+
+def _check_positions(positions: Any, fps: Any) -> tuple[np.ndarray, float]:
+    fps = check_fps(fps)
+    pos = check_finite(positions, name="positions")
+    if pos.ndim == 2 and pos.shape[1] % 3 == 0:
+        pos = pos.reshape(pos.shape[0], -1, 3)
+    if pos.ndim != 3 or pos.shape[2] != 3:
+        raise ParameterError(
+            f"positions must have shape (n_frames, n_joints, 3), got {pos.shape}"
+        )
+    if pos.shape[0] < 3:
+        raise ParameterError(
+            f"motion has only {pos.shape[0]} frame(s); at least 3 are needed for velocities"
+        )
+    return pos, fps
+
+
+def _check_seconds(value: Any, *, name: str, allow_zero: bool = True) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={value!r} must be a number of seconds") from None
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise ParameterError(f"{name}={value!r} must be a finite duration >= 0 [s]")
+    if v > 60:
+        raise ParameterError(
+            f"{name}={value!r} s is implausibly long; it is in seconds (did you give frames "
+            "or milliseconds?)"
+        )
+    return v
+
+
+def zscore(x: Any, *, name: str = "values") -> np.ndarray:
+    """Standard score ``(x - mean) / std`` of a 1-D array; all zeros if ``std == 0``.
+
+    A constant input (e.g. a single interval) is legal but carries no contrast: a
+    :class:`BeatsyncWarning` is issued and zeros are returned.
+    """
+    arr = check_finite(x, name=name)
+    if arr.ndim != 1:
+        raise ParameterError(f"{name} must be 1-D, got shape {arr.shape}")
+    if arr.size == 0:
+        return arr.copy()
+    sd = float(arr.std())
+    if sd <= 1e-12 * max(1.0, float(np.abs(arr).max())):
+        if arr.size > 1:
+            warnings.warn(
+                f"{name} is constant; its z-score is set to 0", BeatsyncWarning, stacklevel=2
+            )
+        return np.zeros_like(arr)
+    return (arr - arr.mean()) / sd
+
+
+# --------------------------------------------------------------------------- curves
+
+
+def kinetic_energy(positions: Any, *, fps: float) -> np.ndarray:
+    """Per-frame mean kinetic energy of the joints, ``0.5 * mean_j |v_j|^2``.
+
+    Parameters
+    ----------
+    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
+    fps : float > 0 [Hz]
+
+    Returns
+    -------
+    energy : np.ndarray [shape=(n_frames,)] [(position unit / s)^2]
+        Unit mass per joint; velocities by central differences.
+    """
+    pos, fps = _check_positions(positions, fps)
+    vel = np.gradient(pos, axis=0) * fps
+    return 0.5 * np.mean(np.sum(vel * vel, axis=2), axis=1)
+
+
+def speed_curve(positions: Any, *, fps: float, smooth: float = 0.1) -> np.ndarray:
+    """Mean joint speed per frame, Gaussian-smoothed (sigma ``smooth`` [s]).
+
+    Returns
+    -------
+    speed : np.ndarray [shape=(n_frames,)] [position unit / s]
+    """
+    pos, fps = _check_positions(positions, fps)
+    smooth = _check_seconds(smooth, name="smooth")
+    vel = np.gradient(pos, axis=0) * fps
+    speed = np.mean(np.linalg.norm(vel, axis=2), axis=1)
+    if smooth > 0:
+        speed = gaussian_filter1d(speed, sigma=smooth * fps, mode="nearest")
+    return speed
+
+
+def pca_curve(
+    positions: Any, *, fps: float, window: float = 0.5, smooth: float = 0.1
+) -> np.ndarray:
+    """Projection of each frame on the first principal axis of a sliding window.
+
+    Joint positions are made root-relative (joint 0 subtracted), flattened to
+    ``3 * n_joints`` features; for the window of ``window`` [s] centred on each frame
+    the first principal axis is found (eigenvector of the window's Gram matrix), its
+    sign aligned with the previous window's axis, and the centred frame projected on
+    it. The curve is then Gaussian-smoothed (sigma ``smooth`` [s]).
+
+    Returns
+    -------
+    curve : np.ndarray [shape=(n_frames,)] [position unit]
+    """
+    pos, fps = _check_positions(positions, fps)
+    window = _check_seconds(window, name="window", allow_zero=False)
+    smooth = _check_seconds(smooth, name="smooth")
+    n = pos.shape[0]
+    x = (pos - pos[:, :1, :]).reshape(n, -1) if pos.shape[1] > 1 else pos.reshape(n, -1)
+    half = max(1, int(round(window * fps / 2)))
+    w = 2 * half + 1
+    xp = np.pad(x, ((half, half), (0, 0)), mode="edge")
+    axes = np.empty_like(x)
+    proj = np.empty(n)
+    chunk = max(1, int(4_000_000 // max(1, w * x.shape[1])))
+    for s in range(0, n, chunk):
+        e = min(n, s + chunk)
+        win = np.lib.stride_tricks.sliding_window_view(xp[s : e + 2 * half], w, axis=0)
+        win = np.swapaxes(win, 1, 2)  # (m, w, d)
+        mean = win.mean(axis=1, keepdims=True)
+        c = win - mean
+        gram = c @ np.swapaxes(c, 1, 2)  # (m, w, w)
+        _, evec = np.linalg.eigh(gram)
+        u1 = evec[:, :, -1]  # (m, w)
+        v1 = np.einsum("mw,mwd->md", u1, c)
+        norm = np.linalg.norm(v1, axis=1, keepdims=True)
+        v1 = np.divide(v1, norm, out=np.zeros_like(v1), where=norm > 0)
+        axes[s:e] = v1
+        proj[s:e] = np.einsum("md,md->m", c[:, half, :], v1)
+    # keep the axis orientation consistent from window to window
+    dots = np.einsum("nd,nd->n", axes[1:], axes[:-1])
+    flips = np.concatenate([[1.0], np.where(dots < 0, -1.0, 1.0)])
+    proj = proj * np.cumprod(flips)
+    if smooth > 0:
+        proj = gaussian_filter1d(proj, sigma=smooth * fps, mode="nearest")
+    return proj
+
+
+# --------------------------------------------------------------------------- beats
+
+
+def kinematic_beat_frames(
+    positions: Any,
+    *,
+    fps: float,
+    method: str = "speed",
+    smooth: float = 0.1,
+    min_interval: float = 0.2,
+    rel_prominence: float = 0.02,
+    window: float = 0.5,
+) -> np.ndarray:
+    """Beat frames of joint positions (array-level version of :func:`kinematic_beats`).
+
+    Parameters
+    ----------
+    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
+    fps : float > 0 [Hz]
+    method : {"speed", "pca"}
+    smooth : float >= 0 [s]
+        Gaussian sigma of the curve smoothing.
+    min_interval : float >= 0 [s]
+        Minimum distance between two beats.
+    rel_prominence : float >= 0
+        Minimum prominence of an extremum, relative to the median absolute value
+        (speed) or the median absolute deviation (pca) of the curve.
+    window : float > 0 [s]
+        PCA window length (``method="pca"`` only).
+
+    Returns
+    -------
+    frames : np.ndarray [shape=(n_beats,)] int64 [frames], strictly increasing.
+    """
+    if method not in _METHODS:
+        raise ParameterError(f"method={method!r} is not one of {_METHODS}")
+    pos, fps = _check_positions(positions, fps)
+    min_interval = _check_seconds(min_interval, name="min_interval")
+    try:
+        rel_prominence = float(rel_prominence)
+    except (TypeError, ValueError):
+        raise ParameterError(f"rel_prominence={rel_prominence!r} must be a number >= 0") from None
+    if not np.isfinite(rel_prominence) or rel_prominence < 0:
+        raise ParameterError(f"rel_prominence={rel_prominence!r} must be a number >= 0")
+    distance = max(1, int(round(min_interval * fps)))
+    if method == "speed":
+        curve = speed_curve(pos, fps=fps, smooth=smooth)
+        scale = float(np.median(np.abs(curve)))
+        prom = rel_prominence * scale if scale > 0 else None
+        frames, _ = find_peaks(-curve, distance=distance, prominence=prom)
+    else:
+        curve = pca_curve(pos, fps=fps, window=window, smooth=smooth)
+        scale = float(np.median(np.abs(curve - np.median(curve))))
+        prom = rel_prominence * scale if scale > 0 else None
+        lo, _ = find_peaks(-curve, prominence=prom)
+        hi, _ = find_peaks(curve, prominence=prom)
+        frames = np.sort(np.concatenate([lo, hi]))
+        frames = _thin(frames, distance)
+    frames = np.asarray(frames, dtype=np.int64)
+    if frames.size == 0:
+        warnings.warn(
+            f"no motion beats found in {pos.shape[0]} frames (method={method!r}, "
+            f"smooth={smooth} s): the motion may be static or too short",
+            BeatsyncWarning,
+            stacklevel=2,
+        )
+    return frames
+
+
+def _thin(frames: np.ndarray, distance: int) -> np.ndarray:
+    """Drop extrema closer than ``distance`` frames to the previously kept one."""
+    if frames.size == 0 or distance <= 1:
+        return frames
+    kept = [int(frames[0])]
+    for f in frames[1:]:
+        if f - kept[-1] >= distance:
+            kept.append(int(f))
+    return np.asarray(kept, dtype=np.int64)
+
+
+def kinematic_beats(
+    motion: Any,
+    *,
+    method: str = "speed",
+    smooth: float = 0.1,
+    min_interval: float = 0.2,
+    joints: Any = None,
+    rel_prominence: float = 0.02,
+    window: float = 0.5,
+) -> np.ndarray:
+    """Motion beat times of a clip [s].
+
+    Parameters
+    ----------
+    motion : Motion
+        With a skeleton (forward kinematics) or a marker-position table.
+    method : {"speed", "pca"}
+        ``"speed"`` (default): local minima of the smoothed mean joint speed.
+        ``"pca"``: extrema of a short-term PCA projection (paper B's earlier work).
+    smooth : float >= 0 [s]
+        Gaussian sigma of the smoothing.
+    min_interval : float >= 0 [s]
+        Minimum distance between beats.
+    joints : sequence of str, optional
+        Joints used; default all.
+    rel_prominence : float >= 0
+        See :func:`kinematic_beat_frames`.
+    window : float > 0 [s]
+        PCA window (``method="pca"``).
+
+    Returns
+    -------
+    beats : np.ndarray [shape=(n_beats,)] [s], on frame times, strictly increasing.
+
+    Raises
+    ------
+    ParameterError
+        Unknown method, negative durations, fewer than 3 frames, no positions.
+
+    Examples
+    --------
+    >>> from beatsync import datasets                                  # doctest: +SKIP
+    >>> kinematic_beats(datasets.load_salsa("60_01"))[:3]              # doctest: +SKIP
+    """
+    pos = motion_positions(motion, joints=joints)
+    frames = kinematic_beat_frames(
+        pos,
+        fps=motion.fps,
+        method=method,
+        smooth=smooth,
+        min_interval=min_interval,
+        rel_prominence=rel_prominence,
+        window=window,
+    )
+    return frames_to_time(frames, fps=motion.fps)
+
+
+# --------------------------------------------------------------------------- intensity
+
+
+def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.ndarray:
+    """Mean joint kinetic energy per interval between successive beat frames.
+
+    Parameters
+    ----------
+    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
+    beat_frames : array_like of int [frames], strictly increasing, inside the clip
+    fps : float > 0 [Hz]
+
+    Returns
+    -------
+    intensity : np.ndarray [shape=(len(beat_frames) - 1,)] [(position unit / s)^2]
+        Mean of :func:`kinetic_energy` over frames ``[b_i, b_{i+1})``.
+    """
+    energy = kinetic_energy(positions, fps=fps)
+    bf = np.asarray(beat_frames)
+    if bf.ndim != 1:
+        raise ParameterError(f"beat_frames must be 1-D, got shape {bf.shape}")
+    if bf.size and not np.issubdtype(bf.dtype, np.integer):
+        if not np.all(np.equal(np.mod(bf, 1), 0)):
+            raise ParameterError(
+                "beat_frames must be integer frame indices; convert seconds with "
+                "beatsync.units.time_to_frames"
+            )
+    bf = bf.astype(np.int64)
+    if bf.size < 2:
+        return np.empty(0)
+    if np.any(np.diff(bf) <= 0):
+        raise ParameterError(
+            "beat frames must be strictly increasing and at least one frame apart "
+            "(two beats fell on the same frame: are the beat times too close?)"
+        )
+    if bf[0] < 0 or bf[-1] >= energy.size:
+        raise ParameterError(
+            f"beat frames span {bf[0]}..{bf[-1]} but the clip has {energy.size} frames"
+        )
+    cum = np.concatenate([[0.0], np.cumsum(energy)])
+    return (cum[bf[1:]] - cum[bf[:-1]]) / np.diff(bf)
+
+
+def beat_interval_intensity(motion: Any, beat_times: Any, *, joints: Any = None) -> np.ndarray:
+    """Motion intensity of each interval between successive motion beats.
+
+    Parameters
+    ----------
+    motion : Motion
+    beat_times : array_like [s], strictly increasing, within the clip
+    joints : sequence of str, optional
+
+    Returns
+    -------
+    intensity : np.ndarray [shape=(len(beat_times) - 1,)] [(position unit / s)^2]
+        Mean kinetic energy of the joints (unit mass) over ``[beat_i, beat_{i+1})``.
+
+    Raises
+    ------
+    ParameterError
+        Beat times not seconds, outside the clip, or closer than one frame.
+    """
+    fps = check_fps(motion.fps)
+    n = int(motion.values.shape[0]) if hasattr(motion, "values") else None
+    duration = (n - 1) / fps if n else None
+    beats = check_times(beat_times, name="beat_times", duration=duration)
+    pos = motion_positions(motion, joints=joints)
+    frames = time_to_frames(beats, fps=fps)
+    return interval_intensity(pos, frames, fps=fps)
