@@ -1,0 +1,168 @@
+"""Bundled real data (the repository's ``data/`` folder), verified by SHA-256.
+
+Every file was copied byte for byte from a public source; ``data/README.md`` gives
+origins, licences and the checksums repeated in :data:`CHECKSUMS`. Loading a file
+through this module verifies its checksum once per process, so a corrupted or
+edited file is refused rather than silently used.
+
+The data folder is found next to the source tree (``<repo>/data``) or from the
+environment variable ``BEATSYNC_DATA``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ParameterError
+from .motion import Motion
+
+__all__ = [
+    "CHECKSUMS",
+    "data_dir",
+    "path",
+    "verify_all",
+    "load_salsa",
+    "load_walk",
+    "load_mocap_toolbox",
+    "load_madmom_sample",
+    "load_click_808",
+    "SALSA_CLIPS",
+    "WALK_CLIPS",
+]
+
+CHECKSUMS: dict[str, str] = {
+    "motion/cmu_salsa/60_01_scaled.bvh": "45b79450061bcbd651e0b11afe28349faa9a5beeccf02851eda1720e4cd75189",
+    "motion/cmu_salsa/60_04_scaled.bvh": "47ab436c87c706b68770e9704c584285882c6957135153f6c33cdc9f51124af9",
+    "motion/cmu_salsa/61_01_scaled.bvh": "c0704e7c6fa0d7bd16e656b0f67b1984aa3de10ce6048f697ffe8fde339e06e8",
+    "motion/cmu_salsa/61_04_scaled.bvh": "8c651c30824070dc77cc47ef520d78ba64fbbf2ecebf185ffd0cabe38764a86a",
+    "motion/cmu_walk_modern/005_02.bvh": "496dc2ad1ecbf70d8a2d81e4c694134d2f7d2f2210d487ea30e471f8f7d0d45f",
+    "motion/cmu_walk_modern/007_01.bvh": "82747519b416ea16aafaec551292e11c4c6b33bcf6d26692e975a2de7755a37a",
+    "motion/cmu_walk_modern/007_02.bvh": "33a05a0121da63e1685aa82ef87edc794e235707eecafa258786873e5d902316",
+    "motion/cmu_walk_modern/007_12.bvh": "a56ebf53165e596a6754decabd974f8361ec47591fefb97e110d3098b8705901",
+    "motion/mocaptoolbox/mcdemodata.mat": "d50f1a73759e86af655f2f9b932c0cb92a2025d9dc92faa22bce9da5ab178553",
+    "audio/madmom/sample.beats": "7e68df80cb5c8a77f2a199022e0ffdee771af03c0cfde8794992f9ae0f829503",
+    "audio/madmom/sample.onsets": "d847783458758b52c08246f25fd851b1eaf6fb3c0c71aa0b16c6be8b0e44c239",
+    "audio/madmom/sample.tempo": "d90c1edbcdbb18b621142fd560c071a4db6b04ffd66631ea5e1e80ad964753f8",
+    "audio/madmom/sample.wav": "d06b3c39384c4a0cf59f0bd326eda2443edf668fbb90647e37c801e59602866c",
+    "audio/click_808_120bpm/808kick120bpm.mp3": "3158f626d69f15cf8fb60da6775a1a2fd7a10a48694b79175111734e04232245",
+}
+
+#: CMU salsa takes (subject_take); BVH header says 120 fps, the data is 60 fps.
+SALSA_CLIPS = ("60_01", "61_01", "60_04", "61_04")
+#: CMU subject 7 walking (periodic) and subject 5 pirouette (not periodic).
+WALK_CLIPS = ("007_01", "007_02", "007_12", "005_02")
+#: Frame rate of every bundled CMU clip [Hz].
+CMU_FPS = 60.0
+
+_verified: set[str] = set()
+
+
+def data_dir() -> Path:
+    """The folder holding the bundled data."""
+    env = os.environ.get("BEATSYNC_DATA")
+    if env:
+        d = Path(env)
+    else:
+        d = Path(__file__).resolve().parents[2] / "data"
+    if not (d / "motion").is_dir():
+        raise ParameterError(
+            f"bundled data folder {str(d)!r} not found; run from a clone of the beatsync "
+            "repository or set BEATSYNC_DATA to its data/ folder"
+        )
+    return d
+
+
+def _sha256(p: Path) -> str:
+    h = hashlib.sha256()
+    with open(p, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def path(relpath: str, *, verify: bool = True) -> Path:
+    """Path of a bundled data file (relative to ``data/``), checksum-verified.
+
+    Raises
+    ------
+    ParameterError
+        Unknown file, missing file, or checksum mismatch.
+    """
+    if relpath not in CHECKSUMS:
+        raise ParameterError(f"{relpath!r} is not a bundled data file; known: {sorted(CHECKSUMS)}")
+    p = data_dir() / relpath
+    if not p.is_file():
+        raise ParameterError(f"bundled data file {str(p)!r} is missing")
+    if verify and relpath not in _verified:
+        digest = _sha256(p)
+        if digest != CHECKSUMS[relpath]:
+            raise ParameterError(
+                f"bundled data file {str(p)!r} fails its SHA-256 check ({digest[:12]}... != "
+                f"{CHECKSUMS[relpath][:12]}...): it was modified or corrupted; restore it "
+                "from git"
+            )
+        _verified.add(relpath)
+    return p
+
+
+def verify_all() -> dict[str, bool]:
+    """Check every bundled file; return ``{relpath: ok}``."""
+    out = {}
+    for rel in CHECKSUMS:
+        try:
+            _verified.discard(rel)
+            path(rel)
+            out[rel] = True
+        except ParameterError:
+            out[rel] = False
+    return out
+
+
+def load_salsa(take: str = "60_01") -> Motion:
+    """A CMU salsa clip (``"60_01"``, ``"61_01"``, ``"60_04"``, ``"61_04"``) at 60 fps."""
+    from . import io
+
+    if take not in SALSA_CLIPS:
+        raise ParameterError(f"unknown salsa take {take!r}; choose from {SALSA_CLIPS}")
+    m = io.read_bvh(path(f"motion/cmu_salsa/{take}_scaled.bvh"), fps=CMU_FPS)
+    return m.rename(f"salsa_{take}")
+
+
+def load_walk(clip: str = "007_01") -> Motion:
+    """A CMU subject 7 walk (``"007_01"``, ``"007_02"``, ``"007_12"``) or the 5 pirouette
+    (``"005_02"``, not periodic) at 60 fps."""
+    from . import io
+
+    if clip not in WALK_CLIPS:
+        raise ParameterError(f"unknown clip {clip!r}; choose from {WALK_CLIPS}")
+    m = io.read_bvh(path(f"motion/cmu_walk_modern/{clip}.bvh"), fps=CMU_FPS)
+    return m.rename(f"cmu_{clip}")
+
+
+def load_mocap_toolbox(variable: str = "dance2") -> Motion:
+    """MoCap Toolbox demo markers (``"dance1"``, ``"dance2"``, ``"walk1"``, ``"walk2"``), 60 Hz, metres."""
+    from . import io
+
+    if variable not in ("dance1", "dance2", "walk1", "walk2"):
+        raise ParameterError(f"unknown MoCap Toolbox recording {variable!r}")
+    return io.read_mocap_mat(path("motion/mocaptoolbox/mcdemodata.mat"), variable)
+
+
+def load_madmom_sample() -> tuple[np.ndarray, int, np.ndarray]:
+    """The madmom test recording (2.8 s, 44.1 kHz) and its 4 hand-annotated beats [s]."""
+    from . import io
+
+    y, sr = io.read_audio(path("audio/madmom/sample.wav"))
+    beats = io.read_beats(path("audio/madmom/sample.beats"))
+    return y, sr, beats
+
+
+def load_click_808() -> tuple[np.ndarray, int]:
+    """The BeatNet 808 kick loop (10 s, 120 BPM; tempo only, no beat list)."""
+    from . import io
+
+    return io.read_audio(path("audio/click_808_120bpm/808kick120bpm.mp3"))

@@ -1,0 +1,381 @@
+"""The :class:`Motion` value and forward kinematics.
+
+Data contract
+-------------
+- ``Motion.values`` is ``(n_frames, n_channels)`` float64, time first, sampled at
+  ``fps > 0`` [Hz]. Frame ``i`` is at time ``i / fps`` [s].
+- Channels are named ``"<joint>_<dof>"`` (``"rShin_Xrotation"``, ``"hip_Xposition"``)
+  for skeletal data, ``"<marker>_x"`` for marker positions, ``"<name>_angle"`` for
+  derived joint angles. Rotation channels are degrees, as in BVH; positions are in
+  the file's units (the bundled CMU salsa files are in metres, marker data is
+  converted to metres on reading).
+- A :class:`Skeleton` (from BVH) gives forward kinematics; marker data and plain
+  tables have ``skeleton=None``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .errors import ParameterError
+from .units import check_finite, check_fps
+
+__all__ = ["Joint", "Skeleton", "Motion", "marker_angles", "fill_gaps"]
+
+_ROT_DOFS = ("Xrotation", "Yrotation", "Zrotation")
+_POS_DOFS = ("Xposition", "Yposition", "Zposition")
+
+
+@dataclass(frozen=True, eq=False)
+class Joint:
+    """One joint (or end site) of a BVH hierarchy.
+
+    Attributes
+    ----------
+    name : str
+    parent : int
+        Index of the parent joint in :attr:`Skeleton.joints`; -1 for the root.
+    offset : np.ndarray [shape=(3,)]
+        Offset from the parent, in the file's length units.
+    channels : tuple of str
+        BVH channel names in file order (``()`` for end sites).
+    is_end_site : bool
+    """
+
+    name: str
+    parent: int
+    offset: np.ndarray
+    channels: tuple[str, ...] = ()
+    is_end_site: bool = False
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Joint):
+            return NotImplemented
+        return (
+            self.name == other.name
+            and self.parent == other.parent
+            and self.channels == other.channels
+            and self.is_end_site == other.is_end_site
+            and np.array_equal(self.offset, other.offset)
+        )
+
+    def __hash__(self) -> int:
+        return hash((self.name, self.parent, self.channels, self.is_end_site))
+
+
+@dataclass(frozen=True)
+class Skeleton:
+    """A BVH hierarchy: joints in file (depth-first) order, parents before children."""
+
+    joints: tuple[Joint, ...]
+
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of all joints including end sites (axis 1 of :meth:`Motion.positions`)."""
+        return [j.name for j in self.joints]
+
+    def index(self, name: str) -> int:
+        for i, j in enumerate(self.joints):
+            if j.name == name:
+                return i
+        raise ParameterError(f"joint {name!r} is not in the skeleton; known: {self.joint_names}")
+
+    def channel_names(self) -> tuple[str, ...]:
+        """Motion channel names ``"<joint>_<dof>"`` in BVH frame-line order."""
+        return tuple(f"{j.name}_{c}" for j in self.joints for c in j.channels)
+
+    def same_structure(self, other: Skeleton) -> bool:
+        """True if both skeletons have the same joints, parents and channels (offsets may differ)."""
+        return len(self.joints) == len(other.joints) and all(
+            a.name == b.name and a.parent == b.parent and a.channels == b.channels
+            for a, b in zip(self.joints, other.joints, strict=True)
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """Multi-channel motion sampled at a constant frame rate.
+
+    Parameters
+    ----------
+    values : np.ndarray [shape=(n_frames, n_channels)]
+        Rotations in degrees; positions in the file's units.
+    fps : float > 0 [Hz]
+    channels : tuple of str [len = n_channels]
+    skeleton : Skeleton or None
+    name : str
+    """
+
+    values: np.ndarray
+    fps: float
+    channels: tuple[str, ...]
+    skeleton: Skeleton | None = None
+    name: str = ""
+    _cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        values = np.asarray(self.values, dtype=np.float64)
+        if values.ndim != 2:
+            raise ParameterError(
+                f"motion values must be 2-D (n_frames, n_channels), got shape {values.shape}"
+            )
+        object.__setattr__(self, "values", values)
+        object.__setattr__(self, "fps", check_fps(self.fps))
+        object.__setattr__(self, "channels", tuple(self.channels))
+        if len(self.channels) != values.shape[1]:
+            raise ParameterError(
+                f"motion has {values.shape[1]} value columns but {len(self.channels)} channel "
+                "names; is the array transposed (it must be time first: frames x channels)?"
+            )
+        if self.skeleton is not None and self.skeleton.channel_names() != self.channels:
+            raise ParameterError("channel names do not match the skeleton's channels")
+
+    # -- basic properties -------------------------------------------------
+    @property
+    def n_frames(self) -> int:
+        return int(self.values.shape[0])
+
+    @property
+    def n_channels(self) -> int:
+        return int(self.values.shape[1])
+
+    @property
+    def duration(self) -> float:
+        """Duration [s] = n_frames / fps (each frame covers 1/fps)."""
+        return self.n_frames / self.fps
+
+    @property
+    def times(self) -> np.ndarray:
+        """Time [s] of every frame, ``arange(n_frames) / fps``."""
+        return np.arange(self.n_frames, dtype=np.float64) / self.fps
+
+    @property
+    def joint_names(self) -> list[str]:
+        if self.skeleton is None:
+            raise ParameterError(
+                f"motion {self.name!r} has no skeleton (marker data or a plain table); "
+                "joint positions need a BVH file"
+            )
+        return self.skeleton.joint_names
+
+    def channel_index(self, name: str) -> int:
+        try:
+            return self.channels.index(name)
+        except ValueError:
+            raise ParameterError(
+                f"channel {name!r} not found; channels look like {list(self.channels[:6])}..."
+            ) from None
+
+    # -- derived motions ---------------------------------------------------
+    def with_values(self, values: np.ndarray, fps: float | None = None) -> Motion:
+        """Same channels and skeleton, new values (and optionally a new frame rate)."""
+        return Motion(
+            values=values,
+            fps=self.fps if fps is None else fps,
+            channels=self.channels,
+            skeleton=self.skeleton,
+            name=self.name,
+        )
+
+    def select(self, names: list[str] | tuple[str, ...]) -> Motion:
+        """A motion with only the named channels (no skeleton)."""
+        idx = [self.channel_index(n) for n in names]
+        return Motion(self.values[:, idx], self.fps, tuple(names), None, self.name)
+
+    def slice_frames(self, start: int, stop: int) -> Motion:
+        """Frames ``start:stop`` (frame indices), keeping skeleton and rate."""
+        if not (0 <= start < stop <= self.n_frames):
+            raise ParameterError(
+                f"frame slice {start}:{stop} is outside 0:{self.n_frames} "
+                "(frame indices, not seconds)"
+            )
+        return self.with_values(self.values[start:stop])
+
+    def rename(self, name: str) -> Motion:
+        return replace(self, name=name, _cache={})
+
+    # -- rotations and kinematics -----------------------------------------
+    def rotation_triples(self) -> list[tuple[str, tuple[int, int, int], str]]:
+        """Each joint with three rotation channels: ``(joint, channel indices, order)``.
+
+        ``order`` is the intrinsic Euler order as listed in the file, e.g. ``"ZXY"``
+        for ``Zrotation Xrotation Yrotation`` (R = Rz @ Rx @ Ry).
+        """
+        if "triples" in self._cache:
+            return self._cache["triples"]
+        out: list[tuple[str, tuple[int, int, int], str]] = []
+        by_joint: dict[str, list[tuple[int, str]]] = {}
+        order_seen: list[str] = []
+        for i, ch in enumerate(self.channels):
+            joint, _, dof = ch.rpartition("_")
+            if dof in _ROT_DOFS:
+                if joint not in by_joint:
+                    by_joint[joint] = []
+                    order_seen.append(joint)
+                by_joint[joint].append((i, dof[0]))
+        for joint in order_seen:
+            items = by_joint[joint]
+            if len(items) == 3:
+                idx = tuple(i for i, _ in items)
+                order = "".join(a for _, a in items)
+                out.append((joint, idx, order))  # type: ignore[arg-type]
+        self._cache["triples"] = out
+        return out
+
+    def positions(self) -> np.ndarray:
+        """World positions of every joint and end site by forward kinematics.
+
+        Returns
+        -------
+        positions : np.ndarray [shape=(n_frames, n_joints, 3)]
+            In the file's length units; axis 1 follows :attr:`joint_names`.
+        """
+        if "positions" in self._cache:
+            return self._cache["positions"]
+        if self.skeleton is None:
+            self.joint_names  # raises a clear error
+        assert self.skeleton is not None
+        n = self.n_frames
+        joints = self.skeleton.joints
+        pos = np.zeros((n, len(joints), 3))
+        glob: list[Rotation] = []
+        col = 0
+        for j_idx, joint in enumerate(joints):
+            trans = np.broadcast_to(joint.offset, (n, 3)).copy()
+            rot_axes: list[str] = []
+            rot_cols: list[int] = []
+            for c in joint.channels:
+                if c in _POS_DOFS:
+                    trans[:, "XYZ".index(c[0])] += self.values[:, col]
+                elif c in _ROT_DOFS:
+                    rot_axes.append(c[0])
+                    rot_cols.append(col)
+                col += 1
+            if rot_axes:
+                local = Rotation.from_euler(
+                    "".join(rot_axes), self.values[:, rot_cols], degrees=True
+                )
+            else:
+                local = Rotation.identity(n)
+            if joint.parent < 0:
+                pos[:, j_idx] = trans
+                glob.append(local)
+            else:
+                parent_rot = glob[joint.parent]
+                pos[:, j_idx] = pos[:, joint.parent] + parent_rot.apply(trans)
+                glob.append(parent_rot * local)
+        self._cache["positions"] = pos
+        return pos
+
+
+def fill_gaps(motion: Motion) -> Motion:
+    """Fill NaN gaps in every channel by linear interpolation (edges held constant).
+
+    Marker data often has short dropouts (e.g. MoCap Toolbox ``walk1``).
+
+    Raises
+    ------
+    ParameterError
+        If a channel has no finite value at all.
+    """
+    values = motion.values.copy()
+    t = np.arange(motion.n_frames)
+    for c in range(values.shape[1]):
+        bad = ~np.isfinite(values[:, c])
+        if bad.all():
+            raise ParameterError(f"channel {motion.channels[c]!r} has no finite value at all")
+        if bad.any():
+            values[bad, c] = np.interp(t[bad], t[~bad], values[~bad, c])
+    return motion.with_values(values)
+
+
+def _marker(motion: Motion, names: tuple[str, ...]) -> np.ndarray:
+    cols = []
+    for n in names:
+        cols.append(
+            np.stack([motion.values[:, motion.channel_index(f"{n}_{a}")] for a in "xyz"], axis=1)
+        )
+    return np.mean(cols, axis=0)
+
+
+def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Angle ABC [deg] at vertex b between segments b->a and b->c, per frame."""
+    u = a - b
+    v = c - b
+    cosang = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+    return np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
+
+
+# Marker groups of the MoCap Toolbox demo data (28 markers).
+_MCT_POINTS = {
+    "head": ("Head_FL", "Head_FR", "Head_BL", "Head_BR"),
+    "neck": ("Shoulder_L", "Shoulder_R"),
+    "pelvis": ("Hip_FL", "Hip_FR", "Hip_BL", "Hip_BR"),
+    "hip_L": ("Hip_FL", "Hip_BL"),
+    "hip_R": ("Hip_FR", "Hip_BR"),
+    "shoulder_L": ("Shoulder_L",),
+    "shoulder_R": ("Shoulder_R",),
+    "elbow_L": ("Elbow_L",),
+    "elbow_R": ("Elbow_R",),
+    "wrist_L": ("Radius_L", "Ulna_L"),
+    "wrist_R": ("Radius_R", "Ulna_R"),
+    "knee_L": ("Knee_L",),
+    "knee_R": ("Knee_R",),
+    "ankle_L": ("Ankle_L",),
+    "ankle_R": ("Ankle_R",),
+    "toe_L": ("BigToe_L",),
+    "toe_R": ("BigToe_R",),
+}
+
+# angle name -> (a, vertex, c)
+_MCT_ANGLES = {
+    "knee_L_angle": ("hip_L", "knee_L", "ankle_L"),
+    "knee_R_angle": ("hip_R", "knee_R", "ankle_R"),
+    "hip_L_angle": ("shoulder_L", "hip_L", "knee_L"),
+    "hip_R_angle": ("shoulder_R", "hip_R", "knee_R"),
+    "ankle_L_angle": ("knee_L", "ankle_L", "toe_L"),
+    "ankle_R_angle": ("knee_R", "ankle_R", "toe_R"),
+    "elbow_L_angle": ("shoulder_L", "elbow_L", "wrist_L"),
+    "elbow_R_angle": ("shoulder_R", "elbow_R", "wrist_R"),
+    "shoulder_L_angle": ("hip_L", "shoulder_L", "elbow_L"),
+    "shoulder_R_angle": ("hip_R", "shoulder_R", "elbow_R"),
+    "neck_angle": ("pelvis", "neck", "head"),
+}
+
+
+def marker_angles(motion: Motion) -> Motion:
+    """Joint angles [deg] from MoCap Toolbox markers (the 28-marker demo set).
+
+    Each angle is the interior angle at a joint between its two segments
+    (180 deg = straight), e.g. the knee angle between hip centre -> knee and
+    ankle -> knee. NaN gaps in markers are filled linearly first.
+
+    Parameters
+    ----------
+    motion : Motion
+        Marker positions with channels ``"<marker>_x/_y/_z"`` (see
+        :func:`beatsync.io.read_mocap_mat`).
+
+    Returns
+    -------
+    Motion
+        Channels ``knee_L_angle``, ``knee_R_angle``, ``hip_*``, ``ankle_*``,
+        ``elbow_*``, ``shoulder_*``, ``neck_angle`` at the same frame rate.
+    """
+    motion = fill_gaps(motion)
+    try:
+        points = {k: _marker(motion, v) for k, v in _MCT_POINTS.items()}
+    except ParameterError as exc:
+        raise ParameterError(
+            f"marker_angles needs the MoCap Toolbox 28-marker set (Knee_L, Ankle_L, ...): {exc}"
+        ) from None
+    names = tuple(_MCT_ANGLES)
+    values = np.stack(
+        [_angle(points[a], points[b], points[c]) for a, b, c in _MCT_ANGLES.values()], axis=1
+    )
+    check_finite(values, name="marker angles")
+    return Motion(values, motion.fps, names, None, motion.name)

@@ -1,0 +1,151 @@
+"""Rotation-aware sampling and blending of motion.
+
+Anything that interpolates joint rotations does it on rotations (quaternion slerp),
+never by linear interpolation of Euler angles, which fails across the +-180 deg wrap.
+Euler angles produced here are chosen, among the equivalent triples, as the one
+closest to the source frame's own angles, so a motion sampled at its own frame times
+comes back unchanged and curves stay continuous.
+
+Data contract: times are seconds in the source motion's timeline (frame ``i`` at
+``i / fps``); values are ``(n_frames, n_channels)`` with rotations in degrees.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .errors import ParameterError
+from .motion import Motion
+from .units import check_finite, time_to_frames
+
+__all__ = ["euler_to_rotation", "rotation_to_euler", "sample_motion", "blend_values", "slerp"]
+
+
+def euler_to_rotation(angles_deg: np.ndarray, order: str) -> Rotation:
+    """Rotations from intrinsic Euler angles [deg] in BVH channel ``order`` (e.g. ``"ZXY"``)."""
+    return Rotation.from_euler(order.upper(), np.asarray(angles_deg, dtype=np.float64), degrees=True)
+
+
+def rotation_to_euler(
+    rot: Rotation, order: str, reference: np.ndarray | None = None
+) -> np.ndarray:
+    """Intrinsic Euler angles [deg] of ``rot``; nearest to ``reference`` if given.
+
+    Of the two Euler triples of a rotation (``(a, b, c)`` and
+    ``(a + 180, 180 - b, c + 180)`` for Tait-Bryan orders), each shifted by multiples
+    of 360 deg, the one closest to ``reference`` (shape ``(n, 3)``) is returned.
+    """
+    e = rot.as_euler(order.upper(), degrees=True)
+    if e.ndim == 1:
+        e = e[None, :]
+    if reference is None:
+        return e
+    ref = np.asarray(reference, dtype=np.float64).reshape(e.shape)
+    alt = np.stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0], axis=1)
+    best = None
+    best_d = None
+    for cand in (e, alt):
+        cand = cand + 360.0 * np.round((ref - cand) / 360.0)
+        d = np.sum((cand - ref) ** 2, axis=1)
+        if best is None:
+            best, best_d = cand, d
+        else:
+            take = d < best_d
+            best = np.where(take[:, None], cand, best)
+            best_d = np.where(take, d, best_d)
+    return best
+
+
+def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Spherical linear interpolation of unit quaternions ``(n, 4)`` with weights ``w`` (n,)."""
+    dot = np.sum(q0 * q1, axis=1)
+    q1 = np.where(dot[:, None] < 0, -q1, q1)
+    dot = np.abs(dot)
+    w = np.asarray(w, dtype=np.float64)[:, None]
+    theta = np.arccos(np.clip(dot, -1.0, 1.0))[:, None]
+    sin_t = np.sin(theta)
+    small = sin_t[:, 0] < 1e-9
+    s0 = np.where(small[:, None], 1.0 - w, np.sin((1.0 - w) * theta) / np.where(small[:, None], 1.0, sin_t))
+    s1 = np.where(small[:, None], w, np.sin(w * theta) / np.where(small[:, None], 1.0, sin_t))
+    q = s0 * q0 + s1 * q1
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def _interp_values(
+    motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray
+) -> np.ndarray:
+    """Per-row interpolation from ``v0`` (w=0) to ``v1`` (w=1): slerp on rotation triples."""
+    out = v0 * (1.0 - w[:, None]) + v1 * w[:, None]
+    for _joint, idx, order in motion.rotation_triples():
+        cols = list(idx)
+        q0 = euler_to_rotation(v0[:, cols], order).as_quat()
+        q1 = euler_to_rotation(v1[:, cols], order).as_quat()
+        q = slerp(q0, q1, w)
+        ref = np.where(w[:, None] < 0.5, v0[:, cols], v1[:, cols])
+        out[:, cols] = rotation_to_euler(Rotation.from_quat(q), order, reference=ref)
+    return out
+
+
+def sample_motion(motion: Motion, times: np.ndarray) -> np.ndarray:
+    """Evaluate ``motion`` at arbitrary times [s] of its own timeline.
+
+    Rotation triples are slerped between the two neighbouring frames; every other
+    channel (root translation, marker positions, angles of plain tables) is
+    interpolated linearly. Times are clipped to ``[0, (n_frames - 1) / fps]``.
+
+    Parameters
+    ----------
+    motion : Motion
+    times : np.ndarray [shape=(m,)] [s]
+        Need not be uniform or increasing.
+
+    Returns
+    -------
+    values : np.ndarray [shape=(m, n_channels)]
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> m = Motion(np.array([[0.0], [10.0]]), fps=10.0, channels=("a",))
+    >>> sample_motion(m, np.array([0.05]))
+    array([[5.]])
+    """
+    t = check_finite(times, name="times")
+    if t.ndim != 1:
+        raise ParameterError(f"times must be 1-D [s], got shape {t.shape}")
+    f = time_to_frames(t, fps=motion.fps, round_to_int=False)
+    f = np.clip(f, 0.0, motion.n_frames - 1)
+    i0 = np.floor(f).astype(np.int64)
+    i1 = np.minimum(i0 + 1, motion.n_frames - 1)
+    w = f - i0
+    return _interp_values(motion, motion.values[i0], motion.values[i1], w)
+
+
+def blend_values(motion: Motion, a: np.ndarray, b: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Blend two pose sequences of ``motion``'s channel layout frame by frame.
+
+    Parameters
+    ----------
+    motion : Motion
+        Supplies the channel layout (which columns are rotation triples).
+    a, b : np.ndarray [shape=(n, n_channels)]
+    w : np.ndarray [shape=(n,)]
+        Weight of ``b``, 0 (all ``a``) to 1 (all ``b``).
+
+    Returns
+    -------
+    np.ndarray [shape=(n, n_channels)]
+        Slerp on rotation triples, linear on the other channels.
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    w = np.asarray(w, dtype=np.float64)
+    if a.shape != b.shape or a.ndim != 2 or a.shape[1] != motion.n_channels or w.shape != (a.shape[0],):
+        raise ParameterError(
+            f"blend_values needs a, b of shape (n, {motion.n_channels}) and w of shape (n,); "
+            f"got {a.shape}, {b.shape}, {w.shape}"
+        )
+    if np.any((w < 0) | (w > 1)):
+        raise ParameterError("blend weights w must lie in [0, 1]")
+    return _interp_values(motion, a, b, w)
