@@ -1,0 +1,104 @@
+"""Tests of the dance-music beat alignment scores (beatsync.evaluate.alignment)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.evaluate.alignment import (
+    alignment_scores,
+    beat_alignment_motion,
+    beat_alignment_music,
+    motion_alignment,
+    nearest_distance,
+    offset_control,
+)
+
+MUSIC = np.arange(0.5, 20.0, 0.5)  # 120 BPM impulse train
+
+
+def test_perfect_alignment_scores_one():
+    assert beat_alignment_motion(MUSIC, MUSIC) == 1.0
+    assert beat_alignment_music(MUSIC, MUSIC) == 1.0
+
+
+@pytest.mark.parametrize("shift", [0.01, 0.03, 0.05, 0.1])
+def test_shift_lowers_score_by_gaussian(shift):
+    expected = np.exp(-(shift**2) / (2 * 0.05**2))
+    assert np.isclose(beat_alignment_motion(MUSIC + shift, MUSIC), expected)
+    assert np.isclose(beat_alignment_music(MUSIC + shift, MUSIC), expected)
+
+
+def test_scores_decrease_with_shift():
+    s = [beat_alignment_motion(MUSIC + d, MUSIC) for d in (0.0, 0.02, 0.05, 0.1, 0.25)]
+    assert all(a > b for a, b in zip(s, s[1:], strict=False))
+    assert s[-1] < 1e-5
+
+
+def test_the_two_scores_differ_on_half_tempo_dance():
+    dance = MUSIC[::2]  # dancer marks every other beat
+    assert beat_alignment_motion(dance, MUSIC) == 1.0  # every motion beat is on a beat
+    assert np.isclose(beat_alignment_music(dance, MUSIC), 0.5, atol=0.02)  # half the beats danced
+    extra = np.sort(np.r_[MUSIC, MUSIC[:-1] + 0.25])  # double-time dance
+    assert np.isclose(beat_alignment_music(extra, MUSIC), 1.0)
+    assert np.isclose(beat_alignment_motion(extra, MUSIC), 0.5, atol=0.02)
+
+
+def test_sigma_scales():
+    a = beat_alignment_motion(MUSIC + 0.05, MUSIC, sigma=0.1)
+    assert np.isclose(a, np.exp(-0.125))
+
+
+def test_alignment_scores_dict_and_span():
+    d = alignment_scores(MUSIC[:10], MUSIC, span=(0.0, 5.2))
+    assert d["alignment_motion"] == 1.0 and d["alignment_music"] == 1.0
+    assert d["n_music_beats"] == 10 and d["sigma_s"] == 0.05
+
+
+def test_nearest_distance():
+    d = nearest_distance([0.1, 0.74, 3.0], [0.0, 0.5, 1.0])
+    assert np.allclose(d, [0.1, 0.24, 2.0])
+
+
+def test_empty_warns_and_scores_zero():
+    with pytest.warns(BeatsyncWarning):
+        assert beat_alignment_motion([], MUSIC) == 0.0
+    with pytest.warns(BeatsyncWarning):
+        assert beat_alignment_music(MUSIC, []) == 0.0
+
+
+def test_offset_control_is_lower_than_perfect():
+    c = offset_control(MUSIC, MUSIC, n_trials=200, seed=0)
+    # uniform offsets over a 0.5 s beat: mean Gaussian about sqrt(2 pi) 0.05 / 0.5 = 0.25
+    assert 0.15 < c["alignment_motion_mean"] < 0.35
+    assert c["n_trials"] == 200
+    assert offset_control(MUSIC, MUSIC, seed=0) == offset_control(MUSIC, MUSIC, seed=0)
+
+
+def test_motion_alignment_on_motion(monkeypatch):
+    from beatsync.evaluate import alignment
+
+    monkeypatch.setattr(alignment, "_kinematic_beats", lambda motion, **kw: MUSIC[:8] - 0.5)
+
+    class _M:
+        duration = 3.7
+
+    d = motion_alignment(_M(), MUSIC, offset=0.5)
+    assert d["alignment_motion"] == 1.0 and d["alignment_music"] == 1.0
+
+
+@pytest.mark.parametrize(
+    "motion, music, sigma, match",
+    [
+        (MUSIC, MUSIC, 3, "frames"),  # sigma in frames
+        (MUSIC, MUSIC, 0.0, "sigma"),
+        (MUSIC, MUSIC, float("nan"), "sigma"),
+        (MUSIC[::-1], MUSIC, 0.05, "increasing"),
+        (MUSIC, np.c_[MUSIC, MUSIC], 0.05, "1-D"),
+        (np.r_[-1.0, MUSIC], MUSIC, 0.05, "negative"),
+    ],
+)
+def test_bad_inputs(motion, music, sigma, match):
+    with pytest.raises(ParameterError, match=match):
+        beat_alignment_motion(motion, music, sigma=sigma)

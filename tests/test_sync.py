@@ -1,0 +1,219 @@
+"""Tests of beatsync.sync: the beat-synchronous time warp and resampling."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from beatsync import io
+from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.motion import Joint, Motion, Skeleton
+from beatsync.sync import SyncResult, beats_per_period, blended_rate, synchronize, time_warp
+
+FPS = 30.0
+
+
+def _skeleton() -> Skeleton:
+    pos_rot = ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation")
+    return Skeleton(
+        (
+            Joint("hip", -1, np.zeros(3), pos_rot),
+            Joint("knee", 0, np.array([0.0, -0.4, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
+            Joint("knee_end", 1, np.array([0.0, -0.4, 0.0]), (), True),
+        )
+    )
+
+
+def _periodic_motion(period: float = 1.0, duration: float = 6.0, fps: float = FPS) -> Motion:
+    t = np.arange(int(round(duration * fps))) / fps
+    ph = 2 * np.pi * t / period
+    vals = np.zeros((t.size, 9))
+    vals[:, 0] = 0.3 * t  # walking forward [m]
+    vals[:, 1] = 0.9 + 0.02 * np.cos(ph)
+    vals[:, 3] = 10 * np.sin(ph)
+    vals[:, 4] = 5 * np.sin(ph)
+    vals[:, 7] = 40 * (1 - np.cos(ph))  # knee flexion
+    return Motion(vals, fps, _skeleton().channel_names(), _skeleton(), "synthetic")
+
+
+# ---------------------------------------------------------------- rule and rate
+
+
+@pytest.mark.parametrize(
+    "period, beat, expected",
+    [(1.0, 0.5, 2), (1.0, 1.0, 1), (0.3, 0.5, 1), (3.0, 0.5, 6), (1.1, 0.5, 2)],
+)
+def test_beats_per_period_rule(period, beat, expected):
+    beats = np.arange(20) * beat
+    assert beats_per_period(period, beats) == expected
+
+
+def test_beats_per_period_override():
+    assert beats_per_period(1.0, np.arange(10) * 0.5, override=4) == 4
+
+
+def test_blended_rate_constant_and_between():
+    c = np.array([0.5, 1.5, 2.5])
+    assert np.allclose(blended_rate(np.linspace(0, 3, 7), c, np.ones(3), delta=1.0), 1.0)
+    r = blended_rate(np.array([0.5, 1.0, 1.5]), c[:2], np.array([1.0, 2.0]), delta=0.5)
+    assert r[0] < 1.5 < r[2] and np.isclose(r[1], 1.5)
+
+
+# ---------------------------------------------------------------- warp
+
+
+def test_time_warp_lands_boundaries_exactly():
+    rng = np.random.default_rng(1)
+    s = np.cumsum(np.r_[0.2, rng.uniform(0.7, 1.3, 25)])
+    b = 0.1 + np.cumsum(np.r_[0.0, rng.uniform(0.4, 0.6, 25)])
+    w = time_warp(s, b, start=0.0, end=s[-1] + 0.5)
+    assert np.allclose(w.to_target(s), b, atol=1e-9)
+    assert np.all(np.diff(w.tgt) > 0) and np.all(w.rate > 0)
+    # continuous rate: no jumps much larger than the within-period variation
+    assert np.abs(np.diff(w.rate)).max() < 0.05
+    # inverse
+    assert np.allclose(w.to_source(b), s, atol=1e-9)
+
+
+def test_time_warp_identity_when_tempi_match():
+    s = np.arange(0.0, 5.01, 1.0)
+    w = time_warp(s, s + 0.25)
+    t = np.linspace(0, 5, 101)
+    assert np.allclose(w.to_target(t), t + 0.25)
+    assert np.allclose(w.rate, 1.0)
+
+
+# ---------------------------------------------------------------- synchronize
+
+
+def test_identity_when_tempi_match():
+    m = _periodic_motion()
+    bounds = np.arange(0.0, 5.5, 1.0)
+    beats = np.arange(0.0, 8.0, 0.5)  # 2 beats per 1 s period, first beat on boundary 0
+    res = synchronize(m, bounds, beats)
+    assert isinstance(res, SyncResult)
+    assert res.report["beats_per_period"] == 2
+    assert res.motion.n_frames == m.n_frames
+    assert np.allclose(res.warp_src_times, m.times, atol=1e-9)
+    assert np.allclose(res.motion.values, m.values, atol=1e-6)
+
+
+def test_exact_boundary_placement_other_tempo():
+    m = _periodic_motion(period=1.0, duration=10.0)
+    rng = np.random.default_rng(7)
+    bounds = np.cumsum(np.r_[0.3, rng.uniform(0.9, 1.1, 8)])
+    beats = 0.2 + np.cumsum(np.r_[0.0, rng.uniform(0.36, 0.40, 40)])  # about 158 BPM
+    res = synchronize(m, bounds, beats, out_fps=60.0)
+    rep = res.report
+    assert rep["periods_used"] == 8 and rep["beats_per_period"] == 3
+    frame_ms = 1000 / 60
+    assert np.all(np.abs(rep["residual_ms"]) < 0.05 * frame_ms)
+    assert np.all(np.abs(rep["residual_nearest_frame_ms"]) <= 0.5 * frame_ms + 1e-6)
+    assert rep["max_abs_residual_frames"] <= 1.0
+    assert np.all(np.diff(res.warp_src_times) >= 0)
+    assert res.motion.fps == 60.0
+    # the pose at each boundary is shown on its beat: the knee angle at the beat's frame
+    # matches the source's angle at the boundary
+    k = m.channel_index("knee_Xrotation")
+    frames = np.rint(rep["target_beats_s"] * 60).astype(int)
+    src = 40 * (1 - np.cos(2 * np.pi * bounds))
+    assert np.allclose(res.motion.values[frames, k], src, atol=40 * 2 * np.pi / 60)
+
+
+def test_output_length_follows_tempo():
+    m = _periodic_motion(period=1.0, duration=8.0)
+    bounds = np.arange(0.0, 8.0, 1.0)
+    beats = np.arange(0.0, 20.0, 0.4)  # 1 s periods -> 2 beats of 0.4 s: rate 0.8
+    res = synchronize(m, bounds, beats)
+    assert res.report["beats_per_period"] == 2
+    assert np.allclose(res.report["rate_range"], 0.8)
+    expected = int(np.floor(0.8 * (m.n_frames - 1))) + 1
+    assert abs(res.motion.n_frames - expected) <= 1
+
+
+def test_music_shorter_than_dance_truncates_periods():
+    m = _periodic_motion(period=1.0, duration=8.0)
+    bounds = np.arange(0.0, 8.0, 1.0)
+    beats = np.arange(0.0, 3.1, 0.5)  # 7 beats -> 3 periods of 2 beats
+    res = synchronize(m, bounds, beats)
+    assert res.report["periods_used"] == 3
+    assert res.motion.n_frames == int(round(3.0 * FPS)) + 1
+
+
+def test_first_beat_offset_holds_lead_in():
+    m = _periodic_motion()
+    bounds = np.arange(0.0, 5.5, 1.0)
+    beats = np.arange(0.0, 12.0, 0.5)
+    res = synchronize(m, bounds, beats, first_beat=4)  # boundary 0 on 2.0 s
+    assert res.report["lead_in_hold_frames"] == int(2.0 * FPS)
+    assert res.report["first_boundary_frame"] == int(2.0 * FPS)
+    assert np.allclose(res.motion.values[: int(2.0 * FPS)], m.values[0], atol=1e-6)
+
+
+def test_slerp_across_wrap():
+    # a root yaw that crosses +-180 deg between frames: 178 -> -178 (i.e. 182)
+    n = 8
+    vals = np.zeros((n, 9))
+    vals[:, 5] = np.where(np.arange(n) % 2 == 0, 178.0, -178.0)
+    m = Motion(vals, FPS, _skeleton().channel_names(), _skeleton())
+    bounds = np.array([0.0, 2 / FPS, 4 / FPS, 6 / FPS])
+    res = synchronize(m, bounds, bounds, out_fps=2 * FPS, beats_per_period=1)
+    mid = res.motion.values[1::2, 5][:3]  # half-way between 178 and -178
+    assert np.allclose(np.abs(mid), 180.0, atol=1e-6)  # linear Euler would give 0
+
+
+def test_bvh_round_trip(tmp_path):
+    m = _periodic_motion()
+    res = synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0.1, 9.0, 0.45))
+    out = io.write_bvh(tmp_path / "out.bvh", res.motion)
+    back = io.read_bvh(out)
+    assert back.fps == res.motion.fps
+    assert back.channels == res.motion.channels
+    assert back.skeleton.same_structure(m.skeleton)
+    assert np.array_equal(back.values, res.motion.values)
+
+
+def test_warns_on_extreme_speed_change():
+    m = _periodic_motion()
+    with pytest.warns(BeatsyncWarning, match="speed"):
+        synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0.0, 40, 2.5))
+
+
+def test_no_warning_in_normal_case():
+    m = _periodic_motion()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0.0, 12, 0.55))
+
+
+@pytest.mark.parametrize(
+    "bounds, beats, kwargs, match",
+    [
+        (np.array([1.0]), np.arange(0, 10, 0.5), {}, "periodic"),
+        (np.array([]), np.arange(0, 10, 0.5), {}, "periodic"),
+        (np.arange(0, 180, 30.0), np.arange(0, 10, 0.5), {}, "duration"),  # frames
+        (np.array([2.0, 1.0, 3.0]), np.arange(0, 10, 0.5), {}, "increasing"),
+        (np.arange(0.0, 5.5, 1.0), np.array([1.0]), {}, "beat"),
+        (np.arange(0.0, 5.5, 1.0), np.array([]), {}, "beat"),
+        (np.arange(0.0, 5.5, 1.0), np.array([0.0, 0.5]), {}, "too short"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"out_fps": 0}, "out_fps"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": 99}, "first_beat"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": -1}, "first_beat"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": 0}, "beats"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"delta": -1.0}, "delta"),
+        (np.arange(0.0, 5.5, 1.0), np.array([0.0, np.nan, 1.0]), {}, "NaN"),
+    ],
+)
+def test_bad_inputs_raise(bounds, beats, kwargs, match):
+    m = _periodic_motion()
+    with pytest.raises(ParameterError, match=match):
+        synchronize(m, bounds, beats, **kwargs)
+
+
+def test_time_warp_bad_inputs():
+    with pytest.raises(ParameterError, match="one music time per boundary"):
+        time_warp([0.0, 1.0, 2.0], [0.0, 1.0])
+    with pytest.raises(ParameterError, match="at least 2"):
+        time_warp([0.0], [0.0])
