@@ -331,7 +331,8 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
     except Exception as exc:  # scipy raises several types for bad files
         raise ParameterError(f"cannot read {str(p)!r} as a MATLAB .mat file: {exc}") from None
     cands = [
-        k for k, v in mat.items()
+        k
+        for k, v in mat.items()
         if not k.startswith("__") and hasattr(v, "data") and hasattr(v, "markerName")
     ]
     if variable is None:
@@ -341,7 +342,9 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
             )
         variable = cands[0]
     if variable not in cands:
-        raise ParameterError(f"{str(p)!r} has no marker recording {variable!r}; choose from {cands}")
+        raise ParameterError(
+            f"{str(p)!r} has no marker recording {variable!r}; choose from {cands}"
+        )
     s = mat[variable]
     data = np.asarray(s.data, dtype=np.float64)
     names = [str(n) for n in np.atleast_1d(s.markerName)]
@@ -385,7 +388,9 @@ def read_table(
         try:
             df = pd.read_csv(p)
         except Exception as exc:
-            raise ParameterError(f"cannot read {str(p)!r} as CSV with a header row: {exc}") from None
+            raise ParameterError(
+                f"cannot read {str(p)!r} as CSV with a header row: {exc}"
+            ) from None
         non_num = [c for c in df.columns if not np.issubdtype(df[c].dtype, np.number)]
         if non_num:
             raise ParameterError(
@@ -434,9 +439,7 @@ def read_motion(
 # ----------------------------------------------------------------------- audio
 
 
-def read_audio(
-    path: str | os.PathLike[str], *, sr: int | None = None
-) -> tuple[np.ndarray, int]:
+def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[np.ndarray, int]:
     """Read an audio file as mono float32.
 
     Parameters

@@ -237,8 +237,10 @@ class Motion:
         if "positions" in self._cache:
             return self._cache["positions"]
         if self.skeleton is None:
-            self.joint_names  # raises a clear error
-        assert self.skeleton is not None
+            raise ParameterError(
+                f"motion {self.name!r} has no skeleton (marker data or a plain table); "
+                "joint positions need a BVH file"
+            )
         n = self.n_frames
         joints = self.skeleton.joints
         pos = np.zeros((n, len(joints), 3))

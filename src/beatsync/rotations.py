@@ -24,12 +24,12 @@ __all__ = ["euler_to_rotation", "rotation_to_euler", "sample_motion", "blend_val
 
 def euler_to_rotation(angles_deg: np.ndarray, order: str) -> Rotation:
     """Rotations from intrinsic Euler angles [deg] in BVH channel ``order`` (e.g. ``"ZXY"``)."""
-    return Rotation.from_euler(order.upper(), np.asarray(angles_deg, dtype=np.float64), degrees=True)
+    return Rotation.from_euler(
+        order.upper(), np.asarray(angles_deg, dtype=np.float64), degrees=True
+    )
 
 
-def rotation_to_euler(
-    rot: Rotation, order: str, reference: np.ndarray | None = None
-) -> np.ndarray:
+def rotation_to_euler(rot: Rotation, order: str, reference: np.ndarray | None = None) -> np.ndarray:
     """Intrinsic Euler angles [deg] of ``rot``; nearest to ``reference`` if given.
 
     Of the two Euler triples of a rotation (``(a, b, c)`` and
@@ -66,15 +66,15 @@ def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
     theta = np.arccos(np.clip(dot, -1.0, 1.0))[:, None]
     sin_t = np.sin(theta)
     small = sin_t[:, 0] < 1e-9
-    s0 = np.where(small[:, None], 1.0 - w, np.sin((1.0 - w) * theta) / np.where(small[:, None], 1.0, sin_t))
+    s0 = np.where(
+        small[:, None], 1.0 - w, np.sin((1.0 - w) * theta) / np.where(small[:, None], 1.0, sin_t)
+    )
     s1 = np.where(small[:, None], w, np.sin(w * theta) / np.where(small[:, None], 1.0, sin_t))
     q = s0 * q0 + s1 * q1
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
-def _interp_values(
-    motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray
-) -> np.ndarray:
+def _interp_values(motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Per-row interpolation from ``v0`` (w=0) to ``v1`` (w=1): slerp on rotation triples."""
     out = v0 * (1.0 - w[:, None]) + v1 * w[:, None]
     for _joint, idx, order in motion.rotation_triples():
@@ -141,7 +141,12 @@ def blend_values(motion: Motion, a: np.ndarray, b: np.ndarray, w: np.ndarray) ->
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     w = np.asarray(w, dtype=np.float64)
-    if a.shape != b.shape or a.ndim != 2 or a.shape[1] != motion.n_channels or w.shape != (a.shape[0],):
+    if (
+        a.shape != b.shape
+        or a.ndim != 2
+        or a.shape[1] != motion.n_channels
+        or w.shape != (a.shape[0],)
+    ):
         raise ParameterError(
             f"blend_values needs a, b of shape (n, {motion.n_channels}) and w of shape (n,); "
             f"got {a.shape}, {b.shape}, {w.shape}"

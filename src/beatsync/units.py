@@ -130,14 +130,18 @@ def check_times(
     """
     arr = np.asarray(times, dtype=np.float64)
     if arr.ndim != 1:
-        raise ParameterError(f"{name} must be a 1-D array of times in seconds, got shape {arr.shape}")
+        raise ParameterError(
+            f"{name} must be a 1-D array of times in seconds, got shape {arr.shape}"
+        )
     if arr.size == 0:
         if not allow_empty:
             raise ParameterError(f"{name} is empty: at least one event time [s] is needed")
         return arr
     arr = check_finite(arr, name=name)
     if arr[0] < 0:
-        raise ParameterError(f"{name} has a negative time {arr[0]!r}; times are seconds from the start")
+        raise ParameterError(
+            f"{name} has a negative time {arr[0]!r}; times are seconds from the start"
+        )
     diffs = np.diff(arr)
     if np.any(diffs <= 0):
         i = int(np.argmax(diffs <= 0))

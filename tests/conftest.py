@@ -1,0 +1,49 @@
+"""Shared fixtures: seeded RNG, a tiny BVH skeleton, writable temp data."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from beatsync.motion import Joint, Motion, Skeleton
+
+# Tests never use a user's cache.
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20261122)
+
+
+def make_chain_skeleton() -> Skeleton:
+    """Root with 6 channels, a 'thigh' and 'shin' chain with ZXY rotations, one end site."""
+    return Skeleton(
+        (
+            Joint(
+                "hip",
+                -1,
+                np.zeros(3),
+                ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation"),
+            ),
+            Joint("thigh", 0, np.array([0.1, 0.0, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
+            Joint("shin", 1, np.array([0.0, -0.4, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
+            Joint("shin_end", 2, np.array([0.0, -0.4, 0.0]), (), True),
+        )
+    )
+
+
+@pytest.fixture
+def chain_motion(rng: np.random.Generator) -> Motion:
+    sk = make_chain_skeleton()
+    n = 50
+    t = np.arange(n) / 30.0
+    values = np.zeros((n, 12))
+    values[:, 0] = 0.3 * t  # root x translation
+    values[:, 1] = 0.9
+    values[:, 6:9] = 20 * np.sin(2 * np.pi * t)[:, None] * np.array([0.2, 1.0, 0.1])
+    values[:, 9:12] = 30 * np.sin(2 * np.pi * t + 1)[:, None] * np.array([0.1, 1.0, 0.3])
+    values += rng.normal(0, 0.01, values.shape)
+    return Motion(values, 30.0, sk.channel_names(), sk, "chain")

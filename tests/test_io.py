@@ -1,0 +1,177 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from beatsync import datasets, io
+from beatsync.errors import ParameterError
+from beatsync.motion import Motion
+
+
+def test_bvh_round_trip_exact(tmp_path, chain_motion):
+    p = io.write_bvh(tmp_path / "a.bvh", chain_motion)
+    back = io.read_bvh(p)
+    np.testing.assert_array_equal(back.values, chain_motion.values)
+    assert back.fps == chain_motion.fps
+    assert back.channels == chain_motion.channels
+    assert back.skeleton.joints == chain_motion.skeleton.joints
+
+
+def test_real_bvh_read_write_read(tmp_path):
+    m = datasets.load_salsa("60_01")
+    assert m.values.shape == (2242, 132)
+    assert m.fps == 60.0  # header says 120; bundled loader overrides
+    header = io.read_bvh(datasets.path("motion/cmu_salsa/60_01_scaled.bvh"))
+    assert header.fps == pytest.approx(120.0, rel=1e-3)
+    m2 = io.read_bvh(io.write_bvh(tmp_path / "s.bvh", m))
+    m3 = io.read_bvh(io.write_bvh(tmp_path / "s2.bvh", m2))
+    np.testing.assert_array_equal(m2.values, m.values)
+    np.testing.assert_array_equal(m3.values, m.values)
+    assert m2.skeleton.joints == m.skeleton.joints
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    p = tmp_path / "bad.bvh"
+    p.write_text(text)
+    return p
+
+
+GOOD = """HIERARCHY
+ROOT hip
+{
+ OFFSET 0 0 0
+ CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+ JOINT knee
+ {
+  OFFSET 0 -1 0
+  CHANNELS 3 Zrotation Xrotation Yrotation
+  End Site
+  {
+   OFFSET 0 -1 0
+  }
+ }
+}
+MOTION
+Frames: 2
+Frame Time: 0.04
+0 1 0 0 0 0 0 10 0
+0 1 0 0 0 0 0 20 0
+"""
+
+
+def test_minimal_bvh(tmp_path):
+    m = io.read_bvh(_write(tmp_path, GOOD))
+    assert m.fps == 25.0
+    assert m.channels[-2] == "knee_Xrotation"
+    assert m.positions().shape == (2, 3, 3)
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        (GOOD.split("MOTION")[0][:80], "truncated|MOTION"),
+        (GOOD.replace("0 1 0 0 0 0 0 20 0\n", ""), "declares 2 frames but has 1"),
+        (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 20"), "frame line 2 has 8 values"),
+        (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 nan 0"), "NaN"),
+        (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 x 0"), "non-numeric"),
+        (GOOD.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time"),
+        (GOOD.replace("HIERARCHY", "HIERARCY"), "HIERARCHY"),
+        (GOOD.replace("CHANNELS 3 Zrotation", "CHANNELS 3 Wrotation"), "CHANNELS"),
+        ("not a bvh at all", "MOTION|HIERARCHY"),
+    ],
+)
+def test_malformed_bvh(tmp_path, text, match):
+    with pytest.raises(ParameterError, match=match):
+        io.read_bvh(_write(tmp_path, text))
+
+
+def test_missing_and_empty_files(tmp_path):
+    with pytest.raises(ParameterError, match="does not exist"):
+        io.read_motion(tmp_path / "nope.bvh")
+    (tmp_path / "e.wav").write_bytes(b"")
+    with pytest.raises(ParameterError, match="empty"):
+        io.read_audio(tmp_path / "e.wav")
+    (tmp_path / "junk.wav").write_bytes(b"RIFF garbage not audio" * 10)
+    with pytest.raises(ParameterError, match="cannot read"):
+        io.read_audio(tmp_path / "junk.wav")
+    with pytest.raises(ParameterError, match="unsupported"):
+        io.read_motion(_write(tmp_path, GOOD).rename(tmp_path / "x.txt"))
+
+
+def test_fps_override_and_bad_fps(tmp_path):
+    p = _write(tmp_path, GOOD)
+    assert io.read_bvh(p, fps=60).fps == 60.0
+    with pytest.raises(ParameterError, match="fps"):
+        io.read_bvh(p, fps=0)
+
+
+def test_atomic_write_leaves_nothing_on_error(tmp_path):
+    dest = tmp_path / "out.txt"
+    dest.write_text("original")
+    with pytest.raises(RuntimeError):
+        with io.atomic_write(dest) as fh:
+            fh.write("partial")
+            raise RuntimeError("boom")
+    assert dest.read_text() == "original"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
+
+
+def test_write_bvh_without_skeleton_refused(tmp_path):
+    m = Motion(np.zeros((3, 2)), 30.0, ("a", "b"))
+    with pytest.raises(ParameterError, match="no skeleton"):
+        io.write_bvh(tmp_path / "x.bvh", m)
+    assert not (tmp_path / "x.bvh").exists()
+
+
+def test_tables(tmp_path):
+    m = Motion(np.arange(12.0).reshape(6, 2), 25.0, ("knee", "hip"))
+    p = io.write_table(tmp_path / "t.csv", m)
+    back = io.read_motion(p, fps=25)
+    np.testing.assert_array_equal(back.values, m.values)
+    assert back.channels == ("knee", "hip")
+    with pytest.raises(ParameterError, match="--fps"):
+        io.read_motion(p)
+    np.save(tmp_path / "t.npy", m.values)
+    assert io.read_motion(tmp_path / "t.npy", fps=25).n_channels == 2
+    np.save(tmp_path / "bad.npy", np.zeros(5))
+    with pytest.raises(ParameterError, match="frames, channels"):
+        io.read_motion(tmp_path / "bad.npy", fps=25)
+    (tmp_path / "s.csv").write_text("a,b\n1,x\n2,y\n")
+    with pytest.raises(ParameterError, match="non-numeric"):
+        io.read_motion(tmp_path / "s.csv", fps=25)
+
+
+def test_mocap_mat():
+    d = datasets.load_mocap_toolbox("dance2")
+    assert d.values.shape == (1500, 84) and d.fps == 60.0
+    assert d.channels[:3] == ("Head_FL_x", "Head_FL_y", "Head_FL_z")
+    # metres, z up: head markers are above 1 m
+    assert 1.0 < np.nanmean(d.values[:, 2]) < 2.2
+    with pytest.raises(ParameterError, match="several"):
+        io.read_mocap_mat(datasets.path("motion/mocaptoolbox/mcdemodata.mat"))
+
+
+def test_audio_round_trip_and_mp3(tmp_path):
+    y, sr = datasets.load_click_808()
+    assert sr == 44100 and y.ndim == 1 and 9.5 < y.size / sr < 10.5
+    p = io.write_audio(tmp_path / "a.wav", y[:4410], sr)
+    y2, sr2 = io.read_audio(p)
+    assert sr2 == sr and np.allclose(y2, y[:4410], atol=1e-4)
+    y3, sr3 = io.read_audio(p, sr=22050)
+    assert sr3 == 22050 and abs(y3.size - 2205) <= 1
+
+
+def test_beats_files(tmp_path):
+    y, sr, beats = datasets.load_madmom_sample()
+    np.testing.assert_allclose(beats, [0.0913, 0.7997, 1.4806, 2.1478])
+    p = io.write_beats(tmp_path / "b.beats", beats)
+    np.testing.assert_allclose(io.read_beats(p), beats)
+    (tmp_path / "bad.beats").write_text("1.0\n0.5\n")
+    with pytest.raises(ParameterError, match="increasing"):
+        io.read_beats(tmp_path / "bad.beats")
+    (tmp_path / "ms.beats").write_text("abc\n")
+    with pytest.raises(ParameterError, match="not a time"):
+        io.read_beats(tmp_path / "ms.beats")
+    with pytest.raises(ParameterError, match="increasing"):
+        io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
+    assert not (tmp_path / "w.beats").exists()

@@ -1,0 +1,53 @@
+import numpy as np
+import pytest
+
+from beatsync.errors import ParameterError
+from beatsync.motion import Motion
+from beatsync.rotations import blend_values, euler_to_rotation, sample_motion
+
+CH = ("root_Xposition", "j_Zrotation", "j_Xrotation", "j_Yrotation")
+
+
+def test_sampling_at_frame_times_is_identity(chain_motion):
+    out = sample_motion(chain_motion, chain_motion.times)
+    np.testing.assert_allclose(out, chain_motion.values, atol=1e-9)
+
+
+def test_slerp_across_wrap_takes_short_way():
+    m = Motion(np.array([[0.0, 170.0, 0, 0], [1.0, -170.0, 0, 0]]), 1.0, CH)
+    out = sample_motion(m, np.linspace(0, 1, 5))
+    # linear Euler interpolation would pass through 0 deg; slerp goes through 180
+    z = out[:, 1]
+    assert np.all(np.abs(np.abs(z) - 180) <= 10 + 1e-9)
+    np.testing.assert_allclose(out[:, 0], np.linspace(0, 1, 5))
+    np.testing.assert_allclose(abs(out[2, 1]), 180.0, atol=1e-6)
+
+
+def test_sampled_rotation_matches_geodesic(rng):
+    a = rng.uniform(-180, 180, (20, 3)) * np.array([1, 0.45, 1])
+    b = rng.uniform(-180, 180, (20, 3)) * np.array([1, 0.45, 1])
+    m = Motion(np.zeros((2, 4)), 1.0, CH)
+    va = np.c_[np.zeros(20), a]
+    vb = np.c_[np.zeros(20), b]
+    out = blend_values(m, va, vb, np.full(20, 0.5))
+    ra, rb = euler_to_rotation(a, "ZXY"), euler_to_rotation(b, "ZXY")
+    mid = euler_to_rotation(out[:, 1:], "ZXY")
+    # the midpoint is equidistant from both ends, at half their angle
+    d_a = (ra.inv() * mid).magnitude()
+    d_b = (rb.inv() * mid).magnitude()
+    d_ab = (ra.inv() * rb).magnitude()
+    np.testing.assert_allclose(d_a, d_b, atol=1e-9)
+    np.testing.assert_allclose(d_a, d_ab / 2, atol=1e-9)
+
+
+def test_blend_endpoints_and_errors(chain_motion):
+    a = chain_motion.values[:10]
+    b = chain_motion.values[10:20]
+    np.testing.assert_allclose(blend_values(chain_motion, a, b, np.zeros(10)), a, atol=1e-9)
+    np.testing.assert_allclose(blend_values(chain_motion, a, b, np.ones(10)), b, atol=1e-9)
+    with pytest.raises(ParameterError, match="shape"):
+        blend_values(chain_motion, a, b[:5], np.zeros(10))
+    with pytest.raises(ParameterError, match=r"\[0, 1\]"):
+        blend_values(chain_motion, a, b, np.full(10, 2.0))
+    with pytest.raises(ParameterError, match="NaN"):
+        sample_motion(chain_motion, np.array([np.nan]))
