@@ -30,7 +30,6 @@ setup: $(STAMP)
 
 reproduce: setup
 	$(BIN)/beatsync reproduce --params $(PARAMS) --output results/notebooks
-	$(BIN)/python benchmarks/run_all.py --collect
 
 test: setup test-unit test-notebooks
 

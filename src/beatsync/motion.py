@@ -89,7 +89,7 @@ class Skeleton:
         return tuple(f"{j.name}_{c}" for j in self.joints for c in j.channels)
 
     def same_structure(self, other: Skeleton) -> bool:
-        """True if both skeletons have the same joints, parents and channels (offsets may differ)."""
+        """True if both have the same joints, parents and channels (offsets may differ)."""
         return len(self.joints) == len(other.joints) and all(
             a.name == b.name and a.parent == b.parent and a.channels == b.channels
             for a, b in zip(self.joints, other.joints, strict=True)

@@ -1,0 +1,39 @@
+"""The program frame: help for every subcommand, version, data check."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from beatsync.cli import build_parser, main
+
+
+def _subcommands():
+    parser = build_parser()
+    action = next(a for a in parser._actions if a.dest == "command")
+    return sorted(action.choices)
+
+
+def test_every_subcommand_has_help(capsys):
+    subs = _subcommands()
+    assert {"reproduce", "data"} <= set(subs)
+    for name in subs:
+        with pytest.raises(SystemExit) as exc:
+            main([name, "--help"])
+        assert exc.value.code == 0
+        out = capsys.readouterr().out
+        assert "--json" in out
+
+
+def test_data_command_json(capsys):
+    assert main(["data", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert all(res["files"].values()) and len(res["files"]) == 14
+
+
+def test_console_script_runs():
+    out = subprocess.run(
+        [sys.executable, "-m", "beatsync.cli", "--version"], capture_output=True, text=True
+    )
+    assert out.returncode == 0 and out.stdout.startswith("beatsync ")
