@@ -1,0 +1,515 @@
+"""Stick-figure drawings and videos of motion, with music beats marked.
+
+- :func:`plot_frames`: a strip of skeleton poses at chosen times, side by side, the
+  poses that fall on a music beat drawn in colour (paper A, Figure 3).
+- :func:`plot_beat_timeline`: mean joint speed over time with music beats, kinematic
+  beats and period boundaries.
+- :func:`write_video`: an MP4 of the stick figure with the music as soundtrack, made
+  by piping matplotlib frames to ffmpeg (the binary bundled with ``imageio-ffmpeg``,
+  or one on ``PATH``). Without ffmpeg it writes an animated GIF and the music as a
+  WAV next to it, and says so with a :class:`~beatsync.errors.BeatsyncWarning`.
+
+Data contract
+-------------
+- Poses come from forward kinematics (:meth:`beatsync.motion.Motion.positions`) for
+  skeletal motion, or from ``<marker>_x/_y/_z`` channels for marker tables
+  (:func:`beatsync.motion_beats.motion_positions`); drawn in an orthographic view.
+  BVH skeletons are y-up, marker data (MoCap Toolbox) z-up; ``up=`` overrides.
+- Times and beats are seconds in the motion's timeline (frame ``k`` at ``k / fps``).
+- Audio is mono float ``y`` with its sample rate ``sr`` [Hz], starting at the motion's
+  time 0.
+- Every file is written atomically (temporary file in the same folder, then renamed).
+
+Notebook: ``notebooks/fig03_animation_frames.ipynb`` (paper A, Figure 3).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import BeatsyncWarning, ParameterError
+from .units import check_fps, check_times, frames_to_time, time_to_frames
+
+__all__ = [
+    "pose_positions",
+    "project",
+    "plot_frames",
+    "plot_beat_timeline",
+    "save_figure",
+    "find_ffmpeg",
+    "write_video",
+]
+
+_BEAT_COLOR = "#d62728"
+_POSE_COLOR = "#333333"
+
+
+def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Joint positions and the bones to draw between them.
+
+    Returns
+    -------
+    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
+    bones : np.ndarray [shape=(n_bones, 2)], int
+        Pairs of joint indices (child, parent); empty for marker data.
+    """
+    from .motion_beats import motion_positions
+
+    pos = motion_positions(motion)
+    skel = getattr(motion, "skeleton", None)
+    if skel is None:
+        return pos, np.zeros((0, 2), dtype=np.int64)
+    bones = np.array(
+        [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0], dtype=np.int64
+    ).reshape(-1, 2)
+    return pos, bones
+
+
+def _up_axis(motion: Any, up: str | None) -> int:
+    if up is None:
+        up = "y" if getattr(motion, "skeleton", None) is not None else "z"
+    if up not in ("x", "y", "z"):
+        raise ParameterError(f"up={up!r} must be 'x', 'y' or 'z' (the vertical axis of the data)")
+    return "xyz".index(up)
+
+
+def project(positions: Any, *, up: int = 1, azimuth: float = 0.0) -> np.ndarray:
+    """Orthographic projection of 3-D positions on a vertical image plane.
+
+    Parameters
+    ----------
+    positions : np.ndarray [shape=(..., 3)]
+    up : int
+        Index of the vertical axis (1 for y-up BVH, 2 for z-up markers).
+    azimuth : float [deg]
+        Rotation of the camera about the vertical axis (0: look along the depth axis
+        that follows ``up`` cyclically, i.e. the image's horizontal axis is the axis
+        before ``up``).
+
+    Returns
+    -------
+    xy : np.ndarray [shape=(..., 2)]
+        Horizontal and vertical image coordinates.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    h1, h2 = (up + 1) % 3, (up + 2) % 3  # y-up: z, x ; z-up: x, y
+    a = np.deg2rad(azimuth)
+    # horizontal axis: h2 rotated towards h1 by the azimuth
+    horiz = np.cos(a) * p[..., h2] + np.sin(a) * p[..., h1]
+    return np.stack([horiz, p[..., up]], axis=-1)
+
+
+def _near_beat(times: np.ndarray, beats: np.ndarray | None, tol: float) -> np.ndarray:
+    if beats is None or len(beats) == 0:
+        return np.zeros(times.shape, dtype=bool)
+    idx = np.clip(np.searchsorted(beats, times), 1, len(beats) - 1) if len(beats) > 1 else None
+    if idx is None:
+        return np.abs(times - beats[0]) <= tol
+    d = np.minimum(np.abs(times - beats[idx - 1]), np.abs(times - beats[idx]))
+    return d <= tol
+
+
+def plot_frames(
+    motion: Any,
+    times: Any = None,
+    *,
+    beats: Any = None,
+    n_frames: int = 8,
+    ax: Any = None,
+    up: str | None = None,
+    azimuth: float = 0.0,
+    spacing: float | None = None,
+    tol: float | None = None,
+) -> Any:
+    """Draw skeleton poses at chosen times side by side; poses on a beat in colour.
+
+    Parameters
+    ----------
+    motion : Motion
+    times : np.ndarray [shape=(k,)] [s], optional
+        Times to draw (snapped to the nearest frame); default ``n_frames`` times evenly
+        spread over the motion.
+    beats : np.ndarray [s], optional
+        Music beats (in the motion's timeline). Poses within ``tol`` of a beat are
+        drawn in red and labelled.
+    n_frames : int
+        Number of poses when ``times`` is not given.
+    ax : matplotlib Axes, optional
+    up : {"x", "y", "z"}, optional
+        Vertical axis; default ``y`` for skeletons, ``z`` for markers.
+    azimuth : float [deg]
+        Camera rotation about the vertical axis.
+    spacing : float, optional [position unit]
+        Horizontal distance between poses; default 1.3 times the widest pose.
+    tol : float, optional [s]
+        Beat tolerance; default half a frame.
+
+    Returns
+    -------
+    fig : matplotlib Figure
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+
+    fps = check_fps(motion.fps)
+    if times is None:
+        if n_frames < 1:
+            raise ParameterError(f"n_frames={n_frames!r} must be >= 1")
+        times = np.linspace(0, (motion.n_frames - 1) / fps, int(n_frames))
+    times = np.atleast_1d(np.asarray(times, dtype=np.float64))
+    frames = np.clip(time_to_frames(times, fps=fps), 0, motion.n_frames - 1)
+    shown_t = frames_to_time(frames, fps=fps)
+    beats_arr = None if beats is None else check_times(beats, name="beats")
+    tol = 0.5 / fps + 1e-9 if tol is None else float(tol)
+    on_beat = _near_beat(shown_t, beats_arr, tol)
+
+    pos, bones = pose_positions(motion)
+    xy = project(pos[frames], up=_up_axis(motion, up), azimuth=azimuth)
+    centred = xy - xy[:, :, :1].mean(axis=1, keepdims=True) * np.array([1.0, 0.0])
+    width = float(np.ptp(centred[..., 0], axis=1).max()) if len(frames) else 1.0
+    spacing = 1.3 * max(width, 0.3) if spacing is None else float(spacing)
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(max(4.0, 1.2 * len(frames)), 3.2))
+    else:
+        fig = ax.figure
+    for k, (pose, beat) in enumerate(zip(centred, on_beat, strict=True)):
+        p = pose + np.array([k * spacing, 0.0])
+        color = _BEAT_COLOR if beat else _POSE_COLOR
+        if len(bones):
+            ax.add_collection(LineCollection(p[bones], colors=color, linewidths=1.6))
+        else:
+            ax.plot(p[:, 0], p[:, 1], "o", ms=2.5, color=color)
+        label = f"{shown_t[k]:.2f} s" + ("\nbeat" if beat else "")
+        ax.text(k * spacing, float(np.min(xy[..., 1])) - 0.05 * np.ptp(xy[..., 1]), label,
+                ha="center", va="top", fontsize=7, color=color)
+    ax.set_xlim(-spacing * 0.6, (len(frames) - 0.4) * spacing)
+    lo, hi = float(np.min(xy[..., 1])), float(np.max(xy[..., 1]))
+    ax.set_ylim(lo - 0.25 * (hi - lo + 1e-9), hi + 0.05 * (hi - lo + 1e-9))
+    ax.set_aspect("equal")
+    ax.axis("off")
+    return fig
+
+
+def plot_beat_timeline(
+    motion: Any,
+    *,
+    beats: Any = None,
+    motion_beats: Any = None,
+    boundaries: Any = None,
+    ax: Any = None,
+    smooth: float = 0.05,
+) -> Any:
+    """Mean joint speed over time, with music beats, motion beats and period boundaries.
+
+    Parameters
+    ----------
+    motion : Motion
+    beats : np.ndarray [s], optional
+        Music beats (vertical red lines).
+    motion_beats : np.ndarray [s], optional
+        Kinematic beats (dots on the curve).
+    boundaries : np.ndarray [s], optional
+        Period boundaries (dashed grey lines).
+    ax : matplotlib Axes, optional
+    smooth : float >= 0 [s]
+        Gaussian smoothing of the speed curve.
+
+    Returns
+    -------
+    fig : matplotlib Figure
+    """
+    import matplotlib.pyplot as plt
+
+    from .motion_beats import speed_curve
+
+    pos, _ = pose_positions(motion)
+    speed = speed_curve(pos, fps=motion.fps, smooth=smooth)
+    t = frames_to_time(np.arange(speed.size), fps=motion.fps)
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(8, 2.4))
+    else:
+        fig = ax.figure
+    ax.plot(t, speed, color=_POSE_COLOR, lw=1, label="mean joint speed")
+    if beats is not None:
+        b = check_times(beats, name="beats")
+        b = b[b <= t[-1]]
+        for i, x in enumerate(b):
+            ax.axvline(x, color=_BEAT_COLOR, lw=0.8, alpha=0.7,
+                       label="music beat" if i == 0 else None)
+    if boundaries is not None:
+        s = check_times(boundaries, name="boundaries")
+        for i, x in enumerate(s):
+            ax.axvline(x, color="0.5", lw=1.2, ls="--",
+                       label="period boundary" if i == 0 else None)
+    if motion_beats is not None:
+        mb = check_times(motion_beats, name="motion_beats")
+        ax.plot(mb, np.interp(mb, t, speed), "o", ms=4, color="#1f77b4", label="motion beat")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("speed [unit/s]")
+    ax.set_xlim(t[0], t[-1])
+    ax.legend(loc="upper right", fontsize=7, ncol=4)
+    return fig
+
+
+def save_figure(fig: Any, path: str | os.PathLike[str], *, dpi: int = 100) -> Path:
+    """Save a matplotlib figure atomically; the format follows the suffix (PNG, PDF, SVG)."""
+    from .io import atomic_write
+
+    dest = Path(path)
+    fmt = dest.suffix.lstrip(".").lower() or "png"
+    with atomic_write(dest, "wb") as fh:
+        # fixed metadata so PNG/PDF bytes do not depend on the date or version
+        meta = {"Software": None} if fmt == "png" else {}
+        fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight", metadata=meta)
+    return dest
+
+
+def find_ffmpeg() -> str | None:
+    """Path of an ffmpeg binary: imageio-ffmpeg's bundled one, else ``ffmpeg`` on PATH."""
+    try:
+        import imageio_ffmpeg
+
+        exe = imageio_ffmpeg.get_ffmpeg_exe()
+        if exe and Path(exe).is_file():
+            return str(exe)
+    except Exception:  # noqa: BLE001 - any failure means "not available"
+        pass
+    return shutil.which("ffmpeg")
+
+
+class _FrameRenderer:
+    """Draws one stick-figure frame at a time into an RGB buffer (Agg, no GUI)."""
+
+    def __init__(self, xy: np.ndarray, bones: np.ndarray, size: tuple[int, int], title: str):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.collections import LineCollection
+        from matplotlib.figure import Figure
+
+        w, h = size
+        dpi = 100
+        self.fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi)
+        self.canvas = FigureCanvasAgg(self.fig)
+        ax = self.fig.add_axes((0.02, 0.02, 0.96, 0.9))
+        lo = xy.reshape(-1, 2).min(axis=0)
+        hi = xy.reshape(-1, 2).max(axis=0)
+        pad = 0.08 * float(max(hi - lo))
+        cx, cy = (lo + hi) / 2
+        half = 0.5 * max((hi - lo)[0] * h / w, (hi - lo)[1]) + pad
+        ax.set_xlim(cx - half * w / h, cx + half * w / h)
+        ax.set_ylim(cy - half, cy + half)
+        ax.set_aspect("equal")
+        ax.axis("off")
+        ax.axhline(lo[1], color="0.8", lw=1)
+        self.bones = bones
+        if len(bones):
+            self.artist = LineCollection([], colors=_POSE_COLOR, linewidths=2)
+            ax.add_collection(self.artist)
+        else:
+            (self.artist,) = ax.plot([], [], "o", ms=3, color=_POSE_COLOR)
+        self.dot = ax.text(0.95, 0.95, "\u25cf", transform=ax.transAxes, ha="right", va="top",
+                           fontsize=22, color=_BEAT_COLOR, visible=False)
+        self.text = self.fig.text(0.02, 0.97, title, ha="left", va="top", fontsize=8)
+        self.title = title
+        self.size = (w, h)
+
+    def draw(self, pose: np.ndarray, t: float, beat: bool) -> bytes:
+        color = _BEAT_COLOR if beat else _POSE_COLOR
+        if len(self.bones):
+            self.artist.set_segments(pose[self.bones])
+            self.artist.set_color(color)
+        else:
+            self.artist.set_data(pose[:, 0], pose[:, 1])
+            self.artist.set_color(color)
+        self.dot.set_visible(beat)
+        self.text.set_text(f"{self.title}  t = {t:5.2f} s")
+        self.canvas.draw()
+        buf = np.asarray(self.canvas.buffer_rgba())[..., :3]
+        return np.ascontiguousarray(buf).tobytes()
+
+
+def _video_frames(
+    motion: Any, fps: float, beats: np.ndarray | None, up: str | None, azimuth: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    n_out = int(np.floor((motion.n_frames - 1) / motion.fps * fps + 1e-9)) + 1
+    t = frames_to_time(np.arange(n_out), fps=fps)
+    src = np.clip(time_to_frames(t, fps=motion.fps), 0, motion.n_frames - 1)
+    pos, bones = pose_positions(motion)
+    xy = project(pos[src], up=_up_axis(motion, up), azimuth=azimuth)
+    # a beat lights up for 0.1 s (at least one frame)
+    flash = max(0.1, 1.0 / fps)
+    on = np.zeros(n_out, dtype=bool)
+    if beats is not None and len(beats):
+        idx = np.searchsorted(beats, t, side="right") - 1
+        ok = idx >= 0
+        on[ok] = (t[ok] - beats[idx[ok]]) < flash - 1e-9
+    return t, xy, bones, on
+
+
+def write_video(
+    motion: Any,
+    path: str | os.PathLike[str],
+    *,
+    audio: tuple[np.ndarray, int] | None = None,
+    fps: float | None = None,
+    beats: Any = None,
+    size: tuple[int, int] = (480, 360),
+    up: str | None = None,
+    azimuth: float = 0.0,
+    title: str | None = None,
+    ffmpeg: str | bool | None = None,
+    progress: bool = False,
+) -> Path:
+    """Write a stick-figure video of ``motion``, with the music as soundtrack.
+
+    Parameters
+    ----------
+    motion : Motion
+        Skeletal motion (or marker positions); frame ``k`` at ``k / motion.fps`` [s].
+    path : path-like
+        Output ``.mp4``. Never overwritten in place: written to a temporary file in the
+        same folder, then renamed.
+    audio : (np.ndarray, int), optional
+        ``(y, sr)``: mono samples starting at motion time 0, sample rate [Hz]. Cut to
+        the video's length.
+    fps : float > 0, optional [Hz]
+        Video frame rate; default the motion's (frames are picked, not interpolated).
+    beats : np.ndarray [s], optional
+        Music beats: the figure turns red and a dot lights for 0.1 s from each beat.
+    size : (int, int) [px]
+        Width and height (rounded to even numbers for H.264).
+    up, azimuth
+        As in :func:`plot_frames`.
+    title : str, optional
+        Text in the corner; default the motion's name.
+    ffmpeg : str or bool, optional
+        Path of an ffmpeg binary; ``None`` finds one (:func:`find_ffmpeg`); ``False``
+        forces the GIF + WAV fallback.
+    progress : bool
+        Show a tqdm progress bar on stderr.
+
+    Returns
+    -------
+    path : Path
+        The video written: ``path`` itself, or ``path`` with suffix ``.gif`` in the
+        fallback (the audio is then written next to it as ``.wav``).
+
+    Raises
+    ------
+    ParameterError
+        Bad frame rate or size, unwritable folder, malformed audio, ffmpeg failure.
+    """
+    dest = Path(path)
+    parent = dest.resolve().parent
+    if not parent.is_dir():
+        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
+    if not os.access(parent, os.W_OK):
+        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    fps = check_fps(motion.fps if fps is None else fps, name="video fps")
+    w, h = (int(size[0]) // 2 * 2, int(size[1]) // 2 * 2)
+    if w < 32 or h < 32:
+        raise ParameterError(f"size={size!r} is too small; give (width, height) in pixels >= 32")
+    beats_arr = None if beats is None else check_times(beats, name="beats")
+    y_sr = None
+    if audio is not None:
+        try:
+            y, sr = audio
+        except (TypeError, ValueError):
+            raise ParameterError("audio must be a pair (y, sr)") from None
+        y = np.asarray(y, dtype=np.float32)
+        if y.ndim != 1 or y.size == 0:
+            raise ParameterError(f"audio samples must be a non-empty mono 1-D array, got {y.shape}")
+        if not sr or int(sr) <= 0:
+            raise ParameterError(f"audio sample rate {sr!r} must be > 0 [Hz]")
+        y_sr = (y, int(sr))
+
+    t, xy, bones, on = _video_frames(motion, fps, beats_arr, up, azimuth)
+    renderer = _FrameRenderer(xy, bones, (w, h), motion.name if title is None else title)
+    exe = find_ffmpeg() if ffmpeg is None else (ffmpeg or None)
+    frames_iter: Any = range(len(t))
+    if progress:
+        from tqdm import tqdm
+
+        frames_iter = tqdm(frames_iter, desc="video", unit="frame", leave=False)
+    duration = len(t) / fps
+
+    if exe is None:
+        return _write_gif_fallback(dest, renderer, xy, t, on, fps, y_sr, duration, frames_iter)
+
+    with tempfile.TemporaryDirectory(dir=parent, prefix=".beatsync-video-") as tmp:
+        tmp_video = Path(tmp) / ("out" + (dest.suffix or ".mp4"))
+        cmd = [
+            str(exe), "-y", "-loglevel", "error",
+            "-f", "rawvideo", "-vcodec", "rawvideo", "-pix_fmt", "rgb24",
+            "-s", f"{w}x{h}", "-r", f"{fps:.6f}", "-i", "-",
+        ]  # fmt: skip
+        if y_sr is not None:
+            from .io import write_audio
+
+            y, sr = y_sr
+            n = min(y.size, int(np.ceil(duration * sr)))
+            wav = write_audio(Path(tmp) / "audio.wav", y[:n], sr)
+            cmd += ["-i", str(wav)]
+        cmd += ["-c:v", "libx264", "-preset", "veryfast", "-crf", "23", "-pix_fmt", "yuv420p"]
+        if y_sr is not None:
+            cmd += ["-c:a", "aac", "-b:a", "128k"]
+        cmd += ["-movflags", "+faststart", str(tmp_video)]
+        try:
+            proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        except OSError as exc:
+            raise ParameterError(f"cannot run ffmpeg {exe!r}: {exc}") from None
+        assert proc.stdin is not None
+        try:
+            for k in frames_iter:
+                proc.stdin.write(renderer.draw(xy[k], float(t[k]), bool(on[k])))
+            proc.stdin.close()
+        except BrokenPipeError:
+            pass
+        err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+        code = proc.wait()
+        if code != 0 or not tmp_video.is_file():
+            raise ParameterError(f"ffmpeg failed (exit {code}) writing {str(dest)!r}: {err[-400:]}")
+        os.replace(tmp_video, dest)
+    return dest
+
+
+def _write_gif_fallback(
+    dest: Path,
+    renderer: _FrameRenderer,
+    xy: np.ndarray,
+    t: np.ndarray,
+    on: np.ndarray,
+    fps: float,
+    y_sr: tuple[np.ndarray, int] | None,
+    duration: float,
+    frames_iter: Any,
+) -> Path:
+    from PIL import Image
+
+    from .io import atomic_write, write_audio
+
+    gif = dest.with_suffix(".gif")
+    wav = dest.with_suffix(".wav")
+    w, h = renderer.size
+    images = [
+        Image.frombytes("RGB", (w, h), renderer.draw(xy[k], float(t[k]), bool(on[k])))
+        for k in frames_iter
+    ]
+    with atomic_write(gif, "wb") as fh:
+        images[0].save(fh, format="GIF", save_all=True, append_images=images[1:],
+                       duration=int(round(1000 / fps)), loop=0)
+    msg = f"no ffmpeg found: wrote the animation as {str(gif)!r} without sound"
+    if y_sr is not None:
+        y, sr = y_sr
+        write_audio(wav, y[: min(y.size, int(np.ceil(duration * sr)))], sr)
+        msg += f" and the music as {str(wav)!r}; play them together"
+    msg += " (install ffmpeg or `pip install imageio-ffmpeg` for an MP4 with sound)"
+    warnings.warn(msg, BeatsyncWarning, stacklevel=3)
+    return gif

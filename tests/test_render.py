@@ -1,0 +1,115 @@
+"""Tests of beatsync.render: stick figures, frame strips and video writing."""
+
+from __future__ import annotations
+
+import subprocess
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+
+from beatsync import render
+from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.motion import Joint, Motion, Skeleton
+
+FPS = 20.0
+
+
+def _motion(n: int = 30) -> Motion:
+    skel = Skeleton(
+        (
+            Joint("hip", -1, np.zeros(3), ("Xposition", "Yposition", "Zposition",
+                                           "Zrotation", "Xrotation", "Yrotation")),
+            Joint("spine", 0, np.array([0.0, 0.5, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
+            Joint("head", 1, np.array([0.0, 0.3, 0.0]), (), True),
+            Joint("leg", 0, np.array([0.1, -0.5, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
+            Joint("foot", 3, np.array([0.0, -0.4, 0.0]), (), True),
+        )
+    )
+    t = np.arange(n) / FPS
+    v = np.zeros((n, 12))
+    v[:, 1] = 0.9
+    v[:, 9] = 30 * np.sin(2 * np.pi * t)
+    return Motion(v, FPS, skel.channel_names(), skel, "toy")
+
+
+def test_pose_positions_bones():
+    pos, bones = render.pose_positions(_motion())
+    assert pos.shape == (30, 5, 3)
+    assert bones.tolist() == [[1, 0], [2, 1], [3, 0], [4, 3]]
+
+
+def test_project_y_up():
+    p = np.array([[1.0, 2.0, 3.0]])
+    assert np.allclose(render.project(p, up=1), [[1.0, 2.0]])
+    assert np.allclose(render.project(p, up=1, azimuth=90), [[3.0, 2.0]])
+    assert np.allclose(render.project(p, up=2), [[2.0, 3.0]])
+
+
+def test_plot_frames_marks_beats():
+    fig = render.plot_frames(_motion(), [0.0, 0.25, 0.5], beats=np.array([0.25, 1.0]))
+    ax = fig.axes[0]
+    colours = [tuple(np.round(c.get_colors()[0][:3], 3)) for c in ax.collections]
+    red = tuple(np.round(matplotlib.colors.to_rgb(render._BEAT_COLOR), 3))
+    assert colours.count(red) == 1 and len(colours) == 3
+    assert any("beat" in t.get_text() for t in ax.texts)
+
+
+def test_plot_beat_timeline(tmp_path):
+    fig = render.plot_beat_timeline(_motion(), beats=[0.5, 1.0], motion_beats=[0.25],
+                                    boundaries=[0.0, 1.0])
+    out = render.save_figure(fig, tmp_path / "t.png")
+    assert out.stat().st_size > 1000
+
+
+def _streams(path) -> str:
+    exe = render.find_ffmpeg()
+    return subprocess.run([exe, "-hide_banner", "-i", str(path)], capture_output=True,
+                          text=True).stderr
+
+
+@pytest.mark.skipif(render.find_ffmpeg() is None, reason="no ffmpeg")
+def test_write_video_mp4_with_sound(tmp_path):
+    sr = 8000
+    y = 0.1 * np.sin(2 * np.pi * 440 * np.arange(2 * sr) / sr).astype(np.float32)
+    out = render.write_video(_motion(), tmp_path / "v.mp4", audio=(y, sr), beats=[0.5, 1.0],
+                             size=(96, 64))
+    assert out == tmp_path / "v.mp4" and out.stat().st_size > 0
+    info = _streams(out)
+    assert "Video: h264" in info and "Audio: aac" in info
+    assert [p.name for p in tmp_path.iterdir()] == ["v.mp4"]  # no temporary left
+
+
+def test_write_video_fallback_gif_and_wav(tmp_path):
+    sr = 8000
+    y = np.zeros(sr, dtype=np.float32)
+    with pytest.warns(BeatsyncWarning, match="no ffmpeg"):
+        out = render.write_video(_motion(10), tmp_path / "v.mp4", audio=(y, sr), ffmpeg=False,
+                                 size=(64, 64))
+    assert out.suffix == ".gif" and out.is_file()
+    assert (tmp_path / "v.wav").is_file()
+    assert not (tmp_path / "v.mp4").exists()
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"fps": 0}, "fps"),
+        ({"size": (8, 8)}, "too small"),
+        ({"audio": (np.zeros((2, 10)), 8000)}, "mono"),
+        ({"audio": (np.zeros(10), 0)}, "sample rate"),
+        ({"beats": [1.0, 0.5]}, "increasing"),
+    ],
+)
+def test_write_video_bad_inputs(tmp_path, kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        render.write_video(_motion(), tmp_path / "v.mp4", **kwargs)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_video_missing_folder(tmp_path):
+    with pytest.raises(ParameterError, match="does not exist"):
+        render.write_video(_motion(), tmp_path / "nope" / "v.mp4")
