@@ -102,3 +102,11 @@ def test_motion_alignment_on_motion(monkeypatch):
 def test_bad_inputs(motion, music, sigma, match):
     with pytest.raises(ParameterError, match=match):
         beat_alignment_motion(motion, music, sigma=sigma)
+
+
+def test_phase_consistency_locked_and_drifting():
+    from beatsync.evaluate.alignment import beat_phase_consistency
+
+    assert np.isclose(beat_phase_consistency(MUSIC + 0.1, MUSIC), 1.0)  # locked at 0.2 phase
+    drift = np.arange(0.5, 19.0, 0.5 * 1.0556)  # 5.6 % slower: phase turns twice
+    assert beat_phase_consistency(drift, MUSIC) < 0.3

@@ -50,6 +50,8 @@ __all__ = [
     "alignment_scores",
     "motion_alignment",
     "offset_control",
+    "beat_phase_consistency",
+    "evaluate_sync",
 ]
 
 #: Gaussian width of both published scores: 3 frames at 60 fps [s]
@@ -295,3 +297,139 @@ def offset_control(
         "alignment_music_std": float(np.std(mus)),
         "n_trials": int(n_trials),
     }
+
+
+def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
+    """How consistently motion beats fall at the same phase of the music's beat.
+
+    The phase of a motion beat is its fractional position inside the music beat
+    interval that contains it (0 on a beat, 0.5 half-way); the score is the length of
+    the mean phase vector, ``|mean exp(2 pi i phase)|`` (vector strength): 1 if every
+    motion beat sits at the same phase (phase-locked, whatever that phase is), near 0
+    if the phases are spread (a dance drifting against the music). Motion beats
+    outside the span of the music beats are ignored.
+
+    Unlike the two alignment scores this does not reward one particular phase:
+    synchronising period boundaries to beats (paper A) locks the phase of the dance
+    but the dancer's accents may sit anywhere inside the period.
+
+    Returns
+    -------
+    score : float in [0, 1]
+    """
+    mb, yb = validate(motion_beats, music_beats)
+    if yb.size < 2:
+        raise ParameterError("beat_phase_consistency needs at least 2 music beats")
+    mb = mb[(mb >= yb[0]) & (mb < yb[-1])]
+    if mb.size == 0:
+        warnings.warn("no motion beats inside the music's beats; returning 0", BeatsyncWarning,
+                      stacklevel=2)
+        return 0.0
+    i = np.searchsorted(yb, mb, side="right") - 1
+    phase = (mb - yb[i]) / (yb[i + 1] - yb[i])
+    return float(np.abs(np.mean(np.exp(2j * np.pi * phase))))
+
+
+def evaluate_sync(
+    motion: Any,
+    beats: Any,
+    *,
+    boundaries: Any = None,
+    segment_input: Any = None,
+    period_range: tuple[float, float] = (0.25, 1.25),
+    sigma: float = DEFAULT_SIGMA,
+    n_control: int = 100,
+    seed: int = 0,
+    **sync_kwargs: Any,
+) -> dict[str, Any]:
+    """Synchronise a motion to music beats and score it: one row of a results table.
+
+    Runs :func:`beatsync.segment.segment` (unless ``boundaries`` are given),
+    :func:`beatsync.sync.synchronize`, then both alignment scores and the phase
+    consistency of the kinematic beats against the music beats *before* (the
+    original motion played from music time 0) and *after* synchronisation, and the
+    random-offset control of the synchronised motion (:func:`offset_control`).
+    Motions without positions (plain joint-angle tables) get NaN alignment scores.
+
+    Parameters
+    ----------
+    motion : Motion
+    beats : np.ndarray [s]
+        Music beats.
+    boundaries : np.ndarray [s], optional
+        Period boundaries; default from ``segment(segment_input or motion)``.
+    segment_input : Motion, optional
+        What to segment if different from ``motion`` (e.g. ``marker_angles(markers)``).
+    period_range : (float, float) [s]
+        Passed to ``segment``.
+    sigma : float [s]
+    n_control, seed
+        Random-offset control trials and seed.
+    **sync_kwargs
+        Passed to :func:`~beatsync.sync.synchronize` (``beats_per_period``, ``out_fps``...).
+
+    Returns
+    -------
+    dict
+        ``input_frames``, ``output_frames``, ``periods_available``, ``periods_used``,
+        ``beats_per_period``, ``mean_period_s``, ``speed_min``, ``speed_max``,
+        ``max_residual_ms``, ``max_residual_frames``, and ``before_/after_/control_``
+        ``motion`` / ``music`` alignment and ``before_/after_phase``; plus
+        ``result`` (the :class:`~beatsync.sync.SyncResult`).
+    """
+    from ..sync import synchronize
+
+    yb = check_times(beats, name="beats")
+    n_periods = None
+    if boundaries is None:
+        from ..segment import segment
+
+        seg = segment(motion if segment_input is None else segment_input,
+                      period_range=period_range)
+        boundaries = seg.boundaries
+        n_periods = int(seg.n_periods)
+    res = synchronize(motion, boundaries, yb, **sync_kwargs)
+    rep = res.report
+    row: dict[str, Any] = {
+        "input_frames": rep["input_frames"],
+        "input_fps": rep["input_fps"],
+        "output_frames": rep["output_frames"],
+        "periods_available": rep["periods_available"] if n_periods is None else n_periods,
+        "periods_used": rep["periods_used"],
+        "beats_per_period": rep["beats_per_period"],
+        "mean_period_s": rep["mean_motion_period_s"],
+        "beat_period_s": rep["beat_period_s"],
+        "speed_min": rep["tempo_ratio_range"][0],
+        "speed_max": rep["tempo_ratio_range"][1],
+        "max_residual_ms": rep["max_abs_residual_ms"],
+        "max_residual_frames": rep["max_abs_residual_frames"],
+    }
+    keys = ("before_motion", "before_music", "before_phase", "after_motion", "after_music",
+            "after_phase", "control_motion", "control_music")
+    try:
+        mb_before = _kinematic_beats(motion)
+        mb_after = _kinematic_beats(res.motion)
+    except ParameterError:  # no positions: a plain joint-angle table
+        row.update({k: float("nan") for k in keys})
+        row["result"] = res
+        return row
+    end_before = float(motion.duration)
+    end_after = float(res.motion.duration)
+    before = alignment_scores(mb_before, yb, sigma=sigma, span=(0.0, min(end_before, yb[-1])))
+    after = alignment_scores(mb_after, yb, sigma=sigma, span=(0.0, min(end_after, yb[-1])))
+    in_after = yb[yb <= end_after]
+    ctrl = offset_control(mb_after, in_after, sigma=sigma, n_trials=n_control, seed=seed)
+    row.update(
+        {
+            "before_motion": before["alignment_motion"],
+            "before_music": before["alignment_music"],
+            "before_phase": beat_phase_consistency(mb_before, yb),
+            "after_motion": after["alignment_motion"],
+            "after_music": after["alignment_music"],
+            "after_phase": beat_phase_consistency(mb_after, yb),
+            "control_motion": ctrl["alignment_motion_mean"],
+            "control_music": ctrl["alignment_music_mean"],
+        }
+    )
+    row["result"] = res
+    return row
