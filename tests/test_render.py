@@ -113,3 +113,10 @@ def test_write_video_bad_inputs(tmp_path, kwargs, match):
 def test_write_video_missing_folder(tmp_path):
     with pytest.raises(ParameterError, match="does not exist"):
         render.write_video(_motion(), tmp_path / "nope" / "v.mp4")
+
+
+def test_beat_strip_times():
+    t = render.beat_strip_times([0.0, 0.5, 1.0, 1.5, 2.0], start=0.4, n_beats=2, per_beat=2)
+    assert np.allclose(t, [0.5, 0.75, 1.0, 1.25, 1.5])
+    with pytest.raises(ParameterError, match="fewer than 2 beats"):
+        render.beat_strip_times([0.0, 0.5], start=1.0)

@@ -39,6 +39,7 @@ from .errors import BeatsyncWarning, ParameterError
 from .units import check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
+    "beat_strip_times",
     "pose_positions",
     "project",
     "plot_frames",
@@ -115,6 +116,38 @@ def _near_beat(times: np.ndarray, beats: np.ndarray | None, tol: float) -> np.nd
         return np.abs(times - beats[0]) <= tol
     d = np.minimum(np.abs(times - beats[idx - 1]), np.abs(times - beats[idx]))
     return d <= tol
+
+
+def beat_strip_times(
+    beats: Any, *, start: float = 0.0, n_beats: int = 4, per_beat: int = 2
+) -> np.ndarray:
+    """Times for a strip of poses: ``per_beat`` evenly spaced poses in each of
+    ``n_beats`` beat intervals, starting on the first beat at or after ``start``.
+
+    Parameters
+    ----------
+    beats : np.ndarray [s]
+    start : float [s]
+    n_beats : int >= 1
+    per_beat : int >= 1
+
+    Returns
+    -------
+    times : np.ndarray [shape=(n_beats * per_beat + 1,)] [s]
+        The first and every ``per_beat``-th time is a beat; ends on a beat.
+    """
+    b = check_times(beats, name="beats", allow_empty=False)
+    if int(n_beats) < 1 or int(per_beat) < 1:
+        raise ParameterError(f"n_beats={n_beats!r} and per_beat={per_beat!r} must be >= 1")
+    i0 = int(np.searchsorted(b, float(start) - 1e-9))
+    seg = b[i0 : i0 + int(n_beats) + 1]
+    if seg.size < 2:
+        raise ParameterError(
+            f"fewer than 2 beats at or after start={start!r} s (last beat {b[-1]:.2f} s)"
+        )
+    u = np.arange(int(per_beat)) / int(per_beat)
+    times = (seg[:-1, None] + u[None, :] * np.diff(seg)[:, None]).ravel()
+    return np.concatenate([times, seg[-1:]])
 
 
 def plot_frames(
