@@ -149,6 +149,7 @@ def test_first_beat_offset_holds_lead_in():
     res = synchronize(m, bounds, beats, first_beat=4)  # boundary 0 on 2.0 s
     assert res.report["lead_in_hold_frames"] == int(2.0 * FPS)
     assert res.report["first_boundary_frame"] == int(2.0 * FPS)
+    assert res.report["max_abs_residual_frames"] <= 0.5 + 1e-9
     assert np.allclose(res.motion.values[: int(2.0 * FPS)], m.values[0], atol=1e-6)
 
 

@@ -50,7 +50,7 @@ Method (what the paper leaves open, and our choices)
 The residual of a boundary is measured twice in the report: on the warp as realised
 by the output frames (``residual_ms``: the music time at which the resampled motion
 passes the boundary pose, minus its beat) and as the distance from the beat to the
-output frame that shows the pose closest to the boundary
+output frame nearest to that crossing, i.e. the frame that shows the boundary
 (``residual_nearest_frame_ms``, at most half a frame plus the warp residual).
 
 Notebooks: ``notebooks/tab01_frame_counts.ipynb``, ``notebooks/fig03_animation_frames.ipynb``.
@@ -483,10 +483,13 @@ def synchronize(
 
     # residuals: realised warp (interpolated between output frames) and nearest frame
     live = out_times >= warp.tgt[0]
-    xs, ys = src_times[live], out_times[live]
+    # the realised warp: output frames joined by straight lines, plus the warp's start
+    # (the first boundary may sit exactly where a held lead-in ends)
+    xs = np.concatenate([warp.src[:1], src_times[live]])
+    ys = np.concatenate([warp.tgt[:1], out_times[live]])
     realised = np.interp(used, xs, ys)
     residual = (realised - targets) * 1e3
-    nearest = np.abs(src_times[None, :] - used[:, None]).argmin(axis=1)
+    nearest = np.clip(time_to_frames(realised, fps=out_fps), 0, n_out - 1)
     nearest_res = (frames_to_time(nearest, fps=out_fps) - targets) * 1e3
     frame_ms = 1e3 / out_fps
     lead_in = int(np.count_nonzero(~live))
