@@ -1,0 +1,280 @@
+"""``beatsync sync``: make a periodic dance follow a song (paper A, section 5).
+
+Reads a motion file (BVH, MoCap Toolbox ``.mat``, CSV/NPY table) and a song, finds
+the motion's periods (:func:`beatsync.segment.segment`), the music's beats
+(:func:`beatsync.beats.track_beats`, or a beats file / a known BPM), resamples the
+motion so that every period boundary lands on a beat (:func:`beatsync.sync.synchronize`)
+and writes it as BVH with the input skeleton (or CSV), optionally a video with the
+music, and the report.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ._common import add_json_flag, check_output_path, emit
+
+__all__ = ["register", "run"]
+
+_MOTION_OUT = (".bvh", ".csv")
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "sync",
+        help="resample a periodic dance so that its periods land on the beats of a song",
+        description=(
+            "Make a periodic dance follow a song: find the motion's periods and the "
+            "music's beats, then resample the motion (quaternion slerp) so that every "
+            "period boundary lands on a beat. Writes BVH with the input skeleton (or "
+            "CSV for marker/table input), optionally an MP4 with the music, and prints "
+            "a report (frames, periods, beats per period, tempo ratios, boundary "
+            "residuals in ms). The output's time 0 is the music's time 0."
+        ),
+    )
+    p.add_argument("motion", help="motion file: .bvh, .mat (MoCap Toolbox), .csv or .npy")
+    p.add_argument("audio", help="music file: .wav, .flac, .ogg, .mp3")
+    p.add_argument("-o", "--output", required=True,
+                   help="output motion: .bvh (needs a skeleton) or .csv")
+    p.add_argument("--fps", type=float, default=None,
+                   help="input frame rate [Hz]: overrides the BVH header; required for csv/npy")
+    p.add_argument("--out-fps", type=float, default=None,
+                   help="output frame rate [Hz] (default: the input's)")
+    p.add_argument("--variable", default=None,
+                   help="recording inside a .mat file (e.g. dance2)")
+    p.add_argument("--beats", default=None, metavar="FILE",
+                   help="music beat times [s], one per line (first column): skip beat tracking")
+    p.add_argument("--bpm", type=float, default=None,
+                   help="known tempo of the music [BPM]: the tracker only finds the phase")
+    p.add_argument("--beats-per-period", type=int, default=None, metavar="N",
+                   help="music beats per motion period (default: round(motion period / beat))")
+    p.add_argument("--first-beat", type=int, default=0, metavar="K",
+                   help="index of the beat the first period starts on (default 0)")
+    p.add_argument("--period-range", type=float, nargs=2, default=(0.25, 1.25),
+                   metavar=("LO", "HI"), help="motion period search range [s] (default 0.25 1.25)")
+    p.add_argument("--video", default=None, metavar="OUT.mp4",
+                   help="also write a stick-figure video with the music as soundtrack")
+    p.add_argument("--video-fps", type=float, default=30.0,
+                   help="frame rate of the video [Hz] (default 30)")
+    p.add_argument("--report", default=None, metavar="FILE.json",
+                   help="write the report as JSON")
+    add_json_flag(p)
+    p.set_defaults(func=run)
+
+
+class _Steps:
+    """A tqdm bar over the pipeline steps on stderr (only on a terminal)."""
+
+    def __init__(self, total: int):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=total, file=sys.stderr, disable=None, leave=False,
+                        bar_format="{desc:<24}{bar}| {n_fmt}/{total_fmt} [{elapsed}]")
+        self.interactive = not self.bar.disable
+
+    def step(self, desc: str) -> None:
+        self.bar.set_description_str(desc)
+        self.bar.refresh()
+
+    def done(self) -> None:
+        self.bar.update(1)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | None]:
+    if args.beats is not None and args.bpm is not None:
+        raise ParameterError(
+            "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
+            "not both"
+        )
+    out = Path(args.output)
+    if out.suffix.lower() not in _MOTION_OUT:
+        raise ParameterError(
+            f"output {args.output!r} must end in .bvh or .csv (the motion is written there)"
+        )
+    for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
+        if inp is not None and not Path(inp).is_file():
+            raise ParameterError(f"{what} file {inp!r} does not exist")
+    inputs = (args.motion, args.audio, args.beats)
+    check_output_path(out, *inputs)
+    video = report = None
+    if args.video is not None:
+        video = check_output_path(args.video, *inputs, out)
+        if video.suffix.lower() != ".mp4":
+            raise ParameterError(f"--video {args.video!r} must end in .mp4")
+    if args.report is not None:
+        report = check_output_path(args.report, *inputs, out, args.video)
+        if report.suffix.lower() != ".json":
+            raise ParameterError(f"--report {args.report!r} must end in .json")
+    return out, video, report
+
+
+def _segment_input(motion: Any) -> Any:
+    """Joint angles to segment: the motion itself, or angles derived from markers."""
+    if motion.skeleton is not None:
+        return motion
+    if all(c.rsplit("_", 1)[-1] in ("x", "y", "z") for c in motion.channels):
+        from ..motion import marker_angles
+
+        return marker_angles(motion)
+    return motion
+
+
+def run(args: argparse.Namespace) -> int:
+    from .. import io
+    from ..sync import synchronize
+
+    out, video, report_path = _check_inputs(args)
+    t_start = time.perf_counter()
+    steps = _Steps(5 + (video is not None))
+    timings: dict[str, float] = {}
+    try:
+        steps.step("reading motion")
+        t0 = time.perf_counter()
+        motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+        if out.suffix.lower() == ".bvh" and motion.skeleton is None:
+            raise ParameterError(
+                f"{args.motion!r} has no skeleton (marker data or a joint-angle table), so it "
+                "cannot be written as BVH; give an output ending in .csv instead"
+            )
+        y, sr = io.read_audio(args.audio)
+        timings["read_s"] = time.perf_counter() - t0
+        steps.done()
+
+        steps.step("segmenting periods")
+        t0 = time.perf_counter()
+        from ..segment import segment
+
+        lo, hi = args.period_range
+        seg = segment(_segment_input(motion), period_range=(lo, hi))
+        if seg.n_periods < 1 or len(seg.boundaries) < 2:
+            raise ParameterError(
+                f"{args.motion!r} does not look periodic: no full motion period found "
+                f"in {lo}-{hi} s (try --period-range, or a periodic dance clip)"
+            )
+        timings["segment_s"] = time.perf_counter() - t0
+        steps.done()
+
+        music_s = y.size / sr
+        if music_s < seg.mean_period:
+            raise ParameterError(
+                f"the music ({music_s:.2f} s) is shorter than one motion period "
+                f"({seg.mean_period:.2f} s): use a longer song"
+            )
+
+        steps.step("finding beats")
+        t0 = time.perf_counter()
+        if args.beats is not None:
+            beats = io.read_beats(args.beats)
+            beat_source = f"file {args.beats}"
+        else:
+            from ..beats import track_beats
+
+            track = track_beats(y, sr, bpm=args.bpm)
+            beats = np.asarray(track.beats, dtype=np.float64)
+            beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
+        if beats.size < 2:
+            raise ParameterError(
+                f"no detectable beats in {args.audio!r} ({beats.size} found): is it silent "
+                "or without rhythm? give --bpm or --beats FILE"
+            )
+        timings["beats_s"] = time.perf_counter() - t0
+        steps.done()
+
+        steps.step("resampling motion")
+        t0 = time.perf_counter()
+        res = synchronize(
+            motion,
+            seg.boundaries,
+            beats,
+            beats_per_period=args.beats_per_period,
+            first_beat=args.first_beat,
+            out_fps=args.out_fps,
+        )
+        timings["sync_s"] = time.perf_counter() - t0
+        steps.done()
+
+        written: dict[str, str] = {}
+        if video is not None:
+            steps.step("writing video")
+            t0 = time.perf_counter()
+            vid = _render_video(res.motion, video, (y, sr), beats, args.video_fps,
+                                steps.interactive)
+            written["video"] = str(vid)
+            timings["video_s"] = time.perf_counter() - t0
+            steps.done()
+
+        steps.step("writing motion")
+        if out.suffix.lower() == ".bvh":
+            io.write_bvh(out, res.motion)
+        else:
+            io.write_table(out, res.motion)
+        written["motion"] = str(out)
+        steps.done()
+    finally:
+        steps.close()
+
+    timings["total_s"] = time.perf_counter() - t_start
+    rep = dict(res.report)
+    result: dict[str, Any] = {
+        "motion": str(args.motion),
+        "audio": str(args.audio),
+        "beats_source": beat_source,
+        "n_music_beats": int(beats.size),
+        "music_duration_s": music_s,
+        "segmentation": {
+            "n_periods": int(seg.n_periods),
+            "mean_period_s": float(seg.mean_period),
+            "boundaries_s": np.asarray(seg.boundaries),
+        },
+        "report": rep,
+        "outputs": written,
+        "timings": timings,
+    }
+    if report_path is not None:
+        io.write_json(report_path, result)
+        written["report"] = str(report_path)
+    return emit(result, _text(result), args)
+
+
+def _render_video(motion: Any, path: Path, audio: Any, beats: np.ndarray, fps: float,
+                  progress: bool) -> Path:
+    from .. import render
+
+    return render.write_video(motion, path, audio=audio, fps=fps, beats=beats,
+                              progress=progress)
+
+
+def _text(result: dict[str, Any]) -> str:
+    r = result["report"]
+    res = np.abs(np.asarray(r["residual_ms"]))
+    near = np.abs(np.asarray(r["residual_nearest_frame_ms"]))
+    lines = [
+        f"motion   {result['motion']}: {r['input_frames']} frames at {r['input_fps']:g} fps, "
+        f"{result['segmentation']['n_periods']} periods of "
+        f"{result['segmentation']['mean_period_s']:.3f} s (mean)",
+        f"music    {result['audio']}: {result['music_duration_s']:.2f} s, "
+        f"{result['n_music_beats']} beats ({result['beats_source']}), "
+        f"beat period {r['beat_period_s']:.3f} s",
+        f"mapping  {r['periods_used']} of {r['periods_available']} periods, "
+        f"{r['beats_per_period']} beat(s) per period ({r['beats_per_period_rule']}), "
+        f"first period on beat {r['first_beat']}",
+        f"tempo    playback speed x{r['tempo_ratio_range'][0]:.3f} .. "
+        f"x{r['tempo_ratio_range'][1]:.3f}",
+        f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
+        f"({r['output_duration_s']:.2f} s)",
+        f"residual warp max {res.max():.3f} ms; nearest frame max {near.max():.2f} ms "
+        f"({r['max_abs_residual_frames']:.2f} frame)",
+    ]
+    for k, v in result["outputs"].items():
+        lines.append(f"wrote    {k}: {v}")
+    return "\n".join(lines)

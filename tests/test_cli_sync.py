@@ -1,0 +1,138 @@
+"""End-to-end tests of ``beatsync sync`` (via beatsync.cli.main)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from beatsync import datasets, io
+from beatsync.cli import main
+from beatsync.synth.audio import beat_times, click_track
+
+SR = 22050
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("in")
+    salsa = datasets.load_salsa("60_01").slice_frames(0, 720)  # 12 s at 60 fps
+    io.write_bvh(d / "salsa.bvh", salsa)
+    beats = beat_times(115, duration=20.0, start=0.4)
+    io.write_audio(d / "song.wav", click_track(beats, sr=SR, duration=20.0), SR)
+    io.write_beats(d / "song.beats", beats)
+    io.write_audio(d / "short.wav", click_track(np.array([0.05]), sr=SR, duration=0.3), SR)
+    io.write_audio(d / "silence.wav", np.zeros(5 * SR, dtype=np.float32), SR)
+    # a table without skeleton (joint angles), and pure noise (not periodic)
+    io.write_table(d / "angles.csv", salsa.select([c for c in salsa.channels if "rotation" in c]))
+    rng = np.random.default_rng(0)
+    noise = salsa.with_values(np.cumsum(rng.normal(0, 2.0, salsa.values.shape), axis=0) * 0
+                              + rng.normal(0, 30.0, salsa.values.shape))
+    io.write_bvh(d / "noise.bvh", noise)
+    return d, salsa, beats
+
+
+def _run(argv, capsys):
+    code = main(argv)
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+def test_sync_end_to_end_with_beats_file(inputs, tmp_path, capsys):
+    d, salsa, beats = inputs
+    out = tmp_path / "out.bvh"
+    rep = tmp_path / "report.json"
+    code, stdout, err = _run(
+        [
+            "sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out),
+            "--beats", str(d / "song.beats"), "--report", str(rep), "--json",
+        ],
+        capsys,
+    )
+    assert code == 0, err
+    result = json.loads(stdout)
+    r = result["report"]
+    assert r["input_frames"] == 720 and r["output_frames"] > 100
+    assert r["max_abs_residual_frames"] <= 1.0
+    assert np.all(np.abs(r["residual_ms"]) <= 1000 / 60)
+    back = io.read_bvh(out)
+    assert back.skeleton.same_structure(salsa.skeleton)
+    assert back.n_frames == r["output_frames"] and back.fps == 60.0
+    assert json.loads(rep.read_text())["report"]["output_frames"] == r["output_frames"]
+    # target beats are beats of the file
+    assert np.all(np.isin(np.round(r["target_beats_s"], 6), np.round(beats, 6)))
+
+
+def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
+    d, _, _ = inputs
+    out = tmp_path / "out.bvh"
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--bpm", "115",
+         "--out-fps", "30"],
+        capsys,
+    )
+    assert code == 0, err
+    assert "residual" in stdout and "periods" in stdout
+    assert io.read_bvh(out).fps == 30.0
+
+
+def test_sync_table_to_csv(inputs, tmp_path, capsys):
+    d, _, _ = inputs
+    out = tmp_path / "out.csv"
+    code, _, err = _run(
+        ["sync", str(d / "angles.csv"), str(d / "song.wav"), "-o", str(out), "--fps", "60",
+         "--beats", str(d / "song.beats")],
+        capsys,
+    )
+    assert code == 0, err
+    assert out.is_file()
+
+
+def test_sync_video(inputs, tmp_path, capsys):
+    from beatsync.render import find_ffmpeg
+
+    if find_ffmpeg() is None:
+        pytest.skip("no ffmpeg")
+    d, _, _ = inputs
+    out, vid = tmp_path / "out.bvh", tmp_path / "out.mp4"
+    code, _, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--video", str(vid), "--video-fps", "8"],
+        capsys,
+    )
+    assert code == 0, err
+    assert vid.stat().st_size > 0
+
+
+BAD = [
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--bpm", "120"], "conflict"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{d}/salsa.bvh"], "same"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.mp3"], ".bvh or .csv"),
+    (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "60"], "skeleton"),
+    (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats"],
+     "periodic"),
+    (["{d}/salsa.bvh", "{d}/silence.wav", "-o", "{o}/x.bvh"], "silen"),
+    (["{d}/salsa.bvh", "{d}/short.wav", "-o", "{o}/x.bvh"], "shorter"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--video", "{d}/song.wav"],
+     "same|mp4"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--first-beat", "500",
+      "--beats", "{d}/song.beats"], "first_beat"),
+]
+
+
+@pytest.mark.parametrize("argv, match", BAD)
+def test_sync_bad_inputs(inputs, tmp_path, capsys, argv, match):
+    import re
+
+    d, _, _ = inputs
+    before = sorted(p.name for p in d.iterdir())
+    argv = [a.format(d=d, o=tmp_path) for a in argv]
+    code, stdout, err = _run(["sync", *argv], capsys)
+    assert code == 2
+    assert re.search(match, err, flags=re.IGNORECASE), err
+    assert "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []  # nothing written
+    assert sorted(p.name for p in d.iterdir()) == before
