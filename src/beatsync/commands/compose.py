@@ -1,0 +1,271 @@
+"""``beatsync compose``: compose a dance for a song from a motion library (paper B).
+
+Reads the library's BVH clips (one skeleton), builds their weighted motion graph (or
+loads it from the on-disk cache), finds the music's beats (tracker, a beats file or a
+known BPM) and its level per beat interval, searches the best path by dynamic
+programming, synthesizes the dance (every motion beat on a music beat, blended
+transitions) and writes it as BVH, optionally a video with the music and a JSON
+report (path, number of transitions, graph-build and search times).
+
+The graph cache lives in ``~/.cache/beatsync`` (override with the environment
+variable ``BEATSYNC_CACHE_DIR``); an entry is keyed by the SHA-256 of the library
+files' content, their order, the frame-rate override and every graph parameter, so
+editing a clip or a parameter rebuilds the graph.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ._common import add_json_flag, check_output_path, emit
+
+__all__ = ["register", "run", "cache_dir", "graph_cache_key"]
+
+_AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
+_CACHE_VERSION = 1
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "compose",
+        help="compose a dance for a song from a library of motion clips (motion graph + DP)",
+        description=(
+            "Compose a dance for a song from a library of BVH clips (paper B): the clips' "
+            "beat frames form a weighted motion graph (cached on disk), a dynamic programme "
+            "picks the path whose motion intensity follows the music's, and every motion "
+            "beat is time-warped onto a music beat. Writes BVH (the library's skeleton). "
+            "Example: beatsync compose song.wav --library a.bvh b.bvh -o dance.bvh"
+        ),
+    )
+    p.add_argument("audio", nargs="?", default=None,
+                   help="music file (.wav, .flac, .ogg, .mp3); may also follow --library")
+    p.add_argument("--library", nargs="+", action="extend", required=True, metavar="PATH",
+                   help="BVH clips or folders of BVH clips (one skeleton)")
+    p.add_argument("-o", "--output", required=True, help="output motion (.bvh)")
+    p.add_argument("--fps", type=float, default=None,
+                   help="frame rate of the library clips [Hz]: overrides the BVH headers")
+    p.add_argument("--th", type=float, default=3.0,
+                   help="transition threshold TH on the scale-free pose distance rd (default 3.0)")
+    p.add_argument("--weight-rule", choices=("paper", "rd"), default="paper",
+                   help="transition weight: 'paper' w2 = max(rd, 2) (eq. 2), or 'rd'")
+    p.add_argument("--method", choices=("dp", "conventional", "random"), default="dp",
+                   help="search: dp (paper B), conventional (multi-stage baseline), random walk")
+    p.add_argument("--beats", default=None, metavar="FILE",
+                   help="music beat times [s], one per line: skip beat tracking")
+    p.add_argument("--bpm", type=float, default=None,
+                   help="known tempo of the music [BPM]: the tracker only finds the phase")
+    p.add_argument("--blend", type=float, default=1.0 / 3.0,
+                   help="transition blend length [s] (default 1/3)")
+    p.add_argument("--video", default=None, metavar="OUT.mp4",
+                   help="also write a stick-figure video with the music as soundtrack")
+    p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
+    p.add_argument("--no-cache", action="store_true", help="neither read nor write the graph cache")
+    add_json_flag(p)
+    p.set_defaults(func=run)
+
+
+def cache_dir() -> Path:
+    """The graph cache folder: ``$BEATSYNC_CACHE_DIR`` or ``~/.cache/beatsync``."""
+    env = os.environ.get("BEATSYNC_CACHE_DIR")
+    return Path(env) if env else Path.home() / ".cache" / "beatsync"
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def graph_cache_key(files: list[Path], params: dict[str, Any]) -> str:
+    """Hash of the library files' content (in order) and the graph parameters."""
+    h = hashlib.sha256()
+    from .. import __version__
+
+    h.update(f"beatsync-graph-v{_CACHE_VERSION}-{__version__}".encode())
+    for f in files:
+        h.update(_sha256(f).encode())
+    h.update(json.dumps(params, sort_keys=True, default=str).encode())
+    return h.hexdigest()[:32]
+
+
+def _library_files(entries: list[str]) -> list[Path]:
+    files: list[Path] = []
+    for e in entries:
+        p = Path(e)
+        if p.is_dir():
+            found = sorted(q for q in p.iterdir() if q.suffix.lower() == ".bvh")
+            if not found:
+                raise ParameterError(f"library folder {e!r} contains no .bvh clip")
+            files.extend(found)
+        elif p.is_file():
+            if p.suffix.lower() != ".bvh":
+                raise ParameterError(
+                    f"library clip {e!r} is not a .bvh file (the graph needs skeletal clips)"
+                )
+            files.append(p)
+        else:
+            raise ParameterError(f"library clip {e!r} does not exist")
+    if not files:
+        raise ParameterError("the motion library is empty: give at least one BVH clip")
+    return files
+
+
+def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
+    entries = list(args.library or [])
+    audio = args.audio
+    if audio is None:
+        # argparse lets --library swallow the audio file that follows it
+        moved = [e for e in entries if Path(e).suffix.lower() in _AUDIO_SUFFIXES]
+        if len(moved) == 1:
+            audio = moved[0]
+            entries.remove(audio)
+        else:
+            raise ParameterError("give the music file (AUDIO), e.g. beatsync compose song.wav ...")
+    try:
+        th = float(args.th)
+    except (TypeError, ValueError):
+        raise ParameterError(f"--th {args.th!r} must be a number > 0") from None
+    if not np.isfinite(th) or th <= 0:
+        raise ParameterError(
+            f"--th {args.th!r} must be a threshold > 0 on the scale-free pose distance rd "
+            "(the paper uses 3.0)"
+        )
+    if args.beats is not None and args.bpm is not None:
+        raise ParameterError("--beats and --bpm conflict: give beat times or a tempo, not both")
+    if not Path(audio).is_file():
+        raise ParameterError(f"audio file {audio!r} does not exist")
+    if args.beats is not None and not Path(args.beats).is_file():
+        raise ParameterError(f"beats file {args.beats!r} does not exist")
+    files = _library_files(entries)
+    out = Path(args.output)
+    if out.suffix.lower() != ".bvh":
+        raise ParameterError(f"output {args.output!r} must end in .bvh")
+    inputs = [audio, args.beats, *files]
+    check_output_path(out, *inputs)
+    video = report = None
+    if args.video is not None:
+        video = check_output_path(args.video, *inputs, out)
+        if video.suffix.lower() != ".mp4":
+            raise ParameterError(f"--video {args.video!r} must end in .mp4")
+    if args.report is not None:
+        report = check_output_path(args.report, *inputs, out, args.video)
+        if report.suffix.lower() != ".json":
+            raise ParameterError(f"--report {args.report!r} must end in .json")
+    return {"audio": audio, "files": files, "out": out, "video": video, "report": report, "th": th}
+
+
+def _load_or_build(files, clips, params, use_cache):
+    from .. import io
+    from ..graph import build_graph
+    from ..graph.build import WeightedMotionGraph
+
+    key = graph_cache_key(files, params) if use_cache else None
+    path = cache_dir() / f"graph-{key}.npz" if key else None
+    if path is not None and path.is_file():
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                arrays = {k: data[k] for k in data.files}
+            g = WeightedMotionGraph.from_arrays(arrays, clips, params)
+            if int(g.node_clip.max(initial=-1)) < len(clips):
+                return g, True, path
+        except (OSError, ValueError, KeyError):
+            pass  # a damaged cache entry is rebuilt
+    g = build_graph(
+        clips,
+        th=params["th"],
+        weight_rule=params["weight_rule"],
+    )
+    if path is not None:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with io.atomic_write(path, mode="wb") as fh:
+                np.savez(fh, **g.to_arrays())
+        except OSError:
+            path = None  # an unwritable cache is not an error
+    return g, False, path
+
+
+def run(args: argparse.Namespace) -> int:
+    from .. import io
+    from ..graph.compose import compose_music
+
+    chk = _check_inputs(args)
+    files = chk["files"]
+    t_read = time.perf_counter()
+    clips = [io.read_bvh(f, fps=args.fps) for f in files]
+    y, sr = io.read_audio(chk["audio"])
+    beats = io.read_beats(args.beats) if args.beats is not None else None
+    read_s = time.perf_counter() - t_read
+    if beats is not None and beats.size < 2:
+        raise ParameterError(f"beats file {args.beats!r} has {beats.size} beat(s); need >= 2")
+    from ..graph import check_library
+    from ..music import track_music_beats
+
+    check_library(clips)
+    if beats is None:
+        beats = track_music_beats(y, sr, bpm=args.bpm)
+    params = {
+        "th": chk["th"],
+        "weight_rule": args.weight_rule,
+        "fps": args.fps,
+    }
+    t0 = time.perf_counter()
+    graph, cached, cache_path = _load_or_build(files, clips, params, not args.no_cache)
+    build_s = time.perf_counter() - t0
+    comp = compose_music(graph, y, sr, beats=beats, method=args.method, blend=args.blend)
+    out = io.write_bvh(chk["out"], comp.motion)
+    video_path = None
+    if chk["video"] is not None:
+        from ..render import write_video
+
+        video_path = write_video(comp.motion, chk["video"], audio=(y, sr), beats=comp.music_beats)
+    result = {
+        "output": str(out),
+        "video": str(video_path) if video_path else None,
+        "library": [str(f) for f in files],
+        "method": args.method,
+        "n_transitions": comp.n_transitions,
+        "n_music_beats": int(comp.music_beats.size),
+        "tempo_bpm": float(60.0 / np.median(np.diff(comp.music_beats))),
+        "graph": graph.summary(),
+        "graph_cached": cached,
+        "graph_cache_file": str(cache_path) if cache_path else None,
+        "graph_build_time_s": build_s,
+        "search_time_s": comp.search.search_time,
+        "synthesis_time_s": comp.timings["synthesis_s"],
+        "read_time_s": read_s,
+        "cost": comp.search.cost,
+        "duration_s": comp.motion.n_frames / comp.motion.fps,
+        "n_frames": comp.motion.n_frames,
+        "fps": comp.motion.fps,
+        "transition_times_s": comp.synthesis.transition_times,
+    }
+    if chk["report"] is not None:
+        io.write_json(chk["report"], result)
+    g = graph.summary()
+    text = (
+        f"wrote {out} ({comp.motion.n_frames} frames at {comp.motion.fps:g} fps, "
+        f"{result['duration_s']:.2f} s)\n"
+        f"library: {g['n_clips']} clip(s), {g['n_nodes']} beat frames, "
+        f"{g['n_transitions']} transition edges at TH={g['th']:g}"
+        f"{' (graph from cache)' if cached else ''}\n"
+        f"music: {comp.music_beats.size} beats (~{result['tempo_bpm']:.1f} BPM)\n"
+        f"path: {comp.search.path.size} intervals, {comp.n_transitions} transition(s); "
+        f"graph build {build_s:.3f} s, search ({args.method}) {comp.search.search_time:.4f} s"
+    )
+    if video_path:
+        text += f"\nvideo: {video_path}"
+    if chk["report"] is not None:
+        text += f"\nreport: {chk['report']}"
+    return emit(result, text, args)

@@ -1,0 +1,45 @@
+"""Music-driven dance composition over weighted motion graphs (paper B).
+
+Xu, Takagi, Kawada, "Automatic composition of motion capture animation for music
+synchronization". A motion library becomes a :class:`WeightedMotionGraph` whose
+nodes are beat frames (:mod:`beatsync.graph.build`); a dynamic programme over the
+music's beat intervals chooses the path whose motion intensity follows the music's
+(:mod:`beatsync.graph.search`); the chosen intervals are time-warped onto the music
+beats and blended at transitions (:mod:`beatsync.graph.synthesis`);
+:mod:`beatsync.graph.compose` runs the whole chain and
+:mod:`beatsync.graph.quality` scores the result with objective proxies.
+
+Data contract: event times in seconds (1-D float64, strictly increasing); motions
+are :class:`beatsync.motion.Motion` with one skeleton structure per library.
+
+Notebooks: ``notebooks/tab01_speed_motion_graph.ipynb`` (paper B Table 1) and
+``notebooks/tab02_quality_proxies.ipynb`` (proxies for paper B Table 2).
+"""
+
+from .build import (
+    WEIGHT_RULES,
+    WeightedMotionGraph,
+    aligned_distance_matrix,
+    build_graph,
+    check_library,
+    transition_weight,
+)
+from .search import SearchResult, conventional_search, dp_search, path_cost, random_walk
+from .synthesis import SynthesisResult, beat_warp, synthesize
+
+__all__ = [
+    "WEIGHT_RULES",
+    "WeightedMotionGraph",
+    "aligned_distance_matrix",
+    "build_graph",
+    "check_library",
+    "transition_weight",
+    "SearchResult",
+    "conventional_search",
+    "dp_search",
+    "path_cost",
+    "random_walk",
+    "SynthesisResult",
+    "beat_warp",
+    "synthesize",
+]

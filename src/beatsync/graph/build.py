@@ -1,0 +1,652 @@
+"""Construction of the weighted motion graph of paper B (section 3.2, eqs. 1-2).
+
+Nodes, edges and weights
+------------------------
+- **Nodes** are the beat frames of every clip of a motion library (kinematic beats,
+  :mod:`beatsync.motion_beats`, or beats given by the caller).
+- **Forward edges** join successive beat frames of the same clip. Each carries the
+  *motion intensity* of its interval, the mean kinetic energy of the joints
+  (:func:`beatsync.motion_beats.interval_intensity`), z-scored over all intervals of
+  the library. A node that starts a forward edge is an *interval node*.
+- **Transition edges** join two similar beat frames ``i != j`` (in either direction,
+  across or within clips) when ``rd(i, j) < TH`` (eq. 1, ``TH = 3.0``), weighted by
+  eq. 2 as written in the paper: ``w2 = rd if rd > 2 else 2`` (``weight_rule="paper"``:
+  every transition costs at least 2), or ``w2 = rd`` (``weight_rule="rd"``).
+
+The frame distance ``rd`` (eq. 1), defined here
+-----------------------------------------------
+Following Kovar, Gleicher and Pighin (2002, "Motion graphs"), each beat frame ``f``
+is represented by the point cloud of all joint positions (end sites included) over a
+window of frames ``f - h .. f + h`` (``window`` [s] long, clipped at the clip ends).
+Two clouds are compared after the rigid 2-D transform (rotation about the vertical
+axis, translation on the floor) that best aligns them, which has a closed form:
+with both clouds centred on the floor plane,
+``D^2 = (S_i + S_j - 2 sqrt(a^2 + b^2) - 2 Y_ij) / M`` where ``S`` are the summed
+squared centred coordinates, ``a = sum(x_i x_j + z_i z_j)``,
+``b = sum(x_i z_j - z_i x_j)``, ``Y_ij = sum(y_i y_j)`` and ``M`` the number of points.
+``D`` is the RMS joint distance [position unit] after aligning root position and
+heading.
+
+``D`` has the units of the data, so a fixed ``TH`` would mean different things on
+different libraries. We make it scale-free::
+
+    rd = D / (v_typ * rd_unit),
+
+where ``v_typ`` [position unit / s] is the median over all frames of the library of
+the same aligned window distance between consecutive frames, times ``fps`` (the
+typical speed of the whole body's point cloud), and ``rd_unit = 0.1`` s. ``rd`` thus
+counts how many tenths of a second of typical movement separate the two poses, and
+``rd < TH = 3`` accepts transitions whose pose jump is at most what the dancer
+typically covers in 0.3 s, about the 1/3 s over which transitions are blended. (With
+``rd_unit = 1 / fps``, i.e. "relative to the frame-to-frame distance", the CMU salsa
+library has a single pair below 3: see ``notebooks/tab01_speed_motion_graph.ipynb``.)
+
+Data contract
+-------------
+Clips are :class:`beatsync.motion.Motion` with the same skeleton structure (joint
+names, parents, channels; bone lengths may differ). Beat times are seconds; node
+frames are integer frames of their clip.
+
+Notebook: ``notebooks/tab01_speed_motion_graph.ipynb``; paper B section 3.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import BeatsyncWarning, ParameterError
+from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
+from ..units import check_fps, check_times, time_to_frames
+
+__all__ = [
+    "WeightedMotionGraph",
+    "build_graph",
+    "check_library",
+    "transition_weight",
+    "aligned_distance_matrix",
+    "aligned_pair_distance",
+    "typical_speed",
+    "WEIGHT_RULES",
+]
+
+WEIGHT_RULES = ("paper", "rd")
+
+
+# --------------------------------------------------------------------------- distances
+
+
+def _clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.ndarray:
+    """Point clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` around each frame."""
+    n = positions.shape[0]
+    idx = np.clip(frames[:, None] + np.arange(-half, half + 1)[None, :], 0, n - 1)
+    c = positions[idx]  # (m, w, J, 3)
+    return c.reshape(c.shape[0], -1, 3)
+
+
+def _center(c: np.ndarray, up: int) -> np.ndarray:
+    c = c.copy()
+    for ax in range(3):
+        if ax != up:
+            c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
+    return c
+
+
+def _ground_axes(up: int) -> tuple[int, int]:
+    # right-handed order so that (g0, up, g1) is a rotation of (x, y, z)
+    return {0: (1, 2), 1: (2, 0), 2: (0, 1)}[up]
+
+
+def aligned_distance_matrix(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
+    """RMS distance between point clouds after the best floor-plane rigid alignment.
+
+    Parameters
+    ----------
+    a : np.ndarray [shape=(na, m, 3)] [position unit]
+    b : np.ndarray [shape=(nb, m, 3)]
+    up : int
+        Index of the vertical axis (1 = y, the BVH convention).
+
+    Returns
+    -------
+    d : np.ndarray [shape=(na, nb)] [position unit]
+    """
+    g0, g1 = _ground_axes(up)
+    a = _center(a, up)
+    b = _center(b, up)
+    m = a.shape[1]
+    sa = np.sum(a * a, axis=(1, 2))
+    sb = np.sum(b * b, axis=(1, 2))
+    dot = a[:, :, g0] @ b[:, :, g0].T + a[:, :, g1] @ b[:, :, g1].T
+    crs = a[:, :, g0] @ b[:, :, g1].T - a[:, :, g1] @ b[:, :, g0].T
+    yy = a[:, :, up] @ b[:, :, up].T
+    d2 = sa[:, None] + sb[None, :] - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * yy
+    return np.sqrt(np.maximum(d2, 0.0) / m)
+
+
+def aligned_pair_distance(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
+    """Row-wise version of :func:`aligned_distance_matrix` (``a[k]`` vs ``b[k]``)."""
+    g0, g1 = _ground_axes(up)
+    a = _center(a, up)
+    b = _center(b, up)
+    m = a.shape[1]
+    sa = np.sum(a * a, axis=(1, 2))
+    sb = np.sum(b * b, axis=(1, 2))
+    dot = np.sum(a[:, :, g0] * b[:, :, g0] + a[:, :, g1] * b[:, :, g1], axis=1)
+    crs = np.sum(a[:, :, g0] * b[:, :, g1] - a[:, :, g1] * b[:, :, g0], axis=1)
+    yy = np.sum(a[:, :, up] * b[:, :, up], axis=1)
+    d2 = sa + sb - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * yy
+    return np.sqrt(np.maximum(d2, 0.0) / m)
+
+
+def typical_speed(
+    positions_list: Sequence[np.ndarray], fps_list: Sequence[float], *, half: int, up: int = 1
+) -> float:
+    """Median aligned window distance between consecutive frames, times fps [unit / s]."""
+    vals = []
+    for pos, fps in zip(positions_list, fps_list, strict=True):
+        n = pos.shape[0]
+        step = max(1, n // 2000)  # subsample very long clips
+        f = np.arange(0, n - 1, step)
+        for s in range(0, f.size, 500):
+            ff = f[s : s + 500]
+            d = aligned_pair_distance(_clouds(pos, ff, half), _clouds(pos, ff + 1, half), up=up)
+            vals.append(d * fps)
+    v = float(np.median(np.concatenate(vals))) if vals else 0.0
+    return v
+
+
+def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
+    """Eq. 2: ``w2 = rd if rd > 2 else 2`` (``"paper"``) or ``w2 = rd`` (``"rd"``)."""
+    if rule not in WEIGHT_RULES:
+        raise ParameterError(f"weight_rule={rule!r} is not one of {WEIGHT_RULES}")
+    rd = np.asarray(rd, dtype=np.float64)
+    if rule == "paper":
+        return np.where(rd > 2.0, rd, 2.0)
+    return rd.copy()
+
+
+# --------------------------------------------------------------------------- graph
+
+
+@dataclass(frozen=True, eq=False)
+class WeightedMotionGraph:
+    """A weighted motion graph over the beat frames of a motion library.
+
+    Attributes
+    ----------
+    clips : tuple of Motion
+        The library (same skeleton structure).
+    node_clip : np.ndarray [shape=(N,)] int
+        Clip index of each node.
+    node_frame : np.ndarray [shape=(N,)] int [frames]
+        Beat frame of each node in its clip.
+    next_node : np.ndarray [shape=(N,)] int
+        The following beat node of the same clip (forward edge), -1 at a clip's last beat.
+    intensity : np.ndarray [shape=(N,)] [(position unit / s)^2]
+        Motion intensity of the interval starting at each node; NaN at last beats.
+    z_intensity : np.ndarray [shape=(N,)]
+        ``intensity`` z-scored over all intervals of the library; NaN at last beats.
+    trans_src, trans_dst : np.ndarray [shape=(E,)] int
+        Directed transition edges (every two-way edge appears in both directions).
+    trans_rd : np.ndarray [shape=(E,)]
+        Scale-free distance ``rd`` of each transition (eq. 1, see module docstring).
+    trans_weight : np.ndarray [shape=(E,)]
+        Eq. 2 weight of each transition under ``weight_rule``.
+    th : float
+        Transition threshold TH on ``rd``.
+    weight_rule : str
+    speed_scale : float [position unit / s]
+        ``v_typ`` of the rd normalisation.
+    min_rd : float
+        Smallest ``rd`` between two distinct beat frames (to suggest a TH).
+    params : dict
+        All construction parameters (for caching and reports).
+    build_time : float [s]
+    """
+
+    clips: tuple
+    node_clip: np.ndarray
+    node_frame: np.ndarray
+    next_node: np.ndarray
+    intensity: np.ndarray
+    z_intensity: np.ndarray
+    trans_src: np.ndarray
+    trans_dst: np.ndarray
+    trans_rd: np.ndarray
+    trans_weight: np.ndarray
+    th: float
+    weight_rule: str
+    speed_scale: float
+    min_rd: float
+    params: dict = field(default_factory=dict)
+    build_time: float = 0.0
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    # -- sizes -------------------------------------------------------------
+    @property
+    def n_nodes(self) -> int:
+        return int(self.node_clip.size)
+
+    @property
+    def n_intervals(self) -> int:
+        return int(np.sum(self.next_node >= 0))
+
+    @property
+    def n_transitions(self) -> int:
+        """Number of two-way transition edges (each counted once)."""
+        return int(self.trans_src.size // 2)
+
+    @property
+    def is_interval(self) -> np.ndarray:
+        return self.next_node >= 0
+
+    def node_time(self) -> np.ndarray:
+        """Beat time [s] of each node in its own clip."""
+        fps = np.array([c.fps for c in self.clips])
+        return self.node_frame / fps[self.node_clip]
+
+    def interval_duration(self) -> np.ndarray:
+        """Natural duration [s] of the interval starting at each node (NaN at last beats)."""
+        t = self.node_time()
+        out = np.full(self.n_nodes, np.nan)
+        ok = self.next_node >= 0
+        out[ok] = t[self.next_node[ok]] - t[ok]
+        return out
+
+    def summary(self) -> dict:
+        return {
+            "n_clips": len(self.clips),
+            "clips": [c.name for c in self.clips],
+            "n_nodes": self.n_nodes,
+            "n_intervals": self.n_intervals,
+            "n_transitions": self.n_transitions,
+            "th": self.th,
+            "weight_rule": self.weight_rule,
+            "min_rd": self.min_rd,
+            "speed_scale": self.speed_scale,
+            "build_time_s": self.build_time,
+        }
+
+    # -- successor structure for searches ------------------------------------
+    def successors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Edges between interval nodes: ``(src, dst, weight)``.
+
+        After playing the interval of node ``u`` the dancer stands on beat frame
+        ``a = next_node[u]``; the next interval is ``a``'s own (weight 0, "continue")
+        or that of any ``v`` with a transition edge ``a -> v`` (weight ``w2``).
+        Only interval nodes appear as ``src`` and ``dst``.
+        """
+        if "succ" in self._cache:
+            return self._cache["succ"]
+        isint = self.is_interval
+        u = np.flatnonzero(isint)
+        a = self.next_node[u]
+        keep = isint[a]
+        src = [u[keep]]
+        dst = [a[keep]]
+        w = [np.zeros(int(keep.sum()))]
+        # transitions: for every edge a -> v, every u with next_node[u] == a
+        prev = np.full(self.n_nodes, -1)
+        prev[self.next_node[u]] = u
+        p = prev[self.trans_src]
+        ok = (p >= 0) & isint[self.trans_dst]
+        src.append(p[ok])
+        dst.append(self.trans_dst[ok])
+        w.append(self.trans_weight[ok])
+        out = (
+            np.concatenate(src).astype(np.int64),
+            np.concatenate(dst).astype(np.int64),
+            np.concatenate(w).astype(np.float64),
+        )
+        self._cache["succ"] = out
+        return out
+
+    def predecessor_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Dense padded predecessor table for the DP.
+
+        Returns
+        -------
+        pred : np.ndarray [shape=(N, max_in)] int (padding points at node 0)
+        weight : np.ndarray [shape=(N, max_in)] (padding is +inf)
+        is_trans : np.ndarray [shape=(N, max_in)] bool
+        """
+        if "pred" in self._cache:
+            return self._cache["pred"]
+        src, dst, w = self.successors()
+        n = self.n_nodes
+        order = np.argsort(dst, kind="stable")
+        src, dst, w = src[order], dst[order], w[order]
+        counts = np.bincount(dst, minlength=n)
+        width = max(1, int(counts.max()) if counts.size else 1)
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        col = np.arange(dst.size) - starts[dst]
+        pred = np.zeros((n, width), dtype=np.int64)
+        weight = np.full((n, width), np.inf)
+        is_trans = np.zeros((n, width), dtype=bool)
+        pred[dst, col] = src
+        weight[dst, col] = w
+        is_trans[dst, col] = self.next_node[src] != dst
+        out = (pred, weight, is_trans)
+        self._cache["pred"] = out
+        return out
+
+    def successor_lists(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """CSR successor lists over all nodes: ``(indptr, dst, weight)``."""
+        if "csr" in self._cache:
+            return self._cache["csr"]
+        src, dst, w = self.successors()
+        order = np.lexsort((dst, src))
+        src, dst, w = src[order], dst[order], w[order]
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=self.n_nodes))])
+        out = (indptr, dst, w)
+        self._cache["csr"] = out
+        return out
+
+    # -- (de)serialisation of the arrays (for the on-disk cache) -------------
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        return {
+            "node_clip": self.node_clip,
+            "node_frame": self.node_frame,
+            "next_node": self.next_node,
+            "intensity": self.intensity,
+            "z_intensity": self.z_intensity,
+            "trans_src": self.trans_src,
+            "trans_dst": self.trans_dst,
+            "trans_rd": self.trans_rd,
+            "trans_weight": self.trans_weight,
+            "scalars": np.array([self.th, self.speed_scale, self.min_rd, self.build_time]),
+            "weight_rule": np.array(self.weight_rule),
+        }
+
+    @classmethod
+    def from_arrays(cls, arrays: dict[str, Any], clips: Sequence[Any], params: dict) -> Any:
+        th, speed, min_rd, build_time = (float(x) for x in np.asarray(arrays["scalars"]))
+        return cls(
+            clips=tuple(clips),
+            node_clip=np.asarray(arrays["node_clip"]),
+            node_frame=np.asarray(arrays["node_frame"]),
+            next_node=np.asarray(arrays["next_node"]),
+            intensity=np.asarray(arrays["intensity"]),
+            z_intensity=np.asarray(arrays["z_intensity"]),
+            trans_src=np.asarray(arrays["trans_src"]),
+            trans_dst=np.asarray(arrays["trans_dst"]),
+            trans_rd=np.asarray(arrays["trans_rd"]),
+            trans_weight=np.asarray(arrays["trans_weight"]),
+            th=th,
+            weight_rule=str(np.asarray(arrays["weight_rule"])),
+            speed_scale=speed,
+            min_rd=min_rd,
+            params=dict(params),
+            build_time=build_time,
+        )
+
+    def with_rule(self, weight_rule: str) -> WeightedMotionGraph:
+        """The same graph with transition weights recomputed under another eq. 2 rule."""
+        return WeightedMotionGraph(
+            clips=self.clips,
+            node_clip=self.node_clip,
+            node_frame=self.node_frame,
+            next_node=self.next_node,
+            intensity=self.intensity,
+            z_intensity=self.z_intensity,
+            trans_src=self.trans_src,
+            trans_dst=self.trans_dst,
+            trans_rd=self.trans_rd,
+            trans_weight=transition_weight(self.trans_rd, weight_rule),
+            th=self.th,
+            weight_rule=weight_rule,
+            speed_scale=self.speed_scale,
+            min_rd=self.min_rd,
+            params={**self.params, "weight_rule": weight_rule},
+            build_time=self.build_time,
+        )
+
+
+# --------------------------------------------------------------------------- checks
+
+
+def check_library(clips: Any) -> tuple:
+    """Validate a motion library: non-empty, BVH clips with one skeleton structure.
+
+    Raises
+    ------
+    ParameterError
+        Empty library, a clip without skeleton, or clips whose skeletons differ
+        (the message names both clips and the first differing joint).
+    """
+    if clips is None:
+        raise ParameterError("the motion library is empty: give at least one BVH clip")
+    clips = tuple(clips)
+    if len(clips) == 0:
+        raise ParameterError("the motion library is empty: give at least one BVH clip")
+    for c in clips:
+        if getattr(c, "skeleton", None) is None:
+            raise ParameterError(
+                f"clip {getattr(c, 'name', '?')!r} has no skeleton (marker data or a table); "
+                "a motion graph needs BVH clips with joint rotations"
+            )
+    ref = clips[0]
+    for c in clips[1:]:
+        if abs(float(c.fps) - float(ref.fps)) > 1e-9:
+            raise ParameterError(
+                f"clips {ref.name!r} ({ref.fps} fps) and {c.name!r} ({c.fps} fps) have "
+                "different frame rates; read them at one rate (--fps) or resample first"
+            )
+        if not ref.skeleton.same_structure(c.skeleton):
+            ja = ref.skeleton.joints
+            jb = c.skeleton.joints
+            what = f"{len(ja)} vs {len(jb)} joints"
+            for x, y in zip(ja, jb, strict=False):
+                if x.name != y.name or x.parent != y.parent or x.channels != y.channels:
+                    what = f"joint {x.name!r} vs {y.name!r}"
+                    break
+            raise ParameterError(
+                f"clips {ref.name!r} and {c.name!r} have different skeletons ({what}); "
+                "one motion graph needs clips of one skeleton: build separate libraries"
+            )
+    return clips
+
+
+def _check_th(th: Any) -> float:
+    try:
+        v = float(th)
+    except (TypeError, ValueError):
+        raise ParameterError(f"TH={th!r} must be a number > 0 (the paper uses 3.0)") from None
+    if not np.isfinite(v) or v <= 0:
+        raise ParameterError(
+            f"TH={th!r} must be a finite threshold > 0 on the scale-free distance rd "
+            "(the paper uses 3.0)"
+        )
+    return v
+
+
+def build_graph(
+    clips: Sequence[Any],
+    *,
+    th: float = 3.0,
+    weight_rule: str = "paper",
+    beats: Sequence[Any] | None = None,
+    beat_method: str = "speed",
+    smooth: float = 0.1,
+    min_interval: float = 0.2,
+    joints: Sequence[str] | None = None,
+    window: float = 0.2,
+    rd_unit: float = 0.1,
+    up_axis: str = "y",
+    require_transitions: bool = True,
+) -> WeightedMotionGraph:
+    """Build the weighted motion graph of a motion library (paper B, section 3.2).
+
+    Parameters
+    ----------
+    clips : sequence of Motion
+        BVH clips with the same skeleton structure.
+    th : float > 0
+        TH of eq. 1 on the scale-free distance ``rd`` (paper: 3.0).
+    weight_rule : {"paper", "rd"}
+        Eq. 2 as written (``max(rd, 2)``) or the plain ``rd``.
+    beats : sequence of array_like [s], optional
+        Beat times per clip; default kinematic beats (``beat_method``, ``smooth``,
+        ``min_interval``, see :func:`beatsync.motion_beats.kinematic_beats`).
+    joints : sequence of str, optional
+        Joints used for beats, intensities and distances; default all.
+    window : float > 0 [s]
+        Length of the frame window compared by eq. 1.
+    rd_unit : float > 0 [s]
+        Time unit of ``rd`` (see module docstring).
+    up_axis : {"y", "z"}
+        Vertical axis of the data (BVH: y).
+    require_transitions : bool
+        Raise if no pair of beat frames has ``rd < th``.
+
+    Returns
+    -------
+    WeightedMotionGraph
+
+    Raises
+    ------
+    ParameterError
+        Empty library, different skeletons, TH <= 0, no intervals, no transitions
+        (with the smallest ``rd`` found, to suggest a threshold).
+    """
+    t0 = time.perf_counter()
+    clips = check_library(clips)
+    th = _check_th(th)
+    if weight_rule not in WEIGHT_RULES:
+        raise ParameterError(f"weight_rule={weight_rule!r} is not one of {WEIGHT_RULES}")
+    if up_axis not in ("y", "z"):
+        raise ParameterError(f"up_axis={up_axis!r} must be 'y' (BVH) or 'z'")
+    up = "xyz".index(up_axis)
+    for name, val in (("window", window), ("rd_unit", rd_unit)):
+        try:
+            ok = np.isfinite(float(val)) and 0 < float(val) <= 10
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise ParameterError(f"{name}={val!r} must be a duration in (0, 10] [s]")
+    if beats is not None and len(beats) != len(clips):
+        raise ParameterError(
+            f"beats has {len(beats)} entries for {len(clips)} clips: give one array of beat "
+            "times [s] per clip"
+        )
+
+    positions = []
+    frames_list = []
+    for i, c in enumerate(clips):
+        pos = motion_positions(c, joints=joints)
+        positions.append(pos)
+        if beats is None:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", BeatsyncWarning)
+                fr = kinematic_beat_frames(
+                    pos, fps=c.fps, method=beat_method, smooth=smooth, min_interval=min_interval
+                )
+        else:
+            bt = check_times(beats[i], name=f"beats of clip {c.name!r}", duration=c.duration)
+            fr = np.unique(np.clip(time_to_frames(bt, fps=c.fps), 0, c.n_frames - 1))
+        if fr.size < 2:
+            warnings.warn(
+                f"clip {c.name!r} has {fr.size} beat(s): it contributes no interval",
+                BeatsyncWarning,
+                stacklevel=2,
+            )
+        frames_list.append(np.asarray(fr, dtype=np.int64))
+
+    node_clip = np.concatenate(
+        [np.full(f.size, i, dtype=np.int64) for i, f in enumerate(frames_list)]
+    )
+    node_frame = np.concatenate(frames_list)
+    n = node_frame.size
+    next_node = np.full(n, -1, dtype=np.int64)
+    intensity = np.full(n, np.nan)
+    start = 0
+    for i, fr in enumerate(frames_list):
+        if fr.size >= 2:
+            idx = np.arange(start, start + fr.size - 1)
+            next_node[idx] = idx + 1
+            intensity[idx] = interval_intensity(positions[i], fr, fps=clips[i].fps)
+        start += fr.size
+    ok = next_node >= 0
+    if not ok.any():
+        raise ParameterError(
+            "no clip of the library has two motion beats, so the graph has no interval; "
+            "use longer clips or a smaller min_interval"
+        )
+    z = np.full(n, np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        z[ok] = zscore(intensity[ok], name="motion intensity")
+
+    # eq. 1: scale-free distances between all pairs of beat frames
+    fps0 = [check_fps(c.fps) for c in clips]
+    half = max(1, int(round(window * fps0[0] / 2)))
+    speed = typical_speed(positions, fps0, half=half, up=up)
+    if not speed > 0:
+        raise ParameterError("the library does not move (zero typical speed): rd is undefined")
+    clouds = np.concatenate(
+        [_clouds(p, f, half) for p, f in zip(positions, frames_list, strict=True) if f.size]
+    )
+    src_l, dst_l, rd_l = [], [], []
+    min_rd = np.inf
+    chunk = max(1, int(2_000_000 // max(1, n)))
+    for s in range(0, n, chunk):
+        d = aligned_distance_matrix(clouds[s : s + chunk], clouds, up=up)
+        rd = d / (speed * float(rd_unit))
+        rows = np.arange(s, min(n, s + chunk))
+        rd[rows - s, rows] = np.inf
+        if rd.size:
+            min_rd = min(min_rd, float(rd.min()))
+        ii, jj = np.nonzero(rd < th)
+        src_l.append(ii + s)
+        dst_l.append(jj)
+        rd_l.append(rd[ii, jj])
+    trans_src = np.concatenate(src_l).astype(np.int64)
+    trans_dst = np.concatenate(dst_l).astype(np.int64)
+    trans_rd = np.concatenate(rd_l)
+    if require_transitions and trans_src.size == 0:
+        hint = (
+            f"the smallest rd between two beat frames is {min_rd:.3f}: try --th "
+            f"{max(min_rd * 1.5, min_rd + 0.5):.2f} or more"
+            if np.isfinite(min_rd)
+            else "the library has a single beat frame"
+        )
+        raise ParameterError(
+            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; "
+            + hint
+        )
+    params = {
+        "th": th,
+        "weight_rule": weight_rule,
+        "beat_method": beat_method,
+        "smooth": float(smooth),
+        "min_interval": float(min_interval),
+        "joints": list(joints) if joints is not None else None,
+        "window": float(window),
+        "rd_unit": float(rd_unit),
+        "up_axis": up_axis,
+        "given_beats": beats is not None,
+    }
+    return WeightedMotionGraph(
+        clips=clips,
+        node_clip=node_clip,
+        node_frame=node_frame,
+        next_node=next_node,
+        intensity=intensity,
+        z_intensity=z,
+        trans_src=trans_src,
+        trans_dst=trans_dst,
+        trans_rd=trans_rd,
+        trans_weight=transition_weight(trans_rd, weight_rule),
+        th=th,
+        weight_rule=weight_rule,
+        speed_scale=speed,
+        min_rd=float(min_rd),
+        params=params,
+        build_time=time.perf_counter() - t0,
+    )

@@ -1,0 +1,326 @@
+"""Synthesis of a composed dance from a graph path (paper B, section 3.5).
+
+Every chosen interval (from beat frame ``f_k`` to the next beat frame of its clip) is
+time-warped linearly onto its music beat interval ``[b_k, b_{k+1}]``, so each motion
+beat lands exactly on its music beat: source time
+``s(t) = f_k / fps + (t - b_k) / (b_{k+1} - b_k) * (f_{k+1} - f_k) / fps``.
+Output frames are sampled from the source clips with
+:func:`beatsync.rotations.sample_motion` (slerp on rotations).
+
+Runs of intervals that follow each other in one clip are played as they were
+captured. At a transition (from beat frame ``a`` of one clip to beat frame ``m`` of
+another, or of the same clip) the new run is placed with the rigid floor-plane
+transform (rotation about the vertical axis, translation on the floor) that puts its
+root at ``m`` where the previous run's root is at ``a``, with the same heading, so the
+dancer does not jump (Kovar et al. 2002). Over the first ``blend`` seconds (about
+1/3 s) after the transition the old run, continued past ``a`` at the new interval's
+rate, is blended into the new one with smooth-step weights
+(:func:`beatsync.rotations.blend_values`: slerp on rotations, linear on positions).
+At the beat itself the pose is the old run's beat frame, a beat frame.
+
+Before the first music beat the first interval's warp is extended backwards (the
+source clip's lead-in, held at its first frame), and after the last beat the last
+interval's warp continues until ``end_time``.
+
+Data contract: music beats in seconds, strictly increasing; the result is a
+:class:`beatsync.motion.Motion` with the library's skeleton at ``fps`` [Hz]; frame
+``j`` plays at ``j / fps`` seconds of the music.
+
+Notebook: ``notebooks/tab02_quality_proxies.ipynb``; paper B section 3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import ParameterError
+from ..motion import Motion
+from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
+from ..units import check_fps, check_times
+from .build import WeightedMotionGraph, _ground_axes
+
+__all__ = ["SynthesisResult", "synthesize", "beat_warp", "smoothstep"]
+
+
+@dataclass(frozen=True, eq=False)
+class SynthesisResult:
+    """A composed motion and where each output frame came from.
+
+    Attributes
+    ----------
+    motion : Motion
+    source_clip : np.ndarray [shape=(n_frames,)] int
+        Clip index of the run each output frame belongs to.
+    source_time : np.ndarray [shape=(n_frames,)] [s]
+        Time in that clip.
+    transition_times : np.ndarray [s]
+        Music beats at which a transition starts (blend from there for ``blend`` s).
+    beat_source_times : np.ndarray [shape=(K+1,)] [s]
+        Source time the warp assigns to every music beat (a beat frame time).
+    info : dict
+    """
+
+    motion: Motion
+    source_clip: np.ndarray
+    source_time: np.ndarray
+    transition_times: np.ndarray
+    beat_source_times: np.ndarray
+    info: dict = field(default_factory=dict)
+
+
+def smoothstep(x: np.ndarray) -> np.ndarray:
+    """``3 x^2 - 2 x^3`` on ``[0, 1]`` (zero slope at both ends)."""
+    x = np.clip(np.asarray(x, dtype=np.float64), 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def beat_warp(
+    music_beats: np.ndarray, src_start: np.ndarray, src_end: np.ndarray, times: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Piecewise-linear warp from music time to source time.
+
+    Parameters
+    ----------
+    music_beats : np.ndarray [shape=(K+1,)] [s]
+    src_start, src_end : np.ndarray [shape=(K,)] [s]
+        Source times of the beat frames that start and end each interval.
+    times : np.ndarray [s]
+        Music times to map.
+
+    Returns
+    -------
+    (k, s) : interval index of each time (clipped to 0..K-1) and its source time [s].
+        ``s(b_k) = src_start[k]`` exactly; ``s(b_{k+1}) -> src_end[k]``.
+    """
+    k_n = src_start.size
+    k = np.clip(np.searchsorted(music_beats, times, side="right") - 1, 0, k_n - 1)
+    rate = (src_end - src_start) / np.diff(music_beats)
+    s = src_start[k] + (times - music_beats[k]) * rate[k]
+    return k, s
+
+
+def _root_layout(template: Motion, up: int) -> tuple[list[int], tuple[int, int, int], str]:
+    skel = template.skeleton
+    root = skel.joints[0].name
+    pos_cols = []
+    for ax in "XYZ":
+        name = f"{root}_{ax}position"
+        if name not in template.channels:
+            raise ParameterError(
+                f"the root joint {root!r} has no {ax}position channel: cannot place the "
+                "dancer on the floor"
+            )
+        pos_cols.append(template.channel_index(name))
+    for joint, idx, order in template.rotation_triples():
+        if joint == root:
+            return pos_cols, idx, order
+    raise ParameterError(f"the root joint {root!r} has no rotation triple")
+
+
+def _heading(rot: Rotation, up: int) -> np.ndarray:
+    """Heading angle [rad] about the up axis of the root's local forward axis."""
+    g0, g1 = _ground_axes(up)
+    fwd = np.zeros(3)
+    fwd[g0] = 1.0  # local axis lying on the floor in the rest pose (z for y-up)
+    v = rot.apply(fwd)
+    return np.arctan2(v[..., g1], v[..., g0])
+
+
+def synthesize(
+    graph: WeightedMotionGraph,
+    path: Any,
+    music_beats: Any,
+    *,
+    fps: float | None = None,
+    blend: float = 1.0 / 3.0,
+    start_time: float = 0.0,
+    end_time: float | None = None,
+    warp: str = "pchip",
+) -> SynthesisResult:
+    """Concatenate, warp and blend the chosen intervals into one motion.
+
+    Parameters
+    ----------
+    graph : WeightedMotionGraph
+    path : array_like [shape=(K,)] int
+        Interval nodes (from a search) for the ``K = len(music_beats) - 1`` intervals.
+    music_beats : array_like [shape=(K+1,)] [s]
+    fps : float > 0 [Hz], optional
+        Output frame rate; default the library's.
+    blend : float >= 0 [s]
+        Transition blend length (capped at the interval's duration).
+    start_time, end_time : float [s]
+        Span of the output (default from 0 to the last music beat).
+    warp : {"pchip", "linear"}
+        Time warp inside a run of consecutive intervals: piecewise linear (the rate
+        jumps at every beat) or a monotone cubic (PCHIP) through the same beat
+        correspondences (continuous rate). Both put every motion beat exactly on its
+        music beat.
+
+    Returns
+    -------
+    SynthesisResult
+    """
+    beats = check_times(music_beats, name="music beats")
+    path = np.asarray(path, dtype=np.int64)
+    if beats.size < 2:
+        raise ParameterError("the music has fewer than two beats: nothing to compose")
+    if path.shape != (beats.size - 1,):
+        raise ParameterError(
+            f"path has {path.size} nodes for {beats.size - 1} music intervals "
+            "(one node per interval between successive beats)"
+        )
+    if np.any(path < 0) or np.any(path >= graph.n_nodes) or not graph.is_interval[path].all():
+        raise ParameterError("path contains nodes that do not start an interval")
+    template = graph.clips[0]
+    fps = check_fps(template.fps if fps is None else fps)
+    blend = float(blend)
+    if not np.isfinite(blend) or blend < 0 or blend > 5:
+        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
+    end_time = float(beats[-1]) if end_time is None else float(end_time)
+    if not end_time > start_time >= 0:
+        raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    up = "xyz".index(graph.params.get("up_axis", "y"))
+    g0, g1 = _ground_axes(up)
+    pos_cols, rot_cols, order = _root_layout(template, up)
+    rot_cols = list(rot_cols)
+
+    k_n = path.size
+    nfps = np.array([c.fps for c in graph.clips])
+    clip_of = graph.node_clip[path]
+    src_start = graph.node_frame[path] / nfps[clip_of]
+    nxt = graph.next_node[path]
+    src_end = graph.node_frame[nxt] / nfps[clip_of]
+    trans = np.zeros(k_n, dtype=bool)
+    trans[1:] = graph.next_node[path[:-1]] != path[1:]
+    run_id = np.cumsum(trans)
+
+    j0 = int(np.ceil(start_time * fps - 1e-9))
+    j1 = int(np.floor(end_time * fps + 1e-9))
+    t = np.arange(j0, j1 + 1) / fps
+    if warp not in ("pchip", "linear"):
+        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
+    k_of, s_of = beat_warp(beats, src_start, src_end, t)
+    run_of = run_id[k_of]
+    if warp == "pchip":
+        s_of = _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_of)
+    n_out = t.size
+    values = np.empty((n_out, template.n_channels))
+
+    # rigid floor transforms per run: yaw angle and ground translation
+    n_runs = int(run_id[-1]) + 1
+    yaw = np.zeros(n_runs)
+    shift = np.zeros((n_runs, 3))
+    run_first_k = np.flatnonzero(np.concatenate([[True], trans[1:]]))
+
+    def raw_root(clip: int, s: float) -> tuple[np.ndarray, Rotation]:
+        v = sample_motion(graph.clips[clip], np.array([s]))[0]
+        return v[pos_cols], euler_to_rotation(v[rot_cols][None, :], order)
+
+    def place(r: int, p: np.ndarray) -> np.ndarray:
+        rot = Rotation.from_rotvec(yaw[r] * _unit(up))
+        out = rot.apply(p)
+        out[..., g0] += shift[r, g0]
+        out[..., g1] += shift[r, g1]
+        return out
+
+    for r in range(1, n_runs):
+        k = run_first_k[r]
+        # previous run ends on beat frame a (= next_node[path[k-1]]) of its clip
+        a = graph.next_node[path[k - 1]]
+        ca = graph.node_clip[a]
+        pa, ra = raw_root(ca, graph.node_frame[a] / nfps[ca])
+        pb, rb = raw_root(clip_of[k], src_start[k])
+        ha = _heading(Rotation.from_rotvec(yaw[r - 1] * _unit(up)) * ra, up)[0]
+        hb = _heading(rb, up)[0]
+        yaw[r] = ha - hb
+        target = place(r - 1, pa)
+        moved = Rotation.from_rotvec(yaw[r] * _unit(up)).apply(pb)
+        shift[r] = 0.0
+        shift[r, g0] = target[g0] - moved[g0]
+        shift[r, g1] = target[g1] - moved[g1]
+
+    def transformed(r: int, clip: int, s: np.ndarray) -> np.ndarray:
+        v = sample_motion(graph.clips[clip], s)
+        if r == 0 and yaw[0] == 0.0:
+            return v
+        v = v.copy()
+        v[:, pos_cols] = place(r, v[:, pos_cols])
+        rot = Rotation.from_rotvec(yaw[r] * _unit(up)) * euler_to_rotation(v[:, rot_cols], order)
+        v[:, rot_cols] = rotation_to_euler(rot, order, reference=v[:, rot_cols])
+        return v
+
+    for r in range(n_runs):
+        sel = run_of == r
+        if sel.any():
+            k = run_first_k[r]
+            values[sel] = transformed(r, int(clip_of[k]), s_of[sel])
+
+    # blends after every transition
+    trans_times = beats[:-1][trans]
+    for k in np.flatnonzero(trans):
+        r = run_id[k]
+        length = min(blend, beats[k + 1] - beats[k])
+        if length <= 0:
+            continue
+        sel = (t >= beats[k]) & (t < beats[k] + length)
+        if not sel.any():
+            continue
+        a = graph.next_node[path[k - 1]]
+        ca = int(graph.node_clip[a])
+        rate = (src_end[k] - src_start[k]) / (beats[k + 1] - beats[k])
+        s_old = graph.node_frame[a] / nfps[ca] + (t[sel] - beats[k]) * rate
+        old = transformed(r - 1, ca, s_old)
+        w = smoothstep((t[sel] - beats[k]) / length)
+        values[sel] = blend_values(template, old, values[sel], w)
+
+    # continuous Euler curves in the output file
+    for _joint, idx, _order in template.rotation_triples():
+        cols = list(idx)
+        values[:, cols] = np.unwrap(values[:, cols], period=360.0, axis=0)
+
+    motion = Motion(
+        values=values,
+        fps=fps,
+        channels=template.channels,
+        skeleton=template.skeleton,
+        name="composed",
+    )
+    beat_src = np.concatenate([src_start, src_end[-1:]])
+    return SynthesisResult(
+        motion=motion,
+        source_clip=clip_of[k_of],
+        source_time=s_of,
+        transition_times=trans_times,
+        beat_source_times=beat_src,
+        info={"n_runs": n_runs, "start_frame": j0, "blend_s": blend},
+    )
+
+
+def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
+    """Monotone cubic warp through the beat correspondences of each run."""
+    from scipy.interpolate import PchipInterpolator
+
+    s = s_lin.copy()
+    k_n = src_start.size
+    for r in np.unique(run_id):
+        ks = np.flatnonzero(run_id == r)
+        if ks.size < 2:
+            continue
+        x = beats[ks[0] : ks[-1] + 2]
+        y = np.concatenate([src_start[ks], src_end[ks[-1:]]])
+        inside = (run_id[k_of] == r) & (t >= x[0]) & (t <= x[-1])
+        if ks[-1] == k_n - 1:
+            inside &= t <= x[-1]
+        s[inside] = PchipInterpolator(x, y)(t[inside])
+    return s
+
+
+def _unit(up: int) -> np.ndarray:
+    v = np.zeros(3)
+    v[up] = 1.0
+    return v
