@@ -33,10 +33,15 @@ Method (what the paper leaves open, and our choices)
    ``w_i(t) = exp(-(t - c_i)^2 / (2 delta^2))``, ``c_i`` the centre of period ``i``
    in source time and ``delta`` the mean motion period (default).
 4. The blended rate alone does not make boundaries land on beats (it smears each
-   period's rate into its neighbours). We correct each period by a bump that
-   vanishes at both of its ends, ``r~(t) = r(t) (1 + a_i sin^2(pi u))``, ``u`` the
-   phase in the period, with ``a_i`` chosen so that the integral over the period
-   equals ``B_{i+1} - B_i`` exactly. The rate stays continuous across boundaries
+   period's rate into its neighbours; with ``delta`` = one period the blend is
+   nearly the running mean). We correct each period by a bump ``h(u)`` that
+   vanishes at both of its ends, ``r~(t) = r(t) (1 + a_i h(u))``, ``u`` the phase in
+   the period, with ``a_i`` chosen so that the integral over the period equals
+   ``B_{i+1} - B_i`` exactly. ``h`` is a plateau with raised-cosine ramps over a
+   quarter period at each end (a Tukey window): inside a period the rate then
+   approaches that period's own ``r_i``, and it passes smoothly through the blended
+   eq. 9 value at every boundary. (A ``sin^2`` bump would need twice the
+   amplitude and overshoot ``r_i``.) The rate stays continuous across boundaries
    (if a correction would need ``a_i <= -0.9`` we fall back to scaling the period's
    rate, which makes the rate jump there; the report counts these).
 5. The warp ``tau(t)`` integrates ``r~`` (trapezoid on a fine grid whose knots
@@ -78,8 +83,18 @@ __all__ = [
 
 #: knots of the warp grid inside each period
 _GRID_PER_PERIOD = 128
+#: fraction of a period over which the correction ramps in (and out) at each end
+_TAPER = 0.25
 #: below this bump amplitude the correction would make the rate near zero: scale instead
 _MIN_BUMP = -0.9
+
+
+def _bump(u: np.ndarray, taper: float | None = None) -> np.ndarray:
+    """Correction shape on the period phase ``u`` in [0, 1]: 0 at both ends, 1 in the
+    middle, with raised-cosine ramps over ``taper`` of the period at each end."""
+    taper = _TAPER if taper is None else taper
+    ramp = np.minimum(u, 1.0 - u) / taper
+    return np.where(ramp >= 1.0, 1.0, np.sin(0.5 * np.pi * np.clip(ramp, 0.0, 1.0)) ** 2)
 
 
 def beats_per_period(
@@ -292,8 +307,8 @@ def time_warp(
     rates = tgt_len / src_len
     centres = 0.5 * (s[:-1] + s[1:])
     r = blended_rate(grid.ravel(), centres, rates, delta=delta).reshape(p, k + 1)
-    # exact landing: r~ = r (1 + a_i h), h = sin^2(pi u) vanishes at both ends
-    h = np.sin(np.pi * u) ** 2
+    # exact landing: r~ = r (1 + a_i h), h vanishes at both ends
+    h = _bump(u)
     dt = src_len[:, None] * np.diff(u)[None, :]
     integ = ((r[:, :-1] + r[:, 1:]) * 0.5 * dt).sum(axis=1)
     rh = r * h[None, :]
