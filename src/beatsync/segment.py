@@ -1,0 +1,960 @@
+"""Optimal temporal segmentation of periodic motion into its periods (paper A, sec. 3).
+
+Panagiotakis, Holzapfel, Michel, Argyros, "Beat synchronous dance animation based on
+visual analysis of human motion and audio analysis of music tempo", section 3.
+Notebook: ``notebooks/fig02_segmentation.ipynb`` (Figure 2 and boundary-error table).
+
+Data contract
+-------------
+- Input: motion values ``(n_frames, n_channels)``, time first, at ``fps > 0`` [Hz];
+  rotation channels in degrees (they are unwrapped across +-180 deg before analysis).
+- Output: :class:`Segmentation` whose ``boundaries`` are ``n_periods + 1`` strictly
+  increasing times [s]; the first is 0 (first frame) and the last is
+  ``(n_frames - 1) / fps`` (last frame): the periods tile the clip, as in the paper.
+  Frames are used only inside this module; conversion goes through
+  :func:`beatsync.units.frames_to_time`.
+
+The method
+----------
+A segmentation ``T_p = (t_0 = 0 < t_1 < ... < t_p = n-1)`` (frames) splits the signal
+into periods ``S_i = X[t_i .. t_{i+1}]`` (both ends included, ``t_{i+1} - t_i`` frames
+long). Its energy (eqs. 1-2) is
+
+    E(T_p) = sum_{i=1}^{p-1} sum_c  1 - r( S_{i-1,c}, resample(S_{i,c}, len(S_{i-1})) )
+
+with ``r`` the Pearson correlation and ``resample`` linear interpolation of the later
+period onto the earlier one's samples (end points aligned). Every period length must
+stay inside the alpha band around the nominal period ``L = (n-1)/p`` (eq. 3):
+``(1-alpha) L <= t_{i+1} - t_i <= (1+alpha) L``. The globally optimal ``T_p``
+(eqs. 4-5) is a shortest path in a forward DAG whose nodes are consecutive boundary
+pairs ``(t_{i-1}, t_i)``, with a virtual end node joined to every pair ending at the
+last frame; the DAG is solved by dynamic programming in frame order (no heap).
+Because the graph has no period index, the optimum may use a period count within
+the band other than ``p``; :attr:`Segmentation.n_periods` reports the count found.
+
+Edge costs dominate the time. They are computed for all ``(middle boundary, earlier
+length, later length)`` at once: every sum in a Pearson correlation (sum of A, of A^2,
+of resampled B, of its square, and of A * B) is a fixed linear combination of
+lagged products ``X[s] X[s + l]`` in a window around the middle boundary, so each is
+one matrix product of windowed products with a constant kernel (see
+:func:`_edge_costs`). :func:`_segment_literal` is the direct loop implementation of
+the same equations, kept as the reference for tests and the benchmark.
+
+Documented rules (choices the paper leaves open)
+------------------------------------------------
+- Near-constant channels (Pearson undefined): a channel is excluded when its standard
+  deviation over the clip is at most ``CONSTANT_REL_STD`` (1e-3) times the largest
+  standard deviation among the selected channels, or at most 1e-9. Inside a kept
+  channel, a period whose own variance is below 1e-6 of the channel's variance is
+  treated as flat: its correlation is ~0 (cost ~1).
+- Periodicity: the optimum's normalised energy ``e = E / (n_channels * (p - 1))`` is
+  the mean Pearson distance between consecutive periods. A clip with
+  ``e > MAX_NORMALISED_ENERGY`` (0.5, i.e. mean correlation below 0.5) is refused as
+  not periodic. Calibration (notebook fig02): walking, salsa and MoCap Toolbox dance
+  clips give e <= ~0.2; the CMU 005_02 pirouette gives e >= ~0.7.
+- Default channels: rotation channels of the main limb and spine joints (see
+  :func:`select_channels`), or every ``*_angle`` channel for marker-derived angles.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from .errors import BeatsyncWarning, ParameterError
+from .units import check_finite, check_fps, check_range, frames_to_time
+
+if TYPE_CHECKING:
+    from .motion import Motion
+
+__all__ = [
+    "Segmentation",
+    "segment",
+    "segment_values",
+    "estimate_period_count",
+    "select_channels",
+    "segmentation_energy",
+    "CONSTANT_REL_STD",
+    "MAX_NORMALISED_ENERGY",
+    "MIN_PERIODICITY_CONTRAST",
+    "periodicity_contrast",
+]
+
+CONSTANT_REL_STD = 1e-3
+"""A channel with std <= this times the largest selected std is excluded as constant."""
+
+MAX_NORMALISED_ENERGY = 1.0
+"""Not periodic if E / (channels * (periods - 1)) (mean Pearson distance) reaches this."""
+
+MIN_PERIODICITY_CONTRAST = 0.05
+"""Not periodic if the optimum beats off-period uniform segmentations by less than this."""
+
+_OFF_PERIOD_FACTORS = (0.5, 0.75, 1.25, 1.5)
+
+_FLAT_REL_VAR = 1e-6  # period variance floor, relative to the channel's variance
+_PERIOD_METHODS = ("energy", "fft", "given")
+_MAX_COUNT_CANDIDATES = 400  # period counts tried by the "energy" method (log-spaced)
+_CHUNK_ELEMENTS = 1e5  # window-matrix elements per block of middle boundaries (cache size)
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """Result of :func:`segment`.
+
+    Attributes
+    ----------
+    boundaries : np.ndarray [s]
+        ``n_periods + 1`` strictly increasing times: start of the first period ... end
+        of the last (first frame ... last frame).
+    n_periods : int
+    mean_period : float [s]
+    energy : float
+        E of the optimum (sum over consecutive period pairs and channels of 1 - r).
+    channels : tuple of str
+        Channels used (after selection and constant-channel exclusion).
+    fps : float [Hz]
+    period_method : str
+        ``"energy"``, ``"fft"`` or ``"given"``.
+    """
+
+    boundaries: np.ndarray
+    n_periods: int
+    mean_period: float
+    energy: float
+    channels: tuple[str, ...]
+    fps: float
+    period_method: str
+
+    @property
+    def boundary_frames(self) -> np.ndarray:
+        """Boundaries as frame indices (int64)."""
+        from .units import time_to_frames
+
+        return time_to_frames(self.boundaries, fps=self.fps)
+
+    @property
+    def periods(self) -> np.ndarray:
+        """Period durations [s]."""
+        return np.diff(self.boundaries)
+
+    @property
+    def normalised_energy(self) -> float:
+        """Mean Pearson distance between consecutive periods, E / (channels * (p-1))."""
+        return float(self.energy / (len(self.channels) * max(self.n_periods - 1, 1)))
+
+
+# --------------------------------------------------------------------------- channels
+
+# Joint-name keywords (lower case, side prefixes and CC_Base_ removed) of the main
+# limb and spine joints, for CMU (hip abdomen chest neck rShldr rForeArm rThigh rShin
+# rFoot ...), iClone CC_Base (Spine01, Waist, L_Upperarm, L_Forearm, L_Thigh, L_Calf,
+# L_Foot ...) and Mixamo-like (Spine, LeftArm, LeftUpLeg, LeftLeg ...) rigs.
+_LIMB_SPINE = (
+    "abdomen", "chest", "neck", "spine", "waist", "pelvis",
+    "shldr", "shoulder", "upperarm", "arm", "forearm", "elbow",
+    "thigh", "upleg", "leg", "shin", "calf", "knee", "foot", "ankle",
+)  # fmt: skip
+# Never default: twist/helper bones, extremities, face, and the root/hip (its rotation
+# is the body's global orientation, not a joint angle).
+_EXCLUDE = ("twist", "share", "toe", "hand", "finger", "thumb", "index", "mid", "ring",
+            "pinky", "eye", "jaw", "head", "collar", "clavicle", "breast", "rib",
+            "buttock", "root", "end")  # fmt: skip
+_ROOT_NAMES = ("hip", "hips", "cc_base_hip", "rl_boneroot", "root")
+
+
+def _joint_key(joint: str) -> str:
+    key = joint.lower()
+    key = re.sub(r"^(cc_base_|mixamorig:?|rl_)", "", key)
+    key = re.sub(r"^(l_|r_|left_?|right_?|l(?=[a-z])|r(?=[a-z]))", "", key)
+    return key.replace("_", "")
+
+
+def _is_default_channel(name: str) -> bool:
+    if name.endswith("_angle"):
+        return True
+    joint, sep, dof = name.rpartition("_")
+    if not sep or not dof.lower().endswith("rotation"):
+        return False
+    if joint.lower() in _ROOT_NAMES:
+        return False
+    key = _joint_key(joint)
+    if any(x in key for x in _EXCLUDE):
+        return False
+    return any(key == k or key.endswith(k) for k in _LIMB_SPINE)
+
+
+def select_channels(
+    names: Sequence[str], channels: str | Sequence[str] = "default"
+) -> tuple[str, ...]:
+    """Choose the channels the segmentation uses.
+
+    Parameters
+    ----------
+    names : sequence of str
+        All channel names, e.g. ``Motion.channels`` (``"rShin_Xrotation"``,
+        ``"CC_Base_L_Calf_Zrotation"``, ``"knee_L_angle"``).
+    channels : "default", "all" or sequence of str
+        ``"default"``: rotation channels of the main limb and spine joints (CMU:
+        abdomen chest neck rShldr rForeArm lShldr lForeArm rThigh rShin rFoot lThigh
+        lShin lFoot; iClone: CC_Base_Waist/Spine01/Spine02/*_Upperarm/*_Forearm/
+        *_Thigh/*_Calf/*_Foot; no twist bones, hands, toes, face, nor the root's
+        global orientation), plus every ``*_angle`` channel (marker-derived angles).
+        If nothing matches, all channels are used with a :class:`BeatsyncWarning`.
+        ``"all"``: every channel (constant ones are dropped later). A sequence: exactly
+        those names.
+
+    Returns
+    -------
+    tuple of str
+
+    Raises
+    ------
+    ParameterError
+        Unknown channel names or an empty selection.
+
+    Examples
+    --------
+    >>> select_channels(["hip_Xposition", "hip_Zrotation", "rShin_Xrotation", "rHand_Xrotation"])
+    ('rShin_Xrotation',)
+    """
+    names = tuple(str(n) for n in names)
+    if isinstance(channels, str):
+        if channels == "all":
+            return names
+        if channels != "default":
+            if channels in names:
+                return (channels,)
+            raise ParameterError(
+                f"channels={channels!r}: use 'default', 'all' or a list of channel names "
+                f"(e.g. {list(names[:3])})"
+            )
+        chosen = tuple(n for n in names if _is_default_channel(n))
+        if not chosen:
+            warnings.warn(
+                "no limb/spine rotation or *_angle channel found among "
+                f"{list(names[:4])}...; using all channels",
+                BeatsyncWarning,
+                stacklevel=3,
+            )
+            return names
+        return chosen
+    chosen = tuple(str(c) for c in channels)
+    missing = [c for c in chosen if c not in names]
+    if missing:
+        raise ParameterError(
+            f"channel(s) {missing[:5]} not found; channels look like {list(names[:4])}"
+        )
+    if not chosen:
+        raise ParameterError("channels is an empty list; give at least one channel name")
+    return chosen
+
+
+def _nonconstant(values: np.ndarray) -> np.ndarray:
+    """Boolean mask of channels kept by the documented near-constant rule."""
+    std = values.std(axis=0)
+    top = std.max() if std.size else 0.0
+    return (std > CONSTANT_REL_STD * top) & (std > 1e-9)
+
+
+def _standardise(values: np.ndarray) -> np.ndarray:
+    """Per-channel z-score, returned channel-first ``(C, n)`` (r is invariant to it)."""
+    x = values - values.mean(axis=0)
+    x = x / x.std(axis=0)
+    return np.ascontiguousarray(x.T)
+
+
+# ------------------------------------------------------------------ Pearson distances
+
+
+def _resample_weights(d0: int, d1: int) -> tuple[np.ndarray, np.ndarray]:
+    """Linear resampling of ``d1 + 1`` samples onto ``d0 + 1`` (end points aligned).
+
+    Output sample ``k`` (0..d0) is ``(1 - w_k) B[j_k] + w_k B[j_k + 1]`` with
+    ``j_k + w_k = k d1 / d0`` (exact integer arithmetic).
+    """
+    k = np.arange(d0 + 1)
+    j = (k * d1) // d0
+    w = (k * d1 - j * d0) / d0
+    last = j >= d1
+    j = np.where(last, d1 - 1, j)
+    w = np.where(last, 1.0, w)
+    return j, w
+
+
+def _pair_costs(x: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Pearson distance, summed over channels, for arbitrary boundary triples.
+
+    Parameters
+    ----------
+    x : np.ndarray [shape=(C, n)], standardised channels
+    a, b, c : np.ndarray [frames], int
+        Triples ``a < b < c``: earlier period ``x[a..b]``, later period ``x[b..c]``.
+
+    Returns
+    -------
+    np.ndarray [shape=(len(a),)]
+        ``sum_c 1 - r_c``.
+    """
+    a, b, c = (np.asarray(v, dtype=np.int64) for v in (a, b, c))
+    out = np.empty(a.size)
+    d0_all, d1_all = b - a, c - b
+    n_ch = x.shape[0]
+    # group by earlier length so the sample grid is rectangular
+    for d0 in np.unique(d0_all):
+        sel = np.nonzero(d0_all == d0)[0]
+        for start in range(0, sel.size, 4096):
+            s = sel[start : start + 4096]
+            k = np.arange(d0 + 1)
+            d1 = d1_all[s][:, None]
+            j = (k[None, :] * d1) // d0
+            w = (k[None, :] * d1 - j * d0) / d0
+            last = j >= d1
+            j = np.where(last, d1 - 1, j)
+            w = np.where(last, 1.0, w)
+            pos = b[s][:, None] + j
+            A = x[:, a[s][:, None] + k[None, :]]  # (C, T, d0+1)
+            B = x[:, pos] * (1 - w) + x[:, pos + 1] * w
+            out[s] = n_ch - _pearson(A, B).sum(axis=0)
+    return out
+
+
+def _pearson(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Pearson r along the last axis with the flat-period floor."""
+    m = A.shape[-1]
+    A = A - A.mean(axis=-1, keepdims=True)
+    B = B - B.mean(axis=-1, keepdims=True)
+    floor = _FLAT_REL_VAR * m
+    num = np.sum(A * B, axis=-1)
+    return num / np.sqrt((np.sum(A * A, axis=-1) + floor) * (np.sum(B * B, axis=-1) + floor))
+
+
+@lru_cache(maxsize=32)
+def _kernels(lo: int, hi: int) -> tuple[Any, ...]:
+    """Constant kernels turning windowed lagged products into the Pearson sums.
+
+    For middle boundary ``b``, earlier length ``d0`` and later length ``d1`` (combo
+    ``q = (d0-lo)*band + (d1-lo)``), the resampled later period is
+    ``B_k = (1-w_k) X[b+j_k] + w_k X[b+j_k+1]``. Then
+
+    - ``sum_k B_k = sum_m U[m, q] X[b+m]``,
+    - ``sum_k B_k^2 = sum_m G0[m, q] X[b+m]^2 + G1[m, q] X[b+m] X[b+m+1]``,
+    - ``sum_k A_k B_k = sum_l sum_s H_l[s, q] X[b+s] X[b+s+l]`` with ``A_k = X[b-d0+k]``.
+    """
+    band = hi - lo + 1
+    nq = band * band
+    width_b = hi + 1  # offsets m = 0..hi (j+1 <= d1 <= hi)
+    U = np.zeros((width_b, nq))
+    G0 = np.zeros((width_b, nq))
+    G1 = np.zeros((width_b, nq))
+    # lag l = d0 + j - k (or +1): within [lo, hi] wherever the weight is non-zero;
+    # zero-weight end terms may touch lo-1 or hi+1, so those slots exist (and stay 0)
+    lags = np.arange(lo - 1, hi + 2)
+    H = np.zeros((lags.size, hi + 1, nq))  # offset s = -hi..0 -> row s + hi
+    for i0, d0 in enumerate(range(lo, hi + 1)):
+        for i1, d1 in enumerate(range(lo, hi + 1)):
+            q = i0 * band + i1
+            j, w = _resample_weights(d0, d1)
+            k = np.arange(d0 + 1)
+            np.add.at(U[:, q], j, 1 - w)
+            np.add.at(U[:, q], j + 1, w)
+            np.add.at(G0[:, q], j, (1 - w) ** 2)
+            np.add.at(G0[:, q], j + 1, w**2)
+            np.add.at(G1[:, q], j, 2 * w * (1 - w))
+            s = k - d0 + hi
+            np.add.at(H, (d0 + j - k - lo + 1, s, np.full_like(k, q)), 1 - w)
+            np.add.at(H, (d0 + j + 1 - k - lo + 1, s, np.full_like(k, q)), w)
+    # keep only the rows each lag uses, stacked into one kernel for a single product
+    rows = [np.nonzero(np.any(H[i] != 0, axis=1))[0] for i in range(lags.size)]
+    used = [i for i in range(lags.size) if rows[i].size]
+    H_stack = np.concatenate([H[i][rows[i]] for i in used], axis=0)
+    spans = [(int(lags[i]), int(rows[i][0]) - hi, int(rows[i][-1]) - hi) for i in used]
+    for (_lag, s0, s1), i in zip(spans, used, strict=False):
+        assert rows[i].size == s1 - s0 + 1, "lag rows must be contiguous"
+    return U, np.concatenate([G0, G1], axis=0), H_stack, spans
+
+
+def _edge_costs(x: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """All DAG edge costs, vectorised: ``cost[b, i0, i1]`` (inf where invalid).
+
+    ``b`` is the middle boundary [frames], the earlier period ``x[b-d0 .. b]`` has
+    ``d0 = lo + i0`` frames and the later ``x[b .. b+d1]`` has ``d1 = lo + i1``.
+    """
+    n_ch, n = x.shape
+    band = hi - lo + 1
+    U, G, H, spans = _kernels(lo, hi)
+    pad = hi + 2
+    xp = np.zeros((n_ch, n + 2 * pad))
+    xp[:, pad : pad + n] = x
+    q0 = xp * xp
+    q1 = np.zeros_like(xp)
+    q1[:, :-1] = xp[:, :-1] * xp[:, 1:]
+    lagged = {}
+    for lag, _, _ in spans:
+        q = np.zeros_like(xp)
+        q[:, :-lag] = xp[:, :-lag] * xp[:, lag:]
+        lagged[lag] = q
+    cs = np.concatenate([np.zeros((n_ch, 1)), np.cumsum(x, axis=1)], axis=1)
+    cs2 = np.concatenate([np.zeros((n_ch, 1)), np.cumsum(x * x, axis=1)], axis=1)
+    d0s = np.arange(lo, hi + 1)
+    n0 = (d0s + 1.0)[:, None]  # samples per (resampled) period, by earlier length
+    floor = _FLAT_REL_VAR * n0
+    cost = np.full((n, band, band), np.inf)
+    b_all = np.arange(lo, n - lo)  # middle boundaries that can have both neighbours
+    width = U.shape[0] + G.shape[0] + H.shape[0]
+    chunk = max(16, int(_CHUNK_ELEMENTS // (n_ch * width)))
+    for start in range(0, b_all.size, chunk):
+        b = b_all[start : start + chunk]
+        m = b.size
+        o = pad + b[0]  # padded index of the first middle boundary
+
+        wb = hi + 1
+
+        def win(sig: np.ndarray, off0: int, length: int, o: int = o, m: int = m) -> np.ndarray:
+            v = sliding_window_view(sig[:, o + off0 : o + off0 + m + length - 1], length, axis=1)
+            return v.reshape(n_ch * m, length)
+
+        sb = win(xp, 0, wb) @ U
+        sbb = np.concatenate([win(q0, 0, wb), win(q1, 0, wb)], axis=1) @ G
+        sab = np.concatenate([win(lagged[lag], s0, s1 - s0 + 1) for lag, s0, s1 in spans], 1) @ H
+        sb = sb.reshape(n_ch, m, band, band)
+        sbb = sbb.reshape(n_ch, m, band, band)
+        sab = sab.reshape(n_ch, m, band, band)
+        st = np.clip(b[:, None] - d0s[None, :], 0, None)
+        sa = cs[:, b[:, None] + 1] - cs[:, st]  # (C, m, band)
+        saa = cs2[:, b[:, None] + 1] - cs2[:, st]
+        ss_a = saa - sa * sa / n0[:, 0] + floor[:, 0]
+        # cov = sab - sa * sb / n0 ; ss_b = sbb - sb^2 / n0 (in place, to save passes)
+        sb /= n0
+        sab -= sa[..., None] * sb
+        sbb -= sb * sb * n0
+        sbb += floor
+        sbb *= ss_a[..., None]
+        np.sqrt(sbb, out=sbb)
+        sab /= sbb
+        cost[b] = n_ch - sab.sum(axis=0)
+    bb = np.arange(n)[:, None, None]
+    valid = (bb - d0s[None, :, None] >= 0) & (bb + d0s[None, None, :] <= n - 1)
+    cost[~valid] = np.inf
+    return cost
+
+
+# ---------------------------------------------------------------------- the optimum
+
+
+def _shortest_path(cost: np.ndarray, n: int, lo: int, hi: int) -> tuple[np.ndarray, float]:
+    """DP over the forward DAG of boundary pairs, in frame order (eqs. 4-5).
+
+    ``V[b, i]`` is the least energy of a chain of periods ending at frame ``b`` whose
+    last period has ``lo + i`` frames. A chain may start at any frame ``t_0 < lo``
+    (the lead-in before the first full period is shorter than any period) and joins
+    the virtual end node from any frame ``t_p >= n - lo`` (likewise for the tail).
+    Frames are processed in blocks of ``lo`` (a block only depends on earlier
+    blocks), so the loop runs ``n / lo`` times.
+    """
+    band = hi - lo + 1
+    d = np.arange(lo, hi + 1)
+    V0 = np.full((n, band), np.inf)  # chains of one period (start states)
+    t0 = np.arange(lo)[:, None]
+    t1 = t0 + d[None, :]  # first pairs (t0, t0 + d)
+    ok0 = t1 <= n - 1
+    V0[t1[ok0], np.broadcast_to(np.arange(band), t1.shape)[ok0]] = 0.0
+    V1 = np.full((n, band), np.inf)  # chains of >= 2 periods (at least one edge)
+    ptr = np.full((n, band), -1, dtype=np.int64)
+    from_start = np.zeros((n, band), dtype=bool)
+    Vb = V0.copy()  # min(V0, V1), final once its block is done
+    for start in range(lo, n, lo):
+        b = np.arange(start, min(start + lo, n))
+        prev = b[:, None] - d[None, :]  # (m, band_i1): middle boundary
+        ok = prev >= lo
+        pc = np.where(ok, prev, 0)
+        # total[m, i1, i0] = Vb[prev, i0] + cost[prev, i0, i1]
+        total = Vb[pc] + cost[pc, :, np.arange(band)[None, :]]
+        total = np.where(ok[..., None], total, np.inf)
+        best = np.argmin(total, axis=2)
+        V1[b] = np.take_along_axis(total, best[..., None], axis=2)[..., 0]
+        ptr[b] = best
+        from_start[b] = V0[b] <= V1[b]
+        Vb[b] = np.minimum(V0[b], V1[b])
+    tail = V1[n - lo :]  # candidates for the virtual end node
+    flat = int(np.argmin(tail))
+    end, i = n - lo + flat // band, flat % band
+    energy = float(V1[end, i])
+    if not np.isfinite(energy):
+        raise ParameterError(
+            "the clip is too short for two periods within the alpha band (internal)"
+        )
+    frames = [end]
+    b = end
+    while True:  # (b, i) is a state of V1
+        i_prev = int(ptr[b, i])
+        b_prev = b - (lo + i)
+        frames.append(b_prev)
+        if from_start[b_prev, i_prev]:
+            frames.append(b_prev - (lo + i_prev))
+            break
+        b, i = b_prev, i_prev
+    frames = np.array(frames[::-1], dtype=np.int64)
+    if frames[0] >= lo or frames.size < 3:
+        raise ParameterError("internal error: optimal path does not start in the lead-in")
+    return frames, energy
+
+
+def _segment_literal(x: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray, float]:
+    """Reference: direct, loop-by-loop implementation of eqs. 1-5 (no vectorisation).
+
+    Builds every edge of the DAG of boundary pairs with one Python loop per edge and
+    per channel (resampling with ``np.interp`` and the Pearson correlation written
+    out), then relaxes the edges in topological order. Same optimum as the fast path;
+    used by the tests and by ``benchmarks/bench_segment.py`` as the baseline.
+
+    Parameters
+    ----------
+    x : np.ndarray [shape=(C, n)]
+        Standardised channels (see :func:`_standardise`).
+    lo, hi : int [frames]
+        Alpha band of period lengths.
+
+    Returns
+    -------
+    boundary frames, energy
+    """
+    n_ch, n = x.shape
+    floor_rel = _FLAT_REL_VAR
+    start: set[tuple[int, int]] = set()
+    for t0 in range(lo):  # first pairs (t0, t1): lead-in shorter than any period
+        for t1 in range(t0 + lo, min(t0 + hi, n - 1) + 1):
+            start.add((t0, t1))
+    best: dict[tuple[int, int], float] = {}  # chains with at least one edge
+    back: dict[tuple[int, int], tuple[int, int]] = {}
+    for t1 in range(lo, n):  # topological order: by middle boundary
+        for t0 in range(t1 - hi, t1 - lo + 1):
+            here = min(0.0 if (t0, t1) in start else np.inf, best.get((t0, t1), np.inf))
+            if not np.isfinite(here):
+                continue
+            for t2 in range(t1 + lo, min(t1 + hi, n - 1) + 1):
+                d0, d1 = t1 - t0, t2 - t1
+                e = 0.0
+                for ch in range(n_ch):
+                    a_seg = x[ch, t0 : t1 + 1]
+                    b_seg = np.interp(
+                        np.arange(d0 + 1) * (d1 / d0), np.arange(d1 + 1), x[ch, t1 : t2 + 1]
+                    )
+                    ma, mb = a_seg.mean(), b_seg.mean()
+                    num = 0.0
+                    va = floor_rel * (d0 + 1)
+                    vb = floor_rel * (d0 + 1)
+                    for k in range(d0 + 1):
+                        num += (a_seg[k] - ma) * (b_seg[k] - mb)
+                        va += (a_seg[k] - ma) ** 2
+                        vb += (b_seg[k] - mb) ** 2
+                    e += 1.0 - num / np.sqrt(va * vb)
+                cand = here + e
+                if cand < best.get((t1, t2), np.inf):
+                    best[(t1, t2)] = cand
+                    back[(t1, t2)] = (t0, t1)
+    ends = [(k, v) for k, v in best.items() if k[1] >= n - lo]  # tail shorter than lo
+    if not ends:
+        raise ParameterError("no segmentation into two or more periods fits the alpha band")
+    node, energy = min(ends, key=lambda kv: kv[1])
+    frames = [node[1], node[0]]
+    while True:
+        prev = back[node]
+        frames.append(prev[0])
+        if prev in start and (prev not in best or 0.0 <= best[prev]):
+            break
+        node = prev
+    return np.array(frames[::-1], dtype=np.int64), float(energy)
+
+
+def _band(nominal: float, alpha: float) -> tuple[int, int]:
+    """Whole-frame period lengths allowed around ``nominal`` [frames] (eq. 3).
+
+    The band ``[(1-alpha) L, (1+alpha) L]`` is rounded outward to whole frames, so a
+    period that is within alpha before rounding to frames is never excluded.
+    """
+    return int(np.floor((1 - alpha) * nominal + 1e-9)), int(np.ceil((1 + alpha) * nominal - 1e-9))
+
+
+def segmentation_energy(x: np.ndarray, frames: np.ndarray) -> float:
+    """Energy E (eq. 2) of given boundary frames on standardised channels ``(C, n)``."""
+    frames = np.asarray(frames, dtype=np.int64)
+    if frames.size < 3:
+        return 0.0
+    return float(_pair_costs(x, frames[:-2], frames[1:-1], frames[2:]).sum())
+
+
+# ------------------------------------------------------------------- period count
+
+
+def _check_enough(n: int, fps: float, period_range: tuple[float, float]) -> None:
+    span = (n - 1) / fps
+    if span < 2 * period_range[0]:
+        raise ParameterError(
+            f"clip of {n} frames lasts {span:.3f} s at fps={fps:g}, shorter than two periods "
+            f"of the shortest requested period {period_range[0]:g} s; give a longer clip, a "
+            "shorter --period-range, or check fps (frames vs seconds)"
+        )
+
+
+def _uniform_frames(n: int, period: float) -> np.ndarray:
+    """Uniform boundaries 0, L, 2L, ... (rounded) that fit in frames 0..n-1."""
+    count = int(np.floor((n - 1) / period + 1e-9))
+    return np.rint(np.arange(count + 1) * period).astype(np.int64)
+
+
+def _uniform_energy(x: np.ndarray, periods: np.ndarray) -> np.ndarray:
+    """Mean Pearson distance per channel and pair of uniform segmentations (NaN if < 2)."""
+    n_ch, n = x.shape
+    a_l, b_l, c_l, owner = [], [], [], []
+    for i, per in enumerate(periods):
+        f = _uniform_frames(n, float(per))
+        if f.size < 3 or np.any(np.diff(f) < 1):
+            continue
+        a_l.append(f[:-2])
+        b_l.append(f[1:-1])
+        c_l.append(f[2:])
+        owner.append(np.full(f.size - 2, i))
+    out = np.full(len(periods), np.nan)
+    if not a_l:
+        return out
+    own = np.concatenate(owner)
+    costs = _pair_costs(x, np.concatenate(a_l), np.concatenate(b_l), np.concatenate(c_l))
+    tot = np.bincount(own, weights=costs, minlength=len(periods))
+    cnt = np.bincount(own, minlength=len(periods))
+    ok = cnt > 0
+    out[ok] = tot[ok] / (cnt[ok] * n_ch)
+    return out
+
+
+def _estimate_period(
+    x: np.ndarray, fps: float, period_range: tuple[float, float], method: str
+) -> float:
+    """Nominal period [frames] by FFT peak or by the uniform-segmentation energy."""
+    n = x.shape[1]
+    lo_f = max(period_range[0] * fps, 2.0)
+    hi_f = min(period_range[1] * fps, (n - 1) / 2.0)
+    if hi_f < lo_f:
+        raise ParameterError(
+            f"no period of {period_range[0]:g}-{period_range[1]:g} s fits twice in "
+            f"{(n - 1) / fps:.3f} s at fps={fps:g}; widen period_range or give a longer clip"
+        )
+    if method == "fft":
+        nfft = int(2 ** np.ceil(np.log2(8 * n)))
+        spec = np.abs(np.fft.rfft(x * np.hanning(n)[None, :], n=nfft, axis=1)) ** 2
+        power = spec.sum(axis=0)
+        freqs = np.fft.rfftfreq(nfft, d=1.0)  # [1/frame]
+        band = (freqs >= 1.0 / hi_f) & (freqs <= 1.0 / lo_f)
+        if not band.any():
+            raise ParameterError("period_range too narrow for the FFT resolution")
+        return float(1.0 / freqs[band][np.argmax(power[band])])
+    if method != "energy":
+        raise ParameterError(f"period_method={method!r}: choose one of {_PERIOD_METHODS}")
+    step = 0.25  # [frames]
+    count = int(np.floor((hi_f - lo_f) / step)) + 1
+    if count > _MAX_COUNT_CANDIDATES:
+        cands = np.geomspace(lo_f, hi_f, _MAX_COUNT_CANDIDATES)
+    else:
+        cands = lo_f + step * np.arange(count)
+    e = _uniform_energy(x, cands)
+    if np.all(np.isnan(e)):
+        raise ParameterError("clip too short for two periods of the requested range")
+    return float(cands[np.nanargmin(e)])
+
+
+def estimate_period_count(
+    values: Any,
+    *,
+    fps: float,
+    period_range: tuple[float, float] = (0.25, 1.25),
+    method: str = "energy",
+) -> int:
+    """Number of whole periods ``p`` in a clip, by FFT peak or uniform-segmentation energy.
+
+    Parameters
+    ----------
+    values : np.ndarray [shape=(n_frames, n_channels)]
+        Channels to analyse (near-constant channels are ignored).
+    fps : float > 0 [Hz]
+    period_range : (float, float) [s]
+        Shortest and longest period considered (paper: 0.25-1.25 s).
+    method : {"energy", "fft"}
+        ``"fft"``: the peak of the channel-summed power spectrum (z-scored channels,
+        Hann window, 8x zero padding) within ``1/period_range``. ``"energy"``: the
+        period ``T`` minimising the energy of the uniform segmentation ``0, T, 2T, ...``
+        per pair of consecutive periods (``E(U) / (s - 1)``; the paper writes ``E/s``,
+        which favours fewer, longer periods on short clips), over a 0.25-frame grid
+        (at most 400 log-spaced candidates).
+
+    Returns
+    -------
+    int >= 2
+        ``floor((n_frames - 1) / (T * fps))``.
+
+    Raises
+    ------
+    ParameterError
+        Bad ``fps``/range/values, or a clip shorter than two of the shortest periods.
+    """
+    fps = check_fps(fps)
+    lo_s, hi_s = check_range(*period_range, name="period_range", unit="s")
+    vals = _as_values(values)
+    n = vals.shape[0]
+    _check_enough(n, fps, (lo_s, hi_s))
+    keep = _nonconstant(vals)
+    if not keep.any():
+        raise ParameterError("every channel is constant: there is no motion to segment")
+    x = _standardise(vals[:, keep])
+    per = _estimate_period(x, fps, (lo_s, hi_s), method)
+    return max(2, int(np.floor((n - 1) / per + 1e-9)))
+
+
+def periodicity_contrast(x: np.ndarray, frames: np.ndarray, energy: float) -> float:
+    """How much better the optimum is than uniform segmentations at wrong periods.
+
+    ``min_f e(U_{f T}) - e_opt`` for ``f`` in (0.5, 0.75, 1.25, 1.5), where ``e`` is the
+    mean Pearson distance per channel and pair, ``T`` the optimum's mean period and
+    ``U_{fT}`` the uniform segmentation with period ``f T`` (those with at least two
+    pairs). NaN if none fits.
+    """
+    n_found = frames.size - 1
+    e_opt = energy / (x.shape[0] * max(n_found - 1, 1))
+    period = (frames[-1] - frames[0]) / n_found
+    e_off = _uniform_energy(x, period * np.array(_OFF_PERIOD_FACTORS))
+    if np.all(np.isnan(e_off)):
+        return float("nan")
+    return float(np.nanmin(e_off) - e_opt)
+
+
+# --------------------------------------------------------------------------- public
+
+
+def _as_values(values: Any) -> np.ndarray:
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError("values must be a numeric array (n_frames, n_channels)") from None
+    if arr.ndim == 1:
+        arr = arr[:, None]
+    if arr.ndim != 2:
+        raise ParameterError(f"values must be 2-D (n_frames, n_channels), got shape {arr.shape}")
+    if arr.shape[0] < 3:
+        raise ParameterError(f"values have {arr.shape[0]} frame(s); a segmentation needs more")
+    return check_finite(arr, name="motion values")
+
+
+def _check_alpha(alpha: Any) -> float:
+    try:
+        a = float(alpha)
+    except (TypeError, ValueError):
+        raise ParameterError(f"alpha={alpha!r} is not a number in (0, 0.5)") from None
+    if not (np.isfinite(a) and 0.0 < a < 0.5):
+        hint = " (a fraction of the period, e.g. 0.1, not a percentage)" if a >= 0.5 else ""
+        raise ParameterError(f"alpha={alpha!r} must be in (0, 0.5){hint}")
+    return a
+
+
+def segment_values(
+    values: Any,
+    *,
+    fps: float,
+    alpha: float = 0.1,
+    n_periods: int | None = None,
+    period_range: tuple[float, float] = (0.25, 1.25),
+    period_method: str = "energy",
+    channel_names: Sequence[str] | None = None,
+) -> Segmentation:
+    """Globally optimal segmentation of a periodic multi-channel signal (paper A, sec. 3).
+
+    Parameters
+    ----------
+    values : np.ndarray [shape=(n_frames, n_channels)]
+        Joint angles (any unit; each channel is z-scored, which leaves r unchanged).
+        Angles must already be unwrapped (:func:`segment` does it for BVH rotations).
+    fps : float > 0 [Hz]
+    alpha : float in (0, 0.5)
+        Allowed relative deviation of every period from the nominal period (eq. 3).
+    n_periods : int >= 2, optional
+        Number of periods (e.g. from the music). Overrides ``period_method``.
+    period_range : (float, float) [s]
+        Shortest and longest period for estimating the count (paper: 0.25-1.25 s).
+    period_method : {"energy", "fft", "given"}
+        How to get the count when ``n_periods`` is None (see
+        :func:`estimate_period_count`). ``"given"`` requires ``n_periods``.
+    channel_names : sequence of str, optional
+        Names of the columns (reported in :attr:`Segmentation.channels`).
+
+    Returns
+    -------
+    Segmentation
+
+    Raises
+    ------
+    ParameterError
+        NaN/inf values, ``fps <= 0``, alpha outside (0, 0.5), reversed period range, a
+        clip shorter than two periods of the requested range, all channels constant,
+        or a clip that is not periodic (normalised energy above
+        :data:`MAX_NORMALISED_ENERGY`).
+
+    Examples
+    --------
+    >>> from beatsync.synth.motion import periodic_motion
+    >>> s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
+    >>> seg = segment_values(s.motion.values, fps=25, n_periods=10)
+    >>> int(abs(seg.boundary_frames - s.boundary_frames).max()) <= 1
+    True
+    """
+    fps = check_fps(fps)
+    alpha = _check_alpha(alpha)
+    lo_s, hi_s = check_range(*period_range, name="period_range", unit="s")
+    if period_method not in _PERIOD_METHODS:
+        raise ParameterError(f"period_method={period_method!r}: choose one of {_PERIOD_METHODS}")
+    vals = _as_values(values)
+    n = vals.shape[0]
+    names = (
+        tuple(str(c) for c in channel_names)
+        if channel_names is not None
+        else tuple(f"ch{i}" for i in range(vals.shape[1]))
+    )
+    if len(names) != vals.shape[1]:
+        raise ParameterError(
+            f"{len(names)} channel names for {vals.shape[1]} value columns; is the array "
+            "transposed (it must be frames x channels)?"
+        )
+    keep = _nonconstant(vals)
+    if not keep.any():
+        raise ParameterError(
+            "every selected channel is constant: there is no motion to segment "
+            "(choose other channels, e.g. channels='all')"
+        )
+    used = tuple(nm for nm, k in zip(names, keep, strict=False) if k)
+    x = _standardise(vals[:, keep])
+
+    if n_periods is not None:
+        try:
+            p = int(n_periods)
+        except (TypeError, ValueError):
+            raise ParameterError(f"n_periods={n_periods!r} must be an integer >= 2") from None
+        if p != n_periods or p < 2:
+            raise ParameterError(f"n_periods={n_periods!r} must be an integer >= 2")
+        method = "given"
+        nominal = (n - 1) / p  # [frames]
+    else:
+        if period_method == "given":
+            raise ParameterError("period_method='given' needs n_periods (the period count)")
+        _check_enough(n, fps, (lo_s, hi_s))
+        nominal = _estimate_period(x, fps, (lo_s, hi_s), period_method)
+        method = period_method
+        p = max(2, int(np.floor((n - 1) / nominal + 1e-9)))
+    lo, hi = _band(nominal, alpha)
+    if lo < 2:
+        raise ParameterError(
+            f"{p} periods in {n} frames is {nominal:.2f} frames per period: too short to "
+            "segment (need >= 2 frames per period); fewer periods or a higher frame rate"
+        )
+    if lo > hi:
+        raise ParameterError(
+            f"alpha={alpha:g} allows no whole-frame period length around {nominal:.2f} "
+            "frames; increase alpha"
+        )
+    cost = _edge_costs(x, lo, hi)
+    frames, energy = _shortest_path(cost, n, lo, hi)
+    n_found = frames.size - 1
+    e_norm = energy / (x.shape[0] * max(n_found - 1, 1))
+    contrast = periodicity_contrast(x, frames, energy)
+    if e_norm >= MAX_NORMALISED_ENERGY or (
+        np.isfinite(contrast) and contrast < MIN_PERIODICITY_CONTRAST
+    ):
+        raise ParameterError(
+            f"the motion is not periodic: the best segmentation into {n_found} periods of "
+            f"~{(frames[-1] - frames[0]) / n_found / fps:.3f} s has mean Pearson distance "
+            f"{e_norm:.3f} between consecutive periods, only {contrast:.3f} below uniform "
+            f"segmentations at wrong periods (periodic needs < {MAX_NORMALISED_ENERGY} and a "
+            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. Try other "
+            "channels, another period_range, or a clip with repeated movement"
+        )
+    times = frames_to_time(frames, fps=fps)
+    return Segmentation(
+        boundaries=times,
+        n_periods=int(n_found),
+        mean_period=float((times[-1] - times[0]) / n_found),
+        energy=float(energy),
+        channels=used,
+        fps=fps,
+        period_method=method,
+    )
+
+
+def _unwrap_rotations(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
+    """Unwrap rotation channels [deg] across the +-180 wrap (analysis only)."""
+    rot = [i for i, nm in enumerate(names) if nm.lower().endswith("rotation")]
+    if not rot:
+        return values
+    out = values.copy()
+    out[:, rot] = np.unwrap(values[:, rot], axis=0, period=360.0)
+    return out
+
+
+def segment(
+    motion: Motion,
+    *,
+    alpha: float = 0.1,
+    n_periods: int | None = None,
+    period_range: tuple[float, float] = (0.25, 1.25),
+    period_method: str = "energy",
+    channels: str | Sequence[str] = "default",
+) -> Segmentation:
+    """Split a periodic motion into its periods, globally optimally (paper A, sec. 3).
+
+    Parameters
+    ----------
+    motion : Motion
+        Joint angles (BVH rotations, degrees) or marker-derived ``*_angle`` channels
+        (:func:`beatsync.motion.marker_angles`).
+    alpha : float in (0, 0.5)
+        Allowed relative deviation of each period from the nominal period (eq. 3).
+    n_periods : int >= 2, optional
+        Period count if known (e.g. from the music).
+    period_range : (float, float) [s]
+        Shortest and longest period when estimating the count.
+    period_method : {"energy", "fft", "given"}
+    channels : "default", "all" or list of str
+        See :func:`select_channels`.
+
+    Returns
+    -------
+    Segmentation
+        ``boundaries`` [s] from 0 to ``(n_frames-1)/fps``; ``mean_period`` [s].
+
+    Raises
+    ------
+    ParameterError
+        See :func:`segment_values`.
+
+    Examples
+    --------
+    >>> from beatsync.synth.motion import periodic_motion
+    >>> s = periodic_motion(n_frames=300, n_periods=10, seed=1)
+    >>> seg = segment(s.motion, n_periods=10)
+    >>> seg.n_periods, round(seg.mean_period, 3)
+    (10, 1.196)
+    """
+    names = select_channels(motion.channels, channels)
+    idx = [motion.channel_index(nm) for nm in names]
+    values = check_finite(motion.values[:, idx], name=f"motion {motion.name!r} values")
+    values = _unwrap_rotations(values, names)
+    return segment_values(
+        values,
+        fps=motion.fps,
+        alpha=alpha,
+        n_periods=n_periods,
+        period_range=period_range,
+        period_method=period_method,
+        channel_names=names,
+    )
