@@ -132,9 +132,7 @@ def _check_positions(positions: Any, fps: Any) -> tuple[np.ndarray, float]:
     if pos.ndim == 2 and pos.shape[1] % 3 == 0:
         pos = pos.reshape(pos.shape[0], -1, 3)
     if pos.ndim != 3 or pos.shape[2] != 3:
-        raise ParameterError(
-            f"positions must have shape (n_frames, n_joints, 3), got {pos.shape}"
-        )
+        raise ParameterError(f"positions must have shape (n_frames, n_joints, 3), got {pos.shape}")
     if pos.shape[0] < 3:
         raise ParameterError(
             f"motion has only {pos.shape[0]} frame(s); at least 3 are needed for velocities"

@@ -46,27 +46,66 @@ def register(subparsers: Any) -> None:
             "Example: beatsync compose song.wav --library a.bvh b.bvh -o dance.bvh"
         ),
     )
-    p.add_argument("audio", nargs="?", default=None,
-                   help="music file (.wav, .flac, .ogg, .mp3); may also follow --library")
-    p.add_argument("--library", nargs="+", action="extend", required=True, metavar="PATH",
-                   help="BVH clips or folders of BVH clips (one skeleton)")
+    p.add_argument(
+        "audio",
+        nargs="?",
+        default=None,
+        help="music file (.wav, .flac, .ogg, .mp3); may also follow --library",
+    )
+    p.add_argument(
+        "--library",
+        nargs="+",
+        action="extend",
+        required=True,
+        metavar="PATH",
+        help="BVH clips or folders of BVH clips (one skeleton)",
+    )
     p.add_argument("-o", "--output", required=True, help="output motion (.bvh)")
-    p.add_argument("--fps", type=float, default=None,
-                   help="frame rate of the library clips [Hz]: overrides the BVH headers")
-    p.add_argument("--th", type=float, default=3.0,
-                   help="transition threshold TH on the scale-free pose distance rd (default 3.0)")
-    p.add_argument("--weight-rule", choices=("paper", "rd"), default="paper",
-                   help="transition weight: 'paper' w2 = max(rd, 2) (eq. 2), or 'rd'")
-    p.add_argument("--method", choices=("dp", "conventional", "random"), default="dp",
-                   help="search: dp (paper B), conventional (multi-stage baseline), random walk")
-    p.add_argument("--beats", default=None, metavar="FILE",
-                   help="music beat times [s], one per line: skip beat tracking")
-    p.add_argument("--bpm", type=float, default=None,
-                   help="known tempo of the music [BPM]: the tracker only finds the phase")
-    p.add_argument("--blend", type=float, default=1.0 / 3.0,
-                   help="transition blend length [s] (default 1/3)")
-    p.add_argument("--video", default=None, metavar="OUT.mp4",
-                   help="also write a stick-figure video with the music as soundtrack")
+    p.add_argument(
+        "--fps",
+        type=float,
+        default=None,
+        help="frame rate of the library clips [Hz]: overrides the BVH headers",
+    )
+    p.add_argument(
+        "--th",
+        type=float,
+        default=3.0,
+        help="transition threshold TH on the scale-free pose distance rd (default 3.0)",
+    )
+    p.add_argument(
+        "--weight-rule",
+        choices=("paper", "rd"),
+        default="paper",
+        help="transition weight: 'paper' w2 = max(rd, 2) (eq. 2), or 'rd'",
+    )
+    p.add_argument(
+        "--method",
+        choices=("dp", "conventional", "random"),
+        default="dp",
+        help="search: dp (paper B), conventional (multi-stage baseline), random walk",
+    )
+    p.add_argument(
+        "--beats",
+        default=None,
+        metavar="FILE",
+        help="music beat times [s], one per line: skip beat tracking",
+    )
+    p.add_argument(
+        "--bpm",
+        type=float,
+        default=None,
+        help="known tempo of the music [BPM]: the tracker only finds the phase",
+    )
+    p.add_argument(
+        "--blend", type=float, default=1.0 / 3.0, help="transition blend length [s] (default 1/3)"
+    )
+    p.add_argument(
+        "--video",
+        default=None,
+        metavar="OUT.mp4",
+        help="also write a stick-figure video with the music as soundtrack",
+    )
     p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the graph cache")
     add_json_flag(p)

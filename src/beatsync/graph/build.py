@@ -617,8 +617,7 @@ def build_graph(
             else "the library has a single beat frame"
         )
         raise ParameterError(
-            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; "
-            + hint
+            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; " + hint
         )
     params = {
         "th": th,

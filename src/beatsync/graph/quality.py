@@ -49,8 +49,9 @@ def intensity_correlation(motion: Any, music_beats: Any, music_level: Any) -> fl
     keep = beats <= last + 1e-9
     beats_in = beats[keep]
     if beats_in.size < 3:
-        warnings.warn("fewer than two beat intervals: correlation set to NaN", BeatsyncWarning,
-                      stacklevel=2)
+        warnings.warn(
+            "fewer than two beat intervals: correlation set to NaN", BeatsyncWarning, stacklevel=2
+        )
         return float("nan")
     inten = beat_interval_intensity(motion, beats_in)
     lv = level[: inten.size]

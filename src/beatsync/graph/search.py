@@ -249,7 +249,7 @@ def dp_search(
         raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     t0 = time.perf_counter()
     pred, weight, _ = graph.predecessor_table()
-    lw = lam * weight
+    lw = weight * lam if lam > 0 else np.where(np.isinf(weight), np.inf, 0.0)
     costs = node_costs(graph, music_z, tempo_weight=tw, music_durations=md)
     k_n = music_z.size
     d = costs[0].copy()

@@ -1,0 +1,203 @@
+"""Synthetic dance clips with exact motion beats (tests and a second study library).
+
+A 17-joint BVH skeleton (root ``hip`` with 6 channels, spine, head, arms, legs with
+``lFoot``/``rFoot``) dances in place: every rotation channel, and the root's height,
+moves from one extreme pose to the next once per beat along a half cosine,
+
+    theta_j(t) = A_j * (s_k + (s_{k+1} - s_k) * (1 - cos(pi u)) / 2),  u = (t - t_k) / T,
+
+with ``s_k = (-1)^k a_k`` and ``a_k`` the loudness of the section containing beat
+``k``. All joint velocities vanish together at every beat ``t_k``, so the kinematic
+beats are exactly the beat times, and the motion intensity of an interval grows with
+``(s_{k+1} - s_k)^2``. Clips drawn with different seeds share the pose vocabulary
+(the extremes ``+-A a``), so a library of them has transitions.
+
+Stands in for paper B's second (Indian dance) library in
+``notebooks/tab01_speed_motion_graph.ipynb``; used by ``tests/test_graph.py``.
+
+Data contract: returns a :class:`beatsync.motion.Motion` (degrees, metres, ``fps``)
+and its beat times in seconds.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..motion import Joint, Motion, Skeleton
+from ..units import check_fps
+
+__all__ = ["dance_skeleton", "synthetic_dance", "synthetic_library"]
+
+_ROT = ("Zrotation", "Xrotation", "Yrotation")
+_ROOT = ("Xposition", "Yposition", "Zposition", *_ROT)
+
+
+def dance_skeleton(scale: float = 1.0) -> Skeleton:
+    """A 17-joint humanoid (y up, metres times ``scale``), ZXY rotations."""
+    s = float(scale)
+
+    def j(name, parent, off, end=False):
+        return Joint(name, parent, np.asarray(off, dtype=np.float64) * s, () if end else _ROT, end)
+
+    joints = [
+        Joint("hip", -1, np.zeros(3), _ROOT),
+        j("spine", 0, [0, 0.25, 0]),
+        j("neck", 1, [0, 0.30, 0]),
+        j("head_end", 2, [0, 0.15, 0], True),
+        j("lShoulder", 1, [0.18, 0.25, 0]),
+        j("lElbow", 4, [0.28, 0, 0]),
+        j("lHand_end", 5, [0.25, 0, 0], True),
+        j("rShoulder", 1, [-0.18, 0.25, 0]),
+        j("rElbow", 7, [-0.28, 0, 0]),
+        j("rHand_end", 8, [-0.25, 0, 0], True),
+        j("lThigh", 0, [0.1, 0, 0]),
+        j("lShin", 10, [0, -0.42, 0]),
+        j("lFoot", 11, [0, -0.42, 0]),
+        j("lToe_end", 12, [0, -0.05, 0.12], True),
+        j("rThigh", 0, [-0.1, 0, 0]),
+        j("rShin", 14, [0, -0.42, 0]),
+        j("rFoot", 15, [0, -0.42, 0]),
+        j("rToe_end", 16, [0, -0.05, 0.12], True),
+    ]
+    return Skeleton(tuple(joints))
+
+
+def synthetic_dance(
+    *,
+    duration: float = 10.0,
+    bpm: float = 100.0,
+    fps: float = 60.0,
+    seed: int = 0,
+    section_beats: int = 4,
+    level_range: tuple[float, float] = (0.3, 1.0),
+    start: float = 0.25,
+    scale: float = 1.0,
+    n_moves: int = 3,
+    vocabulary_seed: int = 0,
+    name: str | None = None,
+) -> tuple[Motion, np.ndarray]:
+    """One synthetic dance clip and its exact beat times.
+
+    Parameters
+    ----------
+    duration : float > 0 [s]
+    bpm : float > 0 [bpm]
+        Motion tempo (one extreme pose per beat).
+    fps : float > 0 [Hz]
+    seed : int
+        Draws the joint amplitudes ``A_j`` and the section loudness ``a_k``.
+    section_beats : int >= 1
+        Beats per loudness section.
+    level_range : (float, float)
+        Range of ``a_k`` (uniform).
+    start : float >= 0 [s]
+        First beat; the clip holds the first pose before it.
+    scale : float > 0
+        Length scale of the skeleton and root height (for scale-invariance tests).
+    n_moves : int >= 1
+        Size of the move vocabulary; each section dances one move (drawn by ``seed``).
+    vocabulary_seed : int
+        Draws the moves' joint amplitudes; clips with one vocabulary share poses.
+    name : str, optional
+
+    Returns
+    -------
+    (motion, beats) : Motion, np.ndarray [s]
+        Beats lie on frame times, inside the clip.
+    """
+    fps = check_fps(fps)
+    bpm = check_fps(bpm, name="bpm")
+    duration = check_fps(duration, name="duration")
+    if int(section_beats) < 1:
+        raise ParameterError(f"section_beats={section_beats!r} must be >= 1")
+    rng = np.random.default_rng(seed)
+    skel = dance_skeleton(scale)
+    channels = skel.channel_names()
+    n = int(round(duration * fps))
+    t = np.arange(n) / fps
+    period = 60.0 / bpm
+    # beats on frame times
+    beat_frames = np.unique(np.rint((start + np.arange(0, duration, period)) * fps).astype(int))
+    beat_frames = beat_frames[beat_frames < n]
+    if beat_frames.size < 3:
+        raise ParameterError(
+            f"duration={duration} s at {bpm} BPM gives fewer than 3 beats; make it longer"
+        )
+    beats = beat_frames / fps
+    lo, hi = level_range
+    n_sec = int(np.ceil(beats.size / int(section_beats))) + 1
+    levels = rng.uniform(lo, hi, size=n_sec)
+    moves = rng.integers(0, int(n_moves), size=n_sec)
+    sec = np.arange(beats.size) // int(section_beats)
+    sign = (-1.0) ** np.arange(beats.size)
+    vocab = _move_vocabulary(channels, int(n_moves), vocabulary_seed)  # (n_moves, C)
+    keys = vocab[moves[sec]] * (levels[sec] * sign)[:, None]  # (n_beats, C) key poses
+    root_y = channels.index("hip_Yposition")
+    keys[:, root_y] = (0.9 + 0.04 * levels[sec] * sign) * scale
+    # half-cosine interpolation between key poses: zero velocity at every beat
+    k = np.clip(np.searchsorted(beats, t, side="right") - 1, 0, beats.size - 2)
+    u = np.clip((t - beats[k]) / (beats[k + 1] - beats[k]), 0.0, 1.0)
+    wgt = ((1.0 - np.cos(np.pi * u)) / 2.0)[:, None]
+    values = keys[k] + (keys[k + 1] - keys[k]) * wgt
+    values[t < beats[0]] = keys[0]
+    motion = Motion(values, fps, channels, skel, name or f"synthetic_{seed}")
+    return motion, beats
+
+
+_AMP = {
+    "spine": (8, 10, 15),
+    "neck": (5, 8, 10),
+    "lShoulder": (40, 20, 15),
+    "rShoulder": (-40, 20, -15),
+    "lElbow": (10, 0, 50),
+    "rElbow": (-10, 0, -50),
+    "lThigh": (5, 30, 5),
+    "rThigh": (5, -30, 5),
+    "lShin": (0, -35, 0),
+    "rShin": (0, 35, 0),
+    "lFoot": (0, 10, 0),
+    "rFoot": (0, -10, 0),
+    "hip": (0, 0, 10),
+}
+
+
+def _move_vocabulary(channels: tuple[str, ...], n_moves: int, seed: int) -> np.ndarray:
+    """Joint amplitudes [deg] of each move, shape ``(n_moves, n_channels)``."""
+    if n_moves < 1:
+        raise ParameterError(f"n_moves={n_moves!r} must be >= 1")
+    rng = np.random.default_rng(10_000 + seed)
+    out = np.zeros((n_moves, len(channels)))
+    for ci, ch in enumerate(channels):
+        joint, _, dof = ch.rpartition("_")
+        if joint in _AMP and dof in _ROT:
+            base = _AMP[joint][_ROT.index(dof)]
+            out[:, ci] = base * rng.uniform(-1.4, 1.4, size=n_moves)
+    return out
+
+
+def synthetic_library(
+    n_clips: int = 4,
+    *,
+    duration: float = 20.0,
+    bpm_range: tuple[float, float] = (90.0, 130.0),
+    fps: float = 60.0,
+    seed: int = 0,
+) -> tuple[list[Motion], list[np.ndarray]]:
+    """``n_clips`` synthetic dances at tempi drawn from ``bpm_range`` (seeded)."""
+    if int(n_clips) < 1:
+        raise ParameterError(f"n_clips={n_clips!r} must be >= 1")
+    rng = np.random.default_rng(seed)
+    tempi = rng.uniform(bpm_range[0], bpm_range[1], size=int(n_clips))
+    clips, beats = [], []
+    for i, bpm in enumerate(tempi):
+        m, b = synthetic_dance(
+            duration=duration,
+            bpm=float(bpm),
+            fps=fps,
+            seed=seed * 1000 + i,
+            name=f"synthetic_{i:02d}",
+        )
+        clips.append(m)
+        beats.append(b)
+    return clips, beats

@@ -1,0 +1,170 @@
+"""End-to-end tests of ``beatsync compose``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from beatsync import io
+from beatsync.cli import main
+from beatsync.graph.synthetic import synthetic_dance
+from beatsync.motion import Joint, Motion, Skeleton
+from beatsync.music import drum_song
+
+
+@pytest.fixture
+def workdir(tmp_path, monkeypatch):
+    monkeypatch.setenv("BEATSYNC_CACHE_DIR", str(tmp_path / "cache"))
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    for seed in (0, 1):
+        m, _ = synthetic_dance(duration=6.0, bpm=110.0, seed=seed)
+        io.write_bvh(lib / f"clip{seed}.bvh", m)
+    song = drum_song(6.0, bpm=110.0, sr=22050, seed=1)
+    io.write_audio(tmp_path / "song.wav", song.y, song.sr)
+    io.write_beats(tmp_path / "song.beats", song.beats)
+    return tmp_path
+
+
+def _outputs(d):
+    return sorted(p.name for p in d.iterdir() if p.suffix in (".bvh", ".json", ".mp4"))
+
+
+def test_compose_end_to_end_with_beats(workdir, capsys):
+    out = workdir / "dance.bvh"
+    rep = workdir / "report.json"
+    argv = [
+        "compose",
+        str(workdir / "song.wav"),
+        "--library",
+        str(workdir / "lib" / "clip0.bvh"),
+        str(workdir / "lib" / "clip1.bvh"),
+        "--beats",
+        str(workdir / "song.beats"),
+        "-o",
+        str(out),
+        "--report",
+        str(rep),
+    ]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "transition" in text and "search (dp)" in text
+    m = io.read_bvh(out)
+    src = io.read_bvh(workdir / "lib" / "clip0.bvh")
+    assert m.channels == src.channels
+    report = json.loads(rep.read_text())
+    beats = io.read_beats(workdir / "song.beats")
+    assert report["n_music_beats"] == beats.size
+    assert report["graph_cached"] is False
+    assert report["n_transitions"] >= 0 and report["search_time_s"] >= 0
+    assert report["graph"]["n_transitions"] > 0
+    assert m.n_frames == int(np.floor(6.0 * m.fps)) + 1  # lasts as long as the song
+    cache = list((workdir / "cache").glob("graph-*.npz"))
+    assert len(cache) == 1
+    # second run: the graph comes from the cache, the result is the same
+    out2 = workdir / "dance2.bvh"
+    argv2 = [a if a != str(out) else str(out2) for a in argv if a not in ("--report", str(rep))]
+    assert main([*argv2, "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["graph_cached"] is True
+    np.testing.assert_allclose(io.read_bvh(out2).values, m.values, atol=1e-4)
+    # audio after --library is understood, folders are libraries
+    out3 = workdir / "dance3.bvh"
+    assert (
+        main(
+            [
+                "compose",
+                "--library",
+                str(workdir / "lib"),
+                str(workdir / "song.wav"),
+                "--bpm",
+                "110",
+                "-o",
+                str(out3),
+                "--json",
+            ]
+        )
+        == 0
+    )
+    res3 = json.loads(capsys.readouterr().out)
+    assert res3["tempo_bpm"] == pytest.approx(110, rel=0.05)
+    assert out3.is_file()
+
+
+def test_cache_key_changes_with_content_and_params(workdir):
+    from beatsync.commands.compose import graph_cache_key
+
+    files = sorted((workdir / "lib").glob("*.bvh"))
+    k1 = graph_cache_key(files, {"th": 3.0})
+    assert graph_cache_key(files, {"th": 2.0}) != k1
+    assert graph_cache_key(files[::-1], {"th": 3.0}) != k1
+    m, _ = synthetic_dance(duration=6.0, bpm=110.0, seed=5)
+    io.write_bvh(files[0], m)
+    assert graph_cache_key(files, {"th": 3.0}) != k1
+
+
+def _odd_clip(path):
+    m, _ = synthetic_dance(duration=6.0, bpm=110.0, seed=2)
+    joints = list(m.skeleton.joints)
+    j = joints[1]
+    joints[1] = Joint("torso", j.parent, j.offset, j.channels, j.is_end_site)
+    sk = Skeleton(tuple(joints))
+    io.write_bvh(path, Motion(m.values, m.fps, sk.channel_names(), sk, "odd"))
+
+
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        ("th0", "--th"),
+        ("th_tiny", "no transition edges"),
+        ("skeletons", "different skeletons"),
+        ("empty_folder", "no .bvh"),
+        ("silent", "silent"),
+        ("one_beat", "need >= 2"),
+        ("missing_clip", "does not exist"),
+    ],
+)
+def test_bad_inputs_write_nothing(workdir, capsys, case, message):
+    lib = [str(workdir / "lib" / "clip0.bvh"), str(workdir / "lib" / "clip1.bvh")]
+    song = str(workdir / "song.wav")
+    extra: list[str] = ["--beats", str(workdir / "song.beats")]
+    if case == "th0":
+        extra += ["--th", "0"]
+    elif case == "th_tiny":
+        extra += ["--th", "1e-9"]
+    elif case == "skeletons":
+        _odd_clip(workdir / "odd.bvh")
+        lib.append(str(workdir / "odd.bvh"))
+    elif case == "empty_folder":
+        (workdir / "empty").mkdir()
+        lib = [str(workdir / "empty")]
+    elif case == "silent":
+        io.write_audio(workdir / "silence.wav", np.zeros(22050 * 3, dtype=np.float32), 22050)
+        song = str(workdir / "silence.wav")
+        extra = []
+    elif case == "one_beat":
+        io.write_beats(workdir / "one.beats", np.array([0.5]))
+        extra = ["--beats", str(workdir / "one.beats")]
+    elif case == "missing_clip":
+        lib.append(str(workdir / "nope.bvh"))
+    before = _outputs(workdir)
+    out = workdir / "dance.bvh"
+    argv = [
+        "compose",
+        song,
+        "--library",
+        *lib,
+        "-o",
+        str(out),
+        "--report",
+        str(workdir / "r.json"),
+        *extra,
+    ]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+    assert _outputs(workdir) == before
+    assert not out.exists()
