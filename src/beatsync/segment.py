@@ -9,14 +9,14 @@ Data contract
 - Input: motion values ``(n_frames, n_channels)``, time first, at ``fps > 0`` [Hz];
   rotation channels in degrees (they are unwrapped across +-180 deg before analysis).
 - Output: :class:`Segmentation` whose ``boundaries`` are ``n_periods + 1`` strictly
-  increasing times [s]; the first is 0 (first frame) and the last is
-  ``(n_frames - 1) / fps`` (last frame): the periods tile the clip, as in the paper.
+  increasing times [s] within ``[0, (n_frames - 1) / fps]``: start of the first full
+  period ... end of the last (lead-in and tail shorter than a period are left out).
   Frames are used only inside this module; conversion goes through
   :func:`beatsync.units.frames_to_time`.
 
 The method
 ----------
-A segmentation ``T_p = (t_0 = 0 < t_1 < ... < t_p = n-1)`` (frames) splits the signal
+A segmentation ``T_p = (t_0 < t_1 < ... < t_p)`` (frames) splits the signal
 into periods ``S_i = X[t_i .. t_{i+1}]`` (both ends included, ``t_{i+1} - t_i`` frames
 long). Its energy (eqs. 1-2) is
 
@@ -27,8 +27,8 @@ period onto the earlier one's samples (end points aligned). Every period length 
 stay inside the alpha band around the nominal period ``L = (n-1)/p`` (eq. 3):
 ``(1-alpha) L <= t_{i+1} - t_i <= (1+alpha) L``. The globally optimal ``T_p``
 (eqs. 4-5) is a shortest path in a forward DAG whose nodes are consecutive boundary
-pairs ``(t_{i-1}, t_i)``, with a virtual end node joined to every pair ending at the
-last frame; the DAG is solved by dynamic programming in frame order (no heap).
+pairs ``(t_{i-1}, t_i)``, with a virtual end node joined to every pair ending in the
+tail of the clip; the DAG is solved by dynamic programming in frame order (no heap).
 Because the graph has no period index, the optimum may use a period count within
 the band other than ``p``; :attr:`Segmentation.n_periods` reports the count found.
 
@@ -47,11 +47,21 @@ Documented rules (choices the paper leaves open)
   standard deviation among the selected channels, or at most 1e-9. Inside a kept
   channel, a period whose own variance is below 1e-6 of the channel's variance is
   treated as flat: its correlation is ~0 (cost ~1).
-- Periodicity: the optimum's normalised energy ``e = E / (n_channels * (p - 1))`` is
-  the mean Pearson distance between consecutive periods. A clip with
-  ``e > MAX_NORMALISED_ENERGY`` (0.5, i.e. mean correlation below 0.5) is refused as
-  not periodic. Calibration (notebook fig02): walking, salsa and MoCap Toolbox dance
-  clips give e <= ~0.2; the CMU 005_02 pirouette gives e >= ~0.7.
+- Periodicity: a clip is refused as not periodic when the optimum's mean Pearson
+  distance per channel and pair, ``E / (n_channels * (p - 1))``, reaches
+  ``MAX_NORMALISED_ENERGY`` (1.0: consecutive periods uncorrelated on average), or
+  when its periodicity contrast (:func:`periodicity_contrast`: how much better the
+  uniform segmentation at the found period is than uniform segmentations at 0.5,
+  0.75, 1.25 and 1.5 times it) is below ``MIN_PERIODICITY_CONTRAST`` (0.05).
+  Calibration (default channels, both period methods): CMU salsa 60_01/61_01/60_04/
+  61_04 0.06-0.13, CMU walks 007_* 1.06-1.27, MoCap Toolbox dance1/dance2/walk1/walk2
+  0.10-0.82; the CMU 005_02 pirouette -0.15 and -0.02; white noise (16 trials) <= 0.02.
+  Known limit: a random walk (integrated noise) passed in 3 of 16 trials (up to 0.11).
+- Free ends: real clips do not start or end on a period boundary, so the first
+  boundary may lie anywhere in the lead-in ``t_0 < lo`` and the last in the tail
+  ``t_p >= n - lo`` (``lo``: shortest allowed period); the band of eq. 3 is rounded
+  outward to whole frames. A synthetic clip that is an exact tiling is recovered with
+  ``t_0 = 0`` and ``t_p = n - 1``.
 - Default channels: rotation channels of the main limb and spine joints (see
   :func:`select_channels`), or every ``*_angle`` channel for marker-derived angles.
 """
@@ -112,7 +122,7 @@ class Segmentation:
     ----------
     boundaries : np.ndarray [s]
         ``n_periods + 1`` strictly increasing times: start of the first period ... end
-        of the last (first frame ... last frame).
+        of the last, within ``[0, (n_frames - 1) / fps]``.
     n_periods : int
     mean_period : float [s]
     energy : float
@@ -170,10 +180,11 @@ _ROOT_NAMES = ("hip", "hips", "cc_base_hip", "rl_boneroot", "root")
 
 
 def _joint_key(joint: str) -> str:
-    key = joint.lower()
-    key = re.sub(r"^(cc_base_|mixamorig:?|rl_)", "", key)
-    key = re.sub(r"^(l_|r_|left_?|right_?|l(?=[a-z])|r(?=[a-z]))", "", key)
-    return key.replace("_", "")
+    """Joint key: ``"rShin"`` -> ``"shin"``, ``"CC_Base_L_Calf"`` -> ``"calf"``."""
+    key = re.sub(r"^(CC_Base_|mixamorig:?|RL_)", "", joint, flags=re.IGNORECASE)
+    key = re.sub(r"^([LR]_|[lr](?=[A-Z])|Left_?|Right_?)", "", key, flags=0)
+    key = re.sub(r"^(left_?|right_?)", "", key, flags=re.IGNORECASE)
+    return re.sub(r"\d+$", "", key.lower().replace("_", ""))
 
 
 def _is_default_channel(name: str) -> bool:
@@ -715,21 +726,23 @@ def estimate_period_count(
     return max(2, int(np.floor((n - 1) / per + 1e-9)))
 
 
-def periodicity_contrast(x: np.ndarray, frames: np.ndarray, energy: float) -> float:
-    """How much better the optimum is than uniform segmentations at wrong periods.
+def periodicity_contrast(x: np.ndarray, frames: np.ndarray) -> float:
+    """How much better the found period is than wrong periods, for uniform segmentations.
 
-    ``min_f e(U_{f T}) - e_opt`` for ``f`` in (0.5, 0.75, 1.25, 1.5), where ``e`` is the
-    mean Pearson distance per channel and pair, ``T`` the optimum's mean period and
-    ``U_{fT}`` the uniform segmentation with period ``f T`` (those with at least two
-    pairs). NaN if none fits.
+    ``min_f e(U_{f T}) - e(U_T)`` for ``f`` in (0.5, 0.75, 1.25, 1.5), where ``e`` is the
+    mean Pearson distance per channel and consecutive pair, ``T`` the optimum's mean
+    period and ``U_P`` the uniform segmentation with period ``P`` starting at the
+    optimum's first boundary (only those with at least two pairs count). Both sides are
+    unoptimised, so noise or a non-repeating motion scores about 0 (or below), while a
+    periodic motion scores clearly above. NaN if no off-period segmentation fits.
     """
     n_found = frames.size - 1
-    e_opt = energy / (x.shape[0] * max(n_found - 1, 1))
     period = (frames[-1] - frames[0]) / n_found
-    e_off = _uniform_energy(x, period * np.array(_OFF_PERIOD_FACTORS))
-    if np.all(np.isnan(e_off)):
+    xs = x[:, frames[0] :]
+    e = _uniform_energy(xs, period * np.array((1.0,) + _OFF_PERIOD_FACTORS))
+    if np.isnan(e[0]) or np.all(np.isnan(e[1:])):
         return float("nan")
-    return float(np.nanmin(e_off) - e_opt)
+    return float(np.nanmin(e[1:]) - e[0])
 
 
 # --------------------------------------------------------------------------- public
@@ -867,15 +880,16 @@ def segment_values(
     frames, energy = _shortest_path(cost, n, lo, hi)
     n_found = frames.size - 1
     e_norm = energy / (x.shape[0] * max(n_found - 1, 1))
-    contrast = periodicity_contrast(x, frames, energy)
+    contrast = periodicity_contrast(x, frames)
     if e_norm >= MAX_NORMALISED_ENERGY or (
         np.isfinite(contrast) and contrast < MIN_PERIODICITY_CONTRAST
     ):
         raise ParameterError(
             f"the motion is not periodic: the best segmentation into {n_found} periods of "
             f"~{(frames[-1] - frames[0]) / n_found / fps:.3f} s has mean Pearson distance "
-            f"{e_norm:.3f} between consecutive periods, only {contrast:.3f} below uniform "
-            f"segmentations at wrong periods (periodic needs < {MAX_NORMALISED_ENERGY} and a "
+            f"{e_norm:.3f} between consecutive periods, and uniform segmentations at this "
+            f"period beat those at wrong periods by only {contrast:.3f} (periodic needs "
+            f"< {MAX_NORMALISED_ENERGY} and a "
             f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. Try other "
             "channels, another period_range, or a clip with repeated movement"
         )
@@ -930,7 +944,7 @@ def segment(
     Returns
     -------
     Segmentation
-        ``boundaries`` [s] from 0 to ``(n_frames-1)/fps``; ``mean_period`` [s].
+        ``boundaries`` [s] within ``[0, (n_frames-1)/fps]``; ``mean_period`` [s].
 
     Raises
     ------

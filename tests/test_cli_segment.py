@@ -1,0 +1,114 @@
+"""End-to-end tests of ``beatsync segment`` via ``beatsync.cli.main``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from beatsync import datasets
+from beatsync.cli import main
+from beatsync.synth.motion import periodic_motion
+
+
+@pytest.fixture
+def synth_csv(tmp_path):
+    s = periodic_motion(n_frames=400, n_channels=6, n_periods=12, snr_db=25, seed=4)
+    p = tmp_path / "angles.csv"
+    pd.DataFrame(s.motion.values, columns=list(s.motion.channels)).to_csv(p, index=False)
+    return p, s
+
+
+def test_segment_csv_json_and_out(tmp_path, synth_csv, capsys):
+    path, s = synth_csv
+    out = tmp_path / "bounds.csv"
+    rc = main(["segment", str(path), "--fps", "25", "--periods", "12", "--json", "--out", str(out)])
+    assert rc == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["n_periods"] == 12
+    assert np.abs(np.array(res["boundary_frames"]) - s.boundary_frames).max() <= 1
+    assert res["mean_period_s"] == pytest.approx(s.period, rel=0.01)
+    table = pd.read_csv(out)
+    assert list(table.columns) == ["boundary", "time_s", "frame"]
+    np.testing.assert_allclose(table["time_s"], res["boundaries_s"])
+
+
+def test_segment_text_output(synth_csv, capsys):
+    path, _ = synth_csv
+    assert main(["segment", str(path), "--fps", "25", "--alpha", "0.15"]) == 0
+    text = capsys.readouterr().out
+    assert "periods, mean period" in text and "boundaries [s]:" in text
+
+
+def test_segment_bvh_with_fps_override_and_channels(capsys):
+    bvh = datasets.path("motion/cmu_salsa/60_01_scaled.bvh")
+    rc = main(["segment", str(bvh), "--fps", "60", "--channels", "rShin_Xrotation",
+               "lShin_Xrotation", "--json"])  # fmt: skip
+    assert rc == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["mean_period_s"] == pytest.approx(1.0, abs=0.08)
+    assert res["channels"] == ["rShin_Xrotation", "lShin_Xrotation"]
+
+
+def test_segment_mat_markers_become_angles(capsys):
+    mat = datasets.path("motion/mocaptoolbox/mcdemodata.mat")
+    rc = main(["segment", str(mat), "--variable", "dance2", "--channels", "knee_L_angle",
+               "knee_R_angle", "--json"])  # fmt: skip
+    assert rc == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["marker_angles"] is True
+    assert res["mean_period_s"] == pytest.approx(0.51, abs=0.04)
+
+
+def _bad_files(tmp_path):
+    trunc = tmp_path / "trunc.bvh"
+    trunc.write_text("HIERARCHY\nROOT hip\n{\n  OFFSET 0 0 0\n")
+    nan_csv = tmp_path / "nan.csv"
+    v = periodic_motion(n_frames=200, n_channels=3, n_periods=8, seed=0).motion.values
+    v[3, 1] = np.nan
+    pd.DataFrame(v, columns=["a_angle", "b_angle", "c_angle"]).to_csv(nan_csv, index=False)
+    short = tmp_path / "short.csv"
+    pd.DataFrame(v[20:30], columns=["a_angle", "b_angle", "c_angle"]).to_csv(short, index=False)
+    noise = tmp_path / "noise.csv"
+    rnd = np.random.default_rng(0).standard_normal((300, 4))
+    pd.DataFrame(rnd, columns=[f"c{i}_angle" for i in range(4)]).to_csv(noise, index=False)
+    return {"trunc": trunc, "nan": nan_csv, "short": short, "noise": noise}
+
+
+@pytest.mark.parametrize(
+    "key,extra,match",
+    [
+        ("missing", ["--fps", "25"], ""),
+        ("trunc", [], ""),
+        ("nan", ["--fps", "25"], "NaN"),
+        ("short", ["--fps", "25"], "shorter than two periods"),
+        ("noise", ["--fps", "25"], "not periodic"),
+        ("pirouette", [], "not periodic"),
+        ("good", ["--fps", "0"], "fps"),
+        ("good", ["--fps", "25", "--alpha", "0.7"], "alpha"),
+        ("good", ["--fps", "25", "--period-range", "1.25", "0.25"], "reversed"),
+        ("good", [], "fps"),  # a table without --fps
+    ],
+)
+def test_segment_bad_input_writes_nothing(tmp_path, synth_csv, capsys, key, extra, match):
+    files = _bad_files(tmp_path)
+    files["missing"] = tmp_path / "nope.bvh"
+    files["good"] = synth_csv[0]
+    files["pirouette"] = datasets.path("motion/cmu_walk_modern/005_02.bvh")
+    out = tmp_path / "out.csv"
+    rc = main(["segment", str(files[key]), *extra, "--out", str(out)])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert err.startswith("beatsync segment: error:")
+    assert match in err
+    assert "Traceback" not in err
+    assert not out.exists()
+
+
+def test_segment_refuses_out_equal_to_input(synth_csv, capsys):
+    path, _ = synth_csv
+    before = path.read_bytes()
+    assert main(["segment", str(path), "--fps", "25", "--out", str(path)]) == 2
+    assert path.read_bytes() == before

@@ -1,0 +1,267 @@
+"""Tests of the optimal periodic segmentation (beatsync.segment, paper A sec. 3)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from beatsync import datasets
+from beatsync import segment as S
+from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.motion import Motion, marker_angles
+from beatsync.segment import (
+    Segmentation,
+    estimate_period_count,
+    segment,
+    segment_values,
+    select_channels,
+)
+from beatsync.synth.motion import periodic_motion
+
+
+# ----------------------------------------------------------------- synthetic truth
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+@pytest.mark.parametrize("method", ["given", "energy"])
+def test_synthetic_boundaries_within_one_frame(seed, method):
+    """Paper-scale synthetic signal (29 ch, 25 Hz, n=750) at 20 dB SNR, alpha 0.1."""
+    s = periodic_motion(n_frames=750, n_channels=29, fps=25.0, n_periods=25, jitter=0.08,
+                        variation=0.05, snr_db=20.0, seed=seed)  # fmt: skip
+    n_periods = 25 if method == "given" else None
+    seg = segment(s.motion, alpha=0.1, n_periods=n_periods)
+    assert isinstance(seg, Segmentation)
+    assert seg.n_periods == s.n_periods
+    err = np.abs(seg.boundary_frames - s.boundary_frames)
+    assert err.max() <= 1, err
+    assert seg.mean_period == pytest.approx(s.period, rel=0.01)
+    assert seg.period_method == method
+    assert np.all(np.diff(seg.boundaries) > 0)
+
+
+def test_noiseless_synthetic_is_exact():
+    s = periodic_motion(n_frames=500, n_periods=16, snr_db=None, variation=0.0, seed=9)
+    seg = segment_values(s.motion.values, fps=25.0, n_periods=16)
+    assert np.array_equal(seg.boundary_frames, s.boundary_frames)
+    assert seg.normalised_energy < 1e-3  # only linear-resampling error remains
+
+
+def test_constant_channels_are_excluded():
+    s = periodic_motion(n_frames=400, n_periods=12, n_constant=4, seed=2)
+    seg = segment(s.motion, n_periods=12)
+    assert len(seg.channels) == 25
+    assert np.abs(seg.boundary_frames - s.boundary_frames).max() <= 1
+
+
+def test_estimate_period_count_synthetic():
+    s = periodic_motion(seed=5)
+    for method in ("energy", "fft"):
+        p = estimate_period_count(s.motion.values, fps=25.0, method=method)
+        assert abs(p - 25) <= 1
+
+
+# ------------------------------------------------------- DP optimum vs reference
+def _brute_force(x, lo, hi):
+    n = x.shape[1]
+    best = (np.inf, None)
+
+    def rec(fr):
+        nonlocal best
+        if len(fr) >= 3 and fr[-1] >= n - lo:
+            e = S.segmentation_energy(x, np.array(fr))
+            if e < best[0]:
+                best = (e, list(fr))
+        for d in range(lo, hi + 1):
+            if fr[-1] + d <= n - 1:
+                rec(fr + [fr[-1] + d])
+
+    for t0 in range(lo):
+        rec([t0])
+    return best
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_dp_equals_literal_and_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(14, 36))
+    n_ch = int(rng.integers(1, 4))
+    lo = int(rng.integers(3, 6))
+    hi = lo + int(rng.integers(0, 3))
+    t = np.arange(n)
+    raw = np.sin(2 * np.pi * t / rng.uniform(4, 8))[:, None] + 0.5 * rng.standard_normal((n, n_ch))
+    x = S._standardise(raw)
+    f_fast, e_fast = S._shortest_path(S._edge_costs(x, lo, hi), n, lo, hi)
+    f_lit, e_lit = S._segment_literal(x, lo, hi)
+    e_bf, f_bf = _brute_force(x, lo, hi)
+    assert e_fast == pytest.approx(e_lit, abs=1e-9)
+    assert e_fast == pytest.approx(e_bf, abs=1e-9)
+    assert np.array_equal(f_fast, f_lit)
+    assert S.segmentation_energy(x, f_fast) == pytest.approx(e_fast, abs=1e-9)
+
+
+def test_vectorised_edge_costs_match_direct_pearson(rng):
+    s = periodic_motion(n_frames=300, n_channels=5, n_periods=10, seed=1)
+    x = S._standardise(s.motion.values)
+    lo, hi = 26, 33
+    cost = S._edge_costs(x, lo, hi)
+    n = x.shape[1]
+    b = rng.integers(lo, n - lo, 500)
+    i0 = rng.integers(0, hi - lo + 1, 500)
+    i1 = rng.integers(0, hi - lo + 1, 500)
+    ok = (b - lo - i0 >= 0) & (b + lo + i1 <= n - 1)
+    b, i0, i1 = b[ok], i0[ok], i1[ok]
+    ref = S._pair_costs(x, b - lo - i0, b, b + lo + i1)
+    np.testing.assert_allclose(cost[b, i0, i1], ref, atol=1e-10)
+    # one edge by hand: np.interp + np.corrcoef
+    a0, b0, c0 = 40, 70, 101
+    want = 0.0
+    for ch in range(x.shape[0]):
+        bb = np.interp(np.arange(31) * 31 / 30, np.arange(32), x[ch, b0 : c0 + 1])
+        want += 1 - np.corrcoef(x[ch, a0 : b0 + 1], bb)[0, 1]
+    assert cost[b0, 30 - lo, 31 - lo] == pytest.approx(want, abs=1e-5)
+
+
+# --------------------------------------------------------------------- real data
+def test_salsa_knee_period_about_one_second():
+    m = datasets.load_salsa("60_01")
+    seg = segment(m, channels=["rShin_Xrotation", "lShin_Xrotation"])
+    assert seg.mean_period == pytest.approx(1.0, abs=0.08)
+    assert seg.n_periods >= 30
+
+
+def test_salsa_default_channels_period():
+    seg = segment(datasets.load_salsa("60_01"))
+    assert len(seg.channels) == 39
+    assert 0.9 <= seg.mean_period <= 1.15
+
+
+def test_dance2_knee_period_near_toolbox_value():
+    """MoCap Toolbox documents a 0.51 s vertical period for dance2; the knees give ~0.53 s.
+
+    With all 11 marker angles the energy method prefers the double (~1.1 s), the cycle
+    over which left and right legs alternate (see notebook fig02)."""
+    angles = marker_angles(datasets.load_mocap_toolbox("dance2"))
+    knees = segment(angles, channels=["knee_L_angle", "knee_R_angle"])
+    assert knees.mean_period == pytest.approx(0.51, abs=0.04)
+    full = segment(angles)
+    assert full.mean_period == pytest.approx(2 * knees.mean_period, rel=0.1)
+
+
+@pytest.mark.parametrize("clip,period", [("007_01", 1.07), ("007_12", 0.87)])
+def test_walking_gait_cycle(clip, period):
+    seg = segment(datasets.load_walk(clip))
+    assert seg.mean_period == pytest.approx(period, abs=0.06)
+    assert seg.channels[0].startswith("CC_Base_")
+
+
+@pytest.mark.parametrize("method", ["energy", "fft"])
+def test_pirouette_is_not_periodic(method):
+    with pytest.raises(ParameterError, match="not periodic"):
+        segment(datasets.load_walk("005_02"), period_method=method)
+
+
+# ---------------------------------------------------------------------- channels
+def test_default_channels_cmu_names():
+    m = datasets.load_salsa("60_01")
+    chosen = select_channels(m.channels)
+    joints = {c.rsplit("_", 1)[0] for c in chosen}
+    assert joints == {"abdomen", "chest", "neck", "rShldr", "rForeArm", "lShldr", "lForeArm",
+                      "rThigh", "rShin", "rFoot", "lThigh", "lShin", "lFoot"}  # fmt: skip
+    assert all(c.endswith("rotation") for c in chosen)
+
+
+def test_default_channels_iclone_names():
+    joints_in = ("CC_Base_L_Thigh", "CC_Base_L_Calf", "CC_Base_Spine01", "CC_Base_L_CalfTwist01",
+                 "CC_Base_L_Hand", "CC_Base_Hip", "CC_Base_R_Upperarm", "CC_Base_R_Forearm",
+                 "CC_Base_L_Foot", "CC_Base_L_ToeBase")  # fmt: skip
+    names = [f"{j}_{d}rotation" for j in joints_in for d in "XYZ"]
+    names += ["RL_BoneRoot_Xposition", "CC_Base_Spine01_Xposition"]
+    joints = {c.rsplit("_", 1)[0] for c in select_channels(names)}
+    assert joints == {"CC_Base_L_Thigh", "CC_Base_L_Calf", "CC_Base_Spine01",
+                      "CC_Base_R_Upperarm", "CC_Base_R_Forearm", "CC_Base_L_Foot"}  # fmt: skip
+
+
+def test_channel_selection_modes():
+    names = ["knee_L_angle", "knee_R_angle", "Head_FL_x"]
+    assert select_channels(names) == ("knee_L_angle", "knee_R_angle")
+    assert select_channels(names, "all") == tuple(names)
+    assert select_channels(names, ["Head_FL_x"]) == ("Head_FL_x",)
+    with pytest.raises(ParameterError, match="not found"):
+        select_channels(names, ["knee_X"])
+    with pytest.raises(ParameterError):
+        select_channels(names, "some")
+    with pytest.warns(BeatsyncWarning, match="using all channels"):
+        assert select_channels(["a", "b"]) == ("a", "b")
+
+
+def test_rotation_channels_are_unwrapped():
+    """A knee-like rotation crossing the +-180 wrap segments like its unwrapped self."""
+    s = periodic_motion(n_frames=400, n_channels=3, n_periods=12, snr_db=30, seed=3)
+    vals = s.motion.values - s.motion.values.mean(axis=0) + 175.0
+    wrapped = (vals + 180.0) % 360.0 - 180.0
+    names = ("rShin_Xrotation", "lShin_Xrotation", "rThigh_Xrotation")
+    seg_w = segment(Motion(wrapped, 25.0, names), n_periods=12)
+    seg_u = segment(Motion(vals, 25.0, names), n_periods=12)
+    assert np.array_equal(seg_w.boundary_frames, seg_u.boundary_frames)
+
+
+# -------------------------------------------------------------------- bad input
+def _vals(n=300, c=4):
+    return periodic_motion(n_frames=n, n_channels=c, n_periods=10, seed=0).motion.values
+
+
+def _with_nan():
+    v = _vals()
+    v[10, 1] = np.nan
+    return v
+
+
+def _with_inf():
+    v = _vals()
+    v[5, 0] = np.inf
+    return v
+
+
+@pytest.mark.parametrize(
+    "values,kwargs,match",
+    [
+        (_with_nan(), {}, "NaN"),
+        (_with_inf(), {}, "NaN or infinite"),
+        (_vals(), {"fps": 0.0}, "fps"),
+        (_vals(), {"fps": -25.0}, "fps"),
+        (_vals(), {"fps": float("nan")}, "fps"),
+        (_vals(), {"alpha": 0.0}, "alpha"),
+        (_vals(), {"alpha": 0.5}, "alpha"),
+        (_vals(), {"alpha": 10.0}, "percentage"),
+        (_vals(), {"alpha": -0.1}, "alpha"),
+        (_vals(), {"period_range": (1.25, 0.25)}, "reversed"),
+        (_vals(), {"period_range": (0.0, 1.0)}, "> 0"),
+        (_vals()[:12], {}, "shorter than two periods"),
+        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "shorter than two periods"),
+        (_vals(), {"n_periods": 1}, "n_periods"),
+        (_vals(), {"n_periods": 2.5}, "n_periods"),
+        (_vals(), {"n_periods": 200}, "too short"),
+        (_vals(), {"period_method": "wavelet"}, "period_method"),
+        (_vals(), {"period_method": "given"}, "needs n_periods"),
+        (np.ones((300, 4)), {}, "constant"),
+        (np.zeros((2, 300, 4)), {}, "2-D"),
+        (np.random.default_rng(0).standard_normal((300, 4)), {}, "not periodic"),
+        (np.random.default_rng(1).standard_normal((300, 29)), {}, "not periodic"),
+    ],
+)
+def test_bad_input_raises(values, kwargs, match):
+    kw = {"fps": 25.0} | kwargs
+    with pytest.raises(ParameterError, match=match):
+        segment_values(values, **kw)
+
+
+def test_channel_name_count_mismatch():
+    with pytest.raises(ParameterError, match="transposed"):
+        segment_values(_vals(), fps=25.0, channel_names=["a", "b"])
+
+
+def test_no_warning_on_normal_input():
+    s = periodic_motion(n_frames=300, n_periods=10, seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        segment(s.motion)
