@@ -177,17 +177,18 @@ def path_cost(
             raise ParameterError("tempo_weight > 0 needs music_durations [s]")
         dm = graph.interval_duration()[path]
         tempo = tw * float(np.sum(np.log(dm / md) ** 2))
-    src, dst, w = graph.successors()
-    lookup = {(int(a), int(b)): float(c) for a, b, c in zip(src, dst, w, strict=True)}
+    indptr, succ, sw = graph.successor_lists()
     trans = np.zeros(path.size, dtype=bool)
     tcost = 0.0
     for k in range(1, path.size):
-        key = (int(path[k - 1]), int(path[k]))
-        if key not in lookup:
-            raise ParameterError(f"path step {k}: no edge from node {key[0]} to node {key[1]}")
-        if graph.next_node[path[k - 1]] != path[k]:
+        a, b = int(path[k - 1]), int(path[k])
+        out = succ[indptr[a] : indptr[a + 1]]
+        hit = np.flatnonzero(out == b)
+        if hit.size == 0:
+            raise ParameterError(f"path step {k}: no edge from node {a} to node {b}")
+        if graph.next_node[a] != b:
             trans[k] = True
-            tcost += lam * lookup[key]
+            tcost += lam * float(sw[indptr[a] + hit[0]])
     return inten + tcost + tempo, inten, tcost, tempo, trans
 
 
