@@ -265,3 +265,16 @@ def test_no_warning_on_normal_input():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         segment(s.motion)
+
+
+def test_float32_edge_costs_close_to_float64():
+    s = periodic_motion(n_frames=750, n_channels=29, n_periods=25, seed=6)
+    x = S._standardise(s.motion.values)
+    c64 = S._edge_costs(x, 26, 33)
+    c32 = S._edge_costs(x, 26, 33, dtype=np.float32)
+    ok = np.isfinite(c64)
+    assert np.array_equal(ok, np.isfinite(c32))
+    assert np.abs(c64[ok] - c32[ok]).max() < 1e-4
+    f64, _ = S._shortest_path(c64, 750, 26, 33)
+    f32, _ = S._shortest_path(c32, 750, 26, 33)
+    assert np.array_equal(f64, f32)
