@@ -110,3 +110,35 @@ def test_phase_consistency_locked_and_drifting():
     assert np.isclose(beat_phase_consistency(MUSIC + 0.1, MUSIC), 1.0)  # locked at 0.2 phase
     drift = np.arange(0.5, 19.0, 0.5 * 1.0556)  # 5.6 % slower: phase turns twice
     assert beat_phase_consistency(drift, MUSIC) < 0.3
+
+
+def test_kinematic_phase_offset():
+    from beatsync.evaluate.alignment import kinematic_phase_offset
+
+    assert np.isclose(kinematic_phase_offset(MUSIC + 0.1, MUSIC), 0.1)
+    assert np.isclose(kinematic_phase_offset(MUSIC[1:] - 0.1, MUSIC), -0.1)
+    with pytest.raises(ParameterError, match="no motion beat"):
+        kinematic_phase_offset([30.0], MUSIC)
+
+
+def test_evaluate_sync_aligned_accents_hit_the_beat():
+    from beatsync.evaluate.alignment import evaluate_sync
+    from beatsync.motion import Joint, Motion, Skeleton
+
+    fps = 60.0
+    skel = Skeleton((
+        Joint("hip", -1, np.zeros(3), ("Xposition", "Yposition", "Zposition")),
+        Joint("end", 0, np.array([0.0, 0.5, 0.0]), (), True),
+    ))
+    t = np.arange(int(12 * fps)) / fps
+    # a bounce of period 1.1 s whose speed minima (turning points) sit at phase 0.3
+    v = np.zeros((t.size, 3))
+    v[:, 1] = np.cos(2 * np.pi * (t / 1.1 - 0.3))
+    m = Motion(v, fps, skel.channel_names(), skel, "bounce")
+    bounds = np.arange(0.0, 11.9, 1.1)
+    beats = 0.5 + np.arange(40) * 0.5  # 1 period -> 2 beats of 0.5 s
+    row = evaluate_sync(m, beats, boundaries=bounds, n_control=20)
+    assert row["max_residual_frames"] <= 0.5 + 1e-6
+    assert row["after_phase"] > 0.9  # phase-locked after sync
+    assert row["aligned_motion"] > 0.9  # and on the beat once the lag is removed
+    assert row["aligned_motion"] > row["control_motion"]

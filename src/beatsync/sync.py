@@ -393,6 +393,7 @@ def synchronize(
     first_beat: int = 0,
     out_fps: float | None = None,
     delta: float | None = None,
+    phase_offset: float = 0.0,
 ) -> SyncResult:
     """Resample periodic motion so that its period boundaries land on music beats.
 
@@ -412,6 +413,10 @@ def synchronize(
         Output frame rate; default ``motion.fps``.
     delta : float > 0, optional [s]
         Gaussian width of eq. 9; default the mean motion period.
+    phase_offset : float [s]
+        Land the boundaries this long after their beats (negative: before). Use it to
+        put the dancer's accents, rather than the segmentation's boundaries, on the
+        beat (see :func:`beatsync.evaluate.alignment.kinematic_phase_offset`).
 
     Returns
     -------
@@ -471,7 +476,18 @@ def synchronize(
             "or fewer beats_per_period"
         )
     p = min(n_periods, n_fit)
-    targets = beats[first_beat : first_beat + m * p + 1 : m]
+    try:
+        phase_offset = float(phase_offset)
+    except (TypeError, ValueError):
+        raise ParameterError(f"phase_offset={phase_offset!r} must be a time in seconds") from None
+    if not np.isfinite(phase_offset):
+        raise ParameterError(f"phase_offset={phase_offset!r} must be finite [s]")
+    targets = beats[first_beat : first_beat + m * p + 1 : m] + phase_offset
+    if targets[0] < 0:
+        raise ParameterError(
+            f"phase_offset={phase_offset:.3f} s puts the first boundary at {targets[0]:.3f} s, "
+            "before the music starts; use first_beat >= 1 or a smaller offset"
+        )
     used = s[: p + 1]
     ratio = mean_period / beat_period / m
     if ratio > 2.0 or ratio < 0.5:
@@ -490,24 +506,26 @@ def synchronize(
             f"the warped motion ends at music time {tau_end:.3f} s <= 0: first_beat={first_beat} "
             "is too early for the motion before the first boundary"
         )
-    n_out = int(np.floor(tau_end * out_fps + 1e-9)) + 1
+    # the last frame is the first one at or after the last warped time, so the frame
+    # nearest to the last boundary exists (the source is clipped there)
+    n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
     out_times = frames_to_time(np.arange(n_out), fps=out_fps)
     src_times = warp.to_source(out_times)
     values = _sample_motion(motion, src_times)
     out_motion = motion.with_values(values, fps=out_fps)
 
     # residuals: realised warp (interpolated between output frames) and nearest frame
-    live = out_times >= warp.tgt[0]
-    # the realised warp: output frames joined by straight lines, plus the warp's start
-    # (the first boundary may sit exactly where a held lead-in ends)
-    xs = np.concatenate([warp.src[:1], src_times[live]])
-    ys = np.concatenate([warp.tgt[:1], out_times[live]])
+    live = (out_times > warp.tgt[0]) & (out_times < warp.tgt[-1])
+    # the realised warp: output frames joined by straight lines, plus the warp's ends
+    # (a boundary may sit exactly where a held lead-in or the clipped tail starts)
+    xs = np.concatenate([warp.src[:1], src_times[live], warp.src[-1:]])
+    ys = np.concatenate([warp.tgt[:1], out_times[live], warp.tgt[-1:]])
     realised = np.interp(used, xs, ys)
     residual = (realised - targets) * 1e3
     nearest = np.clip(time_to_frames(realised, fps=out_fps), 0, n_out - 1)
     nearest_res = (frames_to_time(nearest, fps=out_fps) - targets) * 1e3
     frame_ms = 1e3 / out_fps
-    lead_in = int(np.count_nonzero(~live))
+    lead_in = int(np.count_nonzero(out_times < warp.tgt[0]))
     report: dict[str, Any] = {
         "input_frames": n_frames,
         "output_frames": n_out,
@@ -520,6 +538,7 @@ def synchronize(
         "beats_per_period": int(m),
         "beats_per_period_rule": rule,
         "first_beat": first_beat,
+        "phase_offset_s": phase_offset,
         "mean_motion_period_s": mean_period,
         "beat_period_s": beat_period,
         "delta_s": float(warp.delta),

@@ -51,6 +51,7 @@ __all__ = [
     "motion_alignment",
     "offset_control",
     "beat_phase_consistency",
+    "kinematic_phase_offset",
     "evaluate_sync",
     "sync_table",
 ]
@@ -321,14 +322,40 @@ def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
     mb, yb = validate(motion_beats, music_beats)
     if yb.size < 2:
         raise ParameterError("beat_phase_consistency needs at least 2 music beats")
-    mb = mb[(mb >= yb[0]) & (mb < yb[-1])]
-    if mb.size == 0:
+    phase, _ = _phases(mb, yb)
+    if phase.size == 0:
         warnings.warn("no motion beats inside the music's beats; returning 0", BeatsyncWarning,
                       stacklevel=2)
         return 0.0
-    i = np.searchsorted(yb, mb, side="right") - 1
-    phase = (mb - yb[i]) / (yb[i + 1] - yb[i])
     return float(np.abs(np.mean(np.exp(2j * np.pi * phase))))
+
+
+def _phases(mb: np.ndarray, yb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    mb = mb[(mb >= yb[0]) & (mb < yb[-1])]
+    i = np.searchsorted(yb, mb, side="right") - 1
+    return (mb - yb[i]) / (yb[i + 1] - yb[i]), np.diff(yb)[i]
+
+
+def kinematic_phase_offset(motion_beats: Any, music_beats: Any) -> float:
+    """Mean lag of the motion beats behind the music beats [s], in ``(-T/2, T/2]``.
+
+    The circular mean of the motion beats' phases inside their beat intervals, times
+    the median beat period ``T``. Synchronising with ``phase_offset=-lag``
+    (:func:`beatsync.sync.synchronize`) moves the dancer's accents onto the beats.
+
+    Raises
+    ------
+    ParameterError
+        Fewer than 2 music beats, or no motion beat inside the music's beats.
+    """
+    mb, yb = validate(motion_beats, music_beats)
+    if yb.size < 2:
+        raise ParameterError("kinematic_phase_offset needs at least 2 music beats")
+    phase, _ = _phases(mb, yb)
+    if phase.size == 0:
+        raise ParameterError("no motion beat falls inside the music's beats: no phase to measure")
+    mean = np.angle(np.mean(np.exp(2j * np.pi * phase))) / (2 * np.pi)  # (-0.5, 0.5]
+    return float(mean * np.median(np.diff(yb)))
 
 
 def evaluate_sync(
@@ -349,7 +376,9 @@ def evaluate_sync(
     :func:`beatsync.sync.synchronize`, then both alignment scores and the phase
     consistency of the kinematic beats against the music beats *before* (the
     original motion played from music time 0) and *after* synchronisation, and the
-    random-offset control of the synchronised motion (:func:`offset_control`).
+    random-offset control of the synchronised motion (:func:`offset_control`), and
+    ``aligned_*``: synchronised again with ``phase_offset = -kinematic_phase_offset``
+    so that the dancer's accents, not the segmentation's boundaries, land on the beats.
     Motions without positions (plain joint-angle tables) get NaN alignment scores.
 
     Parameters
@@ -406,7 +435,8 @@ def evaluate_sync(
         "max_residual_frames": rep["max_abs_residual_frames"],
     }
     keys = ("before_motion", "before_music", "before_phase", "after_motion", "after_music",
-            "after_phase", "control_motion", "control_music")
+            "after_phase", "control_motion", "control_music", "phase_offset_s",
+            "aligned_motion", "aligned_music")
     try:
         mb_before = _kinematic_beats(motion)
         mb_after = _kinematic_beats(res.motion)
@@ -420,6 +450,17 @@ def evaluate_sync(
     after = alignment_scores(mb_after, yb, sigma=sigma, span=(0.0, min(end_after, yb[-1])))
     in_after = yb[yb <= end_after]
     ctrl = offset_control(mb_after, in_after, sigma=sigma, n_trials=n_control, seed=seed)
+    # accents on the beat: shift the landing by the measured kinematic lag
+    lag = kinematic_phase_offset(mb_after, yb)
+    kw = dict(sync_kwargs)
+    first = int(kw.pop("first_beat", 0))
+    if yb[first] - lag < 0:
+        first += 1
+    res_al = synchronize(motion, boundaries, yb, phase_offset=-lag, first_beat=first, **kw)
+    mb_al = _kinematic_beats(res_al.motion)
+    aligned = alignment_scores(
+        mb_al, yb, sigma=sigma, span=(0.0, min(float(res_al.motion.duration), yb[-1]))
+    )
     row.update(
         {
             "before_motion": before["alignment_motion"],
@@ -430,6 +471,9 @@ def evaluate_sync(
             "after_phase": beat_phase_consistency(mb_after, yb),
             "control_motion": ctrl["alignment_motion_mean"],
             "control_music": ctrl["alignment_music_mean"],
+            "phase_offset_s": -lag,
+            "aligned_motion": aligned["alignment_motion"],
+            "aligned_music": aligned["alignment_music"],
         }
     )
     row["result"] = res
@@ -470,7 +514,8 @@ def sync_table(
         periods used, beats/period, output frames, paper output frames, max residual
         [frames], alignment before/after/control (``_motion``: averaged over motion
         beats, Siyao et al. 2022; ``_music``: averaged over music beats, Li et al.
-        2021), phase consistency before/after.
+        2021), phase consistency before/after, and ``note`` (why a clip has no
+        result, e.g. segmentation refused it as not periodic).
     """
     import pandas as pd
 
@@ -481,7 +526,17 @@ def sync_table(
     for cname, clip in clips.items():
         motion = clip["motion"]
         seg_in = clip.get("segment_input") or motion
-        seg = segment(seg_in, period_range=period_range)
+        try:
+            seg = segment(seg_in, period_range=period_range)
+        except ParameterError as exc:  # e.g. refused as not periodic: say so in the table
+            for sname, song in songs.items():
+                rows.append({"clip": cname, "clip data": clip.get("data", ""),
+                             "fps": float(motion.fps), "input frames": int(motion.n_frames),
+                             "song": sname, "song data": song.get("data", ""),
+                             "BPM": song.get("bpm", float("nan")),
+                             "paper output frames": paper_frames.get((cname, sname), "n/a"),
+                             "note": f"segmentation refused: {str(exc)[:60]}..."})
+            continue
         for sname, song in songs.items():
             r = evaluate_sync(
                 motion, song["beats"], boundaries=seg.boundaries, sigma=sigma,
@@ -510,6 +565,10 @@ def sync_table(
                     "control_music": r["control_music"],
                     "before_phase": r["before_phase"],
                     "after_phase": r["after_phase"],
+                    "phase offset [s]": r["phase_offset_s"],
+                    "aligned_motion": r["aligned_motion"],
+                    "aligned_music": r["aligned_music"],
+                    "note": "",
                 }
             )
     return pd.DataFrame(rows)
