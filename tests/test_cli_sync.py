@@ -81,6 +81,20 @@ def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     assert io.read_bvh(out).fps == 30.0
 
 
+def test_sync_align_accents(inputs, tmp_path, capsys):
+    d, _, _ = inputs
+    out = tmp_path / "out.bvh"
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--align-accents", "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    r = json.loads(stdout)["report"]
+    assert abs(r["phase_offset_s"]) <= 60 / 115 / 2 + 1e-9
+    assert r["max_abs_residual_frames"] <= 1.0
+
+
 def test_sync_table_to_csv(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.csv"
@@ -113,6 +127,8 @@ BAD = [
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
       "--bpm", "120"], "conflict"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{d}/salsa.bvh"], "same"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--align-accents", "--phase-offset",
+      "0.1"], "phase"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.mp3"], ".bvh or .csv"),
     (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "60"], "skeleton"),

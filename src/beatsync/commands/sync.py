@@ -57,6 +57,11 @@ def register(subparsers: Any) -> None:
                    help="music beats per motion period (default: round(motion period / beat))")
     p.add_argument("--first-beat", type=int, default=0, metavar="K",
                    help="index of the beat the first period starts on (default 0)")
+    p.add_argument("--phase-offset", type=float, default=0.0, metavar="S",
+                   help="land period boundaries S seconds after their beats (default 0)")
+    p.add_argument("--align-accents", action="store_true",
+                   help="put the dancer's accents (kinematic beats: minima of joint speed) "
+                   "on the beats instead of the period boundaries")
     p.add_argument("--period-range", type=float, nargs=2, default=(0.25, 1.25),
                    metavar=("LO", "HI"), help="motion period search range [s] (default 0.25 1.25)")
     p.add_argument("--video", default=None, metavar="OUT.mp4",
@@ -91,6 +96,10 @@ class _Steps:
 
 
 def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | None]:
+    if args.align_accents and args.phase_offset != 0.0:
+        raise ParameterError(
+            "--align-accents measures the phase offset itself; do not also give --phase-offset"
+        )
     if args.beats is not None and args.bpm is not None:
         raise ParameterError(
             "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
@@ -199,7 +208,10 @@ def run(args: argparse.Namespace) -> int:
             beats_per_period=args.beats_per_period,
             first_beat=args.first_beat,
             out_fps=args.out_fps,
+            phase_offset=args.phase_offset,
         )
+        if args.align_accents:
+            res = _align_accents(res, motion, seg.boundaries, beats, args)
         timings["sync_s"] = time.perf_counter() - t0
         steps.done()
 
@@ -246,6 +258,29 @@ def run(args: argparse.Namespace) -> int:
     return emit(result, _text(result), args)
 
 
+def _align_accents(res: Any, motion: Any, boundaries: Any, beats: np.ndarray,
+                   args: argparse.Namespace) -> Any:
+    """Synchronise again so that the kinematic beats, not the boundaries, hit the beats."""
+    from ..evaluate.alignment import kinematic_phase_offset
+    from ..motion_beats import kinematic_beats
+    from ..sync import synchronize
+
+    try:
+        mb = kinematic_beats(res.motion)
+    except ParameterError as exc:
+        raise ParameterError(
+            f"--align-accents needs joint positions (a BVH skeleton or markers): {exc}"
+        ) from None
+    lag = kinematic_phase_offset(mb, beats)
+    first = args.first_beat
+    if beats[first] - lag < 0:
+        first += 1
+    return synchronize(
+        motion, boundaries, beats, beats_per_period=args.beats_per_period, first_beat=first,
+        out_fps=args.out_fps, phase_offset=-lag,
+    )
+
+
 def _render_video(motion: Any, path: Path, audio: Any, beats: np.ndarray, fps: float,
                   progress: bool) -> Path:
     from .. import render
@@ -267,7 +302,8 @@ def _text(result: dict[str, Any]) -> str:
         f"beat period {r['beat_period_s']:.3f} s",
         f"mapping  {r['periods_used']} of {r['periods_available']} periods, "
         f"{r['beats_per_period']} beat(s) per period ({r['beats_per_period_rule']}), "
-        f"first period on beat {r['first_beat']}",
+        f"first period on beat {r['first_beat']}"
+        + (f", {r['phase_offset_s'] * 1000:+.0f} ms after it" if r["phase_offset_s"] else ""),
         f"tempo    playback speed x{r['tempo_ratio_range'][0]:.3f} .. "
         f"x{r['tempo_ratio_range'][1]:.3f}",
         f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
