@@ -98,6 +98,12 @@ def register(subparsers: Any) -> None:
         help="known tempo of the music [BPM]: the tracker only finds the phase",
     )
     p.add_argument(
+        "--tempo-weight",
+        type=float,
+        default=0.0,
+        help="weight of a tempo term against strong time warps (0 = paper B, intensity only)",
+    )
+    p.add_argument(
         "--blend", type=float, default=1.0 / 3.0, help="transition blend length [s] (default 1/3)"
     )
     p.add_argument(
@@ -240,6 +246,10 @@ def run(args: argparse.Namespace) -> int:
     from ..graph.compose import compose_music
 
     chk = _check_inputs(args)
+    if not (np.isfinite(args.tempo_weight) and args.tempo_weight >= 0):
+        raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
+    if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
+        raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
     files = chk["files"]
     t_read = time.perf_counter()
     clips = [io.read_bvh(f, fps=args.fps) for f in files]
@@ -262,7 +272,8 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     graph, cached, cache_path = _load_or_build(files, clips, params, not args.no_cache)
     build_s = time.perf_counter() - t0
-    comp = compose_music(graph, y, sr, beats=beats, method=args.method, blend=args.blend)
+    kw = {"tempo_weight": args.tempo_weight} if args.method == "dp" and args.tempo_weight else {}
+    comp = compose_music(graph, y, sr, beats=beats, method=args.method, blend=args.blend, **kw)
     out = io.write_bvh(chk["out"], comp.motion)
     video_path = None
     if chk["video"] is not None:

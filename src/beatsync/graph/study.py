@@ -45,6 +45,8 @@ __all__ = [
     "ratio_table",
     "threshold_table",
     "quality_table",
+    "library_reference",
+    "summary_graphs",
     "plot_speed",
     "plot_intensity",
     "write_artifacts",
@@ -146,6 +148,8 @@ def speed_table(
 
     rows = []
     for name, g in graphs.items():
+        g.predecessor_table()  # search tables belong to the offline graph
+        g.successor_lists()
         for dur in durations:
             beats, level = song(float(dur), bpm=bpm, seed=seed)
             z = _z(level)
@@ -278,6 +282,50 @@ def quality_table(
                 comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
                 q = quality_proxies(comp, sigma=sigma)
                 rows.append({"method": labels[m], "music_s": float(dur), "seed": int(seed), **q})
+    return pd.DataFrame(rows)
+
+
+def library_reference(clips: Sequence[Any]) -> Any:
+    """Foot sliding and velocity-change statistics of the captured clips themselves.
+
+    The reference for :func:`quality_table`: what the proxies read on real capture.
+    """
+    import pandas as pd
+
+    from .quality import _velocity_change, foot_sliding
+
+    rows = []
+    for c in clips:
+        dv = _velocity_change(c)
+        rows.append(
+            {
+                "clip": c.name,
+                "foot_sliding": foot_sliding(c),
+                "velocity_change_p99_over_median": float(np.percentile(dv, 99) / np.median(dv)),
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def summary_graphs(graphs: dict[str, WeightedMotionGraph]) -> Any:
+    """Size of each graph (deterministic: no timings)."""
+    import pandas as pd
+
+    rows = []
+    for name, g in graphs.items():
+        rows.append(
+            {
+                "library": name,
+                "stands_in_for": LIBRARIES.get(name, ("", ""))[0],
+                "clips": len(g.clips),
+                "beat frames": g.n_nodes,
+                "intervals": g.n_intervals,
+                "transition edges": g.n_transitions,
+                "TH": g.th,
+                "smallest rd": g.min_rd,
+                "median beat interval [s]": float(np.nanmedian(g.interval_duration())),
+            }
+        )
     return pd.DataFrame(rows)
 
 
