@@ -97,6 +97,11 @@ __all__ = [
     "MAX_NORMALISED_ENERGY",
     "MIN_PERIODICITY_CONTRAST",
     "periodicity_contrast",
+    "boundary_errors",
+    "uniform_baseline",
+    "minima_baseline",
+    "synthetic_error_table",
+    "plot_segmentation",
 ]
 
 CONSTANT_REL_STD = 1e-3
@@ -432,11 +437,16 @@ def _edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) ->
     buf_b = np.empty((n_ch, chunk, 2 * wb), dtype=dtype)
     buf_ab = np.empty((n_ch, chunk, w_ab), dtype=dtype)
 
-    def fill(buf: np.ndarray, sigs: list, o: int, m: int) -> np.ndarray:
+    # full-length window views, made once; each block slices them (no copy until fill)
+    b_views = [(sliding_window_view(sig, length, axis=1), off0) for sig, off0, length in b_sigs]
+    ab_views = [(sliding_window_view(sig, length, axis=1), off0) for sig, off0, length in ab_sigs]
+    x_view = sliding_window_view(xp, wb, axis=1)
+
+    def fill(buf: np.ndarray, views: list, o: int, m: int) -> np.ndarray:
         col = 0
-        for sig, off0, length in sigs:
-            src = sig[:, o + off0 : o + off0 + m + length - 1]
-            buf[:, :m, col : col + length] = sliding_window_view(src, length, axis=1)
+        for view, off0 in views:
+            length = view.shape[2]
+            buf[:, :m, col : col + length] = view[:, o + off0 : o + off0 + m]
             col += length
         return buf[:, :m].reshape(n_ch * m, col)
 
@@ -444,10 +454,9 @@ def _edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) ->
         b = b_all[start : start + chunk]
         m = b.size
         o = pad + b[0]  # padded index of the first middle boundary
-        xw = sliding_window_view(xp[:, o : o + m + wb - 1], wb, axis=1)
-        sb = (xw.reshape(n_ch * m, wb) @ U).reshape(n_ch, m, band, band)
-        sbb = (fill(buf_b, b_sigs, o, m) @ G).reshape(n_ch, m, band, band)
-        sab = (fill(buf_ab, ab_sigs, o, m) @ H).reshape(n_ch, m, band, band)
+        sb = (x_view[:, o : o + m].reshape(n_ch * m, wb) @ U).reshape(n_ch, m, band, band)
+        sbb = (fill(buf_b, b_views, o, m) @ G).reshape(n_ch, m, band, band)
+        sab = (fill(buf_ab, ab_views, o, m) @ H).reshape(n_ch, m, band, band)
         st = np.clip(b[:, None] - d0s[None, :], 0, None)
         sa = cs[:, b[:, None] + 1] - cs[:, st]  # (C, m, band)
         saa = cs2[:, b[:, None] + 1] - cs2[:, st]
@@ -986,3 +995,222 @@ def segment(
         period_method=period_method,
         channel_names=names,
     )
+
+
+# ---------------------------------------------- evaluation and figures (notebook fig02)
+
+
+def boundary_errors(estimated: Any, reference: Any, *, remove_offset: bool = False) -> dict:
+    """Boundary error [frames] of estimated against reference boundary frames.
+
+    Each reference boundary inside the estimated span is matched to the nearest
+    estimated boundary.
+
+    Parameters
+    ----------
+    estimated, reference : array_like [frames]
+    remove_offset : bool
+        Subtract the median signed error first (for baselines whose boundaries sit at
+        another phase of the cycle, e.g. minima of one angle).
+
+    Returns
+    -------
+    dict
+        ``mean``, ``max`` [frames], ``n_matched``, ``count_error`` (estimated minus
+        reference number of periods) and ``offset`` [frames].
+    """
+    est = np.asarray(estimated, dtype=np.float64)
+    ref = np.asarray(reference, dtype=np.float64)
+    if est.size == 0 or ref.size == 0:
+        return {"mean": np.nan, "max": np.nan, "n_matched": 0, "count_error": est.size - ref.size,
+                "offset": 0.0}  # fmt: skip
+    idx = np.clip(np.searchsorted(est, ref), 1, max(est.size - 1, 1))
+    left = est[idx - 1]
+    right = est[np.minimum(idx, est.size - 1)]
+    nearest = np.where(np.abs(ref - left) <= np.abs(ref - right), left, right)
+    signed = nearest - ref
+    offset = float(np.median(signed)) if remove_offset else 0.0
+    if remove_offset:
+        shifted = est - offset
+        return boundary_errors(shifted, ref) | {"offset": offset}
+    inside = (ref >= est[0] - 0.5) & (ref <= est[-1] + 0.5)
+    err = np.abs(signed[inside]) if inside.any() else np.abs(signed)
+    return {
+        "mean": float(err.mean()),
+        "max": float(err.max()),
+        "n_matched": int(err.size),
+        "count_error": int(est.size - ref.size),
+        "offset": offset,
+    }
+
+
+def uniform_baseline(
+    values: Any,
+    *,
+    fps: float,
+    period_range: tuple[float, float] = (0.25, 1.25),
+    method: str = "fft",
+) -> np.ndarray:
+    """Baseline: one period estimate, uniform boundaries ``0, T, 2T, ...`` [frames].
+
+    Parameters
+    ----------
+    values : np.ndarray [shape=(n_frames, n_channels)]
+    fps : float > 0 [Hz]
+    period_range : (float, float) [s]
+    method : {"fft", "energy"}
+        Period estimate (see :func:`estimate_period_count`).
+    """
+    fps = check_fps(fps)
+    vals = _as_values(values)
+    keep = _nonconstant(vals)
+    x = _standardise(vals[:, keep])
+    per = _estimate_period(x, fps, check_range(*period_range, name="period_range", unit="s"),
+                           method)  # fmt: skip
+    return _uniform_frames(vals.shape[0], per)
+
+
+def minima_baseline(signal: Any, *, fps: float, period: float) -> np.ndarray:
+    """Baseline: local minima of one joint angle as period boundaries [frames].
+
+    Minima at least ``0.7 * period`` apart (``scipy.signal.find_peaks`` on the negated,
+    lightly smoothed signal).
+
+    Parameters
+    ----------
+    signal : np.ndarray [shape=(n_frames,)]
+        One angle, e.g. a knee.
+    fps : float > 0 [Hz]
+    period : float > 0 [s]
+        Expected period (e.g. from :func:`uniform_baseline`'s estimate).
+    """
+    from scipy.ndimage import uniform_filter1d
+    from scipy.signal import find_peaks
+
+    fps = check_fps(fps)
+    y = check_finite(np.asarray(signal, dtype=np.float64).ravel(), name="signal")
+    dist = max(1, int(0.7 * float(period) * fps))
+    smooth = uniform_filter1d(y, size=max(1, int(round(0.05 * fps)) | 1))
+    peaks, _ = find_peaks(-smooth, distance=dist)
+    return peaks.astype(np.int64)
+
+
+def synthetic_error_table(
+    *,
+    snr_dbs: Sequence[float | None] = (30.0, 20.0, 10.0, 5.0),
+    alphas: Sequence[float] = (0.1, 0.2),
+    seeds: Sequence[int] = (0, 1, 2),
+    n_frames: int = 750,
+    n_channels: int = 29,
+    fps: float = 25.0,
+    n_periods: int = 25,
+    jitter: float = 0.08,
+    variation: float = 0.05,
+) -> Any:
+    """Boundary error vs ground truth over noise levels and alpha (notebook fig02).
+
+    For every SNR, alpha and seed: a :func:`beatsync.synth.motion.periodic_motion`
+    signal, segmented (a) by :func:`segment` with the period count estimated
+    (``"energy"``), (b) with the count given, and baselines (c) FFT period + uniform
+    boundaries and (d) local minima of channel 0 (offset-corrected, see
+    :func:`boundary_errors`). Errors in frames, averaged over seeds (``max``: max).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (SNR, alpha, method).
+    """
+    import pandas as pd
+
+    from .synth.motion import periodic_motion
+
+    rows = []
+    for snr in snr_dbs:
+        for alpha in alphas:
+            per_method: dict[str, list[dict]] = {}
+            for seed in seeds:
+                s = periodic_motion(n_frames=n_frames, n_channels=n_channels, fps=fps,
+                                    n_periods=n_periods, jitter=jitter, variation=variation,
+                                    snr_db=snr, seed=seed)  # fmt: skip
+                truth = s.boundary_frames
+                vals = s.motion.values
+                found = {}
+                for name, kw in (("optimal, count estimated", {}),
+                                 ("optimal, count given", {"n_periods": n_periods})):  # fmt: skip
+                    try:
+                        seg = segment_values(vals, fps=fps, alpha=alpha, **kw)
+                        found[name] = (seg.boundary_frames, False)
+                    except ParameterError:
+                        found[name] = (np.array([], dtype=np.int64), False)
+                uni = uniform_baseline(vals, fps=fps, method="fft")
+                found["baseline: FFT period + uniform"] = (uni, False)
+                per = (uni[-1] - uni[0]) / max(uni.size - 1, 1) / fps
+                found["baseline: minima of channel 0"] = (
+                    minima_baseline(vals[:, 0], fps=fps, period=per),
+                    True,
+                )
+                for name, (fr, off) in found.items():
+                    per_method.setdefault(name, []).append(
+                        boundary_errors(fr, truth, remove_offset=off)
+                    )
+            for name, errs in per_method.items():
+                rows.append({
+                    "snr_db": snr if snr is not None else np.inf,
+                    "alpha": alpha,
+                    "method": name,
+                    "mean_error_frames": float(np.nanmean([e["mean"] for e in errs])),
+                    "max_error_frames": float(np.nanmax([e["max"] for e in errs])),
+                    "failed_runs": int(sum(e["n_matched"] == 0 for e in errs)),
+                    "count_error": float(np.mean([abs(e["count_error"]) for e in errs])),
+                })  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def plot_segmentation(
+    motion: Motion,
+    seg: Segmentation,
+    channels: Sequence[str],
+    *,
+    title: str = "",
+    truth: Any = None,
+    ax: Any = None,
+) -> Any:
+    """Plot joint angles with the found period boundaries (paper A, Figure 2 style).
+
+    Parameters
+    ----------
+    motion : Motion
+    seg : Segmentation
+    channels : sequence of str
+        Channels to draw, e.g. left and right knee.
+    title : str
+    truth : array_like [s], optional
+        Ground-truth boundaries, drawn dashed.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(10, 2.8))
+    else:
+        fig = ax.figure
+    t = motion.times
+    for name in channels:
+        v = motion.values[:, motion.channel_index(name)]
+        if name.lower().endswith("rotation"):
+            v = np.unwrap(v, period=360.0)
+        ax.plot(t, v, lw=1.0, label=name)
+    for i, b in enumerate(seg.boundaries):
+        ax.axvline(b, color="k", lw=0.8, alpha=0.7, label="found boundaries" if i == 0 else None)
+    if truth is not None:
+        for i, b in enumerate(np.asarray(truth)):
+            ax.axvline(b, color="r", lw=0.8, ls="--", label="ground truth" if i == 0 else None)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("angle [deg]")
+    ax.set_title(title or f"{motion.name}: {seg.n_periods} periods, mean {seg.mean_period:.3f} s")
+    ax.legend(loc="upper right", fontsize=7, ncol=4)
+    return fig
