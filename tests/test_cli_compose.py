@@ -124,6 +124,8 @@ def _odd_clip(path):
         ("silent", "silent"),
         ("one_beat", "need >= 2"),
         ("missing_clip", "does not exist"),
+        ("tempo_neg", "--tempo-weight"),
+        ("not_bvh_out", "must end in .bvh"),
     ],
 )
 def test_bad_inputs_write_nothing(workdir, capsys, case, message):
@@ -149,8 +151,10 @@ def test_bad_inputs_write_nothing(workdir, capsys, case, message):
         extra = ["--beats", str(workdir / "one.beats")]
     elif case == "missing_clip":
         lib.append(str(workdir / "nope.bvh"))
+    elif case == "tempo_neg":
+        extra += ["--tempo-weight", "-1"]
     before = _outputs(workdir)
-    out = workdir / "dance.bvh"
+    out = workdir / ("dance.csv" if case == "not_bvh_out" else "dance.bvh")
     argv = [
         "compose",
         song,
@@ -168,3 +172,25 @@ def test_bad_inputs_write_nothing(workdir, capsys, case, message):
     assert "Traceback" not in err
     assert _outputs(workdir) == before
     assert not out.exists()
+
+
+@pytest.mark.parametrize("method", ["conventional", "random"])
+def test_compose_other_methods(workdir, capsys, method):
+    out = workdir / f"{method}.bvh"
+    argv = [
+        "compose",
+        str(workdir / "song.wav"),
+        "--library",
+        str(workdir / "lib"),
+        "--beats",
+        str(workdir / "song.beats"),
+        "--method",
+        method,
+        "-o",
+        str(out),
+        "--json",
+    ]
+    assert main(argv) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["method"] == method
+    assert io.read_bvh(out).n_frames == res["n_frames"]

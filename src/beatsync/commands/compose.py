@@ -19,6 +19,7 @@ import argparse
 import hashlib
 import json
 import os
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -279,7 +280,13 @@ def run(args: argparse.Namespace) -> int:
     if chk["video"] is not None:
         from ..render import write_video
 
-        video_path = write_video(comp.motion, chk["video"], audio=(y, sr), beats=comp.music_beats)
+        video_path = write_video(
+            comp.motion,
+            chk["video"],
+            audio=(y, sr),
+            beats=comp.music_beats,
+            progress=sys.stderr.isatty(),
+        )
     result = {
         "output": str(out),
         "video": str(video_path) if video_path else None,
