@@ -58,12 +58,11 @@ def main() -> int:
     with contextlib.suppress(AttributeError, OSError):
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
 
-    from beatsync.segment import segment
-
     import beatsync
     from beatsync import datasets, io
     from beatsync.beats import track_beats
     from beatsync.cli import main as cli_main
+    from beatsync.segment import segment
     from beatsync.sync import synchronize
     from beatsync.synth.audio import beat_times, drum_pattern
 
@@ -103,7 +102,7 @@ def main() -> int:
         ("synchronize (warp + slerp resampling)", t_sync),
         ("write BVH", t_write),
         ("sum of stages", t_e2e),
-        ("`beatsync sync` command (one process call)", t_cli),
+        ("`beatsync sync` command (cli.main in process, with file I/O)", t_cli),
     ]:
         rows.append({"step": name, "seconds": t, "ratio_to_beat_tracking": t / t_beats})
 
