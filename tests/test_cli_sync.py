@@ -29,6 +29,8 @@ def inputs(tmp_path_factory):
     io.write_beats(d / "song.beats", beats)
     io.write_audio(d / "short.wav", click_track(np.array([0.05]), sr=SR, duration=0.3), SR)
     io.write_audio(d / "silence.wav", np.zeros(5 * SR, dtype=np.float32), SR)
+    tone = 0.3 * np.sin(2 * np.pi * 440.0 * np.arange(5 * SR) / SR)
+    io.write_audio(d / "tone.wav", tone.astype(np.float32), SR)  # sound without beats
     # a table without skeleton (joint angles), and pure noise (not periodic)
     io.write_table(d / "angles.csv", salsa.select([c for c in salsa.channels if "rotation" in c]))
     rng = np.random.default_rng(0)
@@ -136,6 +138,7 @@ BAD = [
      "periodic"),
     (["{d}/salsa.bvh", "{d}/silence.wav", "-o", "{o}/x.bvh"], "silen"),
     (["{d}/salsa.bvh", "{d}/short.wav", "-o", "{o}/x.bvh"], "shorter"),
+    (["{d}/salsa.bvh", "{d}/tone.wav", "-o", "{o}/x.bvh"], "no detectable beats"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--video", "{d}/song.wav"],
      "same|mp4"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--first-beat", "500",
