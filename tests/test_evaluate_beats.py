@@ -1,0 +1,83 @@
+"""Tests of the mir_eval.beat wrapper (beatsync.evaluate.beats)."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.evaluate.beats import METRICS, evaluate_beats, octave_relation
+
+REF = np.arange(0.5, 20.0, 0.5)
+
+
+def test_perfect_estimate_scores_one():
+    s = evaluate_beats(REF, REF, min_beat_time=0.0)
+    assert set(s) == set(METRICS)
+    for k in METRICS:
+        if k != "Information gain":
+            assert s[k] == pytest.approx(1.0), k
+    assert s["Information gain"] == pytest.approx(1.0)
+
+
+def test_double_tempo_is_any_level_only():
+    est = np.arange(0.5, 20.0, 0.25)
+    s = evaluate_beats(REF, est, min_beat_time=0.0)
+    assert s["Correct Metric Level Total"] == 0.0
+    assert s["Any Metric Level Total"] > 0.9
+    assert s["F-measure"] == pytest.approx(2 / 3, abs=0.01)
+
+
+def test_min_beat_time_is_applied():
+    est = REF.copy()
+    est[:4] += 0.2  # wrong only in the first 2 s
+    assert evaluate_beats(REF, est, min_beat_time=0.0)["F-measure"] < 1.0
+    assert evaluate_beats(REF, est, min_beat_time=2.3)["F-measure"] == pytest.approx(1.0)
+
+
+def test_min_beat_time_required():
+    with pytest.raises(TypeError):
+        evaluate_beats(REF, REF)  # type: ignore[call-arg]
+
+
+def test_empty_estimate_warns_zero():
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        s = evaluate_beats(REF, np.array([]), min_beat_time=0.0)
+    assert all(v == 0.0 for v in s.values())
+    assert any(issubclass(w.category, BeatsyncWarning) for w in rec)
+
+
+@pytest.mark.parametrize(
+    "ref, est, mbt",
+    [
+        (REF[::-1], REF, 0.0),  # not increasing
+        (REF, np.r_[REF[:3], REF[2:]], 0.0),  # duplicate
+        (REF * 1000, REF, 0.0),  # milliseconds
+        (REF, np.r_[-0.1, REF], 0.0),  # negative time
+        (REF, np.r_[REF, np.nan], 0.0),  # NaN
+        (REF.reshape(-1, 1), REF, 0.0),  # 2-D
+        (REF, REF, -1.0),  # negative min_beat_time
+        (REF, REF, float("nan")),
+        (REF, REF, "five"),
+    ],
+)
+def test_bad_input_raises(ref, est, mbt):
+    with pytest.raises(ParameterError):
+        evaluate_beats(ref, est, min_beat_time=mbt)
+
+
+@pytest.mark.parametrize(
+    "est, ref, name",
+    [
+        (120, 120, "correct"),
+        (240, 120, "double"),
+        (61, 120, "half"),
+        (180, 60, "triple"),
+        (40, 120, "third"),
+        (100, 120, "other"),
+        (float("nan"), 120, "other"),
+    ],
+)
+def test_octave_relation(est, ref, name):
+    assert octave_relation(est, ref) == name
