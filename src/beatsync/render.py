@@ -288,7 +288,7 @@ def plot_beat_timeline(
     ax.set_xlabel("time [s]")
     ax.set_ylabel("speed [unit/s]")
     ax.set_xlim(t[0], t[-1])
-    ax.legend(loc="upper right", fontsize=7, ncol=4)
+    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=7, ncol=4, frameon=False)
     return fig
 
 
