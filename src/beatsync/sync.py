@@ -89,6 +89,13 @@ _TAPER = 0.25
 _MIN_BUMP = -0.9
 
 
+def _is_whole(x: Any) -> bool:
+    """True for an integer-valued number (not a bool, not a string)."""
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+        return False
+    return bool(np.isfinite(x)) and float(x).is_integer()
+
+
 def _bump(u: np.ndarray, taper: float | None = None) -> np.ndarray:
     """Correction shape on the period phase ``u`` in [0, 1]: 0 at both ends, 1 in the
     middle, with raised-cosine ramps over ``taper`` of the period at each end."""
@@ -133,7 +140,7 @@ def beats_per_period(
     2
     """
     if override is not None:
-        if isinstance(override, bool) or not float(override).is_integer() or override < 1:
+        if not _is_whole(override) or override < 1:
             raise ParameterError(
                 f"beats_per_period={override!r} must be a whole number of beats >= 1"
             )
@@ -454,7 +461,7 @@ def synchronize(
             f"the music has {beats.size} detectable beat(s); at least 2 are needed "
             "(is it silent or without rhythm? give the tempo with bpm / --bpm)"
         )
-    if isinstance(first_beat, bool) or not float(first_beat).is_integer() or first_beat < 0:
+    if not _is_whole(first_beat) or first_beat < 0:
         raise ParameterError(f"first_beat={first_beat!r} must be a beat index >= 0")
     first_beat = int(first_beat)
     if first_beat >= beats.size:
