@@ -51,6 +51,10 @@ Method (what the paper leaves open, and our choices)
    fit are dropped and the output ends at the last boundary used.
 6. Output frames at ``k / out_fps`` are mapped back to source times by inverting the
    warp, and the motion is evaluated there with :func:`beatsync.rotations.sample_motion`.
+   Output frames run from music time 0 to the first frame at or after the warp's end
+   (motion warped to negative music times, before the song starts, is dropped).
+7. ``phase_offset`` [s] lands the boundaries that long after their beats, e.g. to put
+   the dancer's accents rather than the segmentation's boundaries on the beat.
 
 The residual of a boundary is measured twice in the report: on the warp as realised
 by the output frames (``residual_ms``: the music time at which the resampled motion
