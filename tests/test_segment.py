@@ -68,8 +68,8 @@ def _brute_force(x, lo, hi):
     def rec(fr):
         nonlocal best
         if len(fr) >= 3 and fr[-1] >= n - lo:
-            e = S.segmentation_energy(x, np.array(fr))
-            if e < best[0]:
+            e = S.segmentation_energy(x, np.array(fr)) / (len(fr) - 2)  # mean per pair
+            if e < best[0] - 1e-12:
                 best = (e, list(fr))
         for d in range(lo, hi + 1):
             if fr[-1] + d <= n - 1:
@@ -90,12 +90,19 @@ def test_dp_equals_literal_and_brute_force(seed):
     t = np.arange(n)
     raw = np.sin(2 * np.pi * t / rng.uniform(4, 8))[:, None] + 0.5 * rng.standard_normal((n, n_ch))
     x = S._standardise(raw)
-    f_fast, e_fast = S._shortest_path(S._edge_costs(x, lo, hi), n, lo, hi)
+    cost = S._edge_costs(x, lo, hi)
+    # plain argmin E (one DP pass) against the literal loops
+    f0, e0 = S._shortest_path(cost, n, lo, hi)
+    f0_lit, e0_lit = S._segment_literal(x, lo, hi, 0.0)
+    assert e0 == pytest.approx(e0_lit, abs=1e-9)
+    assert np.array_equal(f0, f0_lit)
+    # the objective of segment(): min E / (p - 1), vs literal and brute force
+    f_fast, e_fast = S._min_mean_energy(lambda r: S._shortest_path(cost, n, lo, hi, r))
     f_lit, e_lit = S._segment_literal(x, lo, hi)
-    e_bf, f_bf = _brute_force(x, lo, hi)
+    m_bf, f_bf = _brute_force(x, lo, hi)
     assert e_fast == pytest.approx(e_lit, abs=1e-9)
-    assert e_fast == pytest.approx(e_bf, abs=1e-9)
     assert np.array_equal(f_fast, f_lit)
+    assert e_fast / (f_fast.size - 2) == pytest.approx(m_bf, abs=1e-9)
     assert S.segmentation_energy(x, f_fast) == pytest.approx(e_fast, abs=1e-9)
 
 

@@ -29,8 +29,13 @@ stay inside the alpha band around the nominal period ``L = (n-1)/p`` (eq. 3):
 (eqs. 4-5) is a shortest path in a forward DAG whose nodes are consecutive boundary
 pairs ``(t_{i-1}, t_i)``, with a virtual end node joined to every pair ending in the
 tail of the clip; the DAG is solved by dynamic programming in frame order (no heap).
-Because the graph has no period index, the optimum may use a period count within
-the band other than ``p``; :attr:`Segmentation.n_periods` reports the count found.
+Because the graph has no period index (and the ends are free, see below), the
+optimum may use a period count within the band other than ``p``; minimising ``E``
+itself would then favour one period fewer (one term fewer), so the optimum minimises
+the mean energy per consecutive pair ``E / (p - 1)`` (Dinkelbach iteration over the
+same DP: ``argmin E - lambda (p - 1)``, ``lambda`` updated to the current mean; for a
+fixed count this is exactly the paper's ``argmin E``).
+:attr:`Segmentation.n_periods` reports the count found.
 
 Edge costs dominate the time. They are computed for all ``(middle boundary, earlier
 length, later length)`` at once (in float32; on z-scored channels an edge cost then
@@ -56,9 +61,10 @@ Documented rules (choices the paper leaves open)
   uniform segmentation at the found period is than uniform segmentations at 0.5,
   0.75, 1.25 and 1.5 times it) is below ``MIN_PERIODICITY_CONTRAST`` (0.05).
   Calibration (default channels, both period methods): CMU salsa 60_01/61_01/60_04/
-  61_04 0.06-0.13, CMU walks 007_* 1.06-1.27, MoCap Toolbox dance1/dance2/walk1/walk2
-  0.10-0.82; the CMU 005_02 pirouette -0.15 and -0.02; white noise (16 trials) <= 0.02.
-  Known limit: a random walk (integrated noise) passed in 3 of 16 trials (up to 0.11).
+  61_04 0.053-0.16, CMU walks 007_* 1.06-1.27, MoCap Toolbox dance1/dance2/walk1/walk2
+  0.14-0.90; the CMU 005_02 pirouette -0.16 and -0.12; white noise (4 or 29 channels,
+  16 trials) <= 0.04. Known limits: the margin is small (salsa 61_04 with the FFT
+  period: 0.053), and a random walk (integrated noise) passed in 7 of 16 trials.
 - Free ends: real clips do not start or end on a period boundary, so the first
   boundary may lie anywhere in the lead-in ``t_0 < lo`` and the last in the tail
   ``t_p >= n - lo`` (``lo``: shortest allowed period); the band of eq. 3 is rounded
@@ -460,7 +466,7 @@ def _edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) ->
         st = np.clip(b[:, None] - d0s[None, :], 0, None)
         sa = cs[:, b[:, None] + 1] - cs[:, st]  # (C, m, band)
         saa = cs2[:, b[:, None] + 1] - cs2[:, st]
-        ss_a = (saa - sa * sa / n0[:, 0] + floor[:, 0]).astype(dtype)
+        ss_a = (np.maximum(saa - sa * sa / n0[:, 0], 0.0) + floor[:, 0]).astype(dtype)
         sa = sa.astype(dtype)
         # cov = sab - sa * sb / n0 ; ss_b = sbb - sb^2 / n0 (in place, to save passes)
         sb /= n0.astype(dtype)
@@ -468,10 +474,12 @@ def _edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) ->
         sb *= sb
         sb *= n0.astype(dtype)
         sbb -= sb
+        np.maximum(sbb, 0, out=sbb)  # rounding can leave a flat period slightly negative
         sbb += floor.astype(dtype)
         sbb *= ss_a[..., None]
         np.sqrt(sbb, out=sbb)
         sab /= sbb
+        np.clip(sab, -1.0, 1.0, out=sab)  # r of a (near-)flat period: rounding noise
         cost[b] = n_ch - sab.sum(axis=0, dtype=np.float64)
     bb = np.arange(n)[:, None, None]
     valid = (bb - d0s[None, :, None] >= 0) & (bb + d0s[None, None, :] <= n - 1)
@@ -482,7 +490,9 @@ def _edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) ->
 # ---------------------------------------------------------------------- the optimum
 
 
-def _shortest_path(cost: np.ndarray, n: int, lo: int, hi: int) -> tuple[np.ndarray, float]:
+def _shortest_path(
+    cost: np.ndarray, n: int, lo: int, hi: int, reward: float = 0.0
+) -> tuple[np.ndarray, float]:
     """DP over the forward DAG of boundary pairs, in frame order (eqs. 4-5).
 
     ``V[b, i]`` is the least energy of a chain of periods ending at frame ``b`` whose
@@ -509,7 +519,7 @@ def _shortest_path(cost: np.ndarray, n: int, lo: int, hi: int) -> tuple[np.ndarr
         ok = prev >= lo
         pc = np.where(ok, prev, 0)
         # total[m, i1, i0] = Vb[prev, i0] + cost[prev, i0, i1]
-        total = Vb[pc] + cost[pc, :, np.arange(band)[None, :]]
+        total = Vb[pc] + (cost[pc, :, np.arange(band)[None, :]] - reward)
         total = np.where(ok[..., None], total, np.inf)
         best = np.argmin(total, axis=2)
         V1[b] = np.take_along_axis(total, best[..., None], axis=2)[..., 0]
@@ -519,8 +529,8 @@ def _shortest_path(cost: np.ndarray, n: int, lo: int, hi: int) -> tuple[np.ndarr
     tail = V1[n - lo :]  # candidates for the virtual end node
     flat = int(np.argmin(tail))
     end, i = n - lo + flat // band, flat % band
-    energy = float(V1[end, i])
-    if not np.isfinite(energy):
+    value = float(V1[end, i])
+    if not np.isfinite(value):
         raise ParameterError(
             "the clip is too short for two periods within the alpha band (internal)"
         )
@@ -537,10 +547,33 @@ def _shortest_path(cost: np.ndarray, n: int, lo: int, hi: int) -> tuple[np.ndarr
     frames = np.array(frames[::-1], dtype=np.int64)
     if frames[0] >= lo or frames.size < 3:
         raise ParameterError("internal error: optimal path does not start in the lead-in")
+    return frames, value + reward * (frames.size - 2)
+
+
+def _min_mean_energy(solve: Any, max_iter: int = 30) -> tuple[np.ndarray, float]:
+    """Dinkelbach iteration: the segmentation minimising ``E / (p - 1)``.
+
+    ``solve(reward)`` returns the frames and energy ``E`` of ``argmin E - reward (p-1)``.
+    Starting from ``reward = 0`` (plain ``argmin E``), the reward is set to the mean
+    energy per pair of the current solution until it no longer decreases (a few DP
+    passes). With a fixed period count this is the paper's ``argmin E``; with free
+    ends it stops the optimum from dropping a period at an end just to have one term
+    fewer.
+    """
+    frames, energy = solve(0.0)
+    ratio = energy / (frames.size - 2)
+    for _ in range(max_iter):
+        f_new, e_new = solve(ratio)
+        r_new = e_new / (f_new.size - 2)
+        if r_new >= ratio - 1e-12:
+            break
+        frames, energy, ratio = f_new, e_new, r_new
     return frames, energy
 
 
-def _segment_literal(x: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray, float]:
+def _segment_literal(
+    x: np.ndarray, lo: int, hi: int, reward: float | None = None
+) -> tuple[np.ndarray, float]:
     """Reference: direct, loop-by-loop implementation of eqs. 1-5 (no vectorisation).
 
     Builds every edge of the DAG of boundary pairs with one Python loop per edge and
@@ -554,11 +587,16 @@ def _segment_literal(x: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray, float
         Standardised channels (see :func:`_standardise`).
     lo, hi : int [frames]
         Alpha band of period lengths.
+    reward : float or None
+        Solve ``argmin E - reward (p - 1)``; ``None``: the Dinkelbach iteration of
+        :func:`_min_mean_energy` over such solves (the objective of :func:`segment`).
 
     Returns
     -------
-    boundary frames, energy
+    boundary frames, energy E
     """
+    if reward is None:
+        return _min_mean_energy(lambda r: _segment_literal(x, lo, hi, r))
     n_ch, n = x.shape
     floor_rel = _FLAT_REL_VAR
     start: set[tuple[int, int]] = set()
@@ -589,7 +627,7 @@ def _segment_literal(x: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray, float
                         va += (a_seg[k] - ma) ** 2
                         vb += (b_seg[k] - mb) ** 2
                     e += 1.0 - num / np.sqrt(va * vb)
-                cand = here + e
+                cand = here + e - reward
                 if cand < best.get((t1, t2), np.inf):
                     best[(t1, t2)] = cand
                     back[(t1, t2)] = (t0, t1)
@@ -604,7 +642,8 @@ def _segment_literal(x: np.ndarray, lo: int, hi: int) -> tuple[np.ndarray, float
         if prev in start and (prev not in best or 0.0 <= best[prev]):
             break
         node = prev
-    return np.array(frames[::-1], dtype=np.int64), float(energy)
+    frames_arr = np.array(frames[::-1], dtype=np.int64)
+    return frames_arr, float(energy) + reward * (frames_arr.size - 2)
 
 
 def _band(nominal: float, alpha: float) -> tuple[int, int]:
@@ -699,7 +738,18 @@ def _estimate_period(
     e = _uniform_energy(x, cands)
     if np.all(np.isnan(e)):
         raise ParameterError("clip too short for two periods of the requested range")
-    return float(cands[np.nanargmin(e)])
+    e = np.where(np.isnan(e), np.inf, e)
+    best = int(np.argmin(e))
+    edge = max(1, cands.size // 50)
+    if best < edge:
+        # a minimum at the short end of the range: short windows of a slow signal
+        # correlate trivially (ramps); prefer the lowest interior local minimum
+        inner = np.arange(edge, cands.size - edge)
+        is_min = (e[inner] <= e[inner - 1]) & (e[inner] <= e[inner + 1])
+        if is_min.any():
+            mins = inner[is_min]
+            best = int(mins[np.argmin(e[mins])])
+    return float(cands[best])
 
 
 def estimate_period_count(
@@ -724,7 +774,9 @@ def estimate_period_count(
         period ``T`` minimising the energy of the uniform segmentation ``0, T, 2T, ...``
         per pair of consecutive periods (``E(U) / (s - 1)``; the paper writes ``E/s``,
         which favours fewer, longer periods on short clips), over a 0.25-frame grid
-        (at most 400 log-spaced candidates).
+        (at most 400 log-spaced candidates). If the minimum lies at the short end of
+        the range (where short windows of a slow signal correlate trivially), the
+        lowest interior local minimum is taken instead (if any).
 
     Returns
     -------
@@ -900,7 +952,7 @@ def segment_values(
             "frames; increase alpha"
         )
     cost = _edge_costs(x, lo, hi, dtype=_FAST_DTYPE)
-    frames, energy = _shortest_path(cost, n, lo, hi)
+    frames, energy = _min_mean_energy(lambda r: _shortest_path(cost, n, lo, hi, r))
     n_found = frames.size - 1
     e_norm = energy / (x.shape[0] * max(n_found - 1, 1))
     contrast = periodicity_contrast(x, frames)
