@@ -647,31 +647,37 @@ def _window_energy(env: np.ndarray, fps: float, times: np.ndarray, reach_s: floa
     return cs[b] - cs[a]
 
 
-def _level_factor(env, fps, beats, level_ratio: float, accent_ratio: float) -> float:
-    """Factor on the beat period (1/2, 1/3, 2 or 1) from onset energies around beats."""
+def _uniformity(signals, fps: float, a: np.ndarray, b: np.ndarray) -> float:
+    """How alike two pulse trains are in onset energy: min/max of their mean squared
+    window energies, the larger over the given onset signals (0: one is silent, 1: equal).
+    """
+    best = 0.0
+    for env in signals:
+        ea = np.mean(_window_energy(env, fps, a) ** 2)
+        eb = np.mean(_window_energy(env, fps, b) ** 2)
+        if max(ea, eb) > 0:
+            best = max(best, min(ea, eb) / max(ea, eb))
+    return best
+
+
+def _level_factor(signals, fps, beats, level_ratio: float) -> float:
+    """Factor on the beat period (1/2, 1/3, 2 or 1) deciding the metrical level.
+
+    One rule: a pulse is the beat if its alternate pulses carry comparable onset energy
+    (uniformity >= ``level_ratio``), in the band-weighted onset signal or in the lowest
+    band (kick and snare, not the hi-hat). The faster pulse (halves, thirds) is tried
+    first; if the current beats themselves alternate strong/weak, the slower pulse wins.
+    """
     d = np.diff(beats)
-    on = np.mean(_window_energy(env, fps, beats) ** 2)
-    if on <= 0:
-        return 1.0
-    half = np.mean(_window_energy(env, fps, beats[:-1] + d / 2) ** 2) / on
-    third = (
-        np.mean(
-            np.minimum(
-                _window_energy(env, fps, beats[:-1] + d / 3),
-                _window_energy(env, fps, beats[:-1] + 2 * d / 3),
-            )
-            ** 2
-        )
-        / on
-    )
-    s_beat = _window_energy(env, fps, beats) ** 2
-    odd, even = s_beat[1::2].mean(), s_beat[0::2].mean()
-    alt = min(odd, even) / max(odd, even, 1e-12)
-    if half >= level_ratio:
+    if _uniformity(signals, fps, beats[:-1], beats[:-1] + d / 2) >= level_ratio:
         return 0.5
-    if third >= level_ratio:
+    thirds = min(
+        _uniformity(signals, fps, beats[:-1], beats[:-1] + d / 3),
+        _uniformity(signals, fps, beats[:-1], beats[:-1] + 2 * d / 3),
+    )
+    if thirds >= level_ratio:
         return 1.0 / 3.0
-    if alt <= accent_ratio:
+    if beats.size >= 4 and _uniformity(signals, fps, beats[0::2], beats[1::2]) < level_ratio:
         return 2.0
     return 1.0
 
@@ -734,8 +740,7 @@ def _track_psf(
     tempo_hop_s,
     time_varying,
     power: float = 2.0,
-    level_ratio: float = 0.5,
-    accent_ratio: float = 0.42,
+    level_ratio: float = 0.45,
 ) -> BeatTrack:
     fps = ons.fps
     raw = ons.envelope
@@ -780,7 +785,7 @@ def _track_psf(
                 sel = beats[(beats >= lo) & (beats < hi)]
                 if sel.size < 4:
                     continue
-                factor = _level_factor(raw, fps, sel, level_ratio, accent_ratio)
+                factor = _level_factor((raw, ons.bands[0]), fps, sel, level_ratio)
                 tempo_new = 60.0 / np.median(period_w[a:b]) / factor
                 if min_bpm <= tempo_new <= max_bpm:
                     new[a:b] = period_w[a:b] * factor
