@@ -24,7 +24,15 @@ from scipy.spatial.transform import Rotation
 from .errors import ParameterError
 from .units import check_finite, check_fps
 
-__all__ = ["Joint", "Skeleton", "Motion", "marker_angles", "fill_gaps"]
+__all__ = [
+    "Joint",
+    "Skeleton",
+    "Motion",
+    "marker_angles",
+    "fill_gaps",
+    "is_marker_motion",
+    "segmentation_view",
+]
 
 _ROT_DOFS = ("Xrotation", "Yrotation", "Zrotation")
 _POS_DOFS = ("Xposition", "Yposition", "Zposition")
@@ -381,3 +389,19 @@ def marker_angles(motion: Motion) -> Motion:
     )
     check_finite(values, name="marker angles")
     return Motion(values, motion.fps, names, None, motion.name)
+
+
+def is_marker_motion(motion: Motion) -> bool:
+    """True for marker positions (channels ``"<marker>_x/_y/_z"``, no skeleton)."""
+    return motion.skeleton is None and all(
+        c.rsplit("_", 1)[-1] in ("x", "y", "z") for c in motion.channels
+    )
+
+
+def segmentation_view(motion: Motion) -> Motion:
+    """The joint-angle motion that segmentation works on (paper A works on joint angles).
+
+    BVH motion and angle tables are returned as they are; marker positions are
+    turned into joint angles with :func:`marker_angles`.
+    """
+    return marker_angles(motion) if is_marker_motion(motion) else motion
