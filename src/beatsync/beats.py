@@ -256,26 +256,36 @@ def phase_slope(
     return _phase_slope(y, sr, fe)
 
 
+def _bin_bands(freqs: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Band index of each FFT bin (-1 outside the edges; the top edge is inclusive)."""
+    band = np.searchsorted(edges, freqs, side="right") - 1
+    band[freqs == edges[-1]] = edges.size - 2
+    band[(freqs < edges[0]) | (freqs > edges[-1])] = -1
+    return band
+
+
+def _band_matrix(freqs: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Membership of each FFT bin in each band, shape (n_bands, n_bins), float32."""
+    band = _bin_bands(freqs, edges)
+    return (band[None, :] == np.arange(edges.size - 1)[:, None]).astype(np.float32)
+
+
 def _phase_slope(y, sr, fe):
     win, hop, n_fft = fe["win"], fe["hop"], fe["n_fft"]
     w = scipy.signal.get_window("hann", win, fftbins=True)
     ramp = np.arange(win) - (win - 1) / 2.0  # time ramp centred on the frame centre
     # librosa centres a win-length window inside the n_fft frame; same for both STFTs
-    X = librosa.stft(y, n_fft=n_fft, hop_length=hop, win_length=win, window=w, center=True)
-    Y = librosa.stft(y, n_fft=n_fft, hop_length=hop, win_length=win, window=w * ramp, center=True)
+    y32 = y.astype(np.float32)
+    X = librosa.stft(y32, n_fft=n_fft, hop_length=hop, win_length=win, window=w, center=True)
+    Y = librosa.stft(y32, n_fft=n_fft, hop_length=hop, win_length=win, window=w * ramp, center=True)
     freqs = librosa.fft_frequencies(sr=sr, n_fft=n_fft)
-    edges = fe["edges"]
+    member = _band_matrix(freqs, fe["edges"])  # (n_bands, n_bins)
     power = X.real**2 + X.imag**2
     cross = X.real * Y.real + X.imag * Y.imag  # Re(X conj(Y))
-    band = np.digitize(freqs, edges) - 1  # band index of each bin
-    n_bands = edges.size - 1
-    band = np.where(freqs >= edges[-1], n_bands - 1 if freqs[-1] <= edges[-1] else -1, band)
-    energy = np.zeros((n_bands, X.shape[1]))
-    num = np.zeros_like(energy)
-    for c in range(n_bands):
-        sel = band == c
-        energy[c] = power[sel].sum(axis=0)
-        num[c] = cross[sel].sum(axis=0)
+    del Y
+    # energy-weighted average over the band's bins: sums as one matrix product each
+    energy = (member @ power).astype(np.float64)
+    num = (member @ cross).astype(np.float64)
     floor = 1e-10 * max(float(energy.max()), 1e-30)
     with np.errstate(invalid="ignore", divide="ignore"):
         centroid = num / energy  # samples relative to the frame centre
@@ -348,15 +358,12 @@ def _onsets(y: np.ndarray, sr: float, fe: dict[str, Any]) -> OnsetSignal:
     psf, energy, fps, mag = _phase_slope(y, sr, fe)
     n_bands, n_frames = psf.shape
     freqs = librosa.fft_frequencies(sr=sr, n_fft=fe["n_fft"])
-    band = np.clip(np.digitize(freqs, fe["edges"]) - 1, 0, n_bands - 1)
-    logmag = np.log1p(100.0 * mag)
-    diff = np.maximum(np.diff(logmag, axis=1, prepend=logmag[:, :1]), 0.0)
-    flux = np.stack(
-        [
-            diff[band == c].mean(axis=0) if np.any(band == c) else np.zeros(n_frames)
-            for c in range(n_bands)
-        ]
-    )
+    member = _band_matrix(freqs, fe["edges"])
+    logmag = np.log1p(np.float32(100.0) * mag)
+    diff = np.diff(logmag, axis=1, prepend=logmag[:, :1])
+    np.maximum(diff, 0.0, out=diff)
+    counts = np.maximum(member.sum(axis=1, keepdims=True), 1.0)
+    flux = (member @ diff).astype(np.float64) / counts  # mean over the band's bins
     if fe["flux_norm_s"] > 0:
         size = max(int(round(fe["flux_norm_s"] * fps)), 3)
         flux = np.maximum(flux - scipy.ndimage.uniform_filter1d(flux, size, axis=1), 0.0)

@@ -15,15 +15,27 @@ Notebook: ``notebooks/tab_beat_tracking.ipynb``; paper A, section 4.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from typing import Any
 
 import mir_eval
 import numpy as np
+import pandas as pd
 
 from ..errors import BeatsyncWarning, ParameterError
 from ..units import check_times
 
-__all__ = ["evaluate_beats", "METRICS", "octave_relation", "MAX_BEAT_INTERVAL"]
+__all__ = [
+    "evaluate_beats",
+    "METRICS",
+    "TABLE_METRICS",
+    "MAX_BEAT_INTERVAL",
+    "octave_relation",
+    "score_items",
+    "summarize_scores",
+    "beat_targets",
+    "sweep_frontend",
+]
 
 #: Beat sequences whose median interval exceeds this [s] are refused (not seconds).
 MAX_BEAT_INTERVAL = 10.0
@@ -158,3 +170,173 @@ def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 
         if abs(r / target - 1.0) <= tol:
             return name
     return "other"
+
+
+# --------------------------------------------------------------------------- study helpers
+
+#: Metrics shown in the study table (``notebooks/tab_beat_tracking.ipynb``).
+TABLE_METRICS = (
+    "F-measure",
+    "Cemgil",
+    "P-score",
+    "Correct Metric Level Total",
+    "Any Metric Level Total",
+    "Information gain",
+)
+
+
+def score_items(
+    items: Sequence[Any],
+    *,
+    methods: Sequence[str] = ("psf", "librosa"),
+    min_beat_time: float,
+    track_kwargs: dict[str, Any] | None = None,
+    progress: bool = False,
+) -> pd.DataFrame:
+    """Track and score every test item with every method.
+
+    Parameters
+    ----------
+    items : sequence of objects with ``name, group, kind, y, sr, beats, bpm``
+        E.g. :func:`beatsync.synth.audio.make_beat_test_set`.
+    methods : sequence of {"psf", "librosa"}
+    min_beat_time : float >= 0 [s]
+        Passed to :func:`evaluate_beats`.
+    track_kwargs : dict, optional
+        Extra keyword arguments of :func:`beatsync.beats.track_beats` (``psf`` only).
+    progress : bool
+        Show a tqdm bar on stderr.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (item, method): ``item, group, kind, bpm, method, tempo_ref,
+        tempo_est, octave`` (see :func:`octave_relation`, from median beat intervals),
+        all :data:`METRICS`, and ``seconds`` (tracking time, not for display).
+    """
+    import time
+
+    from ..beats import track_beats
+
+    rows = []
+    jobs = [(it, m) for it in items for m in methods]
+    if progress:
+        from tqdm import tqdm
+
+        jobs = tqdm(jobs, desc="beat tracking", leave=False)
+    for it, method in jobs:
+        kw = dict(track_kwargs or {}) if method == "psf" else {}
+        t0 = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BeatsyncWarning)
+            track = track_beats(it.y, it.sr, method=method, **kw)
+        seconds = time.perf_counter() - t0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BeatsyncWarning)
+            scores = evaluate_beats(it.beats, track.beats, min_beat_time=min_beat_time)
+        ref_tempo = 60.0 / float(np.median(np.diff(it.beats)))
+        est_tempo = (
+            60.0 / float(np.median(np.diff(track.beats))) if track.beats.size > 1 else np.nan
+        )
+        rows.append(
+            {
+                "item": it.name,
+                "group": it.group,
+                "kind": it.kind,
+                "bpm": float(it.bpm),
+                "method": method,
+                "tempo_ref": ref_tempo,
+                "tempo_est": est_tempo,
+                "octave": octave_relation(est_tempo, ref_tempo),
+                **scores,
+                "seconds": seconds,
+                "audio_seconds": len(it.y) / it.sr,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def summarize_scores(
+    scores: pd.DataFrame, *, by: str = "group", metrics: Sequence[str] = TABLE_METRICS
+) -> pd.DataFrame:
+    """Mean of ``metrics`` per ``by`` and method, with octave-error counts.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``(by, method)``; columns the metrics (means), ``n`` (items),
+        ``octave errors`` (tempo double/half/triple/third) and ``other tempo``.
+    """
+    g = scores.groupby([by, "method"], sort=False)
+    out = g[list(metrics)].mean()
+    out["n"] = g.size()
+    out["octave errors"] = g["octave"].agg(
+        lambda s: int(s.isin(["double", "half", "triple", "third"]).sum())
+    )
+    out["other tempo"] = g["octave"].agg(lambda s: int((s == "other").sum()))
+    return out
+
+
+def beat_targets(scores: pd.DataFrame, *, method: str = "psf") -> pd.DataFrame:
+    """The issue's accuracy targets on the synthetic set, with PASS/FAIL.
+
+    Targets: mean F-measure >= 0.95 on ``clean`` items, mean AMLt >= 0.98 over all
+    items, mean F-measure >= 0.95 on ``change`` (abrupt tempo change) items.
+    """
+    s = scores[scores["method"] == method]
+    rows = []
+    for name, sel, metric, thr in (
+        ("mean F, clean items", s["group"] == "clean", "F-measure", 0.95),
+        ("mean AMLt, all items", slice(None), "Any Metric Level Total", 0.98),
+        ("mean F, tempo-change items", s["group"] == "change", "F-measure", 0.95),
+    ):
+        sub = s.loc[sel]
+        value = float(sub[metric].mean()) if len(sub) else float("nan")
+        rows.append(
+            {
+                "target": name,
+                "method": method,
+                "n": len(sub),
+                "value": value,
+                "threshold": thr,
+                "result": "PASS" if value >= thr else "FAIL",
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def sweep_frontend(
+    items: Sequence[Any],
+    grid: dict[str, Sequence[Any]],
+    *,
+    min_beat_time: float,
+    metrics: Sequence[str] = ("F-measure", "Any Metric Level Total", "Cemgil"),
+) -> pd.DataFrame:
+    """Score the ``psf`` tracker for every combination of front-end parameters.
+
+    Parameters
+    ----------
+    items : sequence of test items
+    grid : dict
+        Parameter name (``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
+        ``flux_norm_s``) -> values. Combinations with ``hop_s > win_s / 2`` are skipped.
+    min_beat_time : float >= 0 [s]
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per combination: the parameters and the mean of ``metrics``.
+    """
+    import itertools
+
+    keys = list(grid)
+    rows = []
+    for combo in itertools.product(*(grid[k] for k in keys)):
+        params = dict(zip(keys, combo, strict=True))
+        if "hop_s" in params and params["hop_s"] > params.get("win_s", 0.023) / 2:
+            continue
+        sc = score_items(items, methods=("psf",), min_beat_time=min_beat_time, track_kwargs=params)
+        row = {k: (str(tuple(v)) if isinstance(v, (list, tuple)) else v) for k, v in params.items()}
+        row.update({m: float(sc[m].mean()) for m in metrics})
+        rows.append(row)
+    return pd.DataFrame(rows)
