@@ -571,15 +571,36 @@ def _min_mean_energy(solve: Any, max_iter: int = 30) -> tuple[np.ndarray, float]
     return frames, energy
 
 
+def _literal_edge_cost(x: np.ndarray, t0: int, t1: int, t2: int) -> float:
+    """Eqs. 1-2 for one pair of consecutive periods, written out with loops."""
+    n_ch = x.shape[0]
+    d0, d1 = t1 - t0, t2 - t1
+    e = 0.0
+    for ch in range(n_ch):
+        a_seg = x[ch, t0 : t1 + 1]
+        b_seg = np.interp(np.arange(d0 + 1) * (d1 / d0), np.arange(d1 + 1), x[ch, t1 : t2 + 1])
+        ma, mb = a_seg.mean(), b_seg.mean()
+        num = 0.0
+        va = _FLAT_REL_VAR * (d0 + 1)
+        vb = _FLAT_REL_VAR * (d0 + 1)
+        for k in range(d0 + 1):
+            num += (a_seg[k] - ma) * (b_seg[k] - mb)
+            va += (a_seg[k] - ma) ** 2
+            vb += (b_seg[k] - mb) ** 2
+        e += 1.0 - num / np.sqrt(va * vb)
+    return e
+
+
 def _segment_literal(
     x: np.ndarray, lo: int, hi: int, reward: float | None = None
 ) -> tuple[np.ndarray, float]:
     """Reference: direct, loop-by-loop implementation of eqs. 1-5 (no vectorisation).
 
-    Builds every edge of the DAG of boundary pairs with one Python loop per edge and
-    per channel (resampling with ``np.interp`` and the Pearson correlation written
-    out), then relaxes the edges in topological order. Same optimum as the fast path;
-    used by the tests and by ``benchmarks/bench_segment.py`` as the baseline.
+    Builds every edge of the DAG of boundary pairs with one Python loop per edge, per
+    channel and per sample (:func:`_literal_edge_cost`: resampling with ``np.interp``
+    and the Pearson correlation written out), once; then relaxes the edges in
+    topological order with Python loops. Same optimum as the fast path; used by the
+    tests and by ``benchmarks/bench_segment.py`` as the baseline.
 
     Parameters
     ----------
@@ -588,17 +609,30 @@ def _segment_literal(
     lo, hi : int [frames]
         Alpha band of period lengths.
     reward : float or None
-        Solve ``argmin E - reward (p - 1)``; ``None``: the Dinkelbach iteration of
-        :func:`_min_mean_energy` over such solves (the objective of :func:`segment`).
+        Solve ``argmin E - reward (p - 1)`` (0: the plain ``argmin E``); ``None``: the
+        Dinkelbach iteration of :func:`_min_mean_energy` (the objective of
+        :func:`segment`), reusing the edge costs.
 
     Returns
     -------
     boundary frames, energy E
     """
+    n = x.shape[1]
+    edges: dict[tuple[int, int, int], float] = {}
+    for t1 in range(lo, n):  # every edge (t0, t1) -> (t1, t2) of the DAG
+        for t0 in range(max(t1 - hi, 0), t1 - lo + 1):
+            for t2 in range(t1 + lo, min(t1 + hi, n - 1) + 1):
+                edges[(t0, t1, t2)] = _literal_edge_cost(x, t0, t1, t2)
+    solve = lambda r: _literal_dp(edges, n, lo, hi, r)  # noqa: E731
     if reward is None:
-        return _min_mean_energy(lambda r: _segment_literal(x, lo, hi, r))
-    n_ch, n = x.shape
-    floor_rel = _FLAT_REL_VAR
+        return _min_mean_energy(solve)
+    return solve(reward)
+
+
+def _literal_dp(
+    edges: dict[tuple[int, int, int], float], n: int, lo: int, hi: int, reward: float
+) -> tuple[np.ndarray, float]:
+    """Shortest path over the DAG of boundary pairs with plain loops (eqs. 4-5)."""
     start: set[tuple[int, int]] = set()
     for t0 in range(lo):  # first pairs (t0, t1): lead-in shorter than any period
         for t1 in range(t0 + lo, min(t0 + hi, n - 1) + 1):
@@ -611,23 +645,7 @@ def _segment_literal(
             if not np.isfinite(here):
                 continue
             for t2 in range(t1 + lo, min(t1 + hi, n - 1) + 1):
-                d0, d1 = t1 - t0, t2 - t1
-                e = 0.0
-                for ch in range(n_ch):
-                    a_seg = x[ch, t0 : t1 + 1]
-                    b_seg = np.interp(
-                        np.arange(d0 + 1) * (d1 / d0), np.arange(d1 + 1), x[ch, t1 : t2 + 1]
-                    )
-                    ma, mb = a_seg.mean(), b_seg.mean()
-                    num = 0.0
-                    va = floor_rel * (d0 + 1)
-                    vb = floor_rel * (d0 + 1)
-                    for k in range(d0 + 1):
-                        num += (a_seg[k] - ma) * (b_seg[k] - mb)
-                        va += (a_seg[k] - ma) ** 2
-                        vb += (b_seg[k] - mb) ** 2
-                    e += 1.0 - num / np.sqrt(va * vb)
-                cand = here + e - reward
+                cand = here + edges[(t0, t1, t2)] - reward
                 if cand < best.get((t1, t2), np.inf):
                     best[(t1, t2)] = cand
                     back[(t1, t2)] = (t0, t1)
