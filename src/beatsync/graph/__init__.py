@@ -6,8 +6,10 @@ nodes are beat frames (:mod:`beatsync.graph.build`); a dynamic programme over th
 music's beat intervals chooses the path whose motion intensity follows the music's
 (:mod:`beatsync.graph.search`); the chosen intervals are time-warped onto the music
 beats and blended at transitions (:mod:`beatsync.graph.synthesis`);
-:mod:`beatsync.graph.compose` runs the whole chain and
-:mod:`beatsync.graph.quality` scores the result with objective proxies.
+:mod:`beatsync.graph.compose` runs the whole chain,
+:mod:`beatsync.graph.quality` scores the result with objective proxies,
+:mod:`beatsync.graph.synthetic` makes dance clips with exact beats and
+:mod:`beatsync.graph.study` holds the helpers of the paper-B notebooks.
 
 Data contract: event times in seconds (1-D float64, strictly increasing); motions
 are :class:`beatsync.motion.Motion` with one skeleton structure per library.

@@ -278,7 +278,9 @@ def synthesize(
         w = smoothstep((t[sel] - beats[k]) / length)
         values[sel] = blend_values(template, old, values[sel], w)
 
-    # continuous Euler curves in the output file
+    # continuous Euler curves in the output file: the root's triples were re-derived
+    # after the yaw alignment, so choose each frame's triple closest to the previous one
+    values[:, rot_cols] = _continuous_euler(values[:, rot_cols])
     for _joint, idx, _order in template.rotation_triples():
         cols = list(idx)
         values[:, cols] = np.unwrap(values[:, cols], period=360.0, axis=0)
@@ -299,6 +301,23 @@ def synthesize(
         beat_source_times=beat_src,
         info={"n_runs": n_runs, "start_frame": j0, "blend_s": blend},
     )
+
+
+def _continuous_euler(e: np.ndarray) -> np.ndarray:
+    """Pick, frame by frame, the equivalent Tait-Bryan triple nearest the previous frame."""
+    out = e.copy()
+    for i in range(1, e.shape[0]):
+        ref = out[i - 1]
+        a = e[i]
+        alt = np.array([a[0] + 180.0, 180.0 - a[1], a[2] + 180.0])
+        best, best_d = a, np.inf
+        for cand in (a, alt):
+            cand = cand + 360.0 * np.round((ref - cand) / 360.0)
+            d = float(np.sum((cand - ref) ** 2))
+            if d < best_d:
+                best, best_d = cand, d
+        out[i] = best
+    return out
 
 
 def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
