@@ -398,3 +398,13 @@ def test_root_euler_curves_stay_continuous_after_heading_alignment():
     # and the dancer keeps facing the same way across the transition
     r = euler_to_rotation(out.values[:, root_rot], "ZXY")
     assert (r[1:] * r[:-1].inv()).magnitude().max() < np.radians(20)
+
+
+def test_intensity_correlation_known_answers():
+    from beatsync.graph.quality import intensity_correlation
+    from beatsync.motion_beats import beat_interval_intensity
+
+    m, b = synthetic_dance(duration=8, seed=0)
+    inten = beat_interval_intensity(m, b)
+    assert intensity_correlation(m, b, inten) == pytest.approx(1.0)
+    assert intensity_correlation(m, b, -inten) == pytest.approx(-1.0)
