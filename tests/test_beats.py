@@ -132,11 +132,18 @@ def test_steady_tone_gives_no_beats_with_warning():
 _Y = np.random.default_rng(0).standard_normal(SR)
 
 
+def test_noise_warns_no_clear_pulse():
+    y = np.random.default_rng(1).standard_normal(8 * SR)
+    with pytest.warns(BeatsyncWarning, match="no clear pulse"):
+        track_beats(y, SR)
+
+
 @pytest.mark.parametrize(
     "y, sr, kwargs",
     [
         (np.zeros(0), SR, {}),
         (np.zeros(SR), SR, {}),
+        (_Y[:1000], SR, {}),  # 45 ms: too short
         (np.r_[_Y[:100], np.nan, _Y[101:]], SR, {}),
         (_Y, 0, {}),
         (_Y, -22050, {}),

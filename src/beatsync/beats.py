@@ -60,11 +60,19 @@ __all__ = [
     "FRONTEND_DEFAULTS",
     "MIN_SANE_BPM",
     "MAX_SANE_BPM",
+    "MIN_DURATION_S",
+    "MIN_PULSE_CLARITY",
 ]
 
 #: A ``bpm`` outside this range is refused as a likely unit mistake.
 MIN_SANE_BPM = 20.0
 MAX_SANE_BPM = 400.0
+#: Shorter audio is refused [s].
+MIN_DURATION_S = 0.5
+#: Below this pulse clarity (median peak of the harmonic autocorrelation salience;
+#: white noise about 0.35, music and the test items above 1.2) a warning says the
+#: beats may be meaningless.
+MIN_PULSE_CLARITY = 0.7
 
 #: Defaults of the phase-slope front end (all swept in the notebook).
 FRONTEND_DEFAULTS: dict[str, Any] = {
@@ -589,13 +597,15 @@ def track_beats(
     Raises
     ------
     ParameterError
-        Empty, silent or non-finite audio; ``sr <= 0``; ``min_bpm >= max_bpm``; a
-        ``bpm`` outside 20-400; unknown method or front-end parameter.
+        Empty, shorter than 0.5 s, silent or non-finite audio; ``sr <= 0``;
+        ``min_bpm >= max_bpm``; a ``bpm`` outside 20-400; unknown method or front-end
+        parameter.
 
     Warns
     -----
     BeatsyncWarning
-        If no onsets are found (e.g. a steady tone): returns no beats.
+        If no onsets are found (e.g. a steady tone): returns no beats. If the pulse
+        is unclear (e.g. noise, ``MIN_PULSE_CLARITY``): returns the beats found.
 
     Examples
     --------
@@ -607,6 +617,11 @@ def track_beats(
     120
     """
     y, sr = check_audio(y, sr)
+    if y.size / sr < MIN_DURATION_S:
+        raise ParameterError(
+            f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}); "
+            f"beat tracking needs at least {MIN_DURATION_S:g} s (wrong sample rate?)"
+        )
     min_bpm, max_bpm = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="bpm")
     check_bpm(min_bpm, name="min_bpm")
     check_bpm(max_bpm, name="max_bpm")
@@ -625,6 +640,11 @@ def track_beats(
     tempo_win_s = check_fps(tempo_win_s, name="tempo_win_s")
     tempo_hop_s = check_fps(tempo_hop_s, name="tempo_hop_s")
     fe = _frontend(frontend_params, sr)
+    if y.size < 4 * fe["win"]:
+        raise ParameterError(
+            f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}); "
+            f"beat tracking needs at least {MIN_DURATION_S:g} s (wrong sample rate?)"
+        )
     ons = _onsets(y, sr, fe)
     return _track_psf(
         ons,
@@ -761,6 +781,14 @@ def _track_psf(
     else:
         periods = _period_grid(min_bpm, max_bpm)
         sal = _tempo_salience(env**power, fps, starts, stops, periods, n_harm=4)
+        clarity = float(np.median(sal.max(axis=0)))
+        if clarity < MIN_PULSE_CLARITY:
+            warnings.warn(
+                f"no clear pulse in the audio (pulse clarity {clarity:.2f} < "
+                f"{MIN_PULSE_CLARITY}): noise or free rhythm? the beats may be meaningless",
+                BeatsyncWarning,
+                stacklevel=3,
+            )
         if not time_varying:
             sal = np.repeat(sal.sum(axis=1, keepdims=True), centres.size, axis=1)
         path = _tempo_hmm(
