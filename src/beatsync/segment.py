@@ -24,7 +24,9 @@ long). Its energy (eqs. 1-2) is
 
 with ``r`` the Pearson correlation and ``resample`` linear interpolation of the later
 period onto the earlier one's samples (end points aligned). Every period length must
-stay inside the alpha band around the nominal period ``L = (n-1)/p`` (eq. 3):
+stay inside the alpha band around the nominal period ``L`` (eq. 3; ``L = (n-1)/p``
+when the count ``p`` is given, else the estimated period, see
+:func:`estimate_period_count`):
 ``(1-alpha) L <= t_{i+1} - t_i <= (1+alpha) L``. The globally optimal ``T_p``
 (eqs. 4-5) is a shortest path in a forward DAG whose nodes are consecutive boundary
 pairs ``(t_{i-1}, t_i)``, with a virtual end node joined to every pair ending in the
@@ -41,9 +43,9 @@ Edge costs dominate the time. They are computed for all ``(middle boundary, earl
 length, later length)`` at once (in float32; on z-scored channels an edge cost then
 differs from float64 by ~1e-5, checked in the tests): every sum in a Pearson
 correlation (sum of A, of A^2, of resampled B, of its square, and of A * B) is a
-fixed linear combination of
-lagged products ``X[s] X[s + l]`` in a window around the middle boundary, so each is
-one matrix product of windowed products with a constant kernel (see
+fixed linear combination of lagged products ``X[s] X[s + l]`` in a window around the
+middle boundary, so each is one matrix product of windowed products with a constant
+kernel (see
 :func:`_edge_costs`). :func:`_segment_literal` is the direct loop implementation of
 the same equations, kept as the reference for tests and the benchmark.
 
@@ -124,7 +126,7 @@ _OFF_PERIOD_FACTORS = (0.5, 0.75, 1.25, 1.5)
 _FLAT_REL_VAR = 1e-6  # period variance floor, relative to the channel's variance
 _PERIOD_METHODS = ("energy", "fft", "given")
 _FAST_DTYPE = np.float32  # edge-cost sums in float32: ~2x faster, |error| ~1e-5 per edge
-_MAX_COUNT_CANDIDATES = 400  # period counts tried by the "energy" method (log-spaced)
+_MAX_COUNT_CANDIDATES = 400  # candidate periods of the "energy" method (then log-spaced)
 _CHUNK_ELEMENTS = 3e5  # window-matrix elements per block of middle boundaries (cache size)
 
 

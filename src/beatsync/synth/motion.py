@@ -107,7 +107,7 @@ def periodic_motion(
     Examples
     --------
     >>> s = periodic_motion(n_frames=300, n_periods=10, seed=1)
-    >>> s.motion.values.shape, s.n_periods, s.boundary_frames[0], s.boundary_frames[-1]
+    >>> s.motion.values.shape, s.n_periods, int(s.boundary_frames[0]), int(s.boundary_frames[-1])
     ((300, 29), 10, 0, 299)
     """
     fps = check_fps(fps)
