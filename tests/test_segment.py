@@ -285,3 +285,32 @@ def test_float32_edge_costs_close_to_float64():
     f64, _ = S._shortest_path(c64, 750, 26, 33)
     f32, _ = S._shortest_path(c32, 750, 26, 33)
     assert np.array_equal(f64, f32)
+
+
+# ------------------------------------------------------ evaluation helpers (fig02)
+def test_boundary_errors_and_baselines():
+    ref = np.array([0, 30, 61, 90, 120])
+    assert S.boundary_errors(ref, ref)["max"] == 0.0
+    e = S.boundary_errors(ref + 3, ref, remove_offset=True)
+    assert e["max"] == 0.0 and e["offset"] == 3.0
+    e = S.boundary_errors(np.array([0, 32, 61, 88]), ref)
+    assert e["max"] == 2.0 and e["count_error"] == -1
+    t = np.arange(500)
+    sine = np.cos(2 * np.pi * t / 25.0)
+    mins = S.minima_baseline(sine, fps=25.0, period=1.0)
+    assert np.allclose(np.diff(mins), 25, atol=1)
+    uni = S.uniform_baseline(np.stack([sine, np.sin(2 * np.pi * t / 25.0)], 1), fps=25.0)
+    assert abs(np.diff(uni).mean() - 25) < 0.5
+
+
+def test_synthetic_error_table_small():
+    table = S.synthetic_error_table(snr_dbs=[20.0], alphas=[0.1], seeds=[0], n_frames=300,
+                                    n_channels=6, n_periods=10)  # fmt: skip
+    assert set(table["method"]) == {
+        "optimal, count estimated",
+        "optimal, count given",
+        "baseline: FFT period + uniform",
+        "baseline: minima of channel 0",
+    }
+    opt = table[table["method"] == "optimal, count given"].iloc[0]
+    assert opt["max_error_frames"] <= 1
