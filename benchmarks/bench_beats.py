@@ -94,9 +94,7 @@ def main() -> int:
         track_beats(y, sr)  # warm-up (imports, FFT plans)
         track_beats(y, sr, method="librosa")
         t_psf = _median_time(lambda y=y, sr=sr: track_beats(y, sr), args.repeats)
-        t_lib = _median_time(
-            lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr), args.repeats
-        )
+        t_lib = _median_time(lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr), args.repeats)
         per_min = 60.0 / SPEED_SONG_S
         speed_rows.append(
             {
@@ -164,7 +162,7 @@ def main() -> int:
 
     # ------------------------------------------------------------------ write
     facts = {
-        "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "platform": platform.platform(),
         "python": platform.python_version(),
         "cpu_count": os.cpu_count(),
