@@ -146,6 +146,7 @@ BAD = [
 ]
 
 
+@pytest.mark.filterwarnings("ignore::beatsync.errors.BeatsyncWarning")
 @pytest.mark.parametrize("argv, match", BAD)
 def test_sync_bad_inputs(inputs, tmp_path, capsys, argv, match):
     import re
