@@ -81,6 +81,7 @@ FRONTEND_DEFAULTS: dict[str, Any] = {
     "n_fft": None,  # FFT size [samples]; None: next power of two >= window
     "band_edges_hz": (0.0, 250.0, 1000.0, 4000.0, 22050.0),  # 4 bands [Hz]
     "flux_norm_s": 0.5,  # local-mean window removed from the flux [s]
+    "analysis_sr": 22050,  # audio above this rate is resampled to it first [Hz]; None: never
 }
 
 
@@ -202,6 +203,8 @@ def _frontend(params: dict[str, Any], sr: float) -> dict[str, Any]:
             f"unknown front-end parameter(s) {sorted(unknown)}; known: {sorted(FRONTEND_DEFAULTS)}"
         )
     p = {**FRONTEND_DEFAULTS, **params}
+    if p["analysis_sr"] is not None:
+        sr = min(sr, float(int(round(check_fps(p["analysis_sr"], name="analysis_sr")))))
     win = int(round(check_fps(p["win_s"], name="win_s") * sr))
     hop = int(round(check_fps(p["hop_s"], name="hop_s") * sr))
     if win < 16:
@@ -221,7 +224,14 @@ def _frontend(params: dict[str, Any], sr: float) -> dict[str, Any]:
             f"band_edges_hz={p['band_edges_hz']!r} must be increasing frequencies [Hz]"
         )
     flux_norm_s = float(p["flux_norm_s"])
-    return {"win": win, "hop": hop, "n_fft": n_fft, "edges": edges, "flux_norm_s": flux_norm_s}
+    return {
+        "sr": sr,
+        "win": win,
+        "hop": hop,
+        "n_fft": n_fft,
+        "edges": edges,
+        "flux_norm_s": flux_norm_s,
+    }
 
 
 # --------------------------------------------------------------------------- front end
@@ -259,7 +269,14 @@ def phase_slope(
     """
     y, sr = check_audio(y, sr)
     fe = _frontend(
-        {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}, sr
+        {
+            "win_s": win_s,
+            "hop_s": hop_s,
+            "n_fft": n_fft,
+            "band_edges_hz": band_edges_hz,
+            "analysis_sr": None,
+        },
+        sr,
     )
     return _phase_slope(y, sr, fe)
 
@@ -312,6 +329,7 @@ def onset_strength_psf(
     n_fft: int | None = FRONTEND_DEFAULTS["n_fft"],
     band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
     flux_norm_s: float = FRONTEND_DEFAULTS["flux_norm_s"],
+    analysis_sr: float | None = FRONTEND_DEFAULTS["analysis_sr"],
 ) -> OnsetSignal:
     """Onset signal from positive zero crossings of the band phase-slope function.
 
@@ -334,6 +352,10 @@ def onset_strength_psf(
         Band edges (default 0, 250, 1000, 4000, 22050: four bands).
     flux_norm_s : float >= 0 [s]
         Window of the local mean removed from the flux (0: none).
+    analysis_sr : float > 0 [Hz] or None
+        Audio at a higher rate is first resampled to this rate (polyphase), so that
+        the front end behaves the same for 22.05, 44.1 and 48 kHz input and costs
+        the same per second; None analyses at the input rate.
 
     Returns
     -------
@@ -355,13 +377,23 @@ def onset_strength_psf(
             "n_fft": n_fft,
             "band_edges_hz": band_edges_hz,
             "flux_norm_s": flux_norm_s,
+            "analysis_sr": analysis_sr,
         },
         sr,
     )
     return _onsets(y, sr, fe)
 
 
+def _resample(y: np.ndarray, sr: float, target: float) -> np.ndarray:
+    """Polyphase resampling (scipy) from ``sr`` to ``target`` [Hz]."""
+    a, b = int(round(target)), int(round(sr))
+    g = np.gcd(a, b)
+    return scipy.signal.resample_poly(y, a // g, b // g)
+
+
 def _onsets(y: np.ndarray, sr: float, fe: dict[str, Any]) -> OnsetSignal:
+    if fe["sr"] != sr:
+        y, sr = _resample(y, sr, fe["sr"]), fe["sr"]
     y = y / np.max(np.abs(y))
     psf, energy, fps, mag = _phase_slope(y, sr, fe)
     n_bands, n_frames = psf.shape
@@ -531,7 +563,11 @@ def _phase_hmm(
 
 
 def _snap(beats, periods_at_beats, onset_times, onset_strengths, reach: float, min_rel: float):
-    """Move each beat to the strongest onset within ``reach`` beat periods."""
+    """Move each beat to the best onset within ``reach`` beat periods.
+
+    The best onset maximises strength times a Gaussian of its distance to the
+    predicted beat (standard deviation ``reach / 2`` periods).
+    """
     if onset_times.size == 0 or beats.size == 0:
         return beats
     thresh = min_rel * np.max(onset_strengths)
@@ -541,7 +577,8 @@ def _snap(beats, periods_at_beats, onset_times, onset_strengths, reach: float, m
     lo = np.searchsorted(t, beats - reach * periods_at_beats)
     hi = np.searchsorted(t, beats + reach * periods_at_beats)
     for i in np.flatnonzero(hi > lo):
-        j = lo[i] + int(np.argmax(s[lo[i] : hi[i]]))
+        dist = (t[lo[i] : hi[i]] - beats[i]) / (0.5 * reach * periods_at_beats[i])
+        j = lo[i] + int(np.argmax(s[lo[i] : hi[i]] * np.exp(-0.5 * dist**2)))
         out[i] = t[j]
     return out
 
@@ -588,7 +625,7 @@ def track_beats(
         Follow tempo changes (True) or force one tempo for the whole piece (False).
     **frontend_params
         Phase-slope front end: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
-        ``flux_norm_s`` (see :func:`onset_strength_psf`).
+        ``flux_norm_s``, ``analysis_sr`` (see :func:`onset_strength_psf`).
 
     Returns
     -------
@@ -640,7 +677,7 @@ def track_beats(
     tempo_win_s = check_fps(tempo_win_s, name="tempo_win_s")
     tempo_hop_s = check_fps(tempo_hop_s, name="tempo_hop_s")
     fe = _frontend(frontend_params, sr)
-    if y.size < 4 * fe["win"]:
+    if y.size / sr * fe["sr"] < 4 * fe["win"]:
         raise ParameterError(
             f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}); "
             f"beat tracking needs at least {MIN_DURATION_S:g} s (wrong sample rate?)"
@@ -687,13 +724,15 @@ def _uniformity(signals, fps: float, a: np.ndarray, b: np.ndarray) -> float:
     return best
 
 
-def _level_factor(signals, fps, beats, level_ratio: float) -> float:
+def _level_factor(signals, fps, beats, level_ratio: float, accent_ratio: float) -> float:
     """Factor on the beat period (1/2, 1/3, 2 or 1) deciding the metrical level.
 
-    One rule: a pulse is the beat if its alternate pulses carry comparable onset energy
-    (uniformity >= ``level_ratio``), in the band-weighted onset signal or in the lowest
-    band (kick and snare, not the hi-hat). The faster pulse (halves, thirds) is tried
-    first; if the current beats themselves alternate strong/weak, the slower pulse wins.
+    A pulse is the beat if its alternate pulses carry comparable onset energy, in the
+    band-weighted onset signal or in the lowest band (kick and snare, not the hi-hat).
+    The faster pulse (halves, thirds) is taken if its uniformity is at least
+    ``level_ratio``; the slower one only if the current beats clearly alternate strong
+    and weak (uniformity below ``accent_ratio`` < ``level_ratio``): a weak snare
+    against a strong kick must not halve the tempo.
     """
     d = np.diff(beats)
     if _uniformity(signals, fps, beats[:-1], beats[:-1] + d / 2) >= level_ratio:
@@ -704,7 +743,7 @@ def _level_factor(signals, fps, beats, level_ratio: float) -> float:
     )
     if thirds >= level_ratio:
         return 1.0 / 3.0
-    if beats.size >= 4 and _uniformity(signals, fps, beats[0::2], beats[1::2]) < level_ratio:
+    if beats.size >= 4 and _uniformity(signals, fps, beats[0::2], beats[1::2]) < accent_ratio:
         return 2.0
     return 1.0
 
@@ -768,6 +807,7 @@ def _track_psf(
     time_varying,
     power: float = 2.0,
     level_ratio: float = 0.45,
+    accent_ratio: float = 0.45,
 ) -> BeatTrack:
     fps = ons.fps
     raw = ons.envelope
@@ -820,7 +860,7 @@ def _track_psf(
                 sel = beats[(beats >= lo) & (beats < hi)]
                 if sel.size < 4:
                     continue
-                factor = _level_factor((raw, ons.bands[0]), fps, sel, level_ratio)
+                factor = _level_factor((raw, ons.bands[0]), fps, sel, level_ratio, accent_ratio)
                 tempo_new = 60.0 / np.median(period_w[a:b]) / factor
                 if min_bpm <= tempo_new <= max_bpm:
                     new[a:b] = period_w[a:b] * factor
