@@ -18,16 +18,30 @@ Method (``method="psf"``)
 2. **Onsets** (:func:`onset_strength_psf`): positive zero crossings of the phase
    slope in 4 bands, each weighted by the band's (locally normalised) spectral flux
    (eq. 6-7), bands combined with weights ``6 - c`` (c = 1..4, low bands count most).
-3. **Tempo**: autocorrelation of the onset signal in 8 s windows with 1 s hop,
-   a harmonic sum over multiples of the period (the shortest period whose multiples
-   are all supported wins: this sets the metrical level), a log-normal prior on the
-   beat period (around 0.55 s), and a tempo HMM with log-normal period-ratio
-   transitions (plus a small jump probability so an abrupt tempo change is followed),
-   decoded with :func:`librosa.sequence.viterbi`.
+3. **Tempo**: autocorrelation (unbiased, of the squared, slightly smoothed onset
+   signal) in 8 s windows with 1 s hop; the salience of a beat period is the sum of
+   the autocorrelation at its first 4 multiples; a log-normal prior on the period
+   (around 0.55 s) and a tempo HMM with log-normal period-ratio transitions (plus a
+   small jump probability, so that an abrupt tempo change is followed rather than
+   averaged away), decoded with :func:`librosa.sequence.viterbi`.
 4. **Phase**: the onset signal is correlated with a reference pulse train that
-   follows the decoded tempo curve (eq. 8), per window, for every phase offset; a
-   circular phase HMM decoded with Viterbi picks the offset; beats are snapped to the
-   nearest strong onset.
+   follows the decoded tempo curve (eq. 8; band weighting is linear, so the
+   weighted sum of band correlations is the correlation of the weighted onset
+   signal), in 4-beat windows every 0.25 s, for 64 phase offsets; a circular phase
+   HMM decoded with Viterbi picks the offset. Each beat is then snapped to the
+   nearby onset with the best strength x closeness (phase-slope zero crossings give
+   the onset time to a fraction of a frame).
+5. **Metrical level** (octave errors), deliberately and per constant-tempo segment:
+   the beat is the pulse whose alternate pulses carry comparable onset energy
+   (uniformity >= 0.45, in the band-weighted onset signal or in the lowest band). If
+   the points halfway (or a third of the way) between the beats are as strong as
+   the beats, the faster pulse is the beat (a 180 BPM click track decoded at 90);
+   if every other beat is much weaker, the slower one is (hi-hat eighths decoded as
+   beats). A known tempo (``bpm=``) bypasses the tempo HMM and this rule; a BPM
+   range restricts both.
+
+Audio above 22.05 kHz is first resampled to 22.05 kHz (``analysis_sr``), so the
+front end behaves the same for 44.1 and 48 kHz input.
 
 ``method="librosa"`` wraps :func:`librosa.beat.beat_track` for comparison.
 
@@ -844,12 +858,8 @@ def _track_psf(
     t_frames = frames_to_time(np.arange(n), fps=fps)
     beats, pb = _place_beats(ons, raw, fps, period_w, centres, t_frames, tempo_win_s, duration)
     if bpm is None and beats.size > 2:
-        # metrical level (octave errors): compare the onset energy between the beats
-        # with the energy on the beats. If the halves (or thirds) of the beat carry
-        # nearly as much as the beats, the beat is the faster pulse (a 180 BPM click
-        # track decoded at 90 or 60 BPM); if every other beat is much weaker, it is
-        # the slower one. Kick/snare alternation stays between the two thresholds.
-        # decided per constant-tempo segment, so a tempo change is handled on each side
+        # metrical level (octave errors), see _level_factor; decided per
+        # constant-tempo segment, so each side of a tempo change gets its own level
         for _ in range(2):
             jumps = np.flatnonzero(np.abs(np.diff(np.log(period_w))) > 0.1) + 1
             bounds = np.concatenate([[0], jumps, [period_w.size]])
@@ -871,6 +881,17 @@ def _track_psf(
                 ons, raw, fps, period_w, centres, t_frames, tempo_win_s, duration
             )
     tempo_curve = 60.0 / period_w
+    if bpm is None and beats.size > 3:
+        # refine the grid tempo (0.5 % steps) with the median beat interval per window
+        ibi = np.diff(beats)
+        mid = (beats[1:] + beats[:-1]) / 2
+        reach = tempo_win_s / 2 if time_varying else np.inf  # one tempo: whole piece
+        for i, c in enumerate(centres):
+            sel = ibi[np.abs(mid - c) <= reach]
+            if sel.size >= 3:
+                est = 60.0 / np.median(sel)
+                if abs(np.log(est / tempo_curve[i])) < 0.05:  # same metrical level
+                    tempo_curve[i] = est
     return BeatTrack(
         beats.astype(np.float64),
         float(np.median(tempo_curve)),
