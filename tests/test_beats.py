@@ -162,3 +162,21 @@ def test_noise_warns_no_clear_pulse():
 def test_bad_input_raises(y, sr, kwargs):
     with pytest.raises(ParameterError):
         track_beats(y, sr, **kwargs)
+
+
+@pytest.mark.parametrize("sr", [16000, 44100, 48000])
+def test_other_sample_rates(sr):
+    ref = beat_times(132, duration=12.0, start=0.35)
+    y = drum_pattern(ref, sr=sr, duration=12.0, seed=2)
+    bt = track_beats(y, sr)
+    assert _score(ref, bt.beats)["Any Metric Level Total"] >= 0.95
+    # the tempo curve is refined from the beats: close to the truth, not a grid step
+    assert bt.tempo == pytest.approx(132, rel=0.01) or bt.tempo == pytest.approx(66, rel=0.01)
+
+
+def test_slow_tempo_drift_is_followed():
+    items = make_beat_test_set(duration=30.0, bpms=[120], kinds=["click"], groups=["drift"])
+    it = items[0]
+    bt = track_beats(it.y, it.sr)
+    assert np.ptp(bt.tempo_curve) > 6.0  # +-5 % of 120 BPM over the clip
+    assert _score(it.beats, bt.beats)["F-measure"] >= 0.95
