@@ -99,3 +99,13 @@ def test_bad_input_exit_2_nothing_written(case, song, tmp_path, capsys):
     assert err.startswith("beatsync beats: error:")
     assert sorted(p.name for p in tmp_path.iterdir()) == before
     assert path.stat().st_size == size
+
+
+def test_noise_warns_on_stderr(tmp_path, capsys):
+    path = tmp_path / "noise.wav"
+    y = np.random.default_rng(0).standard_normal(5 * SR).astype(np.float32) * 0.3
+    io.write_audio(path, y, SR)
+    assert main(["beats", str(path), "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "beatsync beats: warning: no clear pulse" in captured.err
+    assert json.loads(captured.out)["warnings"]

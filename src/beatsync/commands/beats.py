@@ -9,11 +9,13 @@ happen only after tracking succeeded, and never overwrite the input.
 
 from __future__ import annotations
 
+import sys
+import warnings
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import BeatsyncWarning, ParameterError
 from ._common import add_json_flag, check_output_path, emit
 
 __all__ = ["register", "run"]
@@ -86,9 +88,14 @@ def run(args: Any) -> int:
             raise ParameterError("--out and --click name the same file; choose two names")
 
     y, sr = io.read_audio(args.audio)
-    track = track_beats(
-        y, sr, method=args.method, bpm=args.bpm, min_bpm=args.min_bpm, max_bpm=args.max_bpm
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BeatsyncWarning)
+        track = track_beats(
+            y, sr, method=args.method, bpm=args.bpm, min_bpm=args.min_bpm, max_bpm=args.max_bpm
+        )
+    notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+    for note in notes:
+        print(f"beatsync beats: warning: {note}", file=sys.stderr)
     if track.beats.size == 0:
         raise ParameterError(
             f"no beats found in {args.audio!r} (no onsets: a steady tone or near silence?); "
@@ -114,6 +121,7 @@ def run(args: Any) -> int:
         "tempo_times": track.tempo_times,
         "tempo_curve_bpm": track.tempo_curve,
         "written": written,
+        "warnings": notes,
     }
     text = "".join(f"{t:.6f}\n" for t in track.beats)
     return emit(result, text, args)
