@@ -11,7 +11,6 @@ environment variable ``BEATSYNC_DATA``.
 
 from __future__ import annotations
 
-import hashlib
 import os
 from pathlib import Path
 
@@ -76,14 +75,6 @@ def data_dir() -> Path:
     return d
 
 
-def _sha256(p: Path) -> str:
-    h = hashlib.sha256()
-    with open(p, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
 def path(relpath: str, *, verify: bool = True) -> Path:
     """Path of a bundled data file (relative to ``data/``), checksum-verified.
 
@@ -98,7 +89,9 @@ def path(relpath: str, *, verify: bool = True) -> Path:
     if not p.is_file():
         raise ParameterError(f"bundled data file {str(p)!r} is missing")
     if verify and relpath not in _verified:
-        digest = _sha256(p)
+        from .io import sha256_file
+
+        digest = sha256_file(p)
         if digest != CHECKSUMS[relpath]:
             raise ParameterError(
                 f"bundled data file {str(p)!r} fails its SHA-256 check ({digest[:12]}... != "

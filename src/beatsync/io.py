@@ -43,6 +43,9 @@ __all__ = [
     "write_beats",
     "write_json",
     "write_csv",
+    "sha256_file",
+    "read_npz",
+    "write_npz",
     "AUDIO_SUFFIXES",
     "MOTION_SUFFIXES",
 ]
@@ -564,4 +567,36 @@ def write_csv(path: str | os.PathLike[str], frame: Any) -> Path:
     """Write a pandas DataFrame as CSV without its index (atomic)."""
     with atomic_write(path) as fh:
         frame.to_csv(fh, index=False)
+    return Path(path)
+
+
+# ------------------------------------------------------------------ binaries
+
+
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    """SHA-256 hex digest of a file's bytes."""
+    import hashlib
+
+    p = _existing_file(path, "input")
+    h = hashlib.sha256()
+    with open(p, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def read_npz(path: str | os.PathLike[str]) -> dict[str, np.ndarray]:
+    """Read every array of an ``.npz`` file (no pickles)."""
+    p = _existing_file(path, "npz")
+    try:
+        with np.load(p, allow_pickle=False) as data:
+            return {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"cannot read {str(p)!r} as an .npz archive: {exc}") from None
+
+
+def write_npz(path: str | os.PathLike[str], arrays: dict[str, np.ndarray]) -> Path:
+    """Write named arrays as an uncompressed ``.npz`` file (atomic)."""
+    with atomic_write(path, mode="wb") as fh:
+        np.savez(fh, **arrays)
     return Path(path)

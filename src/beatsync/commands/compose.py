@@ -125,22 +125,15 @@ def cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "beatsync"
 
 
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
 def graph_cache_key(files: list[Path], params: dict[str, Any]) -> str:
     """Hash of the library files' content (in order) and the graph parameters."""
-    h = hashlib.sha256()
     from .. import __version__
+    from ..io import sha256_file
 
+    h = hashlib.sha256()
     h.update(f"beatsync-graph-v{_CACHE_VERSION}-{__version__}".encode())
     for f in files:
-        h.update(_sha256(f).encode())
+        h.update(sha256_file(f).encode())
     h.update(json.dumps(params, sort_keys=True, default=str).encode())
     return h.hexdigest()[:32]
 
@@ -220,12 +213,10 @@ def _load_or_build(files, clips, params, use_cache):
     path = cache_dir() / f"graph-{key}.npz" if key else None
     if path is not None and path.is_file():
         try:
-            with np.load(path, allow_pickle=False) as data:
-                arrays = {k: data[k] for k in data.files}
-            g = WeightedMotionGraph.from_arrays(arrays, clips, params)
+            g = WeightedMotionGraph.from_arrays(io.read_npz(path), clips, params)
             if int(g.node_clip.max(initial=-1)) < len(clips):
                 return g, True, path
-        except (OSError, ValueError, KeyError):
+        except (ParameterError, ValueError, KeyError):
             pass  # a damaged cache entry is rebuilt
     g = build_graph(
         clips,
@@ -235,8 +226,7 @@ def _load_or_build(files, clips, params, use_cache):
     if path is not None:
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            with io.atomic_write(path, mode="wb") as fh:
-                np.savez(fh, **g.to_arrays())
+            io.write_npz(path, g.to_arrays())
         except OSError:
             path = None  # an unwritable cache is not an error
     return g, False, path
