@@ -66,6 +66,7 @@ def test_sync_end_to_end_with_beats_file(inputs, tmp_path, capsys):
     assert back.skeleton.same_structure(salsa.skeleton)
     assert back.n_frames == r["output_frames"] and back.fps == 60.0
     assert json.loads(rep.read_text())["report"]["output_frames"] == r["output_frames"]
+    assert result["warnings"] == []
     # target beats are beats of the file
     assert np.all(np.isin(np.round(r["target_beats_s"], 6), np.round(beats, 6)))
 
@@ -80,6 +81,7 @@ def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     )
     assert code == 0, err
     assert "residual" in stdout and "periods" in stdout
+    assert "Traceback" not in err
     assert io.read_bvh(out).fps == 30.0
 
 

@@ -13,12 +13,13 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import BeatsyncWarning, ParameterError
 from ._common import add_json_flag, check_output_path, emit
 
 __all__ = ["register", "run"]
@@ -140,9 +141,25 @@ def _segment_input(motion: Any) -> Any:
 
 def run(args: argparse.Namespace) -> int:
     from .. import io
-    from ..sync import synchronize
 
     out, video, report_path = _check_inputs(args)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BeatsyncWarning)
+        result = _pipeline(args, out, video)
+    notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+    for note in notes:
+        print(f"beatsync sync: warning: {note}", file=sys.stderr)
+    result["warnings"] = notes
+    if report_path is not None:
+        io.write_json(report_path, result)
+        result["outputs"]["report"] = str(report_path)
+    return emit(result, _text(result), args)
+
+
+def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[str, Any]:
+    from .. import io
+    from ..sync import synchronize
+
     t_start = time.perf_counter()
     steps = _Steps(5 + (video is not None))
     timings: dict[str, float] = {}
@@ -252,10 +269,7 @@ def run(args: argparse.Namespace) -> int:
         "outputs": written,
         "timings": timings,
     }
-    if report_path is not None:
-        io.write_json(report_path, result)
-        written["report"] = str(report_path)
-    return emit(result, _text(result), args)
+    return result
 
 
 def _align_accents(res: Any, motion: Any, boundaries: Any, beats: np.ndarray,
