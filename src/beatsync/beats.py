@@ -32,13 +32,15 @@ Method (``method="psf"``)
    nearby onset with the best strength x closeness (phase-slope zero crossings give
    the onset time to a fraction of a frame).
 5. **Metrical level** (octave errors), deliberately and per constant-tempo segment:
-   the beat is the pulse whose alternate pulses carry comparable onset energy
-   (uniformity >= 0.45, in the band-weighted onset signal or in the lowest band). If
-   the points halfway (or a third of the way) between the beats are as strong as
-   the beats, the faster pulse is the beat (a 180 BPM click track decoded at 90);
-   if every other beat is much weaker, the slower one is (hi-hat eighths decoded as
-   beats). A known tempo (``bpm=``) bypasses the tempo HMM and this rule; a BPM
-   range restricts both.
+   the beat is the pulse whose alternate pulses carry comparable onset *energy*
+   (uniformity >= 0.15 of the mean squared energy flux in +-30 ms, where the energy
+   flux is the rectified increase of the smoothed band energies: loudness-
+   proportional, unlike the log-compressed flux used for the onsets). If the points
+   halfway (or a third of the way) between the beats are that strong, the faster
+   pulse is the beat (a 180 BPM click track decoded at 90); if every other beat is
+   much weaker, the slower one is (soft hi-hat eighths decoded as beats). Kick/snare
+   alternation stays a single level. A known tempo (``bpm=``) bypasses the tempo
+   HMM and this rule; a BPM range restricts both.
 
 Audio above 22.05 kHz is first resampled to 22.05 kHz (``analysis_sr``), so the
 front end behaves the same for 44.1 and 48 kHz input.
@@ -144,6 +146,10 @@ class OnsetSignal:
         Weight ``6 - c`` of each band.
     psf : np.ndarray [shape=(n_bands, n_frames)] [s]
         Phase-slope function per band (NaN where the band is silent).
+    energy_flux : np.ndarray [shape=(n_frames,)]
+        Square root of the half-wave rectified increase of the band energies, summed
+        over the bands, minus its local mean: a loudness-proportional onset signal
+        (unlike the log-compressed flux), used to decide the metrical level.
     """
 
     envelope: np.ndarray
@@ -153,6 +159,7 @@ class OnsetSignal:
     onset_strengths: np.ndarray
     band_weights: np.ndarray
     psf: np.ndarray = field(repr=False)
+    energy_flux: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
 
 
 # --------------------------------------------------------------------------- checks
@@ -418,6 +425,20 @@ def _onsets(y: np.ndarray, sr: float, fe: dict[str, Any]) -> OnsetSignal:
     np.maximum(diff, 0.0, out=diff)
     counts = np.maximum(member.sum(axis=1, keepdims=True), 1.0)
     flux = (member @ diff).astype(np.float64) / counts  # mean over the band's bins
+    del diff, logmag
+    # loudness-proportional onset signal: rectified increase of each band's energy
+    # (band sums first, so the bin-to-bin beating of sustained low tones cancels)
+    # smoothed over one window length first: the windowed energy of a low tone (an 808
+    # kick's boom) oscillates from frame to frame with its phase
+    span = max(int(round(fe["win"] / fe["hop"])), 2)
+    smooth = scipy.ndimage.uniform_filter1d(energy, span, axis=1)
+    d_energy = np.diff(smooth, axis=1, prepend=smooth[:, :1])
+    energy_flux = np.sqrt(np.maximum(d_energy, 0.0).sum(axis=0))
+    if fe["flux_norm_s"] > 0:  # remove the fluctuation floor of sustained sounds
+        size = max(int(round(fe["flux_norm_s"] * fps)), 3)
+        energy_flux = np.maximum(
+            energy_flux - scipy.ndimage.uniform_filter1d(energy_flux, size), 0.0
+        )
     if fe["flux_norm_s"] > 0:
         size = max(int(round(fe["flux_norm_s"] * fps)), 3)
         flux = np.maximum(flux - scipy.ndimage.uniform_filter1d(flux, size, axis=1), 0.0)
@@ -455,7 +476,7 @@ def _onsets(y: np.ndarray, sr: float, fe: dict[str, Any]) -> OnsetSignal:
         t, s = t[order], s[order]
     else:
         t = s = np.empty(0)
-    return OnsetSignal(envelope, bands, fps, t, s, weights, psf)
+    return OnsetSignal(envelope, bands, fps, t, s, weights, psf, energy_flux)
 
 
 # --------------------------------------------------------------------------- tempo
@@ -741,12 +762,10 @@ def _uniformity(signals, fps: float, a: np.ndarray, b: np.ndarray) -> float:
 def _level_factor(signals, fps, beats, level_ratio: float, accent_ratio: float) -> float:
     """Factor on the beat period (1/2, 1/3, 2 or 1) deciding the metrical level.
 
-    A pulse is the beat if its alternate pulses carry comparable onset energy, in the
-    band-weighted onset signal or in the lowest band (kick and snare, not the hi-hat).
-    The faster pulse (halves, thirds) is taken if its uniformity is at least
-    ``level_ratio``; the slower one only if the current beats clearly alternate strong
-    and weak (uniformity below ``accent_ratio`` < ``level_ratio``): a weak snare
-    against a strong kick must not halve the tempo.
+    A pulse is the beat if its alternate pulses carry comparable onset energy
+    (``signals``: the energy flux). The faster pulse (halves, thirds) is taken if its
+    uniformity is at least ``level_ratio``; the slower one if the current beats
+    alternate strong and very weak (uniformity below ``accent_ratio``).
     """
     d = np.diff(beats)
     if _uniformity(signals, fps, beats[:-1], beats[:-1] + d / 2) >= level_ratio:
@@ -820,8 +839,8 @@ def _track_psf(
     tempo_hop_s,
     time_varying,
     power: float = 2.0,
-    level_ratio: float = 0.45,
-    accent_ratio: float = 0.45,
+    level_ratio: float = 0.15,
+    accent_ratio: float = 0.15,
 ) -> BeatTrack:
     fps = ons.fps
     raw = ons.envelope
@@ -870,7 +889,7 @@ def _track_psf(
                 sel = beats[(beats >= lo) & (beats < hi)]
                 if sel.size < 4:
                     continue
-                factor = _level_factor((raw, ons.bands[0]), fps, sel, level_ratio, accent_ratio)
+                factor = _level_factor((ons.energy_flux,), fps, sel, level_ratio, accent_ratio)
                 tempo_new = 60.0 / np.median(period_w[a:b]) / factor
                 if min_bpm <= tempo_new <= max_bpm:
                     new[a:b] = period_w[a:b] * factor
