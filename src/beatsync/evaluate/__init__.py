@@ -1,2 +1,19 @@
-"""Scores: beat tracking (:mod:`beatsync.evaluate.beats`, mir_eval) and dance-music
-beat alignment (:mod:`beatsync.evaluate.alignment`)."""
+"""Scores.
+
+- :mod:`beatsync.evaluate.beats`: beat tracking against annotations, every
+  ``mir_eval.beat`` metric with an explicit ``min_beat_time``.
+- :mod:`beatsync.evaluate.alignment`: dance-music beat alignment, both published
+  scores (averaged over motion beats, or over music beats; Gaussian sigma in seconds).
+"""
+
+from .alignment import alignment_scores, beat_alignment_motion, beat_alignment_music
+from .beats import METRICS, evaluate_beats, octave_relation
+
+__all__ = [
+    "evaluate_beats",
+    "octave_relation",
+    "METRICS",
+    "alignment_scores",
+    "beat_alignment_motion",
+    "beat_alignment_music",
+]
