@@ -63,7 +63,7 @@ import scipy.ndimage
 import scipy.signal
 
 from .errors import BeatsyncWarning, ParameterError
-from .units import check_fps, check_range, frames_to_time, time_to_frames
+from .units import check_positive, check_range, frames_to_time, time_to_frames
 
 __all__ = [
     "BeatTrack",
@@ -225,9 +225,11 @@ def _frontend(params: dict[str, Any], sr: float) -> dict[str, Any]:
         )
     p = {**FRONTEND_DEFAULTS, **params}
     if p["analysis_sr"] is not None:
-        sr = min(sr, float(int(round(check_fps(p["analysis_sr"], name="analysis_sr")))))
-    win = int(round(check_fps(p["win_s"], name="win_s") * sr))
-    hop = int(round(check_fps(p["hop_s"], name="hop_s") * sr))
+        sr = min(
+            sr, float(int(round(check_positive(p["analysis_sr"], name="analysis_sr", unit="Hz"))))
+        )
+    win = int(round(check_positive(p["win_s"], name="win_s", unit="s") * sr))
+    hop = int(round(check_positive(p["hop_s"], name="hop_s", unit="s") * sr))
     if win < 16:
         raise ParameterError(f"win_s={p['win_s']!r} s is only {win} samples at sr={sr:g}")
     if hop < 1 or hop > win // 2:
@@ -707,10 +709,10 @@ def track_beats(
         return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
     if method != "psf":
         raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
-    prior_period_s = check_fps(prior_period_s, name="prior_period_s")
-    prior_sigma = check_fps(prior_sigma, name="prior_sigma")
-    tempo_win_s = check_fps(tempo_win_s, name="tempo_win_s")
-    tempo_hop_s = check_fps(tempo_hop_s, name="tempo_hop_s")
+    prior_period_s = check_positive(prior_period_s, name="prior_period_s", unit="s")
+    prior_sigma = check_positive(prior_sigma, name="prior_sigma", unit="log-period")
+    tempo_win_s = check_positive(tempo_win_s, name="tempo_win_s", unit="s")
+    tempo_hop_s = check_positive(tempo_hop_s, name="tempo_hop_s", unit="s")
     fe = _frontend(frontend_params, sr)
     if y.size / sr * fe["sr"] < 4 * fe["win"]:
         raise ParameterError(

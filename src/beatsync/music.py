@@ -27,7 +27,7 @@ import numpy as np
 
 from .errors import ParameterError
 from .motion_beats import zscore
-from .units import check_finite, check_fps, check_times
+from .units import check_finite, check_positive, check_times
 
 __all__ = [
     "beat_rms_db",
@@ -39,7 +39,7 @@ __all__ = [
 
 
 def _check_audio(y: Any, sr: Any) -> tuple[np.ndarray, float]:
-    sr = check_fps(sr, name="sr")
+    sr = check_positive(sr, name="sr", unit="Hz")
     y = check_finite(y, name="audio samples")
     if y.ndim != 1:
         raise ParameterError(
@@ -102,7 +102,7 @@ def track_music_beats(
     """
     y, sr = _check_audio(y, sr)
     if bpm is not None:
-        bpm = check_fps(bpm, name="bpm")
+        bpm = check_positive(bpm, name="bpm", unit="BPM")
     if not np.any(np.abs(y) > 1e-6):
         raise ParameterError("the music is silent: no beats to dance to")
     try:
@@ -185,8 +185,8 @@ def drum_song(
     """
     from .synth.audio import beat_times, drum_pattern
 
-    duration = check_fps(duration, name="duration")
-    bpm = check_fps(bpm, name="bpm")
+    duration = check_positive(duration, name="duration", unit="s")
+    bpm = check_positive(bpm, name="bpm", unit="BPM")
     if int(section_beats) < 1:
         raise ParameterError(f"section_beats={section_beats!r} must be >= 1")
     lo, hi = (float(v) for v in level_range_db)

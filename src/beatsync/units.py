@@ -24,7 +24,12 @@ __all__ = [
     "check_times",
     "check_finite",
     "check_range",
+    "check_positive",
+    "MIN_PLAUSIBLE_FPS",
 ]
+
+#: Frame rates below this [Hz] are refused as a likely frame period in seconds.
+MIN_PLAUSIBLE_FPS = 1.0
 
 
 def check_fps(fps: Any, *, name: str = "fps") -> float:
@@ -44,7 +49,28 @@ def check_fps(fps: Any, *, name: str = "fps") -> float:
             f"{name}={fps!r} must be a finite frame rate > 0 [Hz] "
             "(did you pass a frame period in seconds, or zero?)"
         )
+    if value < MIN_PLAUSIBLE_FPS:
+        raise ParameterError(
+            f"{name}={fps!r} Hz looks like a frame period in seconds, not a frame rate; "
+            f"did you mean {name}={1.0 / value:.6g}?"
+        )
     return value
+
+
+def check_positive(value: Any, *, name: str, unit: str, allow_zero: bool = False) -> float:
+    """Return ``value`` as a float after checking it is finite and > 0 (or >= 0) [unit].
+
+    Use for durations, tempi, window lengths: anything positive that is not a frame
+    rate (see :func:`check_fps`).
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={value!r} is not a number [{unit}]") from None
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        bound = ">= 0" if allow_zero else "> 0"
+        raise ParameterError(f"{name}={value!r} must be a finite number {bound} [{unit}]")
+    return v
 
 
 def frames_to_time(frames: Any, *, fps: float) -> np.ndarray:
@@ -68,7 +94,9 @@ def frames_to_time(frames: Any, *, fps: float) -> np.ndarray:
     return np.asarray(frames, dtype=np.float64) / fps
 
 
-def time_to_frames(times: Any, *, fps: float, round_to_int: bool = True) -> np.ndarray:
+def time_to_frames(
+    times: Any, *, fps: float, round_to_int: bool = True, mode: str = "round"
+) -> np.ndarray:
     """Convert times in seconds to frame indices: ``frames = round(t * fps)``.
 
     Parameters
@@ -76,8 +104,11 @@ def time_to_frames(times: Any, *, fps: float, round_to_int: bool = True) -> np.n
     times : array_like [s]
     fps : float > 0 [Hz]
     round_to_int : bool
-        Round to the nearest integer frame (``int64``); otherwise return fractional
-        frames (``float64``).
+        Return integer frames (``int64``); otherwise fractional frames (``float64``).
+    mode : {"round", "floor", "ceil"}
+        How times between frames become integer frames: the nearest frame, the last
+        frame at or before the time, or the first frame at or after it. A tolerance of
+        1e-9 frames absorbs floating-point error (``ceil(3 * (1/3) * 3)`` is 3).
 
     Examples
     --------
@@ -86,9 +117,15 @@ def time_to_frames(times: Any, *, fps: float, round_to_int: bool = True) -> np.n
     """
     fps = check_fps(fps)
     frames = np.asarray(times, dtype=np.float64) * fps
-    if round_to_int:
+    if not round_to_int:
+        return frames
+    if mode == "round":
         return np.rint(frames).astype(np.int64)
-    return frames
+    if mode == "floor":
+        return np.floor(frames + 1e-9).astype(np.int64)
+    if mode == "ceil":
+        return np.ceil(frames - 1e-9).astype(np.int64)
+    raise ParameterError(f"mode={mode!r} must be 'round', 'floor' or 'ceil'")
 
 
 def check_finite(values: Any, *, name: str) -> np.ndarray:
@@ -151,10 +188,10 @@ def check_times(
         )
     if duration is not None and arr[-1] > duration + 1e-9:
         hint = ""
-        if arr[-1] > 30 * duration:
+        if arr[-1] > 2 * duration:
             hint = " (these look like frame indices or milliseconds, not seconds)"
         raise ParameterError(
-            f"{name} ends at {arr[-1]!r} s, after the signal's duration {duration:.3f} s{hint}"
+            f"{name} ends at {arr[-1]:g} s, after the signal's duration {duration:.3f} s{hint}"
         )
     return arr
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..units import check_fps
+from ..units import check_fps, check_positive
 
 __all__ = ["dance_skeleton", "synthetic_dance", "synthetic_library"]
 
@@ -107,8 +107,8 @@ def synthetic_dance(
         Beats lie on frame times, inside the clip.
     """
     fps = check_fps(fps)
-    bpm = check_fps(bpm, name="bpm")
-    duration = check_fps(duration, name="duration")
+    bpm = check_positive(bpm, name="bpm", unit="BPM")
+    duration = check_positive(duration, name="duration", unit="s")
     if int(section_beats) < 1:
         raise ParameterError(f"section_beats={section_beats!r} must be >= 1")
     rng = np.random.default_rng(seed)

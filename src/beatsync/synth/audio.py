@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_fps, check_range, check_times
+from ..units import check_positive, check_range, check_times
 
 __all__ = [
     "BeatTestItem",
@@ -122,7 +122,7 @@ def beat_times(
     beats : np.ndarray [s]
     """
     bpm = _check_bpm(bpm)
-    duration = check_fps(duration, name="duration")
+    duration = check_positive(duration, name="duration", unit="s")
     if not 0.0 <= drift < 0.5:
         raise ParameterError(f"drift={drift!r} must be a relative amplitude in [0, 0.5)")
     if start < 0 or start >= duration:
@@ -180,8 +180,8 @@ def _offbeats(beats: np.ndarray, swing: float) -> np.ndarray:
 
 def _check_common(beats, sr, duration):
     beats = check_times(beats, name="beats")
-    sr_f = check_fps(sr, name="sr")
-    duration = check_fps(duration, name="duration")
+    sr_f = check_positive(sr, name="sr", unit="Hz")
+    duration = check_positive(duration, name="duration", unit="s")
     return beats, int(round(sr_f)), duration
 
 
@@ -324,8 +324,8 @@ def make_beat_test_set(
     >>> [it.name for it in items][:2]
     ['click_120_clean', 'click_120_drift']
     """
-    sr_i = int(round(check_fps(sr, name="sr")))
-    duration = check_fps(duration, name="duration")
+    sr_i = int(round(check_positive(sr, name="sr", unit="Hz")))
+    duration = check_positive(duration, name="duration", unit="s")
     if duration < 4.0:
         raise ParameterError(f"duration={duration!r} s is too short for a test item (>= 4 s)")
     for k in kinds:
