@@ -51,3 +51,31 @@ def test_blend_endpoints_and_errors(chain_motion):
         blend_values(chain_motion, a, b, np.full(10, 2.0))
     with pytest.raises(ParameterError, match="NaN"):
         sample_motion(chain_motion, np.array([np.nan]))
+
+
+@pytest.mark.parametrize(
+    "channels, v0, v1, expected",
+    [
+        (("knee_Zrotation",), [179.0], [-179.0], [180.0]),
+        (("elbow_Zrotation", "elbow_Xrotation"), [170.0, 10.0], [-170.0, 30.0], [180.0, 20.0]),
+    ],
+)
+def test_one_and_two_axis_joints_interpolate_the_short_way(channels, v0, v1, expected):
+    m = Motion(np.array([v0, v1]), 10.0, channels)
+    out = sample_motion(m, np.array([0.05]))[0]
+    np.testing.assert_allclose(np.abs(out), np.abs(expected), atol=1e-9)
+
+
+def test_continuous_euler_removes_flips():
+    from beatsync.rotations import continuous_euler, nearest_euler
+
+    e = np.array([[170.0, 10.0, 0.0], [-175.0, 10.0, 0.0], [-10.0, 170.0, 180.0]])
+    out = continuous_euler(e)
+    np.testing.assert_allclose(out[1], [185.0, 10.0, 0.0])
+    # the third row is the alternative triple of (170, 10, 0): it maps back next to it
+    np.testing.assert_allclose(out[2], [170.0, 10.0, 0.0], atol=1e-9)
+    r = euler_to_rotation(e, "ZXY")
+    np.testing.assert_allclose(
+        (euler_to_rotation(out, "ZXY").inv() * r).magnitude(), 0.0, atol=1e-9
+    )
+    np.testing.assert_allclose(nearest_euler(e[:1], e[:1]), e[:1])

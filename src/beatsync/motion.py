@@ -234,6 +234,15 @@ class Motion:
         self._cache["triples"] = out
         return out
 
+    def partial_rotation_columns(self) -> list[int]:
+        """Columns of rotation channels of joints with only one or two rotation channels."""
+        in_triples = {i for _, idx, _ in self.rotation_triples() for i in idx}
+        return [
+            i
+            for i, ch in enumerate(self.channels)
+            if ch.rpartition("_")[2] in _ROT_DOFS and i not in in_triples
+        ]
+
     def positions(self) -> np.ndarray:
         """World positions of every joint and end site by forward kinematics.
 

@@ -19,7 +19,61 @@ from .errors import ParameterError
 from .motion import Motion
 from .units import check_finite, time_to_frames
 
-__all__ = ["euler_to_rotation", "rotation_to_euler", "sample_motion", "blend_values", "slerp"]
+__all__ = [
+    "euler_to_rotation",
+    "rotation_to_euler",
+    "nearest_euler",
+    "continuous_euler",
+    "wrap_degrees",
+    "sample_motion",
+    "blend_values",
+    "slerp",
+]
+
+
+def wrap_degrees(angle: np.ndarray) -> np.ndarray:
+    """Wrap angles [deg] into [-180, 180)."""
+    return (np.asarray(angle, dtype=np.float64) + 180.0) % 360.0 - 180.0
+
+
+def nearest_euler(euler: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Of the equivalent Tait-Bryan triples of each row, the one nearest ``reference``.
+
+    A rotation has two Euler triples, ``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)``,
+    each defined up to multiples of 360 deg per angle; this returns, row by row, the
+    candidate with the smallest squared distance to the reference row.
+
+    Parameters
+    ----------
+    euler, reference : np.ndarray [shape=(n, 3)] [deg]
+    """
+    e = np.atleast_2d(np.asarray(euler, dtype=np.float64))
+    ref = np.asarray(reference, dtype=np.float64).reshape(e.shape)
+    alt = np.stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0], axis=1)
+    best = best_d = None
+    for cand in (e, alt):
+        cand = cand + 360.0 * np.round((ref - cand) / 360.0)
+        d = np.sum((cand - ref) ** 2, axis=1)
+        if best is None:
+            best, best_d = cand, d
+        else:
+            take = d < best_d
+            best = np.where(take[:, None], cand, best)
+            best_d = np.where(take, d, best_d)
+    return best
+
+
+def continuous_euler(euler: np.ndarray) -> np.ndarray:
+    """Make an Euler-triple curve ``(n, 3)`` [deg] continuous frame to frame.
+
+    Each frame takes the equivalent triple (see :func:`nearest_euler`) nearest the
+    previous output frame, so a BVH curve has no 360 deg jumps or gimbal flips.
+    """
+    e = np.asarray(euler, dtype=np.float64)
+    out = e.copy()
+    for i in range(1, e.shape[0]):
+        out[i] = nearest_euler(e[i : i + 1], out[i - 1 : i])[0]
+    return out
 
 
 def euler_to_rotation(angles_deg: np.ndarray, order: str) -> Rotation:
@@ -41,20 +95,7 @@ def rotation_to_euler(rot: Rotation, order: str, reference: np.ndarray | None = 
         e = e[None, :]
     if reference is None:
         return e
-    ref = np.asarray(reference, dtype=np.float64).reshape(e.shape)
-    alt = np.stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0], axis=1)
-    best = None
-    best_d = None
-    for cand in (e, alt):
-        cand = cand + 360.0 * np.round((ref - cand) / 360.0)
-        d = np.sum((cand - ref) ** 2, axis=1)
-        if best is None:
-            best, best_d = cand, d
-        else:
-            take = d < best_d
-            best = np.where(take[:, None], cand, best)
-            best_d = np.where(take, d, best_d)
-    return best
+    return nearest_euler(e, reference)
 
 
 def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -75,8 +116,17 @@ def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 def _interp_values(motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Per-row interpolation from ``v0`` (w=0) to ``v1`` (w=1): slerp on rotation triples."""
+    """Per-row interpolation from ``v0`` (w=0) to ``v1`` (w=1): slerp on rotation triples.
+
+    Joints with one or two rotation channels turn about fixed axes: each angle is
+    interpolated along its shortest difference (the 1-axis slerp), never across the
+    +-180 deg wrap the long way.
+    """
     out = v0 * (1.0 - w[:, None]) + v1 * w[:, None]
+    partial = motion.partial_rotation_columns()
+    if partial:
+        d = wrap_degrees(v1[:, partial] - v0[:, partial])
+        out[:, partial] = v0[:, partial] + w[:, None] * d
     for _joint, idx, order in motion.rotation_triples():
         cols = list(idx)
         q0 = euler_to_rotation(v0[:, cols], order).as_quat()
