@@ -72,3 +72,34 @@ def test_batch_cli_writes_summary(inputs, tmp_path, capsys):
     assert code == 0
     assert (tmp_path / "summary.csv").is_file()
     assert (tmp_path / "salsa__click100.bvh").is_file()
+
+
+def test_batch_refuses_to_overwrite_inputs(inputs, tmp_path):
+    _, clips, songs = inputs
+    before = songs[0].read_bytes()
+    code = main(
+        [
+            "batch",
+            "--clips",
+            str(clips[0]),
+            "--songs",
+            str(songs[0]),
+            "--out-dir",
+            str(tmp_path),
+            "--summary",
+            str(songs[0]),
+        ]
+    )
+    assert code == 2
+    assert songs[0].read_bytes() == before
+
+
+def test_batch_refuses_duplicate_song_names(inputs, tmp_path):
+    d, clips, songs = inputs
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    twins = [tmp_path / "a" / "song.wav", tmp_path / "b" / "song.wav"]
+    for t in twins:
+        t.write_bytes(songs[0].read_bytes())
+    with pytest.raises(ParameterError, match="song file names must differ"):
+        sync_grid(clips[:1], twins, tmp_path)

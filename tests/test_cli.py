@@ -16,8 +16,10 @@ def _subcommands():
 
 
 def test_every_subcommand_has_help(capsys):
+    from beatsync.commands import COMMAND_MODULES
+
     subs = _subcommands()
-    assert {"reproduce", "data"} <= set(subs)
+    assert set(subs) == set(COMMAND_MODULES)  # none silently missing
     for name in subs:
         with pytest.raises(SystemExit) as exc:
             main([name, "--help"])
@@ -37,3 +39,12 @@ def test_console_script_runs():
         [sys.executable, "-m", "beatsync.cli", "--version"], capture_output=True, text=True
     )
     assert out.returncode == 0 and out.stdout.startswith("beatsync ")
+
+
+def test_json_output_is_strict(capsys):
+    import argparse
+
+    from beatsync.commands._common import emit
+
+    emit({"x": float("nan"), "y": [1.0, float("inf")]}, "", argparse.Namespace(json=True))
+    assert json.loads(capsys.readouterr().out) == {"x": None, "y": [1.0, None]}

@@ -175,3 +175,23 @@ def test_beats_files(tmp_path):
     with pytest.raises(ParameterError, match="increasing"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
     assert not (tmp_path / "w.beats").exists()
+
+
+def test_csv_without_header_refused(tmp_path):
+    np.savetxt(tmp_path / "noheader.csv", np.arange(12.0).reshape(6, 2) + 0.5, delimiter=",")
+    with pytest.raises(ParameterError, match="header"):
+        io.read_motion(tmp_path / "noheader.csv", fps=25)
+
+
+def test_atomic_write_respects_umask_and_existing_mode(tmp_path):
+    import os
+
+    old = os.umask(0o077)
+    try:
+        p = io.write_beats(tmp_path / "private.beats", [0.5, 1.0])
+    finally:
+        os.umask(old)
+    assert p.stat().st_mode & 0o777 == 0o600
+    p.chmod(0o640)
+    io.write_beats(p, [0.5, 1.5])
+    assert p.stat().st_mode & 0o777 == 0o640

@@ -79,6 +79,9 @@ def sync_pair(
     except ParameterError as exc:
         row.update(status="error", error=str(exc))
         return row
+    except Exception as exc:  # one broken pair must not stop a study of thousands
+        row.update(status="error", error=f"{type(exc).__name__}: {exc}")
+        return row
     motion = res.motion
     suffix = ".bvh" if motion.skeleton is not None else ".csv"
     out = Path(out_dir) / f"{clip_name}__{song_name}{suffix}"
@@ -102,13 +105,15 @@ def sync_pair(
 
 
 def _guard(func: Any) -> Any:
-    """Wrap a task so a ParameterError is returned (and recorded), not raised."""
+    """Wrap a task so its error is returned (and recorded by the pairs), not raised."""
 
     def wrapped(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
         except ParameterError as exc:
             return exc
+        except Exception as exc:  # recorded per pair, like bad input
+            return RuntimeError(f"{type(exc).__name__}: {exc}")
 
     wrapped.__name__ = func.__name__
     return wrapped
@@ -165,9 +170,24 @@ def sync_grid(
     out = Path(out_dir)
     if not out.is_dir():
         raise ParameterError(f"output folder {str(out)!r} does not exist; create it first")
-    stems = [Path(c).stem for c in clips]
-    if len(set(stems)) != len(stems):
-        raise ParameterError("clip file names must differ (outputs are named after them)")
+    for what, paths in (("clip", clips), ("song", songs)):
+        stems = [Path(p).stem for p in paths]
+        dup = sorted({x for x in stems if stems.count(x) > 1})
+        if dup:
+            raise ParameterError(
+                f"{what} file names must differ without their folder and suffix "
+                f"(outputs are named <clip>__<song>): {dup} appear more than once"
+            )
+    inputs = {Path(p).resolve() for p in clips + songs}
+    for c in clips:
+        for s in songs:
+            for suffix in (".bvh", ".csv"):
+                target = (out / f"{Path(c).stem}__{Path(s).stem}{suffix}").resolve()
+                if target in inputs:
+                    raise ParameterError(
+                        f"output {str(target)!r} would overwrite an input file; "
+                        "choose another --out-dir"
+                    )
 
     cluster = None
     if scheduler is None:

@@ -65,6 +65,15 @@ def _existing_file(path: str | os.PathLike[str], what: str) -> Path:
     return p
 
 
+def _new_file_mode(dest: Path) -> int:
+    """Permissions for a written file: the existing file's, else 0o666 less the umask."""
+    if dest.exists():
+        return dest.stat().st_mode & 0o777
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; rename it to ``path`` on success.
@@ -81,7 +90,9 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh
-        os.chmod(tmp, 0o644)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, _new_file_mode(dest))
         os.replace(tmp, dest)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
@@ -341,7 +352,8 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
     if variable is None:
         if len(cands) != 1:
             raise ParameterError(
-                f"{str(p)!r} holds several marker recordings {cands}; choose one with variable="
+                f"{str(p)!r} holds several marker recordings {cands}; choose one with "
+                "variable= (--variable on the command line)"
             )
         variable = cands[0]
     if variable not in cands:
@@ -400,12 +412,25 @@ def read_table(
                 f"{str(p)!r} has non-numeric columns {non_num[:5]}; the first row must be "
                 "channel names and every other row numbers"
             )
-        values = df.to_numpy(dtype=np.float64)
         names = tuple(str(c) for c in df.columns)
+        if all(_is_number(c) for c in names):
+            raise ParameterError(
+                f"the first row of {str(p)!r} is numbers, not channel names: add a header "
+                "row (e.g. knee_L,knee_R,...) or save the array as .npy"
+            )
+        values = df.to_numpy(dtype=np.float64)
     values = check_finite(values, name=f"{p.name} values")
     if values.shape[0] < 2:
         raise ParameterError(f"{str(p)!r} has {values.shape[0]} frame(s); need at least 2")
     return Motion(values, rate, names, None, p.stem)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def write_table(path: str | os.PathLike[str], motion: Motion) -> Path:
@@ -558,7 +583,7 @@ def write_json(path: str | os.PathLike[str], obj: Any) -> Path:
     from .commands._common import to_jsonable
 
     with atomic_write(path) as fh:
-        json.dump(to_jsonable(obj), fh, indent=2)
+        json.dump(to_jsonable(obj), fh, indent=2, allow_nan=False)
         fh.write("\n")
     return Path(path)
 

@@ -17,6 +17,7 @@ parameters, package version and time of every notebook.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -158,10 +159,17 @@ def run_notebooks(
                 progress_bar=False,
                 report_mode=False,
             )
-            with open(tmp) as src, atomic_write(dest) as fh:
-                fh.write(src.read())
-        finally:
-            tmp.unlink(missing_ok=True)
+        except Exception:
+            # keep the executed notebook with its traceback cells for the user to read
+            failed = dest.with_name(f"{dest.stem}.failed.ipynb")
+            if tmp.exists():
+                os.replace(tmp, failed)
+                if progress:
+                    progress(f"  {name} FAILED; executed notebook kept in {failed}")
+            raise
+        with open(tmp) as src, atomic_write(dest) as fh:
+            fh.write(src.read())
+        tmp.unlink(missing_ok=True)
         seconds = time.perf_counter() - start
         runs.append(NotebookRun(name, dest, params[name], seconds))
         if progress:

@@ -22,7 +22,10 @@ def add_json_flag(parser: argparse.ArgumentParser) -> None:
 
 
 def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays and paths inside ``obj`` to plain JSON types."""
+    """Convert numpy scalars/arrays and paths inside ``obj`` to plain JSON types.
+
+    Non-finite floats become ``None`` (``null``): strict JSON has no NaN.
+    """
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -31,8 +34,9 @@ def to_jsonable(obj: Any) -> Any:
         return to_jsonable(obj.tolist())
     if isinstance(obj, np.integer):
         return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if np.isfinite(value) else None  # JSON has no NaN/Infinity
     if isinstance(obj, np.bool_):
         return bool(obj)
     if isinstance(obj, Path):
@@ -43,7 +47,7 @@ def to_jsonable(obj: Any) -> Any:
 def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
     """Print ``result`` as JSON if ``--json`` was given, else ``text``; return exit code 0."""
     if getattr(args, "json", False):
-        json.dump(to_jsonable(result), sys.stdout, indent=2)
+        json.dump(to_jsonable(result), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     else:
         sys.stdout.write(text.rstrip("\n") + "\n")

@@ -45,7 +45,10 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import io
     from ..batch import sync_grid
+    from ._common import check_output_path
 
+    summary = Path(args.summary) if args.summary else Path(args.out_dir) / "summary.csv"
+    check_output_path(summary, *args.clips, *args.songs)
     table = sync_grid(
         args.clips,
         args.songs,
@@ -56,8 +59,8 @@ def run(args: argparse.Namespace) -> int:
         bpm=args.bpm,
         period_range=tuple(args.period_range),
     )
-    summary = Path(args.summary) if args.summary else Path(args.out_dir) / "summary.csv"
     io.write_csv(summary, table)
     n_ok = int((table["status"] == "ok").sum())
     text = table.to_string(index=False) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
-    return emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
+    emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
+    return 0 if n_ok else 1
