@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 
 from beatsync import datasets
-from beatsync.beats import BeatTrack, onset_strength_psf, phase_slope, track_beats
+from beatsync.beats import (
+    MIN_DURATION_S,
+    BeatTrack,
+    beat_tempo,
+    check_audio,
+    onset_strength_psf,
+    phase_slope,
+    track_beats,
+)
 from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.evaluate.beats import evaluate_beats
 from beatsync.synth.audio import beat_times, click_track, drum_pattern, make_beat_test_set
@@ -96,10 +104,53 @@ def test_frontend_parameters_accepted():
     assert _score(ref, bt.beats)["F-measure"] >= 0.95
 
 
-def test_librosa_method_runs():
+def test_librosa_method_scores_on_clean_clicks():
     ref = beat_times(120, duration=10.0, start=0.3)
     bt = track_beats(click_track(ref, sr=SR, duration=10.0), SR, method="librosa")
-    assert bt.method == "librosa" and bt.beats.size > 5
+    assert bt.method == "librosa"
+    assert _score(ref, bt.beats)["F-measure"] >= 0.9
+    assert bt.tempo == pytest.approx(120, rel=0.05)
+
+
+@pytest.mark.parametrize("method", ["psf", "librosa"])
+@pytest.mark.parametrize("duration", [0.5, 1.0, MIN_DURATION_S - 0.01])
+def test_too_short_audio_is_refused(method, duration):
+    # a 0.5 s click gave "109 BPM, 1 beat" (the tempo prior), exit 0
+    y = click_track(beat_times(120, duration=duration, start=0.1), sr=SR, duration=duration)
+    with pytest.raises(ParameterError, match=rf"only {duration:.3f} s long.*at least 1\.5 s"):
+        track_beats(y, SR, method=method)
+
+
+def test_short_audio_rule_with_known_bpm():
+    y = click_track(beat_times(90, duration=1.8, start=0.1), sr=SR, duration=1.8)
+    # 1.8 s passes the fixed minimum but is less than two beat periods at 50 BPM (2.4 s)
+    with pytest.raises(ParameterError, match=r"at least 2\.4 s \(two beat periods at the given"):
+        track_beats(y, SR, bpm=50.0)
+    assert track_beats(y, SR, bpm=90.0).beats.size >= 2  # 1.33 s needed
+    # exactly the minimum is accepted
+    n = int(MIN_DURATION_S * SR)
+    yy = click_track(
+        beat_times(120, duration=MIN_DURATION_S, start=0.1), sr=SR, duration=MIN_DURATION_S
+    )
+    assert yy.size == n and track_beats(yy, SR).beats.size >= 2
+
+
+def test_beat_tempo_known_answer():
+    starts, bpm = beat_tempo([0.0, 0.5, 1.0, 1.75])
+    np.testing.assert_allclose(starts, [0.0, 0.5, 1.0])
+    np.testing.assert_allclose(bpm, [120.0, 120.0, 80.0])
+    assert beat_tempo([1.0])[1].size == 0
+    with pytest.raises(ParameterError):
+        beat_tempo([1.0, 0.5])
+
+
+def test_check_audio_silence_threshold_and_allow_silent():
+    quiet = np.full(100, 5e-7)  # above the silence threshold (1e-7)
+    assert check_audio(quiet, SR)[0].dtype == np.float64
+    with pytest.raises(ParameterError, match="silent"):
+        check_audio(np.full(100, 5e-8), SR)
+    y, sr = check_audio(np.zeros(100), SR, allow_silent=True)
+    assert sr == SR and not y.any()
 
 
 def test_madmom_sample():
@@ -144,6 +195,7 @@ def test_noise_warns_no_clear_pulse():
         (np.zeros(0), SR, {}),
         (np.zeros(SR), SR, {}),
         (_Y[:1000], SR, {}),  # 45 ms: too short
+        (_Y[: SR // 2], SR, {}),  # 0.5 s: too short for two beat periods
         (np.r_[_Y[:100], np.nan, _Y[101:]], SR, {}),
         (_Y, 0, {}),
         (_Y, -22050, {}),

@@ -43,12 +43,18 @@ def test_json_out_and_click(song, tmp_path, capsys):
 
 
 def test_librosa_and_bpm_options(song, capsys):
-    path, _ = song
+    path, ref = song
     assert main(["beats", str(path), "--method", "librosa", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["method"] == "librosa"
+    res = json.loads(capsys.readouterr().out)
+    assert res["method"] == "librosa"
+    assert evaluate_beats(ref, res["beats"], min_beat_time=0.0)["F-measure"] >= 0.9
     assert main(["beats", str(path), "--bpm", "60", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert np.median(np.diff(res["beats"])) == pytest.approx(1.0, rel=0.02)
+    # every reference beat at 120 BPM is tapped, every other one at 60 BPM
+    assert evaluate_beats(ref[::2], res["beats"], min_beat_time=0.0)["F-measure"] >= 0.9 or (
+        evaluate_beats(ref[1::2], res["beats"], min_beat_time=0.0)["F-measure"] >= 0.9
+    )
 
 
 def _bad_cases(tmp_path):
@@ -58,7 +64,12 @@ def _bad_cases(tmp_path):
     empty.write_bytes(b"")
     text = tmp_path / "notaudio.wav"
     text.write_text("hello")
+    short = tmp_path / "short.wav"  # 0.5 s of clicks: shorter than 1.5 s
+    io.write_audio(
+        short, click_track(beat_times(120, duration=0.5, start=0.1), sr=SR, duration=0.5), SR
+    )
     return {
+        "short": ["beats", str(short)],
         "missing": ["beats", str(tmp_path / "nope.wav")],
         "empty": ["beats", str(empty)],
         "notaudio": ["beats", str(text)],
@@ -74,6 +85,7 @@ def _bad_cases(tmp_path):
 @pytest.mark.parametrize(
     "case",
     [
+        "short",
         "missing",
         "empty",
         "notaudio",
@@ -97,6 +109,8 @@ def test_bad_input_exit_2_nothing_written(case, song, tmp_path, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("beatsync beats: error:")
+    if case == "short":
+        assert "only 0.500 s long" in err and "at least 1.5 s" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == before
     assert path.stat().st_size == size
 

@@ -3,10 +3,11 @@
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from beatsync.errors import BeatsyncWarning, ParameterError
-from beatsync.evaluate.beats import METRICS, evaluate_beats, octave_relation
+from beatsync.evaluate.beats import METRICS, evaluate_beats, octave_relation, summarize_scores
 
 REF = np.arange(0.5, 20.0, 0.5)
 
@@ -81,3 +82,43 @@ def test_bad_input_raises(ref, est, mbt):
 )
 def test_octave_relation(est, ref, name):
     assert octave_relation(est, ref) == name
+
+
+def _toy_scores():
+    rows = []
+    for method, octaves, f in (
+        ("psf", ["correct", "double", "half", "other"], [1.0, 0.6, 0.6, 0.2]),
+        ("librosa", ["correct", "correct", "triple", "correct"], [0.9, 0.9, 0.5, 0.9]),
+    ):
+        for i, (o, fi) in enumerate(zip(octaves, f, strict=True)):
+            rows.append(
+                {
+                    "item": f"x{i}",
+                    "group": "ab"[i % 2],
+                    "method": method,
+                    "octave": o,
+                    "F-measure": fi,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def test_summarize_scores_overall_and_by_group():
+    sc = _toy_scores()
+    overall = summarize_scores(sc, by=None, metrics=["F-measure"])
+    assert list(overall.index) == ["psf", "librosa"]
+    assert overall.loc["psf", "octave errors"] == 2  # double + half
+    assert overall.loc["psf", "other tempo"] == 1
+    assert overall.loc["librosa", "octave errors"] == 1  # triple
+    assert overall.loc["psf", "n"] == 4
+    assert overall.loc["psf", "F-measure"] == pytest.approx(0.6)
+    per = summarize_scores(sc, by="group", metrics=["F-measure"])
+    assert per.loc[("a", "psf"), "octave errors"] == 1  # half (x2)
+    assert per.loc[("b", "psf"), "octave errors"] == 1  # double (x1)
+    assert per.loc[("b", "psf"), "other tempo"] == 1
+    assert per["n"].sum() == len(sc)
+
+
+def test_summarize_scores_missing_column():
+    with pytest.raises(ParameterError, match="no column"):
+        summarize_scores(_toy_scores(), by="kind", metrics=["F-measure"])

@@ -79,6 +79,49 @@ def test_bad_beats(beats):
         beat_rms_db(y, SR, beats)
 
 
+def test_quiet_music_is_not_silence():
+    # one silence threshold (beatsync.beats.SILENCE_PEAK = 1e-7) for level and tracker;
+    # music.py used 1e-6 and refused this -130 dBFS click track as "silent"
+    from beatsync.synth.audio import beat_times, click_track
+
+    ref = beat_times(120, duration=8.0, start=0.3)
+    y = click_track(ref, sr=22050, duration=8.0)
+    y = y / np.max(np.abs(y)) * 3e-7
+    est = track_music_beats(y, 22050)
+    hit = np.min(np.abs(ref[:, None] - est[None, :]), axis=1) < 0.07
+    assert hit.mean() > 0.9
+    with pytest.raises(ParameterError, match="silent"):
+        track_music_beats(y * 0.1, 22050)
+
+
+@pytest.mark.parametrize("bpm", [0.0, 2.0, 1200.0])
+def test_bpm_checked_like_the_tracker(bpm):
+    y = np.random.default_rng(0).normal(size=4 * SR)
+    with pytest.raises(ParameterError, match="sane range"):
+        track_music_beats(y, SR, bpm=bpm)
+
+
+def test_too_short_music_is_refused():
+    y = np.random.default_rng(0).normal(size=SR // 2)  # 0.5 s
+    with pytest.raises(ParameterError, match="only 0.500 s long"):
+        track_music_beats(y, SR)
+
+
+def test_beat_samples_go_through_units(monkeypatch):
+    import beatsync.music as music
+    from beatsync import units
+
+    calls = []
+
+    def spy(times, **kw):
+        calls.append(kw)
+        return units.time_to_frames(times, **kw)
+
+    monkeypatch.setattr(music, "time_to_frames", spy)
+    beat_rms_db(np.ones(SR), SR, [0.0, 0.5, 1.0])
+    assert calls and calls[0]["fps"] == SR and calls[0]["mode"] == "round"
+
+
 def test_bad_audio():
     with pytest.raises(ParameterError, match="mono"):
         beat_rms_db(np.zeros((SR, 2)), SR, [0.0, 0.5])

@@ -6,10 +6,12 @@ import pytest
 from beatsync.errors import ParameterError
 from beatsync.synth.audio import (
     GROUPS,
+    DrumSong,
     add_noise,
     beat_times,
     click_track,
     drum_pattern,
+    drum_song,
     make_beat_test_set,
 )
 
@@ -88,3 +90,36 @@ def test_make_beat_test_set_bad(kwargs):
 def test_click_track_bad_beats():
     with pytest.raises(ParameterError):
         click_track([1.0, 0.5], sr=22050, duration=2.0)
+
+
+def test_drum_song_known_beats_and_gains():
+    song = drum_song(10.0, bpm=120, sr=8000, section_beats=4, level_range_db=(-20.0, -6.0), seed=1)
+    assert isinstance(song, DrumSong)
+    assert song.y.dtype == np.float32 and song.y.size == 10 * 8000
+    np.testing.assert_allclose(song.beats, beat_times(120, duration=10.0, start=0.5))
+    assert song.duration == pytest.approx(10.0)
+    # one gain per 4-beat section, inside the range, seeded
+    assert np.all((song.gain_db >= -20.0) & (song.gain_db <= -6.0))
+    assert np.all(song.gain_db[:4] == song.gain_db[0]) and song.gain_db[4] != song.gain_db[0]
+    again = drum_song(10.0, bpm=120, sr=8000, section_beats=4, level_range_db=(-20.0, -6.0), seed=1)
+    np.testing.assert_array_equal(song.y, again.y)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"level_range_db": (-10.0, 5.0)},
+        {"section_beats": 0},
+        {"bpm": -120.0},
+    ],
+)
+def test_drum_song_bad_input(kwargs):
+    with pytest.raises(ParameterError):
+        drum_song(10.0, **kwargs)
+
+
+def test_music_drum_song_is_a_reexport():
+    from beatsync import music
+    from beatsync.synth import audio
+
+    assert music.drum_song is audio.drum_song and music.DrumSong is audio.DrumSong

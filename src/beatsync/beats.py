@@ -63,7 +63,7 @@ import scipy.ndimage
 import scipy.signal
 
 from .errors import BeatsyncWarning, ParameterError
-from .units import check_positive, check_range, frames_to_time, time_to_frames
+from .units import check_positive, check_range, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "BeatTrack",
@@ -73,18 +73,26 @@ __all__ = [
     "phase_slope",
     "check_audio",
     "check_bpm",
+    "check_duration",
+    "beat_tempo",
     "FRONTEND_DEFAULTS",
     "MIN_SANE_BPM",
     "MAX_SANE_BPM",
     "MIN_DURATION_S",
+    "SILENCE_PEAK",
     "MIN_PULSE_CLARITY",
 ]
 
 #: A ``bpm`` outside this range is refused as a likely unit mistake.
 MIN_SANE_BPM = 20.0
 MAX_SANE_BPM = 400.0
-#: Shorter audio is refused [s].
-MIN_DURATION_S = 0.5
+#: Audio shorter than this is refused [s] (:func:`check_duration`): two beat periods
+#: at 80 BPM, three at 120 BPM. A shorter clip cannot show a pulse (two beat periods)
+#: at any but the fastest tempi, and the tracker would return a tempo made up by its
+#: prior. The madmom sample (2.8 s) passes.
+MIN_DURATION_S = 1.5
+#: Audio whose peak magnitude is below this (re full scale 1.0, -140 dBFS) is silent.
+SILENCE_PEAK = 1e-7
 #: Below this pulse clarity (median peak of the harmonic autocorrelation salience;
 #: white noise about 0.35, music and the test items above 1.2) a warning says the
 #: beats may be meaningless.
@@ -165,13 +173,23 @@ class OnsetSignal:
 # --------------------------------------------------------------------------- checks
 
 
-def check_audio(y: Any, sr: Any) -> tuple[np.ndarray, float]:
+def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndarray, float]:
     """Validate mono audio; return ``(y float64, sr float)``.
+
+    Parameters
+    ----------
+    y : array_like [shape=(n,)]
+        Mono audio samples.
+    sr : float > 0 [Hz]
+    allow_silent : bool
+        Accept all-silent audio (peak below :data:`SILENCE_PEAK`), e.g. to measure
+        its level; beat tracking refuses it.
 
     Raises
     ------
     ParameterError
-        Empty, multi-channel, non-finite or all-silent audio, or ``sr <= 0``.
+        Empty, multi-channel, non-finite or (unless ``allow_silent``) all-silent
+        audio, or ``sr <= 0``.
     """
     try:
         sr_f = float(sr)
@@ -196,11 +214,67 @@ def check_audio(y: Any, sr: Any) -> tuple[np.ndarray, float]:
             f"the audio contains {int(bad.sum())} NaN or infinite sample(s) "
             f"(first at sample {int(np.argmax(bad))}); repair or trim the file"
         )
-    if not np.any(arr != 0.0) or np.max(np.abs(arr)) < 1e-7:
+    if not allow_silent and not np.max(np.abs(arr)) >= SILENCE_PEAK:
         raise ParameterError(
-            "the audio is all silent: there are no beats to track (check the file and gain)"
+            f"the audio is all silent (peak below {SILENCE_PEAK:g}): there are no beats to "
+            "track (check the file and gain)"
         )
     return arr, sr_f
+
+
+def check_duration(n_samples: int, sr: float, *, bpm: float | None = None) -> float:
+    """Refuse audio too short to hold a pulse; return its duration [s].
+
+    Rule: the audio must last at least :data:`MIN_DURATION_S` (1.5 s, two beat
+    periods at 80 BPM) and, when the tempo is known (``bpm``), at least two beat
+    periods of it (``2 * 60 / bpm`` s).
+
+    Parameters
+    ----------
+    n_samples : int >= 0
+    sr : float > 0 [Hz]
+    bpm : float, optional [bpm]
+
+    Raises
+    ------
+    ParameterError
+        If the audio is shorter; the message gives its duration and the rule.
+    """
+    duration = float(frames_to_time(n_samples, fps=sr))
+    need, why = MIN_DURATION_S, "the fixed minimum: two beat periods at 80 BPM"
+    if bpm is not None and 2 * 60.0 / bpm > need:
+        need, why = 2 * 60.0 / bpm, f"two beat periods at the given bpm={bpm:g}"
+    if duration < need:
+        raise ParameterError(
+            f"the audio is only {duration:.3f} s long ({n_samples} samples at sr={sr:g} Hz): "
+            f"beat tracking needs at least {need:.3g} s ({why}); give a longer excerpt "
+            "(or check the sample rate)"
+        )
+    return duration
+
+
+def beat_tempo(beats: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Instantaneous tempo of each beat interval: ``60 / (b[i+1] - b[i])``.
+
+    Parameters
+    ----------
+    beats : np.ndarray [shape=(K,)] [s]
+        Strictly increasing beat times.
+
+    Returns
+    -------
+    starts : np.ndarray [shape=(K-1,)] [s]
+        Start ``b[i]`` of each interval (plot as steps with ``where="post"``).
+    bpm : np.ndarray [shape=(K-1,)] [bpm]
+        Tempo of each interval (empty for fewer than two beats).
+
+    Examples
+    --------
+    >>> beat_tempo([0.0, 0.5, 1.0, 1.75])[1]
+    array([120., 120.,  80.])
+    """
+    beats = check_times(beats, name="beats")
+    return beats[:-1].copy(), 60.0 / np.diff(beats)
 
 
 def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
@@ -228,8 +302,8 @@ def _frontend(params: dict[str, Any], sr: float) -> dict[str, Any]:
         sr = min(
             sr, float(int(round(check_positive(p["analysis_sr"], name="analysis_sr", unit="Hz"))))
         )
-    win = int(round(check_positive(p["win_s"], name="win_s", unit="s") * sr))
-    hop = int(round(check_positive(p["hop_s"], name="hop_s", unit="s") * sr))
+    win = int(time_to_frames(check_positive(p["win_s"], name="win_s", unit="s"), fps=sr))
+    hop = int(time_to_frames(check_positive(p["hop_s"], name="hop_s", unit="s"), fps=sr))
     if win < 16:
         raise ParameterError(f"win_s={p['win_s']!r} s is only {win} samples at sr={sr:g}")
     if hop < 1 or hop > win // 2:
@@ -437,12 +511,12 @@ def _onsets(y: np.ndarray, sr: float, fe: dict[str, Any]) -> OnsetSignal:
     d_energy = np.diff(smooth, axis=1, prepend=smooth[:, :1])
     energy_flux = np.sqrt(np.maximum(d_energy, 0.0).sum(axis=0))
     if fe["flux_norm_s"] > 0:  # remove the fluctuation floor of sustained sounds
-        size = max(int(round(fe["flux_norm_s"] * fps)), 3)
+        size = max(int(time_to_frames(fe["flux_norm_s"], fps=fps)), 3)
         energy_flux = np.maximum(
             energy_flux - scipy.ndimage.uniform_filter1d(energy_flux, size), 0.0
         )
     if fe["flux_norm_s"] > 0:
-        size = max(int(round(fe["flux_norm_s"] * fps)), 3)
+        size = max(int(time_to_frames(fe["flux_norm_s"], fps=fps)), 3)
         flux = np.maximum(flux - scipy.ndimage.uniform_filter1d(flux, size, axis=1), 0.0)
     # the flux peaks when the onset enters the window, up to half a window before the
     # phase-slope zero crossing: take its maximum over a window-long neighbourhood
@@ -486,7 +560,7 @@ def _onsets(y: np.ndarray, sr: float, fe: dict[str, Any]) -> OnsetSignal:
 
 def _windows(n_frames: int, fps: float, win_s: float, hop_s: float):
     """Start/stop frames and centre times of analysis windows covering the signal."""
-    dur = n_frames / fps
+    dur = float(frames_to_time(n_frames, fps=fps))
     if dur <= win_s:
         centres = np.array([dur / 2])
     else:
@@ -494,7 +568,7 @@ def _windows(n_frames: int, fps: float, win_s: float, hop_s: float):
         centres = win_s / 2 + hop_s * np.arange(n_win)
         if dur - (centres[-1] + win_s / 2) > hop_s / 2:
             centres = np.append(centres, dur - win_s / 2)
-    half = int(round(win_s * fps / 2))
+    half = int(time_to_frames(win_s / 2, fps=fps))
     c = time_to_frames(centres, fps=fps)
     return np.maximum(c - half, 0), np.minimum(c + half, n_frames), centres
 
@@ -671,7 +745,9 @@ def track_beats(
     Raises
     ------
     ParameterError
-        Empty, shorter than 0.5 s, silent or non-finite audio; ``sr <= 0``;
+        Empty, silent or non-finite audio; audio too short for a pulse (shorter
+        than 1.5 s, or than two beat periods of a given ``bpm``, see
+        :func:`check_duration`); ``sr <= 0``;
         ``min_bpm >= max_bpm``; a ``bpm`` outside 20-400; unknown method or front-end
         parameter.
 
@@ -691,16 +767,12 @@ def track_beats(
     120
     """
     y, sr = check_audio(y, sr)
-    if y.size / sr < MIN_DURATION_S:
-        raise ParameterError(
-            f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}); "
-            f"beat tracking needs at least {MIN_DURATION_S:g} s (wrong sample rate?)"
-        )
     min_bpm, max_bpm = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="bpm")
     check_bpm(min_bpm, name="min_bpm")
     check_bpm(max_bpm, name="max_bpm")
     if bpm is not None:
         bpm = check_bpm(bpm)
+    check_duration(y.size, sr, bpm=bpm)
     if method == "librosa":
         if frontend_params:
             raise ParameterError(
@@ -716,8 +788,8 @@ def track_beats(
     fe = _frontend(frontend_params, sr)
     if y.size / sr * fe["sr"] < 4 * fe["win"]:
         raise ParameterError(
-            f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}); "
-            f"beat tracking needs at least {MIN_DURATION_S:g} s (wrong sample rate?)"
+            f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}): "
+            f"shorter than 4 analysis windows of {fe['win']} samples at {fe['sr']:g} Hz"
         )
     ons = _onsets(y, sr, fe)
     return _track_psf(

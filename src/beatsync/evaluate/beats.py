@@ -33,6 +33,7 @@ __all__ = [
     "octave_relation",
     "score_items",
     "summarize_scores",
+    "OCTAVE_ERRORS",
     "beat_targets",
     "sweep_frontend",
 ]
@@ -256,24 +257,51 @@ def score_items(
     return pd.DataFrame(rows)
 
 
+#: Values of the ``octave`` column (:func:`octave_relation`) that are octave errors.
+OCTAVE_ERRORS = ("double", "half", "triple", "third")
+
+
+def _count_octave_errors(octave: pd.Series) -> int:
+    return int(octave.isin(OCTAVE_ERRORS).sum())
+
+
+def _count_other_tempo(octave: pd.Series) -> int:
+    return int((octave == "other").sum())
+
+
 def summarize_scores(
-    scores: pd.DataFrame, *, by: str = "group", metrics: Sequence[str] = TABLE_METRICS
+    scores: pd.DataFrame, *, by: str | None = "group", metrics: Sequence[str] = TABLE_METRICS
 ) -> pd.DataFrame:
     """Mean of ``metrics`` per ``by`` and method, with octave-error counts.
+
+    Parameters
+    ----------
+    scores : pandas.DataFrame
+        Output of :func:`score_items`.
+    by : str or None
+        Column to group by besides ``method`` (e.g. ``"group"``, ``"kind"``); ``None``:
+        one row per method over all items.
+    metrics : sequence of str
 
     Returns
     -------
     pandas.DataFrame
-        Index ``(by, method)``; columns the metrics (means), ``n`` (items),
-        ``octave errors`` (tempo double/half/triple/third) and ``other tempo``.
+        Index ``(by, method)`` (or ``method`` if ``by`` is None); columns the metrics
+        (means), ``n`` (items), ``octave errors`` (tempo double/half/triple/third,
+        :data:`OCTAVE_ERRORS`) and ``other tempo``.
     """
-    g = scores.groupby([by, "method"], sort=False)
+    keys = ["method"] if by is None else [by, "method"]
+    missing = [k for k in [*keys, "octave", *metrics] if k not in scores.columns]
+    if missing:
+        raise ParameterError(
+            f"scores has no column(s) {missing}; pass the table from score_items "
+            f"(columns: {list(scores.columns)})"
+        )
+    g = scores.groupby(keys, sort=False)
     out = g[list(metrics)].mean()
     out["n"] = g.size()
-    out["octave errors"] = g["octave"].agg(
-        lambda s: int(s.isin(["double", "half", "triple", "third"]).sum())
-    )
-    out["other tempo"] = g["octave"].agg(lambda s: int((s == "other").sum()))
+    out["octave errors"] = g["octave"].agg(_count_octave_errors)
+    out["other tempo"] = g["octave"].agg(_count_other_tempo)
     return out
 
 

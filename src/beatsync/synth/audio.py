@@ -14,6 +14,12 @@ drift of +-5 %), ``swing`` (off-beat eighths delayed to 2/3 of the beat),
 ``noise`` (white noise at 10 dB SNR) and ``change`` (an abrupt tempo change halfway).
 It stands in for the paper's test music, which is not available.
 
+:func:`drum_song` renders a song for the motion-graph studies (paper B): the drum
+pattern of :func:`drum_pattern` at a constant tempo, with a gain that changes every
+``section_beats`` beats to a random level in ``level_range_db`` (seeded), so its
+intensity varies like verses and choruses. Its beats are exact. It is re-exported as
+:func:`beatsync.music.drum_song`.
+
 Notebook: ``notebooks/tab_beat_tracking.ipynb``; paper A, section 4.
 """
 
@@ -25,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_positive, check_range, check_times
+from ..units import check_positive, check_range, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "BeatTestItem",
@@ -34,6 +40,8 @@ __all__ = [
     "drum_pattern",
     "add_noise",
     "make_beat_test_set",
+    "DrumSong",
+    "drum_song",
     "GROUPS",
     "KINDS",
 ]
@@ -363,3 +371,82 @@ def make_beat_test_set(
                 name = f"{kind}_{bpm:g}_{group}"
                 items.append(BeatTestItem(name, group, kind, y, sr_i, beats, bpm, bpm_end))
     return items
+
+
+@dataclass(frozen=True)
+class DrumSong:
+    """A synthetic song with exact beats and known loudness sections.
+
+    Attributes
+    ----------
+    y : np.ndarray float32
+    sr : int [Hz]
+    beats : np.ndarray [s]
+    bpm : float [bpm]
+    gain_db : np.ndarray [shape=(len(beats),)] [dB]
+        Gain applied from each beat on.
+    """
+
+    y: np.ndarray
+    sr: int
+    beats: np.ndarray
+    bpm: float
+    gain_db: np.ndarray
+
+    @property
+    def duration(self) -> float:
+        """Length of the song [s]."""
+        return len(self.y) / self.sr
+
+
+def drum_song(
+    duration: float,
+    *,
+    bpm: float = 100.0,
+    sr: int = 22050,
+    section_beats: int = 8,
+    level_range_db: tuple[float, float] = (-24.0, 0.0),
+    seed: int = 0,
+    start: float = 0.5,
+) -> DrumSong:
+    """Render a drum song whose loudness changes every ``section_beats`` beats.
+
+    Parameters
+    ----------
+    duration : float > 0 [s]
+    bpm : float > 0 [bpm]
+    sr : int > 0 [Hz]
+    section_beats : int >= 1
+    level_range_db : (float, float) [dB]
+        Range of the random section gains (uniform, seeded), both <= 0 dB.
+    seed : int
+    start : float >= 0 [s]
+        Time of the first beat.
+
+    Returns
+    -------
+    DrumSong
+        The gain is constant between beats, with 5 ms ramps at changes (no clicks).
+    """
+    duration = check_positive(duration, name="duration", unit="s")
+    bpm = check_positive(bpm, name="bpm", unit="BPM")
+    if int(section_beats) < 1:
+        raise ParameterError(f"section_beats={section_beats!r} must be >= 1")
+    lo, hi = (float(v) for v in level_range_db)
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi <= 0):
+        raise ParameterError(f"level_range_db={level_range_db!r} must be (low, high) <= 0 dB")
+    beats = beat_times(bpm, duration=duration, start=start)
+    y = drum_pattern(beats, sr=sr, duration=duration, seed=seed).astype(np.float64)
+    rng = np.random.default_rng(seed)
+    n_sec = int(np.ceil(beats.size / int(section_beats)))
+    levels = rng.uniform(lo, hi, size=n_sec)
+    gain_db = levels[np.arange(beats.size) // int(section_beats)]
+    t = frames_to_time(np.arange(y.size), fps=sr)
+    k = np.clip(np.searchsorted(beats, t, side="right") - 1, 0, beats.size - 1)
+    env = 10.0 ** (gain_db[k] / 20.0)
+    ramp = max(1, int(time_to_frames(0.005, fps=sr, mode="floor")))
+    env = np.convolve(np.pad(env, (ramp, ramp), mode="edge"), np.ones(ramp) / ramp, "same")[
+        ramp:-ramp
+    ]
+    y = (y * env).astype(np.float32)
+    return DrumSong(y=y, sr=int(sr), beats=beats, bpm=bpm, gain_db=gain_db)
