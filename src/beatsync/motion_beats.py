@@ -233,7 +233,7 @@ def pca_curve(
     smooth = _check_seconds(smooth, name="smooth")
     n = pos.shape[0]
     x = (pos - pos[:, :1, :]).reshape(n, -1) if pos.shape[1] > 1 else pos.reshape(n, -1)
-    half = max(1, int(round(window * fps / 2)))
+    half = max(1, int(time_to_frames(window / 2, fps=fps, mode="round")))
     w = 2 * half + 1
     xp = np.pad(x, ((half, half), (0, 0)), mode="edge")
     axes = np.empty_like(x)
@@ -306,7 +306,7 @@ def kinematic_beat_frames(
         raise ParameterError(f"rel_prominence={rel_prominence!r} must be a number >= 0") from None
     if not np.isfinite(rel_prominence) or rel_prominence < 0:
         raise ParameterError(f"rel_prominence={rel_prominence!r} must be a number >= 0")
-    distance = max(1, int(round(min_interval * fps)))
+    distance = max(1, int(time_to_frames(min_interval, fps=fps, mode="round")))
     if method == "speed":
         curve = speed_curve(pos, fps=fps, smooth=smooth)
         scale = float(np.median(np.abs(curve)))
@@ -463,7 +463,7 @@ def beat_interval_intensity(motion: Any, beat_times: Any, *, joints: Any = None)
     """
     fps = check_fps(motion.fps)
     n = int(motion.values.shape[0]) if hasattr(motion, "values") else None
-    duration = (n - 1) / fps if n else None
+    duration = float(frames_to_time(n - 1, fps=fps)) if n else None
     beats = check_times(beat_times, name="beat_times", duration=duration)
     pos = motion_positions(motion, joints=joints)
     frames = time_to_frames(beats, fps=fps)

@@ -7,10 +7,14 @@ programming, synthesizes the dance (every motion beat on a music beat, blended
 transitions) and writes it as BVH, optionally a video with the music and a JSON
 report (path, number of transitions, graph-build and search times).
 
-The graph cache lives in ``~/.cache/beatsync`` (override with the environment
-variable ``BEATSYNC_CACHE_DIR``); an entry is keyed by the SHA-256 of the library
-files' content, their order, the frame-rate override and every graph parameter, so
-editing a clip or a parameter rebuilds the graph.
+Graph cache (on by default): built graphs are stored as ``graph-<key>.npz`` in
+``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else in
+``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it, and deleting the
+folder is always safe. An entry is keyed by the SHA-256 of the library files'
+content, their order, the frame-rate override, every graph parameter, the package
+version and the source code of the modules that determine the graph
+(``beatsync/graph/build.py`` and ``beatsync/motion_beats.py``), so editing a clip, a
+parameter or the graph code (also in an editable install) rebuilds the graph.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ import numpy as np
 from ..errors import ParameterError
 from ._common import add_json_flag, check_output_path, emit
 
-__all__ = ["register", "run", "cache_dir", "graph_cache_key"]
+__all__ = ["register", "run", "cache_dir", "graph_cache_key", "graph_source_hash"]
 
 _AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
 _CACHE_VERSION = 1
@@ -44,6 +48,8 @@ def register(subparsers: Any) -> None:
             "beat frames form a weighted motion graph (cached on disk), a dynamic programme "
             "picks the path whose motion intensity follows the music's, and every motion "
             "beat is time-warped onto a music beat. Writes BVH (the library's skeleton). "
+            "The graph is cached in $BEATSYNC_CACHE_DIR (default ~/.cache/beatsync), keyed "
+            "by the clips, the graph parameters and the graph code; --no-cache bypasses it. "
             "Example: beatsync compose song.wav --library a.bvh b.bvh -o dance.bvh"
         ),
     )
@@ -114,7 +120,12 @@ def register(subparsers: Any) -> None:
         help="also write a stick-figure video with the music as soundtrack",
     )
     p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
-    p.add_argument("--no-cache", action="store_true", help="neither read nor write the graph cache")
+    p.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="neither read nor write the graph cache (folder: $BEATSYNC_CACHE_DIR, "
+        "default ~/.cache/beatsync)",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -125,13 +136,35 @@ def cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "beatsync"
 
 
+def graph_source_hash() -> str:
+    """SHA-256 of the source of the modules that determine a graph.
+
+    ``beatsync/graph/build.py`` and ``beatsync/motion_beats.py`` (beat frames,
+    intensities, distances). Part of :func:`graph_cache_key`, so a code change (also
+    in an editable install, where ``__version__`` does not move) rebuilds cached graphs.
+    """
+    from .. import motion_beats
+    from ..graph import build
+    from ..io import sha256_file
+
+    h = hashlib.sha256()
+    for module in (build, motion_beats):
+        h.update(sha256_file(Path(module.__file__)).encode())
+    return h.hexdigest()
+
+
 def graph_cache_key(files: list[Path], params: dict[str, Any]) -> str:
-    """Hash of the library files' content (in order) and the graph parameters."""
+    """Hash of the library files' content (in order), the graph parameters and code.
+
+    The code part is the package version, ``_CACHE_VERSION`` (the cache file layout)
+    and :func:`graph_source_hash`.
+    """
     from .. import __version__
     from ..io import sha256_file
 
     h = hashlib.sha256()
     h.update(f"beatsync-graph-v{_CACHE_VERSION}-{__version__}".encode())
+    h.update(graph_source_hash().encode())
     for f in files:
         h.update(sha256_file(f).encode())
     h.update(json.dumps(params, sort_keys=True, default=str).encode())
@@ -171,15 +204,9 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
             entries.remove(audio)
         else:
             raise ParameterError("give the music file (AUDIO), e.g. beatsync compose song.wav ...")
-    try:
-        th = float(args.th)
-    except (TypeError, ValueError):
-        raise ParameterError(f"--th {args.th!r} must be a number > 0") from None
-    if not np.isfinite(th) or th <= 0:
-        raise ParameterError(
-            f"--th {args.th!r} must be a threshold > 0 on the scale-free pose distance rd "
-            "(the paper uses 3.0)"
-        )
+    from ..graph.build import check_th
+
+    th = check_th(args.th, name="--th")
     if args.beats is not None and args.bpm is not None:
         raise ParameterError("--beats and --bpm conflict: give beat times or a tempo, not both")
     if not Path(audio).is_file():
@@ -284,6 +311,7 @@ def run(args: argparse.Namespace) -> int:
         "method": args.method,
         "n_transitions": comp.n_transitions,
         "n_music_beats": int(comp.music_beats.size),
+        "path": comp.search.path,
         "tempo_bpm": float(60.0 / np.median(np.diff(comp.music_beats))),
         "graph": graph.summary(),
         "graph_cached": cached,

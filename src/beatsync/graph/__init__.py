@@ -24,6 +24,7 @@ from .build import (
     aligned_distance_matrix,
     build_graph,
     check_library,
+    check_th,
     transition_weight,
 )
 from .search import SearchResult, conventional_search, dp_search, path_cost, random_walk
@@ -35,6 +36,7 @@ __all__ = [
     "aligned_distance_matrix",
     "build_graph",
     "check_library",
+    "check_th",
     "transition_weight",
     "SearchResult",
     "conventional_search",

@@ -62,12 +62,13 @@ import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
-from ..units import check_fps, check_times, time_to_frames
+from ..units import check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "WeightedMotionGraph",
     "build_graph",
     "check_library",
+    "check_th",
     "transition_weight",
     "aligned_distance_matrix",
     "aligned_pair_distance",
@@ -247,9 +248,8 @@ class WeightedMotionGraph:
         return self.next_node >= 0
 
     def node_time(self) -> np.ndarray:
-        """Beat time [s] of each node in its own clip."""
-        fps = np.array([c.fps for c in self.clips])
-        return self.node_frame / fps[self.node_clip]
+        """Beat time [s] of each node in its own clip (all clips share one frame rate)."""
+        return frames_to_time(self.node_frame, fps=self.clips[0].fps)
 
     def interval_duration(self) -> np.ndarray:
         """Natural duration [s] of the interval starting at each node (NaN at last beats)."""
@@ -453,17 +453,53 @@ def check_library(clips: Any) -> tuple:
     return clips
 
 
-def _check_th(th: Any) -> float:
+def check_th(th: Any, *, name: str = "TH") -> float:
+    """Return the transition threshold ``th`` as a float, refusing non-numbers and ``<= 0``.
+
+    Parameters
+    ----------
+    th : float > 0
+        TH of eq. 1 on the scale-free distance ``rd``.
+    name : str
+        How the caller calls it in error messages (the CLI passes ``"--th"``).
+
+    Raises
+    ------
+    ParameterError
+    """
     try:
         v = float(th)
     except (TypeError, ValueError):
-        raise ParameterError(f"TH={th!r} must be a number > 0 (the paper uses 3.0)") from None
+        raise ParameterError(f"{name}={th!r} must be a number > 0 (the paper uses 3.0)") from None
     if not np.isfinite(v) or v <= 0:
         raise ParameterError(
-            f"TH={th!r} must be a finite threshold > 0 on the scale-free distance rd "
+            f"{name}={th!r} must be a finite threshold > 0 on the scale-free distance rd "
             "(the paper uses 3.0)"
         )
     return v
+
+
+def _beat_frames(beats: Any, clip: Any) -> np.ndarray:
+    """Nearest frames of a clip's given beat times [s]; refuses beats after its last frame."""
+    what = f"beats of clip {clip.name!r}"
+    bt = check_times(beats, name=what, duration=clip.duration)
+    last = float(frames_to_time(clip.n_frames - 1, fps=clip.fps))
+    if bt.size and bt[-1] > last + 1e-9:
+        raise ParameterError(
+            f"{what} end at {bt[-1]:g} s, after the clip's last frame at {last:g} s "
+            f"(frame {clip.n_frames - 1} at {clip.fps:g} fps); a beat must lie on the clip"
+        )
+    fr = time_to_frames(bt, fps=clip.fps, mode="round")
+    merged = np.flatnonzero(np.diff(fr) == 0)
+    if merged.size:
+        warnings.warn(
+            f"{merged.size} pair(s) of {what} round to the same frame at {clip.fps:g} fps "
+            f"(first: {bt[merged[0]]:g} s and {bt[merged[0] + 1]:g} s -> frame "
+            f"{fr[merged[0]]}); they are merged into one beat node",
+            BeatsyncWarning,
+            stacklevel=3,
+        )
+    return np.unique(fr)
 
 
 def build_graph(
@@ -493,7 +529,10 @@ def build_graph(
         Eq. 2 as written (``max(rd, 2)``) or the plain ``rd``.
     beats : sequence of array_like [s], optional
         Beat times per clip; default kinematic beats (``beat_method``, ``smooth``,
-        ``min_interval``, see :func:`beatsync.motion_beats.kinematic_beats`).
+        ``min_interval``, see :func:`beatsync.motion_beats.kinematic_beats`). Each
+        time becomes its nearest frame; times after a clip's last frame
+        ``(n_frames - 1) / fps`` are refused, and beats that round to the same frame
+        are merged with a :class:`~beatsync.errors.BeatsyncWarning`.
     joints : sequence of str, optional
         Joints used for beats, intensities and distances; default all.
     window : float > 0 [s]
@@ -512,12 +551,19 @@ def build_graph(
     Raises
     ------
     ParameterError
-        Empty library, different skeletons, TH <= 0, no intervals, no transitions
-        (with the smallest ``rd`` found, to suggest a threshold).
+        Empty library, different skeletons, TH <= 0, given beats after a clip's last
+        frame, no intervals, no transitions (with the smallest ``rd`` found, to
+        suggest a threshold).
+
+    Warns
+    -----
+    BeatsyncWarning
+        Given beats of a clip that round to the same frame (merged into one node), a
+        clip with fewer than two beats.
     """
     t0 = time.perf_counter()
     clips = check_library(clips)
-    th = _check_th(th)
+    th = check_th(th)
     if weight_rule not in WEIGHT_RULES:
         raise ParameterError(f"weight_rule={weight_rule!r} is not one of {WEIGHT_RULES}")
     if up_axis not in ("y", "z"):
@@ -548,8 +594,7 @@ def build_graph(
                     pos, fps=c.fps, method=beat_method, smooth=smooth, min_interval=min_interval
                 )
         else:
-            bt = check_times(beats[i], name=f"beats of clip {c.name!r}", duration=c.duration)
-            fr = np.unique(np.clip(time_to_frames(bt, fps=c.fps), 0, c.n_frames - 1))
+            fr = _beat_frames(beats[i], c)
         if fr.size < 2:
             warnings.warn(
                 f"clip {c.name!r} has {fr.size} beat(s): it contributes no interval",
@@ -585,7 +630,7 @@ def build_graph(
 
     # eq. 1: scale-free distances between all pairs of beat frames
     fps0 = [check_fps(c.fps) for c in clips]
-    half = max(1, int(round(window * fps0[0] / 2)))
+    half = max(1, int(time_to_frames(window / 2, fps=fps0[0], mode="round")))
     speed = typical_speed(positions, fps0, half=half, up=up)
     if not speed > 0:
         raise ParameterError("the library does not move (zero typical speed): rd is undefined")

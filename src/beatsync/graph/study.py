@@ -363,9 +363,11 @@ def plot_intensity(comp: Any) -> Any:
     import matplotlib.pyplot as plt
 
     from ..motion_beats import beat_interval_intensity
+    from ..units import frames_to_time
 
     m = comp.motion
-    beats = comp.music_beats[comp.music_beats <= (m.n_frames - 1) / m.fps]
+    last = float(frames_to_time(m.n_frames - 1, fps=m.fps))
+    beats = comp.music_beats[comp.music_beats <= last]
     inten = _z(beat_interval_intensity(m, beats))
     fig, ax = plt.subplots(figsize=(7, 3))
     mid = (beats[:-1] + beats[1:]) / 2

@@ -39,8 +39,14 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
 from ..motion import Motion
-from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
-from ..units import check_fps, check_times
+from ..rotations import (
+    blend_values,
+    continuous_euler,
+    euler_to_rotation,
+    rotation_to_euler,
+    sample_motion,
+)
+from ..units import check_fps, check_times, frames_to_time, time_to_frames
 from .build import WeightedMotionGraph, _ground_axes
 
 __all__ = ["SynthesisResult", "synthesize", "beat_warp", "smoothstep"]
@@ -190,18 +196,18 @@ def synthesize(
     rot_cols = list(rot_cols)
 
     k_n = path.size
-    nfps = np.array([c.fps for c in graph.clips])
+    node_t = graph.node_time()  # [s] in each node's clip (one frame rate per library)
     clip_of = graph.node_clip[path]
-    src_start = graph.node_frame[path] / nfps[clip_of]
+    src_start = node_t[path]
     nxt = graph.next_node[path]
-    src_end = graph.node_frame[nxt] / nfps[clip_of]
+    src_end = node_t[nxt]
     trans = np.zeros(k_n, dtype=bool)
     trans[1:] = graph.next_node[path[:-1]] != path[1:]
     run_id = np.cumsum(trans)
 
-    j0 = int(np.ceil(start_time * fps - 1e-9))
-    j1 = int(np.floor(end_time * fps + 1e-9))
-    t = np.arange(j0, j1 + 1) / fps
+    j0 = int(time_to_frames(start_time, fps=fps, mode="ceil"))
+    j1 = int(time_to_frames(end_time, fps=fps, mode="floor"))
+    t = frames_to_time(np.arange(j0, j1 + 1), fps=fps)
     if warp not in ("pchip", "linear"):
         raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
     k_of, s_of = beat_warp(beats, src_start, src_end, t)
@@ -233,7 +239,7 @@ def synthesize(
         # previous run ends on beat frame a (= next_node[path[k-1]]) of its clip
         a = graph.next_node[path[k - 1]]
         ca = graph.node_clip[a]
-        pa, ra = raw_root(ca, graph.node_frame[a] / nfps[ca])
+        pa, ra = raw_root(ca, node_t[a])
         pb, rb = raw_root(clip_of[k], src_start[k])
         ha = _heading(Rotation.from_rotvec(yaw[r - 1] * _unit(up)) * ra, up)[0]
         hb = _heading(rb, up)[0]
@@ -273,14 +279,14 @@ def synthesize(
         a = graph.next_node[path[k - 1]]
         ca = int(graph.node_clip[a])
         rate = (src_end[k] - src_start[k]) / (beats[k + 1] - beats[k])
-        s_old = graph.node_frame[a] / nfps[ca] + (t[sel] - beats[k]) * rate
+        s_old = node_t[a] + (t[sel] - beats[k]) * rate
         old = transformed(r - 1, ca, s_old)
         w = smoothstep((t[sel] - beats[k]) / length)
         values[sel] = blend_values(template, old, values[sel], w)
 
     # continuous Euler curves in the output file: the root's triples were re-derived
     # after the yaw alignment, so choose each frame's triple closest to the previous one
-    values[:, rot_cols] = _continuous_euler(values[:, rot_cols])
+    values[:, rot_cols] = continuous_euler(values[:, rot_cols])
     for _joint, idx, _order in template.rotation_triples():
         cols = list(idx)
         values[:, cols] = np.unwrap(values[:, cols], period=360.0, axis=0)
@@ -303,38 +309,20 @@ def synthesize(
     )
 
 
-def _continuous_euler(e: np.ndarray) -> np.ndarray:
-    """Pick, frame by frame, the equivalent Tait-Bryan triple nearest the previous frame."""
-    out = e.copy()
-    for i in range(1, e.shape[0]):
-        ref = out[i - 1]
-        a = e[i]
-        alt = np.array([a[0] + 180.0, 180.0 - a[1], a[2] + 180.0])
-        best, best_d = a, np.inf
-        for cand in (a, alt):
-            cand = cand + 360.0 * np.round((ref - cand) / 360.0)
-            d = float(np.sum((cand - ref) ** 2))
-            if d < best_d:
-                best, best_d = cand, d
-        out[i] = best
-    return out
-
-
 def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
     """Monotone cubic warp through the beat correspondences of each run."""
     from scipy.interpolate import PchipInterpolator
 
     s = s_lin.copy()
-    k_n = src_start.size
     for r in np.unique(run_id):
         ks = np.flatnonzero(run_id == r)
         if ks.size < 2:
             continue
         x = beats[ks[0] : ks[-1] + 2]
         y = np.concatenate([src_start[ks], src_end[ks[-1:]]])
+        # times before the first beat / after the last beat of the run keep the
+        # linear warp's extrapolation (lead-in and tail of the dance)
         inside = (run_id[k_of] == r) & (t >= x[0]) & (t <= x[-1])
-        if ks[-1] == k_n - 1:
-            inside &= t <= x[-1]
         s[inside] = PchipInterpolator(x, y)(t[inside])
     return s
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..units import check_fps, check_positive
+from ..units import check_fps, check_positive, frames_to_time, time_to_frames
 
 __all__ = ["dance_skeleton", "synthetic_dance", "synthetic_library"]
 
@@ -114,17 +114,19 @@ def synthetic_dance(
     rng = np.random.default_rng(seed)
     skel = dance_skeleton(scale)
     channels = skel.channel_names()
-    n = int(round(duration * fps))
-    t = np.arange(n) / fps
+    n = int(time_to_frames(duration, fps=fps, mode="round"))
+    t = frames_to_time(np.arange(n), fps=fps)
     period = 60.0 / bpm
     # beats on frame times
-    beat_frames = np.unique(np.rint((start + np.arange(0, duration, period)) * fps).astype(int))
+    beat_frames = np.unique(
+        time_to_frames(start + np.arange(0, duration, period), fps=fps, mode="round")
+    )
     beat_frames = beat_frames[beat_frames < n]
     if beat_frames.size < 3:
         raise ParameterError(
             f"duration={duration} s at {bpm} BPM gives fewer than 3 beats; make it longer"
         )
-    beats = beat_frames / fps
+    beats = frames_to_time(beat_frames, fps=fps)
     lo, hi = level_range
     n_sec = int(np.ceil(beats.size / int(section_beats))) + 1
     levels = rng.uniform(lo, hi, size=n_sec)
