@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -58,9 +59,18 @@ def test_compose_end_to_end_with_beats(workdir, capsys):
     beats = io.read_beats(workdir / "song.beats")
     assert report["n_music_beats"] == beats.size
     assert report["graph_cached"] is False
-    assert report["n_transitions"] >= 0 and report["search_time_s"] >= 0
+    # one graph node per music beat interval, every one an interval start
+    path = np.asarray(report["path"])
+    assert path.shape == (beats.size - 1,)
     assert report["graph"]["n_transitions"] > 0
+    # two 6 s clips cannot cover the song without jumping: the path uses transitions,
+    # exactly where consecutive path nodes are not consecutive beats of one clip
+    assert report["n_transitions"] == int(np.sum(np.diff(path) != 1)) > 0
+    assert len(report["transition_times_s"]) == report["n_transitions"]
+    assert report["search_time_s"] > 0 and report["graph_build_time_s"] > 0
     assert m.n_frames == int(np.floor(6.0 * m.fps)) + 1  # lasts as long as the song
+    assert report["n_frames"] == m.n_frames
+    assert report["duration_s"] == pytest.approx(m.n_frames / m.fps)
     cache = list((workdir / "cache").glob("graph-*.npz"))
     assert len(cache) == 1
     # second run: the graph comes from the cache, the result is the same
@@ -103,6 +113,61 @@ def test_cache_key_changes_with_content_and_params(workdir):
     m, _ = synthetic_dance(duration=6.0, bpm=110.0, seed=5)
     io.write_bvh(files[0], m)
     assert graph_cache_key(files, {"th": 3.0}) != k1
+
+
+def test_cache_key_changes_with_graph_code(workdir, monkeypatch, tmp_path):
+    # an editable install keeps __version__ when build_graph changes: the key must not
+    from beatsync import motion_beats
+    from beatsync.commands import compose as cmd
+    from beatsync.graph import build
+
+    files = sorted((workdir / "lib").glob("*.bvh"))
+    k1 = cmd.graph_cache_key(files, {"th": 3.0})
+    for module in (build, motion_beats):
+        edited = tmp_path / f"edited_{module.__name__.rsplit('.', 1)[-1]}.py"
+        edited.write_bytes(Path(module.__file__).read_bytes() + b"\n# changed\n")
+        with monkeypatch.context() as mp:
+            mp.setattr(module, "__file__", str(edited))
+            assert cmd.graph_cache_key(files, {"th": 3.0}) != k1
+    assert cmd.graph_cache_key(files, {"th": 3.0}) == k1
+
+
+def test_stale_cache_entry_is_not_served(workdir, monkeypatch, capsys):
+    from beatsync.commands import compose as cmd
+
+    argv = [
+        "compose",
+        str(workdir / "song.wav"),
+        "--library",
+        str(workdir / "lib"),
+        "--beats",
+        str(workdir / "song.beats"),
+        "-o",
+        str(workdir / "a.bvh"),
+        "--json",
+    ]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert Path(first["graph_cache_file"]).parent == workdir / "cache"
+    # the graph code changed (simulated): the old entry must not be used
+    monkeypatch.setattr(cmd, "graph_source_hash", lambda: "0" * 64)
+    assert main(argv) == 0
+    second = json.loads(capsys.readouterr().out)
+    assert second["graph_cached"] is False
+    assert second["graph_cache_file"] != first["graph_cache_file"]
+    assert len(list((workdir / "cache").glob("graph-*.npz"))) == 2
+    # --no-cache neither reads nor writes
+    assert main([*argv, "--no-cache"]) == 0
+    third = json.loads(capsys.readouterr().out)
+    assert third["graph_cached"] is False and third["graph_cache_file"] is None
+    assert len(list((workdir / "cache").glob("graph-*.npz"))) == 2
+
+
+def test_help_names_the_cache(capsys):
+    with pytest.raises(SystemExit):
+        main(["compose", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "BEATSYNC_CACHE_DIR" in out and "--no-cache" in out and "~/.cache/beatsync" in out
 
 
 def _odd_clip(path):

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from beatsync.errors import ParameterError
+from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.graph import (
     aligned_distance_matrix,
     beat_warp,
@@ -24,7 +25,7 @@ from beatsync.graph.compose import compose
 from beatsync.graph.quality import foot_sliding, quality_proxies, transition_jumps
 from beatsync.graph.synthetic import dance_skeleton, synthetic_dance, synthetic_library
 from beatsync.motion import Motion
-from beatsync.motion_beats import kinematic_beats
+from beatsync.motion_beats import beat_interval_intensity, kinematic_beats
 from beatsync.rotations import euler_to_rotation
 
 
@@ -132,6 +133,38 @@ def test_different_skeletons_named(library):
     m = Motion(clips[0].values, clips[0].fps, sk.channel_names(), sk, "odd_clip")
     with pytest.raises(ParameterError, match="odd_clip.*different skeletons|different skeletons"):
         build_graph([clips[0], m])
+
+
+def test_given_beats_after_last_frame_refused(library):
+    clips, beats = library
+    m = clips[0]
+    last = (m.n_frames - 1) / m.fps
+    # Motion.duration (n / fps) is one frame after the last frame: refused, not clipped
+    bad = np.concatenate([beats[0][:-1], [m.duration]])
+    with pytest.raises(ParameterError, match="after the clip's last frame"):
+        build_graph([m], beats=[bad], require_transitions=False)
+    ok = np.concatenate([beats[0][:-1], [last]])
+    g = build_graph([m], beats=[ok], require_transitions=False)
+    assert g.node_frame[-1] == m.n_frames - 1
+
+
+def test_given_beats_on_one_frame_merge_with_warning(library):
+    clips, beats = library
+    m = clips[0]
+    b = beats[0]
+    close = np.sort(np.concatenate([b, [b[2] + 0.2 / m.fps]]))  # rounds to b[2]'s frame
+    with pytest.warns(BeatsyncWarning, match="round to the same frame"):
+        g = build_graph([m], beats=[close], require_transitions=False)
+    assert g.n_nodes == b.size
+    np.testing.assert_allclose(g.node_time(), b, atol=1e-9)
+
+
+def test_check_th_is_the_one_threshold_check():
+    from beatsync.graph import check_th
+
+    assert check_th("2.5") == 2.5
+    with pytest.raises(ParameterError, match="--th=0"):
+        check_th(0.0, name="--th")
 
 
 @pytest.mark.parametrize("th", [0.0, -1.0, float("nan"), "abc"])
@@ -338,6 +371,44 @@ def test_synthesize_bad_inputs(graph):
 
 
 # ----------------------------------------------------------------- compose + quality
+
+
+def test_quality_known_answer_exact_composition():
+    # one clip, music beats = the clip's own beats, music level = its own intensities:
+    # the DP must play the clip as captured (no transition, identity warp), so the
+    # composed motion's beats land exactly on the music beats and its intensity
+    # follows the level exactly
+    m, b = synthetic_dance(duration=8.0, seed=4)
+    g = build_graph([m], beats=[b], require_transitions=False)
+    inten = beat_interval_intensity(m, b)
+    music = b[1:-1]
+    comp = compose(g, music, inten[1:-1], end_time=7.9)
+    np.testing.assert_array_equal(comp.search.path, np.arange(1, b.size - 2))
+    assert comp.n_transitions == 0
+    np.testing.assert_allclose(comp.motion.values, m.values[: comp.motion.n_frames], atol=1e-9)
+    q = quality_proxies(comp, beat_smooth=0.0)
+    assert q["alignment_motion"] == pytest.approx(1.0, abs=1e-9)
+    assert q["alignment_music"] == pytest.approx(1.0, abs=1e-9)
+    assert q["intensity_r"] == pytest.approx(1.0, abs=1e-9)
+    assert q["n_transitions"] == 0 and np.isnan(q["transition_jump_max"])
+    # the same dance against music beats half a beat off scores near zero
+    off = dataclasses.replace(comp, music_beats=music[:-1] + 0.3)
+    q_off = quality_proxies(off, beat_smooth=0.0)
+    assert q_off["alignment_motion"] < 0.01 and q_off["alignment_music"] < 0.01
+
+
+def test_dp_beats_random_walk_on_intensity_correlation(graph):
+    rng = np.random.default_rng(2)
+    beats = 0.5 + 0.55 * np.arange(15)
+    level = rng.uniform(-30, -5, size=14)
+    r_dp = quality_proxies(compose(graph, beats, level))["intensity_r"]
+    r_rand = [
+        quality_proxies(compose(graph, beats, level, method="random", seed=s))["intensity_r"]
+        for s in range(5)
+    ]
+    assert r_dp > 0.5
+    assert max(r_rand) < r_dp
+    assert np.mean(r_rand) < r_dp - 0.3
 
 
 def test_compose_and_quality(graph):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 from dataclasses import dataclass
 
 import numpy as np
@@ -155,9 +154,6 @@ def test_unknown_joint_name():
         kinematic_beats(as_markers(oscillator()), joints=["nose"])
 
 
-@pytest.mark.skipif(
-    importlib.util.find_spec("beatsync.datasets") is None, reason="datasets not available yet"
-)
 def test_salsa_beats_plausible():
     from beatsync import datasets
 
