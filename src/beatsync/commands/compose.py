@@ -140,15 +140,16 @@ def graph_source_hash() -> str:
     """SHA-256 of the source of the modules that determine a graph.
 
     ``beatsync/graph/build.py`` and ``beatsync/motion_beats.py`` (beat frames,
-    intensities, distances). Part of :func:`graph_cache_key`, so a code change (also
+    intensities, distances) and the foundation they rest on: ``io.py`` (BVH
+    reading), ``motion.py`` (forward kinematics) and ``units.py``. Part of :func:`graph_cache_key`, so a code change (also
     in an editable install, where ``__version__`` does not move) rebuilds cached graphs.
     """
-    from .. import motion_beats
+    from .. import io, motion, motion_beats, units
     from ..graph import build
     from ..io import sha256_file
 
     h = hashlib.sha256()
-    for module in (build, motion_beats):
+    for module in (build, motion_beats, io, motion, units):
         h.update(sha256_file(Path(module.__file__)).encode())
     return h.hexdigest()
 
