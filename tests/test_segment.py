@@ -314,3 +314,125 @@ def test_synthetic_error_table_small():
     }
     opt = table[table["method"] == "optimal, count given"].iloc[0]
     assert opt["max_error_frames"] <= 1
+
+
+# ------------------------------------------- fixed period count (n_periods honoured)
+def _brute_force_count(x, lo, hi, count):
+    """Least E over segmentations with exactly ``count`` periods (free ends)."""
+    n = x.shape[1]
+    best = (np.inf, None)
+
+    def rec(fr):
+        nonlocal best
+        if len(fr) == count + 1:
+            if fr[-1] >= n - lo:
+                e = S.segmentation_energy(x, np.array(fr))
+                if e < best[0] - 1e-12:
+                    best = (e, list(fr))
+            return
+        for d in range(lo, hi + 1):
+            if fr[-1] + d <= n - 1:
+                rec(fr + [fr[-1] + d])
+
+    for t0 in range(lo):
+        rec([t0])
+    return best
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_fixed_count_dp_equals_brute_force(seed):
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(16, 34))
+    lo = int(rng.integers(3, 6))
+    hi = lo + int(rng.integers(0, 3))
+    t = np.arange(n)
+    raw = np.sin(2 * np.pi * t / rng.uniform(4, 8))[:, None] + 0.5 * rng.standard_normal((n, 2))
+    x = S._standardise(raw)
+    cost = S._edge_costs(x, lo, hi)
+    checked = 0
+    for count in range(2, n // lo + 1):
+        e_bf, f_bf = _brute_force_count(x, lo, hi, count)
+        if f_bf is None:
+            with pytest.raises(ParameterError, match="do not fit"):
+                S._shortest_path_count(cost, n, lo, hi, count)
+            continue
+        frames, energy = S._shortest_path_count(cost, n, lo, hi, count)
+        assert frames.size == count + 1
+        assert energy == pytest.approx(e_bf, abs=1e-9)
+        assert S.segmentation_energy(x, frames) == pytest.approx(e_bf, abs=1e-9)
+        checked += 1
+    assert checked >= 1
+
+
+def test_given_count_is_honoured_or_refused():
+    """True count 10: n_periods=12 used to return 10 periods silently."""
+    s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
+    assert segment_values(s.motion.values, fps=25.0, n_periods=10).n_periods == 10
+    with pytest.raises(ParameterError, match="n_periods=12 was given"):
+        segment_values(s.motion.values, fps=25.0, n_periods=12)
+    seg = segment_values(s.motion.values, fps=25.0, n_periods=9, alpha=0.2)
+    assert seg.n_periods == 9
+
+
+def test_given_count_that_cannot_fit_is_refused():
+    s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
+    x = S._standardise(s.motion.values)
+    cost = S._edge_costs(x, 40, 42)
+    S._shortest_path_count(cost, 300, 40, 42, 7)  # 7 * 40..42 frames fit in 300
+    with pytest.raises(ParameterError, match="8 periods of 40-42 frames"):
+        S._shortest_path_count(cost, 300, 40, 42, 8)  # 8 * 40 > 299
+
+
+# ------------------------------------------------------- memory of long periods
+def test_long_period_runs_within_memory():
+    """A ~400-frame period needed a (lags, hi+1, band^2) kernel of ~1.9 GiB."""
+    import tracemalloc
+
+    s = periodic_motion(n_frames=2401, n_channels=3, fps=400.0, n_periods=6, snr_db=30,
+                        seed=3)  # fmt: skip
+    x = S._standardise(s.motion.values)
+    tracemalloc.start()
+    try:
+        seg = segment_values(s.motion.values, fps=400.0, n_periods=6)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < S.SEARCH_MEMORY_BUDGET
+    lo, hi = S._band(2400 / 6, 0.1)
+    assert S._search_bytes(2401, lo, hi, 3, 6) > 2 * S.SEARCH_MEMORY_BUDGET
+    assert seg.search_decimation > 1
+    assert seg.n_periods == 6
+    assert np.abs(seg.boundary_frames - s.boundary_frames).max() <= 3
+    assert seg.energy == pytest.approx(S.segmentation_energy(x, seg.boundary_frames), abs=1e-9)
+
+
+@pytest.mark.parametrize("n_periods", [10, None])
+def test_decimated_search_finds_the_exact_optimum(monkeypatch, n_periods):
+    s = periodic_motion(n_frames=1200, n_channels=4, fps=100.0, n_periods=10, snr_db=20, seed=1)
+    kw = dict(fps=100.0, n_periods=n_periods, period_range=(0.5, 2.0))
+    exact = segment_values(s.motion.values, **kw)
+    assert exact.search_decimation == 1
+    monkeypatch.setattr(S, "SEARCH_MEMORY_BUDGET", 24 * 2**20)
+    coarse = segment_values(s.motion.values, **kw)
+    assert coarse.search_decimation >= 2
+    np.testing.assert_array_equal(coarse.boundary_frames, exact.boundary_frames)
+    assert coarse.energy == pytest.approx(exact.energy, abs=1e-4)  # float32 vs float64 sums
+
+
+def test_undecimatable_period_is_refused(monkeypatch):
+    s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
+    monkeypatch.setattr(S, "SEARCH_MEMORY_BUDGET", 1)
+    with pytest.raises(ParameterError, match="lower --fps"):
+        segment_values(s.motion.values, fps=25.0, n_periods=10)
+
+
+def test_resample_weights_vectorised_equals_scalar():
+    d1 = np.array([7, 9, 10, 12])
+    j, w = S._resample_weights(10, d1)
+    assert j.shape == w.shape == (4, 11)
+    for row, d in enumerate(d1):
+        js, ws = S._resample_weights(10, int(d))
+        np.testing.assert_array_equal(j[row], js)
+        np.testing.assert_array_equal(w[row], ws)
+        # resampling a ramp is exact: k * d1 / d0
+        np.testing.assert_allclose(js + ws, np.arange(11) * d / 10)

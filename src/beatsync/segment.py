@@ -31,13 +31,14 @@ when the count ``p`` is given, else the estimated period, see
 (eqs. 4-5) is a shortest path in a forward DAG whose nodes are consecutive boundary
 pairs ``(t_{i-1}, t_i)``, with a virtual end node joined to every pair ending in the
 tail of the clip; the DAG is solved by dynamic programming in frame order (no heap).
-Because the graph has no period index (and the ends are free, see below), the
-optimum may use a period count within the band other than ``p``; minimising ``E``
-itself would then favour one period fewer (one term fewer), so the optimum minimises
-the mean energy per consecutive pair ``E / (p - 1)`` (Dinkelbach iteration over the
-same DP: ``argmin E - lambda (p - 1)``, ``lambda`` updated to the current mean; for a
-fixed count this is exactly the paper's ``argmin E``).
-:attr:`Segmentation.n_periods` reports the count found.
+When the count ``p`` is given (``n_periods``), the DP carries the number of periods in
+its state and returns the optimum with exactly ``p`` periods (``argmin E``, as in the
+paper). When the count is estimated, the graph has no period index (and the ends are
+free, see below), so the optimum may use a period count within the band other than
+the estimate; minimising ``E`` itself would then favour one period fewer (one term
+fewer), so that optimum minimises the mean energy per consecutive pair ``E / (p - 1)``
+(Dinkelbach iteration over the same DP: ``argmin E - lambda (p - 1)``, ``lambda``
+updated to the current mean). :attr:`Segmentation.n_periods` reports the count found.
 
 Edge costs dominate the time. They are computed for all ``(middle boundary, earlier
 length, later length)`` at once (in float32; on z-scored channels an edge cost then
@@ -72,6 +73,12 @@ Documented rules (choices the paper leaves open)
   ``t_p >= n - lo`` (``lo``: shortest allowed period); the band of eq. 3 is rounded
   outward to whole frames. A synthetic clip that is an exact tiling is recovered with
   ``t_0 = 0`` and ``t_p = n - 1``.
+- Memory: the edge-cost kernels grow with the cube of the period length in frames.
+  When the exact search would need more than :data:`SEARCH_MEMORY_BUDGET` (512 MiB),
+  it runs on the signal decimated in time by the smallest integer factor ``f`` that
+  fits (box filter, every ``f``-th frame), and every boundary is then refined at full
+  rate by an exact DP within ``+-f`` frames of the coarse optimum, repeated until the
+  energy stops decreasing (:attr:`Segmentation.search_decimation` reports ``f``).
 - Default channels: rotation channels of the main limb and spine joints (see
   :func:`select_channels`), or every ``*_angle`` channel for marker-derived angles.
 """
@@ -89,7 +96,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from .errors import BeatsyncWarning, ParameterError
-from .units import check_finite, check_fps, check_range, frames_to_time
+from .units import check_finite, check_fps, check_range, frames_to_time, time_to_frames
 
 if TYPE_CHECKING:
     from .motion import Motion
@@ -104,6 +111,7 @@ __all__ = [
     "CONSTANT_REL_STD",
     "MAX_NORMALISED_ENERGY",
     "MIN_PERIODICITY_CONTRAST",
+    "SEARCH_MEMORY_BUDGET",
     "periodicity_contrast",
     "boundary_errors",
     "uniform_baseline",
@@ -128,6 +136,11 @@ _PERIOD_METHODS = ("energy", "fft", "given")
 _FAST_DTYPE = np.float32  # edge-cost sums in float32: ~2x faster, |error| ~1e-5 per edge
 _MAX_COUNT_CANDIDATES = 400  # candidate periods of the "energy" method (then log-spaced)
 _CHUNK_ELEMENTS = 3e5  # window-matrix elements per block of middle boundaries (cache size)
+_DP_BLOCK_ELEMENTS = 2e6  # elements of one block of the fixed-count DP
+_MAX_REFINE_PASSES = 10  # full-rate refinement passes after a decimated search
+
+SEARCH_MEMORY_BUDGET = 512 * 2**20
+"""Bytes [B] the exact search may use; above it the search runs on a decimated signal."""
 
 
 @dataclass(frozen=True)
@@ -148,6 +161,10 @@ class Segmentation:
     fps : float [Hz]
     period_method : str
         ``"energy"``, ``"fft"`` or ``"given"``.
+    search_decimation : int >= 1
+        Time decimation factor of the search (1: exact search at full rate; above
+        :data:`SEARCH_MEMORY_BUDGET` the search runs at ``fps / f`` and the boundaries
+        are refined at full rate, see :func:`segment_values`).
     """
 
     boundaries: np.ndarray
@@ -157,12 +174,11 @@ class Segmentation:
     channels: tuple[str, ...]
     fps: float
     period_method: str
+    search_decimation: int = 1
 
     @property
     def boundary_frames(self) -> np.ndarray:
         """Boundaries as frame indices (int64)."""
-        from .units import time_to_frames
-
         return time_to_frames(self.boundaries, fps=self.fps)
 
     @property
@@ -300,12 +316,15 @@ def _standardise(values: np.ndarray) -> np.ndarray:
 # ------------------------------------------------------------------ Pearson distances
 
 
-def _resample_weights(d0: int, d1: int) -> tuple[np.ndarray, np.ndarray]:
+def _resample_weights(d0: int, d1: Any) -> tuple[np.ndarray, np.ndarray]:
     """Linear resampling of ``d1 + 1`` samples onto ``d0 + 1`` (end points aligned).
 
     Output sample ``k`` (0..d0) is ``(1 - w_k) B[j_k] + w_k B[j_k + 1]`` with
-    ``j_k + w_k = k d1 / d0`` (exact integer arithmetic).
+    ``j_k + w_k = k d1 / d0`` (exact integer arithmetic). ``d1`` may be an int
+    (returns shape ``(d0 + 1,)``) or an array of ints (shape ``d1.shape + (d0 + 1,)``).
     """
+    d1 = np.asarray(d1, dtype=np.int64)
+    d1 = d1[..., None] if d1.ndim else d1
     k = np.arange(d0 + 1)
     j = (k * d1) // d0
     w = (k * d1 - j * d0) / d0
@@ -339,12 +358,7 @@ def _pair_costs(x: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> n
         for start in range(0, sel.size, 4096):
             s = sel[start : start + 4096]
             k = np.arange(d0 + 1)
-            d1 = d1_all[s][:, None]
-            j = (k[None, :] * d1) // d0
-            w = (k[None, :] * d1 - j * d0) / d0
-            last = j >= d1
-            j = np.where(last, d1 - 1, j)
-            w = np.where(last, 1.0, w)
+            j, w = _resample_weights(int(d0), d1_all[s])  # (T, d0+1)
             pos = b[s][:, None] + j
             A = x[:, a[s][:, None] + k[None, :]]  # (C, T, d0+1)
             B = x[:, pos] * (1 - w) + x[:, pos + 1] * w
@@ -573,6 +587,213 @@ def _min_mean_energy(solve: Any, max_iter: int = 30) -> tuple[np.ndarray, float]
     return frames, energy
 
 
+def _count_windows(n: int, lo: int, hi: int, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Feasible frames ``first[k] .. last[k]`` of boundary ``t_k`` (k = 0..count).
+
+    From the start (``t_0 < lo``, periods of ``lo..hi`` frames) and from the end
+    (``n - lo <= t_count <= n - 1``).
+    """
+    k = np.arange(count + 1)
+    first = np.maximum(k * lo, (n - lo) - (count - k) * hi)
+    last = np.minimum(lo - 1 + k * hi, (n - 1) - (count - k) * lo)
+    return first, last
+
+
+def _shortest_path_count(
+    cost: np.ndarray, n: int, lo: int, hi: int, count: int
+) -> tuple[np.ndarray, float]:
+    """DP of :func:`_shortest_path` constrained to exactly ``count`` periods (eqs. 4-5).
+
+    Layer ``k`` holds ``V_k[b, i]``, the least energy of a chain of ``k`` periods ending
+    at frame ``b`` whose last period has ``lo + i`` frames, for the frames ``b`` where
+    boundary ``t_k`` can lie (:func:`_count_windows`; same free ends: ``t_0 < lo``,
+    ``t_p >= n - lo``). With the count fixed, ``argmin E`` is the paper's objective (no
+    Dinkelbach iteration needed).
+
+    Raises
+    ------
+    ParameterError
+        ``count`` periods of ``lo..hi`` frames do not fit the clip.
+    """
+    band = hi - lo + 1
+    d = np.arange(lo, hi + 1)
+    i1 = np.arange(band)[None, :]
+    first, last = _count_windows(n, lo, hi, count)
+    if np.any(first > last):
+        raise ParameterError(
+            f"{count} periods of {lo}-{hi} frames (the alpha band) do not fit in {n} frames "
+            f"with a lead-in and a tail shorter than {lo} frames; check n_periods (the period "
+            "count, not a period length) or increase alpha"
+        )
+    b = np.arange(first[1], last[1] + 1)
+    start = b[:, None] - d[None, :]
+    V = np.where((start >= first[0]) & (start <= last[0]), 0.0, np.inf)  # layer 1
+    ptrs = []
+    for k in range(2, count + 1):
+        b_all = np.arange(first[k], last[k] + 1)
+        Vk = np.full((b_all.size, band), np.inf)
+        pk = np.zeros((b_all.size, band), dtype=np.int32)
+        rows = max(1, int(_DP_BLOCK_ELEMENTS // (band * band)))
+        for s0 in range(0, b_all.size, rows):
+            b = b_all[s0 : s0 + rows]
+            prev = b[:, None] - d[None, :]  # (m, band_i1): middle boundary t_{k-1}
+            ok = (prev >= first[k - 1]) & (prev <= last[k - 1])
+            pc = np.clip(prev, first[k - 1], last[k - 1])
+            # total[m, i1, i0] = V_{k-1}[prev, i0] + cost[prev, i0, i1]
+            total = V[pc - first[k - 1]] + cost[pc, :, i1]
+            total[~ok] = np.inf
+            best = np.argmin(total, axis=2)
+            Vk[s0 : s0 + b.size] = np.take_along_axis(total, best[..., None], axis=2)[..., 0]
+            pk[s0 : s0 + b.size] = best
+        V = Vk
+        ptrs.append(pk)
+    flat = int(np.argmin(V))
+    value = float(V.flat[flat])
+    if not np.isfinite(value):
+        raise ParameterError(
+            f"{count} periods of {lo}-{hi} frames (the alpha band) do not fit in {n} frames "
+            f"with a lead-in and a tail shorter than {lo} frames; check n_periods (the period "
+            "count, not a period length) or increase alpha"
+        )
+    b, i = first[count] + flat // band, flat % band
+    frames = [int(b)]
+    for k in range(count, 1, -1):
+        i_prev = int(ptrs[k - 2][b - first[k], i])
+        b = b - (lo + i)
+        frames.append(int(b))
+        i = i_prev
+    frames.append(int(b - (lo + i)))
+    return np.array(frames[::-1], dtype=np.int64), value
+
+
+def _coarse_band(lo: int, hi: int, factor: int) -> tuple[int, int]:
+    """Period band [coarse frames] at 1/``factor`` of the rate, inside ``[lo, hi]`` if possible."""
+    lo_c, hi_c = -(-lo // factor), hi // factor
+    if lo_c > hi_c:
+        lo_c, hi_c = lo // factor, -(-hi // factor)
+    return lo_c, hi_c
+
+
+def _search_bytes(n: int, lo: int, hi: int, n_ch: int, count: int | None) -> float:
+    """Estimated peak memory [bytes] of the exact search (kernels, edge costs, DP)."""
+    band = hi - lo + 1
+    nq = band * band
+    kernels = 8.0 * nq * (hi + 1) * (2 * (band + 2) + 6)  # H (dense and stacked), U, G
+    chunk = max(16.0, _CHUNK_ELEMENTS / (n_ch * (hi + 1)))
+    blocks = 3 * 4.0 * n_ch * chunk * nq  # float32 block products
+    costs = 11.0 * n * nq  # float64 cost table and its validity masks
+    if count is None:
+        dp = 8.0 * 4 * lo * nq + 8.0 * 6 * n * band
+    else:
+        first, last = _count_windows(n, lo, hi, count)
+        states = float(np.clip(last - first + 1, 0, None).sum()) * band
+        dp = 12.0 * states + 24.0 * min(_DP_BLOCK_ELEMENTS, n * nq)
+    return kernels + blocks + costs + dp
+
+
+def _decimate(x: np.ndarray, factor: int) -> np.ndarray:
+    """Box-filtered, every ``factor``-th frame (coarse frame ``k`` is frame ``k * factor``)."""
+    from scipy.ndimage import uniform_filter1d
+
+    xs = uniform_filter1d(x, size=factor, axis=1, mode="nearest")[:, ::factor]
+    xs = xs - xs.mean(axis=1, keepdims=True)
+    return xs / np.maximum(xs.std(axis=1, keepdims=True), 1e-12)
+
+
+def _refine(
+    x: np.ndarray, guess: np.ndarray, lo: int, hi: int, radius: int
+) -> tuple[np.ndarray, float]:
+    """Exact ``argmin E`` at full rate with each boundary within ``radius`` of ``guess``.
+
+    A DP over the boundary index (states: pairs of candidate frames for consecutive
+    boundaries), keeping the count, the band ``lo..hi`` and the free-end rules.
+    """
+    n = x.shape[1]
+    p = guess.size - 1
+    off = np.arange(-radius, radius + 1)
+    cands = []
+    for i, g in enumerate(guess):
+        c = np.unique(np.clip(g + off, 0, n - 1))
+        if i == 0:
+            c = c[c < lo]
+        if i == p:
+            c = c[c >= n - lo]
+        cands.append(c)
+    length = cands[1][None, :] - cands[0][:, None]
+    S = np.where((length >= lo) & (length <= hi), 0.0, np.inf)  # S[u, v]
+    ptrs = []
+    for i in range(2, p + 1):
+        U, Vv, W = np.meshgrid(cands[i - 2], cands[i - 1], cands[i], indexing="ij")
+        ok = np.isfinite(S)[:, :, None] & (W - Vv >= lo) & (W - Vv <= hi)
+        c = np.full(U.shape, np.inf)
+        if ok.any():
+            c[ok] = _pair_costs(x, U[ok], Vv[ok], W[ok])
+        total = S[:, :, None] + c
+        arg = np.argmin(total, axis=0)  # (v, w) -> u
+        S = np.take_along_axis(total, arg[None], axis=0)[0]
+        ptrs.append(arg)
+    flat = int(np.argmin(S)) if S.size else 0
+    if not S.size or not np.isfinite(S.flat[flat]):
+        raise ParameterError(
+            "internal error: no full-rate segmentation near the decimated optimum fits the "
+            "alpha band; try a lower fps or another period_range"
+        )
+    iv, iw = divmod(flat, S.shape[1])
+    idx = [iw, iv]  # boundary indices p, p-1, ...
+    for arg in reversed(ptrs):
+        idx.append(int(arg[idx[-1], idx[-2]]))
+    idx = idx[::-1]
+    frames = np.array([cands[i][j] for i, j in enumerate(idx)], dtype=np.int64)
+    return frames, float(S.flat[flat])
+
+
+def _optimum(x: np.ndarray, lo: int, hi: int, count: int | None) -> tuple[np.ndarray, float, int]:
+    """Optimal boundary frames, energy and the search decimation factor.
+
+    If the exact search at full rate fits :data:`SEARCH_MEMORY_BUDGET`, it is run as is
+    (factor 1). Otherwise the signal is decimated in time by the smallest integer
+    factor ``f`` whose search fits (box filter of ``f`` frames, every ``f``-th frame,
+    band ``ceil(lo/f)..floor(hi/f)``), the optimum is found on it, and every boundary
+    is then refined at full rate within ``+-f`` frames (exact ``argmin E`` for the
+    count found, float64 costs), re-centring the window until the energy stops
+    decreasing. This is a local refinement: the result equals the full-rate optimum
+    whenever that lies within the window (on the synthetic tests: the same boundaries).
+    """
+    n_ch, n = x.shape
+
+    def search(xx: np.ndarray, lo_: int, hi_: int) -> tuple[np.ndarray, float]:
+        nn = xx.shape[1]
+        cost = _edge_costs(xx, lo_, hi_, dtype=_FAST_DTYPE)
+        if count is None:
+            return _min_mean_energy(lambda r: _shortest_path(cost, nn, lo_, hi_, r))
+        return _shortest_path_count(cost, nn, lo_, hi_, count)
+
+    if _search_bytes(n, lo, hi, n_ch, count) <= SEARCH_MEMORY_BUDGET:
+        frames, energy = search(x, lo, hi)
+        return frames, energy, 1
+    factor = 2
+    while True:
+        lo_c, hi_c = _coarse_band(lo, hi, factor)
+        n_c = (n - 1) // factor + 1
+        if lo_c < 2:
+            raise ParameterError(
+                f"the period of ~{(lo + hi) / 2:.0f} frames (band {lo}-{hi}) needs more than "
+                f"{SEARCH_MEMORY_BUDGET / 2**20:.0f} MiB to search and cannot be decimated "
+                "further; give a lower --fps or a shorter --period-range / more periods"
+            )
+        if _search_bytes(n_c, lo_c, hi_c, n_ch, count) <= SEARCH_MEMORY_BUDGET:
+            break
+        factor += 1
+    frames_c, _ = search(_decimate(x, factor), lo_c, hi_c)
+    frames, energy = _refine(x, frames_c * factor, lo, hi, radius=factor)
+    for _ in range(_MAX_REFINE_PASSES):  # re-centre the window until it no longer moves
+        f_new, e_new = _refine(x, frames, lo, hi, radius=factor)
+        if e_new >= energy - 1e-12:
+            break
+        frames, energy = f_new, e_new
+    return frames, energy, factor
+
+
 def _literal_edge_cost(x: np.ndarray, t0: int, t1: int, t2: int) -> float:
     """Eqs. 1-2 for one pair of consecutive periods, written out with loops."""
     n_ch = x.shape[0]
@@ -687,7 +908,7 @@ def segmentation_energy(x: np.ndarray, frames: np.ndarray) -> float:
 
 
 def _check_enough(n: int, fps: float, period_range: tuple[float, float]) -> None:
-    span = (n - 1) / fps
+    span = float(frames_to_time(n - 1, fps=fps))
     if span < 2 * period_range[0]:
         raise ParameterError(
             f"clip of {n} frames lasts {span:.3f} s at fps={fps:g}, shorter than two periods "
@@ -731,12 +952,14 @@ def _estimate_period(
 ) -> float:
     """Nominal period [frames] by FFT peak or by the uniform-segmentation energy."""
     n = x.shape[1]
-    lo_f = max(period_range[0] * fps, 2.0)
-    hi_f = min(period_range[1] * fps, (n - 1) / 2.0)
+    lo_p, hi_p = time_to_frames(period_range, fps=fps, round_to_int=False)  # [frames]
+    lo_f = max(float(lo_p), 2.0)
+    hi_f = min(float(hi_p), (n - 1) / 2.0)
     if hi_f < lo_f:
         raise ParameterError(
             f"no period of {period_range[0]:g}-{period_range[1]:g} s fits twice in "
-            f"{(n - 1) / fps:.3f} s at fps={fps:g}; widen period_range or give a longer clip"
+            f"{float(frames_to_time(n - 1, fps=fps)):.3f} s at fps={fps:g}; widen period_range "
+            "or give a longer clip"
         )
     if method == "fft":
         nfft = int(2 ** np.ceil(np.log2(8 * n)))
@@ -889,7 +1112,10 @@ def segment_values(
     alpha : float in (0, 0.5)
         Allowed relative deviation of every period from the nominal period (eq. 3).
     n_periods : int >= 2, optional
-        Number of periods (e.g. from the music). Overrides ``period_method``.
+        Number of periods (e.g. from the music). Overrides ``period_method``; the result
+        then has exactly this many periods, each within the alpha band around
+        ``(n_frames - 1) / n_periods`` frames (or a ParameterError if they do not fit
+        or the forced segmentation is not periodic).
     period_range : (float, float) [s]
         Shortest and longest period for estimating the count (paper: 0.25-1.25 s).
     period_method : {"energy", "fft", "given"}
@@ -907,8 +1133,9 @@ def segment_values(
     ParameterError
         NaN/inf values, ``fps <= 0``, alpha outside (0, 0.5), reversed period range, a
         clip shorter than two periods of the requested range, all channels constant,
-        or a clip that is not periodic (normalised energy above
-        :data:`MAX_NORMALISED_ENERGY`).
+        ``n_periods`` periods that do not fit the clip within the alpha band, or a
+        clip that is not periodic (normalised energy above
+        :data:`MAX_NORMALISED_ENERGY`; with ``n_periods`` given, often a wrong count).
 
     Examples
     --------
@@ -971,22 +1198,33 @@ def segment_values(
             f"alpha={alpha:g} allows no whole-frame period length around {nominal:.2f} "
             "frames; increase alpha"
         )
-    cost = _edge_costs(x, lo, hi, dtype=_FAST_DTYPE)
-    frames, energy = _min_mean_energy(lambda r: _shortest_path(cost, n, lo, hi, r))
+    frames, energy, factor = _optimum(x, lo, hi, p if method == "given" else None)
     n_found = frames.size - 1
     e_norm = energy / (x.shape[0] * max(n_found - 1, 1))
     contrast = periodicity_contrast(x, frames)
     if e_norm >= MAX_NORMALISED_ENERGY or (
         np.isfinite(contrast) and contrast < MIN_PERIODICITY_CONTRAST
     ):
+        hint = ""
+        if method == "given":
+            try:
+                est = _estimate_period(x, fps, (lo_s, hi_s), "energy")
+                hint = (
+                    f"; n_periods={p} was given: is it right? The energy estimate of the "
+                    f"count in {lo_s:g}-{hi_s:g} s periods is "
+                    f"{max(2, int(np.floor((n - 1) / est + 1e-9)))}"
+                )
+            except ParameterError:
+                hint = f"; n_periods={p} was given: check the count"
         raise ParameterError(
             f"the motion is not periodic: the best segmentation into {n_found} periods of "
-            f"~{(frames[-1] - frames[0]) / n_found / fps:.3f} s has mean Pearson distance "
+            f"~{float(frames_to_time((frames[-1] - frames[0]) / n_found, fps=fps)):.3f} s has "
+            f"mean Pearson distance "
             f"{e_norm:.3f} between consecutive periods, and uniform segmentations at this "
             f"period beat those at wrong periods by only {contrast:.3f} (periodic needs "
             f"< {MAX_NORMALISED_ENERGY} and a "
             f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. Try other "
-            "channels, another period_range, or a clip with repeated movement"
+            "channels, another period_range, or a clip with repeated movement" + hint
         )
     times = frames_to_time(frames, fps=fps)
     return Segmentation(
@@ -997,6 +1235,7 @@ def segment_values(
         channels=used,
         fps=fps,
         period_method=method,
+        search_decimation=factor,
     )
 
 
@@ -1029,7 +1268,8 @@ def segment(
     alpha : float in (0, 0.5)
         Allowed relative deviation of each period from the nominal period (eq. 3).
     n_periods : int >= 2, optional
-        Period count if known (e.g. from the music).
+        Period count if known (e.g. from the music); the result has exactly this many
+        periods (see :func:`segment_values`).
     period_range : (float, float) [s]
         Shortest and longest period when estimating the count.
     period_method : {"energy", "fft", "given"}
@@ -1161,8 +1401,8 @@ def minima_baseline(signal: Any, *, fps: float, period: float) -> np.ndarray:
 
     fps = check_fps(fps)
     y = check_finite(np.asarray(signal, dtype=np.float64).ravel(), name="signal")
-    dist = max(1, int(0.7 * float(period) * fps))
-    smooth = uniform_filter1d(y, size=max(1, int(round(0.05 * fps)) | 1))
+    dist = max(1, int(time_to_frames(0.7 * float(period), fps=fps, mode="floor")))
+    smooth = uniform_filter1d(y, size=max(1, int(time_to_frames(0.05, fps=fps))) | 1)
     peaks, _ = find_peaks(-smooth, distance=dist)
     return peaks.astype(np.int64)
 
@@ -1216,7 +1456,7 @@ def synthetic_error_table(
                         found[name] = (np.array([], dtype=np.int64), False)
                 uni = uniform_baseline(vals, fps=fps, method="fft")
                 found["baseline: FFT period + uniform"] = (uni, False)
-                per = (uni[-1] - uni[0]) / max(uni.size - 1, 1) / fps
+                per = float(frames_to_time((uni[-1] - uni[0]) / max(uni.size - 1, 1), fps=fps))
                 found["baseline: minima of channel 0"] = (
                     minima_baseline(vals[:, 0], fps=fps, period=per),
                     True,
