@@ -112,3 +112,32 @@ def test_segment_refuses_out_equal_to_input(synth_csv, capsys):
     before = path.read_bytes()
     assert main(["segment", str(path), "--fps", "25", "--out", str(path)]) == 2
     assert path.read_bytes() == before
+
+
+def test_segment_marker_table_becomes_angles_like_mat(tmp_path, capsys):
+    """A marker-position CSV goes through motion.segmentation_view, like the .mat file."""
+    m = datasets.load_mocap_toolbox("dance2")
+    path = tmp_path / "dance2_markers.csv"
+    pd.DataFrame(m.values, columns=list(m.channels)).to_csv(path, index=False)
+    chans = ["--channels", "knee_L_angle", "knee_R_angle", "--json"]
+    assert main(["segment", str(path), "--fps", str(m.fps), *chans]) == 0
+    from_csv = json.loads(capsys.readouterr().out)
+    mat = datasets.path("motion/mocaptoolbox/mcdemodata.mat")
+    assert main(["segment", str(mat), "--variable", "dance2", *chans]) == 0
+    from_mat = json.loads(capsys.readouterr().out)
+    assert from_csv["marker_angles"] is True
+    assert from_csv["channels"] == ["knee_L_angle", "knee_R_angle"]
+    np.testing.assert_allclose(from_csv["boundaries_s"], from_mat["boundaries_s"], atol=1e-9)
+
+
+def test_segment_periods_is_honoured(synth_csv, capsys):
+    """True count 12; --periods 11 used to come back as 12 periods."""
+    path, _ = synth_csv
+    rc = main(["segment", str(path), "--fps", "25", "--periods", "11", "--alpha", "0.2", "--json"])
+    assert rc == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["n_periods"] == 11
+    assert len(res["boundaries_s"]) == 12
+    rc = main(["segment", str(path), "--fps", "25", "--periods", "15"])
+    assert rc == 2
+    assert "n_periods=15 was given" in capsys.readouterr().err

@@ -20,7 +20,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "consecutive periods are as similar as possible (Pearson correlation of joint "
             "angles) while every period stays within +-alpha of the nominal period. "
             "MOTION is a .bvh (rotations), .mat (MoCap Toolbox markers, converted to "
-            "joint angles), or a .csv/.npy joint-angle table (needs --fps)."
+            "joint angles), or a .csv/.npy table (needs --fps) of joint angles or of marker "
+            "positions (columns <marker>_x/_y/_z, converted to joint angles). With "
+            "--periods N the result has exactly N periods."
         ),
     )
     p.add_argument("motion", metavar="MOTION", help="motion file (.bvh, .mat, .csv, .npy)")
@@ -42,7 +44,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--periods",
         type=int,
         default=None,
-        help="number of periods if known (e.g. from the music); default: estimate",
+        help="number of periods if known (e.g. from the music); the result then has exactly "
+        "N periods; default: estimate",
     )
     p.add_argument(
         "--period-range",
@@ -74,17 +77,14 @@ def run(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from .. import io
-    from ..motion import marker_angles
+    from ..motion import is_marker_motion, segmentation_view
     from ..segment import segment
     from ..units import time_to_frames
 
     out = check_output_path(args.out, args.motion) if args.out else None
     motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
-    converted = False
-    if motion.skeleton is None and any(c.endswith("_x") for c in motion.channels):
-        if str(args.motion).lower().endswith(".mat"):
-            motion = marker_angles(motion)
-            converted = True
+    converted = is_marker_motion(motion)
+    motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
     channels = args.channels
     chan: str | list[str] = (
         channels[0]
@@ -125,6 +125,7 @@ def run(args: argparse.Namespace) -> int:
         "alpha": args.alpha,
         "channels": list(seg.channels),
         "marker_angles": converted,
+        "search_decimation": seg.search_decimation,
         "out": str(out) if out is not None else None,
     }
     text = "\n".join(
