@@ -128,17 +128,6 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | N
     return out, video, report
 
 
-def _segment_input(motion: Any) -> Any:
-    """Joint angles to segment: the motion itself, or angles derived from markers."""
-    if motion.skeleton is not None:
-        return motion
-    if all(c.rsplit("_", 1)[-1] in ("x", "y", "z") for c in motion.channels):
-        from ..motion import marker_angles
-
-        return marker_angles(motion)
-    return motion
-
-
 def run(args: argparse.Namespace) -> int:
     from .. import io
 
@@ -178,10 +167,11 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
 
         steps.step("segmenting periods")
         t0 = time.perf_counter()
+        from ..motion import segmentation_view
         from ..segment import segment
 
         lo, hi = args.period_range
-        seg = segment(_segment_input(motion), period_range=(lo, hi))
+        seg = segment(segmentation_view(motion), period_range=(lo, hi))
         if seg.n_periods < 1 or len(seg.boundaries) < 2:
             raise ParameterError(
                 f"{args.motion!r} does not look periodic: no full motion period found "

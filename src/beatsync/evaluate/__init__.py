@@ -6,7 +6,15 @@
   scores (averaged over motion beats, or over music beats; Gaussian sigma in seconds).
 """
 
-from .alignment import alignment_scores, beat_alignment_motion, beat_alignment_music
+from .alignment import (
+    alignment_scores,
+    beat_alignment_motion,
+    beat_alignment_music,
+    beat_phase_consistency,
+    evaluate_sync,
+    kinematic_phase_offset,
+    offset_control,
+)
 from .beats import METRICS, evaluate_beats, octave_relation
 
 __all__ = [
@@ -16,4 +24,8 @@ __all__ = [
     "alignment_scores",
     "beat_alignment_motion",
     "beat_alignment_music",
+    "beat_phase_consistency",
+    "kinematic_phase_offset",
+    "offset_control",
+    "evaluate_sync",
 ]
