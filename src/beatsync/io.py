@@ -31,6 +31,7 @@ from .units import check_finite, check_fps, check_times
 
 __all__ = [
     "atomic_write",
+    "check_output_folder",
     "read_motion",
     "read_bvh",
     "write_bvh",
@@ -74,6 +75,16 @@ def _new_file_mode(dest: Path) -> int:
     return 0o666 & ~umask
 
 
+def check_output_folder(path: str | os.PathLike[str]) -> Path:
+    """Refuse an output path whose folder is missing or not writable; return its folder."""
+    parent = Path(path).resolve().parent
+    if not parent.is_dir():
+        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
+    if not os.access(parent, os.W_OK):
+        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    return parent
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; rename it to ``path`` on success.
@@ -81,11 +92,7 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
     On any exception the temporary file is removed and ``path`` is untouched.
     """
     dest = Path(path)
-    parent = dest.resolve().parent
-    if not parent.is_dir():
-        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
-    if not os.access(parent, os.W_OK):
-        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    parent = check_output_folder(dest)
     fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=parent)
     try:
         with os.fdopen(fd, mode) as fh:

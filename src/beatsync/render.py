@@ -221,8 +221,15 @@ def plot_frames(
         else:
             ax.plot(p[:, 0], p[:, 1], "o", ms=2.5, color=color)
         label = f"{shown_t[k]:.2f} s" + ("\nbeat" if beat else "")
-        ax.text(k * spacing, float(np.min(xy[..., 1])) - 0.05 * np.ptp(xy[..., 1]), label,
-                ha="center", va="top", fontsize=7, color=color)
+        ax.text(
+            k * spacing,
+            float(np.min(xy[..., 1])) - 0.05 * np.ptp(xy[..., 1]),
+            label,
+            ha="center",
+            va="top",
+            fontsize=7,
+            color=color,
+        )
     ax.set_xlim(-spacing * 0.6, (len(frames) - 0.4) * spacing)
     lo, hi = float(np.min(xy[..., 1])), float(np.max(xy[..., 1]))
     ax.set_ylim(lo - 0.25 * (hi - lo + 1e-9), hi + 0.05 * (hi - lo + 1e-9))
@@ -275,13 +282,13 @@ def plot_beat_timeline(
         b = check_times(beats, name="beats")
         b = b[b <= t[-1]]
         for i, x in enumerate(b):
-            ax.axvline(x, color=_BEAT_COLOR, lw=0.8, alpha=0.7,
-                       label="music beat" if i == 0 else None)
+            ax.axvline(
+                x, color=_BEAT_COLOR, lw=0.8, alpha=0.7, label="music beat" if i == 0 else None
+            )
     if boundaries is not None:
         s = check_times(boundaries, name="boundaries")
         for i, x in enumerate(s):
-            ax.axvline(x, color="0.5", lw=1.2, ls="--",
-                       label="period boundary" if i == 0 else None)
+            ax.axvline(x, color="0.5", lw=1.2, ls="--", label="period boundary" if i == 0 else None)
     if motion_beats is not None:
         mb = check_times(motion_beats, name="motion_beats")
         ax.plot(mb, np.interp(mb, t, speed), "o", ms=4, color="#1f77b4", label="motion beat")
@@ -347,8 +354,17 @@ class _FrameRenderer:
             ax.add_collection(self.artist)
         else:
             (self.artist,) = ax.plot([], [], "o", ms=3, color=_POSE_COLOR)
-        self.dot = ax.text(0.95, 0.95, "\u25cf", transform=ax.transAxes, ha="right", va="top",
-                           fontsize=22, color=_BEAT_COLOR, visible=False)
+        self.dot = ax.text(
+            0.95,
+            0.95,
+            "\u25cf",
+            transform=ax.transAxes,
+            ha="right",
+            va="top",
+            fontsize=22,
+            color=_BEAT_COLOR,
+            visible=False,
+        )
         self.text = self.fig.text(0.02, 0.97, title, ha="left", va="top", fontsize=8)
         self.title = title
         self.size = (w, h)
@@ -439,12 +455,10 @@ def write_video(
     ParameterError
         Bad frame rate or size, unwritable folder, malformed audio, ffmpeg failure.
     """
+    from .io import check_output_folder
+
     dest = Path(path)
-    parent = dest.resolve().parent
-    if not parent.is_dir():
-        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
-    if not os.access(parent, os.W_OK):
-        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    parent = check_output_folder(dest)
     fps = check_fps(motion.fps if fps is None else fps, name="video fps")
     w, h = (int(size[0]) // 2 * 2, int(size[1]) // 2 * 2)
     if w < 32 or h < 32:
@@ -536,8 +550,14 @@ def _write_gif_fallback(
         for k in frames_iter
     ]
     with atomic_write(gif, "wb") as fh:
-        images[0].save(fh, format="GIF", save_all=True, append_images=images[1:],
-                       duration=int(round(1000 / fps)), loop=0)
+        images[0].save(
+            fh,
+            format="GIF",
+            save_all=True,
+            append_images=images[1:],
+            duration=int(round(1000 / fps)),
+            loop=0,
+        )
     msg = f"no ffmpeg found: wrote the animation as {str(gif)!r} without sound"
     if y_sr is not None:
         y, sr = y_sr

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = ["emit", "add_json_flag", "check_output_path", "to_jsonable"]
+__all__ = ["emit", "add_json_flag", "check_output_path", "check_side_outputs", "to_jsonable"]
 
 
 def add_json_flag(parser: argparse.ArgumentParser) -> None:
@@ -70,11 +70,29 @@ def check_output_path(out: str | Path, *inputs: str | Path | None) -> Path:
             raise ParameterError(
                 f"output path {str(out)!r} is the same as input {str(inp)!r}; choose another name"
             )
-    parent = out_p.resolve().parent
-    if not parent.is_dir():
-        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
-    import os
+    from ..io import check_output_folder
 
-    if not os.access(parent, os.W_OK):
-        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    check_output_folder(out_p)
     return out_p
+
+
+def check_side_outputs(
+    video: str | Path | None,
+    report: str | Path | None,
+    inputs: tuple[str | Path | None, ...],
+    out: Path,
+) -> tuple[Path | None, Path | None]:
+    """Check the optional ``--video`` (.mp4) and ``--report`` (.json) outputs of a command.
+
+    Neither may equal an input or the main output, nor each other.
+    """
+    video_p = report_p = None
+    if video is not None:
+        video_p = check_output_path(video, *inputs, out)
+        if video_p.suffix.lower() != ".mp4":
+            raise ParameterError(f"--video {str(video)!r} must end in .mp4")
+    if report is not None:
+        report_p = check_output_path(report, *inputs, out, video)
+        if report_p.suffix.lower() != ".json":
+            raise ParameterError(f"--report {str(report)!r} must end in .json")
+    return video_p, report_p

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import add_json_flag, check_output_path, emit
+from ._common import add_json_flag, check_output_path, check_side_outputs, emit
 
 __all__ = ["register", "run", "cache_dir", "graph_cache_key", "graph_source_hash"]
 
@@ -141,8 +141,9 @@ def graph_source_hash() -> str:
 
     ``beatsync/graph/build.py`` and ``beatsync/motion_beats.py`` (beat frames,
     intensities, distances) and the foundation they rest on: ``io.py`` (BVH
-    reading), ``motion.py`` (forward kinematics) and ``units.py``. Part of :func:`graph_cache_key`, so a code change (also
-    in an editable install, where ``__version__`` does not move) rebuilds cached graphs.
+    reading), ``motion.py`` (forward kinematics) and ``units.py``. Part of
+    :func:`graph_cache_key`, so a code change (also in an editable install, where
+    ``__version__`` does not move) rebuilds cached graphs.
     """
     from .. import io, motion, motion_beats, units
     from ..graph import build
@@ -218,17 +219,9 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     out = Path(args.output)
     if out.suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
-    inputs = [audio, args.beats, *files]
+    inputs = (audio, args.beats, *files)
     check_output_path(out, *inputs)
-    video = report = None
-    if args.video is not None:
-        video = check_output_path(args.video, *inputs, out)
-        if video.suffix.lower() != ".mp4":
-            raise ParameterError(f"--video {args.video!r} must end in .mp4")
-    if args.report is not None:
-        report = check_output_path(args.report, *inputs, out, args.video)
-        if report.suffix.lower() != ".json":
-            raise ParameterError(f"--report {args.report!r} must end in .json")
+    video, report = check_side_outputs(args.video, args.report, inputs, out)
     return {"audio": audio, "files": files, "out": out, "video": video, "report": report, "th": th}
 
 

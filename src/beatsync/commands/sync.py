@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ._common import add_json_flag, check_output_path, emit
+from ._common import add_json_flag, check_output_path, check_side_outputs, emit
 
 __all__ = ["register", "run"]
 
@@ -42,35 +42,76 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("motion", help="motion file: .bvh, .mat (MoCap Toolbox), .csv or .npy")
     p.add_argument("audio", help="music file: .wav, .flac, .ogg, .mp3")
-    p.add_argument("-o", "--output", required=True,
-                   help="output motion: .bvh (needs a skeleton) or .csv")
-    p.add_argument("--fps", type=float, default=None,
-                   help="input frame rate [Hz]: overrides the BVH header; required for csv/npy")
-    p.add_argument("--out-fps", type=float, default=None,
-                   help="output frame rate [Hz] (default: the input's)")
-    p.add_argument("--variable", default=None,
-                   help="recording inside a .mat file (e.g. dance2)")
-    p.add_argument("--beats", default=None, metavar="FILE",
-                   help="music beat times [s], one per line (first column): skip beat tracking")
-    p.add_argument("--bpm", type=float, default=None,
-                   help="known tempo of the music [BPM]: the tracker only finds the phase")
-    p.add_argument("--beats-per-period", type=int, default=None, metavar="N",
-                   help="music beats per motion period (default: round(motion period / beat))")
-    p.add_argument("--first-beat", type=int, default=0, metavar="K",
-                   help="index of the beat the first period starts on (default 0)")
-    p.add_argument("--phase-offset", type=float, default=0.0, metavar="S",
-                   help="land period boundaries S seconds after their beats (default 0)")
-    p.add_argument("--align-accents", action="store_true",
-                   help="put the dancer's accents (kinematic beats: minima of joint speed) "
-                   "on the beats instead of the period boundaries")
-    p.add_argument("--period-range", type=float, nargs=2, default=(0.25, 1.25),
-                   metavar=("LO", "HI"), help="motion period search range [s] (default 0.25 1.25)")
-    p.add_argument("--video", default=None, metavar="OUT.mp4",
-                   help="also write a stick-figure video with the music as soundtrack")
-    p.add_argument("--video-fps", type=float, default=30.0,
-                   help="frame rate of the video [Hz] (default 30)")
-    p.add_argument("--report", default=None, metavar="FILE.json",
-                   help="write the report as JSON")
+    p.add_argument(
+        "-o", "--output", required=True, help="output motion: .bvh (needs a skeleton) or .csv"
+    )
+    p.add_argument(
+        "--fps",
+        type=float,
+        default=None,
+        help="input frame rate [Hz]: overrides the BVH header; required for csv/npy",
+    )
+    p.add_argument(
+        "--out-fps", type=float, default=None, help="output frame rate [Hz] (default: the input's)"
+    )
+    p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    p.add_argument(
+        "--beats",
+        default=None,
+        metavar="FILE",
+        help="music beat times [s], one per line (first column): skip beat tracking",
+    )
+    p.add_argument(
+        "--bpm",
+        type=float,
+        default=None,
+        help="known tempo of the music [BPM]: the tracker only finds the phase",
+    )
+    p.add_argument(
+        "--beats-per-period",
+        type=int,
+        default=None,
+        metavar="N",
+        help="music beats per motion period (default: round(motion period / beat))",
+    )
+    p.add_argument(
+        "--first-beat",
+        type=int,
+        default=0,
+        metavar="K",
+        help="index of the beat the first period starts on (default 0)",
+    )
+    p.add_argument(
+        "--phase-offset",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="land period boundaries S seconds after their beats (default 0)",
+    )
+    p.add_argument(
+        "--align-accents",
+        action="store_true",
+        help="put the dancer's accents (kinematic beats: minima of joint speed) "
+        "on the beats instead of the period boundaries",
+    )
+    p.add_argument(
+        "--period-range",
+        type=float,
+        nargs=2,
+        default=(0.25, 1.25),
+        metavar=("LO", "HI"),
+        help="motion period search range [s] (default 0.25 1.25)",
+    )
+    p.add_argument(
+        "--video",
+        default=None,
+        metavar="OUT.mp4",
+        help="also write a stick-figure video with the music as soundtrack",
+    )
+    p.add_argument(
+        "--video-fps", type=float, default=30.0, help="frame rate of the video [Hz] (default 30)"
+    )
+    p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -81,8 +122,13 @@ class _Steps:
     def __init__(self, total: int):
         from tqdm import tqdm
 
-        self.bar = tqdm(total=total, file=sys.stderr, disable=None, leave=False,
-                        bar_format="{desc:<24}{bar}| {n_fmt}/{total_fmt} [{elapsed}]")
+        self.bar = tqdm(
+            total=total,
+            file=sys.stderr,
+            disable=None,
+            leave=False,
+            bar_format="{desc:<24}{bar}| {n_fmt}/{total_fmt} [{elapsed}]",
+        )
         self.interactive = not self.bar.disable
 
     def step(self, desc: str) -> None:
@@ -116,15 +162,7 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | N
             raise ParameterError(f"{what} file {inp!r} does not exist")
     inputs = (args.motion, args.audio, args.beats)
     check_output_path(out, *inputs)
-    video = report = None
-    if args.video is not None:
-        video = check_output_path(args.video, *inputs, out)
-        if video.suffix.lower() != ".mp4":
-            raise ParameterError(f"--video {args.video!r} must end in .mp4")
-    if args.report is not None:
-        report = check_output_path(args.report, *inputs, out, args.video)
-        if report.suffix.lower() != ".json":
-            raise ParameterError(f"--report {args.report!r} must end in .json")
+    video, report = check_side_outputs(args.video, args.report, inputs, out)
     return out, video, report
 
 
@@ -226,8 +264,9 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         if video is not None:
             steps.step("writing video")
             t0 = time.perf_counter()
-            vid = _render_video(res.motion, video, (y, sr), beats, args.video_fps,
-                                steps.interactive)
+            vid = _render_video(
+                res.motion, video, (y, sr), beats, args.video_fps, steps.interactive
+            )
             written["video"] = str(vid)
             timings["video_s"] = time.perf_counter() - t0
             steps.done()
@@ -262,8 +301,9 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     return result
 
 
-def _align_accents(res: Any, motion: Any, boundaries: Any, beats: np.ndarray,
-                   args: argparse.Namespace) -> Any:
+def _align_accents(
+    res: Any, motion: Any, boundaries: Any, beats: np.ndarray, args: argparse.Namespace
+) -> Any:
     """Synchronise again so that the kinematic beats, not the boundaries, hit the beats."""
     from ..evaluate.alignment import kinematic_phase_offset
     from ..motion_beats import kinematic_beats
@@ -280,17 +320,22 @@ def _align_accents(res: Any, motion: Any, boundaries: Any, beats: np.ndarray,
     if beats[first] - lag < 0:
         first += 1
     return synchronize(
-        motion, boundaries, beats, beats_per_period=args.beats_per_period, first_beat=first,
-        out_fps=args.out_fps, phase_offset=-lag,
+        motion,
+        boundaries,
+        beats,
+        beats_per_period=args.beats_per_period,
+        first_beat=first,
+        out_fps=args.out_fps,
+        phase_offset=-lag,
     )
 
 
-def _render_video(motion: Any, path: Path, audio: Any, beats: np.ndarray, fps: float,
-                  progress: bool) -> Path:
+def _render_video(
+    motion: Any, path: Path, audio: Any, beats: np.ndarray, fps: float, progress: bool
+) -> Path:
     from .. import render
 
-    return render.write_video(motion, path, audio=audio, fps=fps, beats=beats,
-                              progress=progress)
+    return render.write_video(motion, path, audio=audio, fps=fps, beats=beats, progress=progress)
 
 
 def _text(result: dict[str, Any]) -> str:
