@@ -131,6 +131,7 @@ def run_notebooks(
     progress : callable, optional
         Called with a line of text before and after each notebook.
     """
+    import nbformat
     import papermill as pm
 
     from . import __version__
@@ -167,8 +168,10 @@ def run_notebooks(
                 if progress:
                     progress(f"  {name} FAILED; executed notebook kept in {failed}")
             raise
-        with open(tmp) as src, atomic_write(dest) as fh:
-            fh.write(src.read())
+        executed = nbformat.read(tmp, as_version=4)
+        executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
+        with atomic_write(dest) as fh:
+            nbformat.write(executed, fh)
         tmp.unlink(missing_ok=True)
         seconds = time.perf_counter() - start
         runs.append(NotebookRun(name, dest, params[name], seconds))
