@@ -12,12 +12,32 @@ import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = ["emit", "add_json_flag", "check_output_path", "check_side_outputs", "to_jsonable"]
+__all__ = [
+    "emit",
+    "add_json_flag",
+    "add_period_range",
+    "check_output_path",
+    "check_side_outputs",
+    "to_jsonable",
+]
 
 
 def add_json_flag(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json", action="store_true", help="print a machine-readable JSON object instead of text"
+    )
+
+
+def add_period_range(parser: argparse.ArgumentParser) -> None:
+    """The ``--period-range LO HI`` option [s] shared by the commands that segment motion."""
+    parser.add_argument(
+        "--period-range",
+        nargs=2,
+        type=float,
+        default=(0.25, 1.25),
+        metavar=("LO", "HI"),
+        help="shortest and longest motion period searched [s] (default 0.25 1.25, the "
+        "paper's range; real dance cycles can be longer)",
     )
 
 

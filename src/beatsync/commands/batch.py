@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, emit
+from ._common import add_json_flag, add_period_range, emit
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -23,14 +23,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--fps", type=float, default=None, help="frame-rate override for every clip [Hz]"
     )
     p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
-    p.add_argument(
-        "--period-range",
-        type=float,
-        nargs=2,
-        default=(0.25, 1.25),
-        metavar=("LO", "HI"),
-        help="range of motion periods searched [s] (default 0.25 1.25)",
-    )
+    add_period_range(p)
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument(
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"

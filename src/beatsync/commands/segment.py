@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, check_output_path, emit
+from ._common import add_json_flag, add_period_range, check_output_path, emit
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -47,14 +47,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="number of periods if known (e.g. from the music); the result then has exactly "
         "N periods; default: estimate",
     )
-    p.add_argument(
-        "--period-range",
-        nargs=2,
-        type=float,
-        default=(0.25, 1.25),
-        metavar=("LO", "HI"),
-        help="shortest and longest period [s] when estimating (default 0.25 1.25)",
-    )
+    add_period_range(p)
     p.add_argument(
         "--period-method",
         choices=("energy", "fft"),

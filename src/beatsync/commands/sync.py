@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ._common import add_json_flag, check_output_path, check_side_outputs, emit
+from ._common import add_json_flag, add_period_range, check_output_path, check_side_outputs, emit
 
 __all__ = ["register", "run"]
 
@@ -94,14 +94,7 @@ def register(subparsers: Any) -> None:
         help="put the dancer's accents (kinematic beats: minima of joint speed) "
         "on the beats instead of the period boundaries",
     )
-    p.add_argument(
-        "--period-range",
-        type=float,
-        nargs=2,
-        default=(0.25, 1.25),
-        metavar=("LO", "HI"),
-        help="motion period search range [s] (default 0.25 1.25)",
-    )
+    add_period_range(p)
     p.add_argument(
         "--video",
         default=None,
