@@ -141,7 +141,9 @@ def sync_grid(
     out_dir : path
         Existing folder for the synchronised clips (``<clip>__<song>.bvh``).
     scheduler : str, optional
-        Address of an existing Dask scheduler; default: a local cluster.
+        Address of an existing Dask scheduler; default: a local cluster. The workers
+        read the inputs and write the outputs themselves, so every path must be valid
+        on every worker (a shared file system).
     n_workers : int, optional
         Workers of the local cluster (default: one per core).
     processes : bool
