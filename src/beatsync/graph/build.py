@@ -62,7 +62,7 @@ import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
-from ..units import check_fps, check_times, frames_to_time, time_to_frames
+from ..units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "WeightedMotionGraph",
@@ -468,15 +468,9 @@ def check_th(th: Any, *, name: str = "TH") -> float:
     ParameterError
     """
     try:
-        v = float(th)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}={th!r} must be a number > 0 (the paper uses 3.0)") from None
-    if not np.isfinite(v) or v <= 0:
-        raise ParameterError(
-            f"{name}={th!r} must be a finite threshold > 0 on the scale-free distance rd "
-            "(the paper uses 3.0)"
-        )
-    return v
+        return check_positive(th, name=name, unit="scale-free distance rd")
+    except ParameterError as exc:
+        raise ParameterError(f"{exc}; the paper uses TH = 3.0") from None
 
 
 def _beat_frames(beats: Any, clip: Any) -> np.ndarray:
