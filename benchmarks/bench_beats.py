@@ -23,14 +23,13 @@ from __future__ import annotations
 
 import os
 
-for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_v] = "1"  # one core
+import _machine  # noqa: E402  (benchmarks/ is on sys.path when a script runs)
+
+_machine.pin_one_core()  # before numpy is imported
 
 import argparse  # noqa: E402
 import contextlib  # noqa: E402
-import datetime as _dt  # noqa: E402
 import json  # noqa: E402
-import platform  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -80,7 +79,6 @@ def main() -> int:
 
     import librosa
 
-    import beatsync
     from beatsync import datasets
     from beatsync.beats import track_beats
     from beatsync.evaluate.beats import (
@@ -179,16 +177,7 @@ def main() -> int:
     real = pd.DataFrame(real_rows)
 
     # ------------------------------------------------------------------ write
-    facts = {
-        "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "cpu_count": os.cpu_count(),
-        "cores_used": 1,
-        "numpy": np.__version__,
-        "librosa": librosa.__version__,
-        "beatsync": beatsync.__version__,
-    }
+    facts = _machine.machine_facts()
     out_dir = HERE / "results"
     out_dir.mkdir(exist_ok=True)
     cmd = "  .venv/bin/python benchmarks/bench_beats.py " + (

@@ -15,18 +15,16 @@ run, speedup reported (paper B: 27-543x).
 
 from __future__ import annotations
 
-import argparse
-import datetime as _dt
+import _machine  # (benchmarks/ is on sys.path when a script runs)
+
+_machine.pin_one_core()  # before numpy is imported
+
+import argparse  # noqa: E402
 import json
-import os
-import platform
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
-from beatsync import __version__
 from beatsync.graph import build_graph
 from beatsync.graph.study import LIBRARIES, PAPER_B_TABLE1, load_library, ratio_table, speed_table
 
@@ -75,14 +73,7 @@ def main(argv: list[str] | None = None) -> int:
         ),
     ]
     cmd = "python benchmarks/bench_compose.py" + (" --quick" if args.quick else "")
-    machine = {
-        "platform": platform.platform(),
-        "python": sys.version.split()[0],
-        "cpu_count": os.cpu_count(),
-        "numpy": np.__version__,
-        "beatsync": __version__,
-        "date_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M"),
-    }
+    machine = _machine.machine_facts()
     lines = [
         "# Benchmark: motion-graph search (paper B, Table 1)",
         "",

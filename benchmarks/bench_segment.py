@@ -20,15 +20,12 @@ Writes ``benchmarks/results/segment.md`` and ``benchmarks/results/segment.json``
 
 from __future__ import annotations
 
-import os
+import _machine  # noqa: E402  (benchmarks/ is on sys.path when a script runs)
 
-for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_v] = "1"  # one core
+_machine.pin_one_core()  # before numpy is imported
 
 import argparse  # noqa: E402
-import datetime as _dt  # noqa: E402
 import json  # noqa: E402
-import platform  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -64,7 +61,6 @@ def main() -> int:
     # single-threaded BLAS (set above); not pinned to a core: on a shared machine the
     # scheduler then picks the idle one
 
-    import beatsync
     from beatsync import io
     from beatsync import segment as S
     from beatsync.synth.motion import periodic_motion
@@ -130,15 +126,7 @@ def main() -> int:
     facts = {
         "command": f"python benchmarks/bench_segment.py --repeats {args.repeats} "
         f"--literal-max-n {args.literal_max_n}",
-        "platform": platform.platform(),
-        "processor": platform.processor() or platform.machine(),
-        "cpu_count": os.cpu_count(),
-        "cores_used": 1,
-        "python": sys.version.split()[0],
-        "numpy": np.__version__,
-        "beatsync": beatsync.__version__,
-        "date_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
-        "load_average": os.getloadavg() if hasattr(os, "getloadavg") else None,
+        **_machine.machine_facts(),
     }
     lines = [
         "## segment: optimal periodic segmentation (paper A, sec. 3)",

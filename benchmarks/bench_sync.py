@@ -20,14 +20,13 @@ from __future__ import annotations
 
 import os
 
-for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_v] = "1"  # one core
+import _machine  # noqa: E402  (benchmarks/ is on sys.path when a script runs)
+
+_machine.pin_one_core()  # before numpy is imported
 
 import argparse  # noqa: E402
 import contextlib  # noqa: E402
-import datetime as _dt  # noqa: E402
 import io as _stdio  # noqa: E402
-import platform  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -58,7 +57,6 @@ def main() -> int:
     with contextlib.suppress(AttributeError, OSError):
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
 
-    import beatsync
     from beatsync import datasets, io
     from beatsync.beats import track_beats
     from beatsync.cli import main as cli_main
@@ -111,14 +109,7 @@ def main() -> int:
     passed_time = t_cli < TARGET_E2E_S
     facts = {
         "command": f"python benchmarks/bench_sync.py --repeats {args.repeats}",
-        "platform": platform.platform(),
-        "processor": platform.processor() or platform.machine(),
-        "cpu_count": os.cpu_count(),
-        "cores_used": 1,
-        "python": sys.version.split()[0],
-        "numpy": np.__version__,
-        "beatsync": beatsync.__version__,
-        "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
+        **_machine.machine_facts(),
         "repeats": args.repeats,
     }
     data = {
@@ -150,7 +141,7 @@ def main() -> int:
         f"Command: `{facts['command']}`  ",
         f"Machine: {facts['platform']}, {facts['processor']}, {facts['cpu_count']} CPUs "
         f"(1 used), Python {facts['python']}, numpy {facts['numpy']}, beatsync "
-        f"{facts['beatsync']}; {facts['date']}; median of {args.repeats} runs.",
+        f"{facts['beatsync']}; {facts['date_utc']}; median of {args.repeats} runs.",
         "",
         f"Input: {data['input']['motion']}; {data['input']['music']}. "
         "Baseline: beat tracking alone (`track_beats`, phase-slope + HMM) in the same run.",

@@ -1,0 +1,40 @@
+"""Shared by the benchmark scripts: one-core pinning and the machine facts each
+result file records (so a number can be read against the machine that made it)."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import platform
+import sys
+
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+
+
+def pin_one_core() -> None:
+    """Limit numeric libraries to one thread; call before numpy is imported."""
+    for var in THREAD_VARS:
+        os.environ[var] = "1"
+
+
+def machine_facts() -> dict[str, object]:
+    """Date, platform, CPU, Python and library versions, load average."""
+    import librosa
+    import numpy as np
+
+    import beatsync
+
+    return {
+        "date_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "python": sys.version.split()[0],
+        "cpu_count": os.cpu_count(),
+        "cores_used": 1,
+        "numpy": np.__version__,
+        "librosa": librosa.__version__,
+        "beatsync": beatsync.__version__,
+        "load_average": [round(x, 2) for x in os.getloadavg()]
+        if hasattr(os, "getloadavg")
+        else None,
+    }
