@@ -48,7 +48,7 @@ front end behaves the same for 44.1 and 48 kHz input.
 ``method="librosa"`` wraps :func:`librosa.beat.beat_track` for comparison.
 
 The front-end parameters (window, hop, FFT size, band edges) are not published in
-the paper; the defaults are swept in ``notebooks/tab_beat_tracking.ipynb``.
+the paper; the defaults are swept in ``notebooks/paper_a_sec4_beat_tracking.ipynb``.
 """
 
 from __future__ import annotations

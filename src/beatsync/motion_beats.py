@@ -32,7 +32,7 @@ Data contract
 - Output: beat times, 1-D float64 seconds, strictly increasing, always on frame
   times (``frame / fps``); intensities one per interval between successive beats.
 
-Notebook: ``notebooks/tab01_speed_motion_graph.ipynb``; paper B section 3.
+Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ and loudness sections, for the speed and quality studies.
 Data contract: audio is mono float ``y`` with ``sr`` [Hz]; beats are 1-D float64
 seconds, strictly increasing; intensities are one value per beat interval.
 
-Notebooks: ``notebooks/tab01_speed_motion_graph.ipynb``,
-``notebooks/tab02_quality_proxies.ipynb``; paper B section 3.3.
+Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
+``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.3.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ Data contract
   time 0.
 - Every file is written atomically (temporary file in the same folder, then renamed).
 
-Notebook: ``notebooks/fig03_animation_frames.ipynb`` (paper A, Figure 3).
+Notebook: ``notebooks/paper_a_fig03_animation_frames.ipynb`` (paper A, Figure 3).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ A parameter file (``params/paper.yaml`` for the full study, ``params/ci.yaml`` f
 quick run) maps each notebook name (file stem in ``notebooks/``) to the parameters
 it receives::
 
-    fig02_segmentation:
+    paper_a_fig02_segmentation:
       n_trials: 20
       results_dir: ../results
 

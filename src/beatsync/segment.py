@@ -2,7 +2,7 @@
 
 Panagiotakis, Holzapfel, Michel, Argyros, "Beat synchronous dance animation based on
 visual analysis of human motion and audio analysis of music tempo", section 3.
-Notebook: ``notebooks/fig02_segmentation.ipynb`` (Figure 2 and boundary-error table).
+Notebook: ``notebooks/paper_a_fig02_segmentation.ipynb`` (Figure 2 and boundary-error table).
 
 Data contract
 -------------

@@ -62,7 +62,8 @@ passes the boundary pose, minus its beat) and as the distance from the beat to t
 output frame nearest to that crossing, i.e. the frame that shows the boundary
 (``residual_nearest_frame_ms``, at most half a frame plus the warp residual).
 
-Notebooks: ``notebooks/tab01_frame_counts.ipynb``, ``notebooks/fig03_animation_frames.ipynb``.
+Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb``,
+``notebooks/paper_a_fig03_animation_frames.ipynb``.
 """
 
 from __future__ import annotations

@@ -8,9 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..errors import ParameterError
+from ..io import to_jsonable
 
 __all__ = [
     "emit",
@@ -39,29 +38,6 @@ def add_period_range(parser: argparse.ArgumentParser) -> None:
         help="shortest and longest motion period searched [s] (default 0.25 1.25, the "
         "paper's range; real dance cycles can be longer)",
     )
-
-
-def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays and paths inside ``obj`` to plain JSON types.
-
-    Non-finite floats become ``None`` (``null``): strict JSON has no NaN.
-    """
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        value = float(obj)
-        return value if np.isfinite(value) else None  # JSON has no NaN/Infinity
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
 
 
 def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:

@@ -29,7 +29,7 @@ Beat times are 1-D float64 arrays in seconds, strictly increasing (as in
 sits exactly on a beat of the other set. Empty input is degenerate but legal: a
 :class:`~beatsync.errors.BeatsyncWarning` is issued and the score is 0.
 
-Notebook: ``notebooks/tab01_frame_counts.ipynb`` (alignment before/after sync).
+Notebook: ``notebooks/paper_a_tab01_frame_counts.ipynb`` (alignment before/after sync).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ default (5 s) silently drops the first 5 s, which is most of a short clip.
 All mir_eval.beat metrics are returned: F-measure, Cemgil (and its max-over-variants
 form), Goto, P-score, CMLc, CMLt, AMLc, AMLt and information gain.
 
-Notebook: ``notebooks/tab_beat_tracking.ipynb``; paper A, section 4.
+Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 
 
 # --------------------------------------------------------------------------- study helpers
 
-#: Metrics shown in the study table (``notebooks/tab_beat_tracking.ipynb``).
+#: Metrics shown in the study table (``notebooks/paper_a_sec4_beat_tracking.ipynb``).
 TABLE_METRICS = (
     "F-measure",
     "Cemgil",

@@ -14,8 +14,8 @@ beats and blended at transitions (:mod:`beatsync.graph.synthesis`);
 Data contract: event times in seconds (1-D float64, strictly increasing); motions
 are :class:`beatsync.motion.Motion` with one skeleton structure per library.
 
-Notebooks: ``notebooks/tab01_speed_motion_graph.ipynb`` (paper B Table 1) and
-``notebooks/tab02_quality_proxies.ipynb`` (proxies for paper B Table 2).
+Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb`` (paper B Table 1) and
+``notebooks/paper_b_tab02_quality_proxies.ipynb`` (proxies for paper B Table 2).
 """
 
 from .build import (

@@ -39,7 +39,7 @@ counts how many tenths of a second of typical movement separate the two poses, a
 ``rd < TH = 3`` accepts transitions whose pose jump is at most what the dancer
 typically covers in 0.3 s, about the 1/3 s over which transitions are blended. (With
 ``rd_unit = 1 / fps``, i.e. "relative to the frame-to-frame distance", the CMU salsa
-library has a single pair below 3: see ``notebooks/tab01_speed_motion_graph.ipynb``.)
+library has a single pair below 3: see ``notebooks/paper_b_tab01_search_speed.ipynb``.)
 
 Data contract
 -------------
@@ -47,7 +47,7 @@ Clips are :class:`beatsync.motion.Motion` with the same skeleton structure (join
 names, parents, channels; bone lengths may differ). Beat times are seconds; node
 frames are integer frames of their clip.
 
-Notebook: ``notebooks/tab01_speed_motion_graph.ipynb``; paper B section 3.
+Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 """
 
 from __future__ import annotations

@@ -8,8 +8,8 @@ control) and synthesizes the motion. :func:`compose_music` starts from audio.
 Data contract: beats in seconds (1-D float64, strictly increasing); levels one per
 beat interval; the output motion starts at music time 0.
 
-Notebooks: ``notebooks/tab01_speed_motion_graph.ipynb``,
-``notebooks/tab02_quality_proxies.ipynb``; paper B section 3.
+Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
+``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ for what viewers judged, not a replacement:
 Data contract: motions are :class:`beatsync.motion.Motion` with a skeleton; times in
 seconds.
 
-Notebook: ``notebooks/tab02_quality_proxies.ipynb``; paper B section 4 (Table 2).
+Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 4 (Table 2).
 """
 
 from __future__ import annotations

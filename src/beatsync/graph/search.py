@@ -33,8 +33,8 @@ time-warped onto its music interval); it penalises strong warps when set.
 Data contract: music intensities are 1-D arrays over the K beat intervals (already
 z-scored for the objective); durations in seconds. Paths are arrays of node ids.
 
-Notebook: ``notebooks/tab01_speed_motion_graph.ipynb`` (times),
-``notebooks/tab02_quality_proxies.ipynb`` (quality); paper B sections 3.3-3.4.
+Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb`` (times),
+``notebooks/paper_b_tab02_quality_proxies.ipynb`` (quality); paper B sections 3.3-3.4.
 """
 
 from __future__ import annotations

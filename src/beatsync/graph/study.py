@@ -18,20 +18,20 @@ The notebooks only call these functions.
 - :func:`write_artifacts` writes tables (CSV), figures (PNG) and the parameters with
   the package version (JSON) under ``results/<notebook>/``.
 
-Notebooks: ``notebooks/tab01_speed_motion_graph.ipynb``,
-``notebooks/tab02_quality_proxies.ipynb``.
+Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
+``notebooks/paper_b_tab02_quality_proxies.ipynb``.
 """
 
 from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
+from ..study.artifacts import write_artifacts  # noqa: F401 (re-exported for the notebooks)
 from .build import WeightedMotionGraph, build_graph
 from .compose import compose
 from .search import conventional_search, dp_search
@@ -379,31 +379,3 @@ def plot_intensity(comp: Any) -> Any:
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
-
-
-def write_artifacts(
-    results_dir: str | Path,
-    notebook: str,
-    *,
-    params: dict[str, Any],
-    tables: dict[str, Any] | None = None,
-    figures: dict[str, Any] | None = None,
-) -> list[Path]:
-    """Write ``results/<notebook>/``: tables as CSV, figures as PNG, parameters as JSON."""
-    from .. import __version__, io
-    from ..render import save_figure
-
-    out = Path(results_dir) / notebook
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, df in (tables or {}).items():
-        written.append(io.write_csv(out / f"{name}.csv", df))
-    for name, fig in (figures or {}).items():
-        written.append(save_figure(fig, out / f"{name}.png"))
-    written.append(
-        io.write_json(
-            out / "params.json",
-            {"notebook": notebook, "beatsync_version": __version__, "parameters": params},
-        )
-    )
-    return written

@@ -26,7 +26,7 @@ Data contract: music beats in seconds, strictly increasing; the result is a
 :class:`beatsync.motion.Motion` with the library's skeleton at ``fps`` [Hz]; frame
 ``j`` plays at ``j / fps`` seconds of the music.
 
-Notebook: ``notebooks/tab02_quality_proxies.ipynb``; paper B section 3.
+Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
 """
 
 from __future__ import annotations

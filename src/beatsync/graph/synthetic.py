@@ -13,7 +13,7 @@ beats are exactly the beat times, and the motion intensity of an interval grows 
 (the extremes ``+-A a``), so a library of them has transitions.
 
 Stands in for paper B's second (Indian dance) library in
-``notebooks/tab01_speed_motion_graph.ipynb``; used by ``tests/test_graph.py``.
+``notebooks/paper_b_tab01_search_speed.ipynb``; used by ``tests/test_graph.py``.
 
 Data contract: returns a :class:`beatsync.motion.Motion` (degrees, metres, ``fps``)
 and its beat times in seconds.

@@ -20,7 +20,7 @@ pattern of :func:`drum_pattern` at a constant tempo, with a gain that changes ev
 intensity varies like verses and choruses. Its beats are exact. It is re-exported as
 :func:`beatsync.music.drum_song`.
 
-Notebook: ``notebooks/tab_beat_tracking.ipynb``; paper A, section 4.
+Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
 """
 
 from __future__ import annotations

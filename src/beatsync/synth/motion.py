@@ -14,7 +14,7 @@ Data contract
   the first is frame 0 and the last is frame ``n_frames - 1``, the convention of
   :func:`beatsync.segment.segment`.
 
-Notebook: ``notebooks/fig02_segmentation.ipynb``.
+Notebook: ``notebooks/paper_a_fig02_segmentation.ipynb``.
 """
 
 from __future__ import annotations

@@ -1,0 +1,122 @@
+"""Files in general: atomic writes, output-folder checks, JSON/CSV writers, checksums."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+
+def _existing_file(path: str | os.PathLike[str], what: str) -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"{what} file {str(p)!r} does not exist")
+    if not p.is_file():
+        raise ParameterError(f"{what} path {str(p)!r} is not a file")
+    if p.stat().st_size == 0:
+        raise ParameterError(f"{what} file {str(p)!r} is empty")
+    return p
+
+
+def _new_file_mode(dest: Path) -> int:
+    """Permissions for a written file: the existing file's, else 0o666 less the umask."""
+    if dest.exists():
+        return dest.stat().st_mode & 0o777
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def check_output_folder(path: str | os.PathLike[str]) -> Path:
+    """Refuse an output path whose folder is missing or not writable; return its folder."""
+    parent = Path(path).resolve().parent
+    if not parent.is_dir():
+        raise ParameterError(f"output folder {str(parent)!r} does not exist; create it first")
+    if not os.access(parent, os.W_OK):
+        raise ParameterError(f"output folder {str(parent)!r} is not writable")
+    return parent
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[Any]]:
+    """Open a temporary file next to ``path``; rename it to ``path`` on success.
+
+    On any exception the temporary file is removed and ``path`` is untouched.
+    """
+    dest = Path(path)
+    parent = check_output_folder(dest)
+    fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=parent)
+    try:
+        with os.fdopen(fd, mode) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, _new_file_mode(dest))
+        os.replace(tmp, dest)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays and paths inside ``obj`` to plain JSON types.
+
+    Non-finite floats become ``None`` (``null``): strict JSON has no NaN.
+    """
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if np.isfinite(value) else None  # JSON has no NaN/Infinity
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def write_json(path: str | os.PathLike[str], obj: Any) -> Path:
+    """Write ``obj`` as indented JSON (numpy values converted) (atomic)."""
+    with atomic_write(path) as fh:
+        json.dump(to_jsonable(obj), fh, indent=2, allow_nan=False)
+        fh.write("\n")
+    return Path(path)
+
+
+def write_csv(
+    path: str | os.PathLike[str], frame: Any, *, float_format: str | None = None
+) -> Path:
+    """Write a pandas DataFrame as CSV without its index (atomic).
+
+    ``float_format`` (a printf format such as ``"%.6g"``) fixes the precision of floats.
+    """
+    with atomic_write(path) as fh:
+        frame.to_csv(fh, index=False, float_format=float_format)
+    return Path(path)
+
+
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    """SHA-256 hex digest of a file's bytes."""
+    import hashlib
+
+    p = _existing_file(path, "input")
+    h = hashlib.sha256()
+    with open(p, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()

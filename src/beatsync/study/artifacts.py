@@ -1,0 +1,71 @@
+"""One artefact layout for every notebook of the study.
+
+``results/<notebook>/`` holds the notebook's tables as CSV, its figures as PNG and a
+``params.json`` with the notebook name, the package version and the parameters the
+notebook ran with. CSV floats are written with :data:`CSV_FLOAT_FORMAT` (6
+significant digits), so that re-running the study on another machine (other BLAS,
+other library versions) rewrites the same bytes unless a result really changed;
+PNG figures carry no date or version metadata (:func:`beatsync.render.save_figure`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from .. import __version__, io
+from ..render import save_figure
+
+__all__ = ["CSV_FLOAT_FORMAT", "write_artifacts"]
+
+#: printf format of every float in a study CSV (documented precision: 6 significant digits).
+CSV_FLOAT_FORMAT = "%.6g"
+
+
+def write_artifacts(
+    results_dir: str | Path,
+    notebook: str,
+    *,
+    params: dict[str, Any],
+    tables: dict[str, Any] | None = None,
+    figures: dict[str, Any] | None = None,
+    data: dict[str, Any] | None = None,
+) -> list[Path]:
+    """Write a notebook's artefacts under ``results_dir/notebook/``.
+
+    Parameters
+    ----------
+    results_dir : path
+        The study's results folder (``results`` or ``results/ci``).
+    notebook : str
+        The notebook's name (file stem); the artefacts' folder.
+    params : dict
+        The notebook's parameters, written to ``params.json`` with the version.
+    tables : dict of str -> pandas.DataFrame, optional
+        Written as ``<name>.csv`` (no index, floats at :data:`CSV_FLOAT_FORMAT`).
+    figures : dict of str -> matplotlib Figure, optional
+        Written as ``<name>.png``.
+    data : dict of str -> JSON-able object, optional
+        Further results written as ``<name>.json``.
+
+    Returns
+    -------
+    list of Path
+        Every file written.
+    """
+    out = Path(results_dir) / notebook
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, df in (tables or {}).items():
+        written.append(io.write_csv(out / f"{name}.csv", df, float_format=CSV_FLOAT_FORMAT))
+    for name, fig in (figures or {}).items():
+        written.append(save_figure(fig, out / f"{name}.png"))
+    for name, obj in (data or {}).items():
+        written.append(io.write_json(out / f"{name}.json", obj))
+    written.append(
+        io.write_json(
+            out / "params.json",
+            {"notebook": notebook, "beatsync_version": __version__, "parameters": params},
+        )
+    )
+    return written
