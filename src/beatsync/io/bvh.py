@@ -369,8 +369,10 @@ def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.nd
                 f"BVH {str(path)!r}, line {lineno}: frame line {row + 1} has {len(toks)} values "
                 f"but the hierarchy defines {n_ch} channels"
             )
-        if row >= capacity:
-            row += 1  # more frame lines than declared: count them, store nothing
+        if row >= capacity:  # more frame lines than declared: count them, store nothing
+            if chunk:
+                flush()
+            row += 1
             continue
         if not line.isascii() or "_" in line:  # Python and numpy read "1_0" and Unicode digits
             bad = next((t for t in toks if not _is_plain_number(t)), None)
