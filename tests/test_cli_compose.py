@@ -12,7 +12,7 @@ from beatsync import io
 from beatsync.cli import main
 from beatsync.graph.synthetic import synthetic_dance
 from beatsync.motion import Joint, Motion, Skeleton
-from beatsync.music import drum_song
+from beatsync.synth.audio import drum_song
 
 
 @pytest.fixture

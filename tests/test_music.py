@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from beatsync.errors import ParameterError
-from beatsync.music import beat_rms_db, drum_song, music_intensity, track_music_beats
+from beatsync.music import beat_rms_db, music_intensity, track_music_beats
+from beatsync.synth.audio import drum_song
 
 SR = 8000
 

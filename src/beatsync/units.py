@@ -26,6 +26,11 @@ __all__ = [
     "check_range",
     "check_positive",
     "MIN_PLAUSIBLE_FPS",
+    "check_bpm",
+    "check_audio",
+    "MIN_SANE_BPM",
+    "MAX_SANE_BPM",
+    "SILENCE_PEAK",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
@@ -210,3 +215,84 @@ def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float
             f"smaller than the upper bound [{unit}]"
         )
     return lo_f, hi_f
+
+
+# --------------------------------------------------------------------------- audio, tempo
+
+#: A tempo outside this range [bpm] is refused as a likely unit mistake (one range
+#: for the tracker, the CLI and the synthetic generators).
+MIN_SANE_BPM = 20.0
+MAX_SANE_BPM = 400.0
+#: Audio whose peak magnitude is below this (re full scale 1.0, -140 dBFS) is silent.
+SILENCE_PEAK = 1e-7
+
+
+def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
+    """Return a tempo [bpm] as a float after checking it lies in
+    [:data:`MIN_SANE_BPM`, :data:`MAX_SANE_BPM`] (20-400 BPM).
+
+    Raises
+    ------
+    ParameterError
+        Not a number, not finite, or outside the range (the message suggests a beat
+        period in seconds or beats per second).
+    """
+    try:
+        value = float(bpm)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={bpm!r} is not a number [bpm]") from None
+    if not np.isfinite(value) or not MIN_SANE_BPM <= value <= MAX_SANE_BPM:
+        raise ParameterError(
+            f"{name}={bpm!r} is outside the sane range {MIN_SANE_BPM:g}-{MAX_SANE_BPM:g} BPM "
+            "(did you give a beat period in seconds, or beats per second?)"
+        )
+    return value
+
+
+def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndarray, float]:
+    """Validate mono audio; return ``(y float64, sr float)``.
+
+    Parameters
+    ----------
+    y : array_like [shape=(n,)]
+        Mono audio samples.
+    sr : float > 0 [Hz]
+    allow_silent : bool
+        Accept all-silent audio (peak below :data:`SILENCE_PEAK`), e.g. to measure
+        its level; beat tracking refuses it.
+
+    Raises
+    ------
+    ParameterError
+        Empty, multi-channel, non-finite or (unless ``allow_silent``) all-silent
+        audio, or ``sr <= 0``.
+    """
+    try:
+        sr_f = float(sr)
+    except (TypeError, ValueError):
+        raise ParameterError(f"sr={sr!r} is not a number; give the sample rate in Hz") from None
+    if not np.isfinite(sr_f) or sr_f <= 0:
+        raise ParameterError(f"sr={sr!r} must be a sample rate > 0 [Hz]")
+    try:
+        arr = np.asarray(y, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError("y must be a 1-D array of audio samples") from None
+    if arr.ndim != 1:
+        raise ParameterError(
+            f"y must be mono (1-D), got shape {arr.shape}; mix down with y.mean(axis=0) "
+            "(librosa layout) or y.mean(axis=1) (soundfile layout)"
+        )
+    if arr.size == 0:
+        raise ParameterError("the audio is empty (zero samples): there are no beats to track")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise ParameterError(
+            f"the audio contains {int(bad.sum())} NaN or infinite sample(s) "
+            f"(first at sample {int(np.argmax(bad))}); repair or trim the file"
+        )
+    if not allow_silent and not np.max(np.abs(arr)) >= SILENCE_PEAK:
+        raise ParameterError(
+            f"the audio is all silent (peak below {SILENCE_PEAK:g}): there are no beats to "
+            "track (check the file and gain)"
+        )
+    return arr, sr_f

@@ -107,7 +107,8 @@ def load_library(
 
 def song(duration: float, *, bpm: float = 100.0, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Beats [s] and level per beat interval [dB] of a synthetic drum song."""
-    from ..music import beat_rms_db, drum_song
+    from ..music import beat_rms_db
+    from ..synth.audio import drum_song
 
     s = drum_song(duration, bpm=bpm, seed=seed, sr=22050)
     return s.beats, beat_rms_db(s.y, s.sr, s.beats)
