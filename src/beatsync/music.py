@@ -4,12 +4,11 @@ Paper B matches the *intensity* of the dance with that of the music beat by beat
 Music intensity of a beat interval ``[b_i, b_{i+1})`` is its sound pressure level,
 the RMS of the samples in dB (re full scale 1.0, floored at ``amin``); for the
 search it is z-scored over the song (:func:`music_intensity`). Beats come from
-:func:`beatsync.beats.track_beats` (:func:`track_music_beats`), which validates the
-audio with :func:`beatsync.beats.check_audio` (the same check is used here).
+:func:`beatsync.beats.track_beats` (:func:`track_music_beats`); audio is validated
+with :func:`beatsync.units.check_audio`, as in the tracker.
 
-:func:`drum_song` (and :class:`DrumSong`) is re-exported from
-:func:`beatsync.synth.audio.drum_song`: a documented synthetic song with exact beats
-and loudness sections, for the speed and quality studies.
+A synthetic song with exact beats and loudness sections for the speed and quality
+studies is :func:`beatsync.synth.audio.drum_song` (stages never import ``synth``).
 
 Data contract: audio is mono float ``y`` with ``sr`` [Hz]; beats are 1-D float64
 seconds, strictly increasing; intensities are one value per beat interval.
@@ -24,18 +23,15 @@ from typing import Any
 
 import numpy as np
 
-from .beats import check_audio, check_bpm, track_beats
+from .beats import track_beats
 from .errors import ParameterError
 from .motion_beats import zscore
-from .synth.audio import DrumSong, drum_song
-from .units import check_times, time_to_frames
+from .units import SILENCE_PEAK, check_audio, check_bpm, check_times, time_to_frames
 
 __all__ = [
     "beat_rms_db",
     "music_intensity",
     "track_music_beats",
-    "DrumSong",
-    "drum_song",
 ]
 
 
@@ -54,7 +50,7 @@ def beat_rms_db(y: Any, sr: float, beats: Any, *, amin: float = 1e-5) -> np.ndar
     -------
     level : np.ndarray [shape=(K,)] [dB]
     """
-    y, sr = check_audio(y, sr, allow_silent=True)
+    y, sr = check_audio(y, sr)
     beats = check_times(beats, name="music beats", duration=y.size / sr)
     if beats.size < 2:
         raise ParameterError(
@@ -87,7 +83,7 @@ def track_music_beats(
         Mono audio.
     sr : float > 0 [Hz]
     bpm : float, optional [bpm]
-        Known tempo (20-400 BPM, :func:`beatsync.beats.check_bpm`).
+        Known tempo (20-400 BPM, :func:`beatsync.units.check_bpm`).
     method : {"psf", "librosa"}
 
     Returns
@@ -101,7 +97,7 @@ def track_music_beats(
         Silence, audio too short for a pulse, a bad ``bpm``, or a signal in which
         fewer than two beats were found.
     """
-    y, sr = check_audio(y, sr)
+    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
     if bpm is not None:
         bpm = check_bpm(bpm)
     kwargs: dict[str, Any] = {"method": method}
