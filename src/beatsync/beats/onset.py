@@ -30,6 +30,7 @@ from ..errors import ParameterError
 from ..units import check_audio, check_positive, frames_to_time, time_to_frames
 
 __all__ = [
+    "SILENCE_PEAK",
     "FRONTEND_DEFAULTS",
     "FrontEnd",
     "OnsetSignal",
@@ -38,6 +39,9 @@ __all__ = [
     "onset_strength_psf",
     "compute_onsets",
 ]
+
+#: Audio whose peak magnitude is below this (re full scale 1.0, -140 dBFS) is silent.
+SILENCE_PEAK = 1e-7
 
 #: Defaults of the phase-slope front end (all swept in the notebook).
 FRONTEND_DEFAULTS: dict[str, Any] = {
@@ -252,7 +256,8 @@ def phase_slope(
     mag : np.ndarray [shape=(n_bins, n_frames)]
         STFT magnitude (for the spectral flux).
     """
-    y, sr = check_audio(y, sr)
+    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
+    y = np.asarray(y, dtype=np.float64)
     fe = frontend_settings(
         {
             "win_s": win_s,
@@ -316,7 +321,8 @@ def onset_strength_psf(
     >>> bool(abs(ons.onset_times[np.argmax(ons.onset_strengths)] - 0.5) < 0.01)
     True
     """
-    y, sr = check_audio(y, sr)
+    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
+    y = np.asarray(y, dtype=np.float64)
     fe = frontend_settings(
         {
             "win_s": win_s,
