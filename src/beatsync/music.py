@@ -5,7 +5,7 @@ Music intensity of a beat interval ``[b_i, b_{i+1})`` is its sound pressure leve
 the RMS of the samples in dB (re full scale 1.0, floored at ``amin``); for the
 search it is z-scored over the song (:func:`music_intensity`). Beats come from
 :func:`beatsync.beats.track_beats` (:func:`track_music_beats`); audio is validated
-with :func:`beatsync.units.check_audio`, as in the tracker.
+with :func:`beatsync.beats.check_audio`, the tracker's own check.
 
 A synthetic song with exact beats and loudness sections for the speed and quality
 studies is :func:`beatsync.synth.audio.drum_song` (stages never import ``synth``).
@@ -23,10 +23,10 @@ from typing import Any
 
 import numpy as np
 
-from .beats import track_beats
+from .beats import check_audio, track_beats
 from .errors import ParameterError
 from .motion_beats import zscore
-from .units import SILENCE_PEAK, check_audio, check_bpm, check_times, time_to_frames
+from .units import check_bpm, check_times, time_to_frames
 
 __all__ = [
     "beat_rms_db",
@@ -50,7 +50,7 @@ def beat_rms_db(y: Any, sr: float, beats: Any, *, amin: float = 1e-5) -> np.ndar
     -------
     level : np.ndarray [shape=(K,)] [dB]
     """
-    y, sr = check_audio(y, sr)
+    y, sr = check_audio(y, sr, allow_silent=True)
     beats = check_times(beats, name="music beats", duration=y.size / sr)
     if beats.size < 2:
         raise ParameterError(
@@ -97,7 +97,7 @@ def track_music_beats(
         Silence, audio too short for a pulse, a bad ``bpm``, or a signal in which
         fewer than two beats were found.
     """
-    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
+    y, sr = check_audio(y, sr)
     if bpm is not None:
         bpm = check_bpm(bpm)
     kwargs: dict[str, Any] = {"method": method}

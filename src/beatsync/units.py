@@ -49,7 +49,6 @@ __all__ = [
     "MIN_PLAUSIBLE_SR",
     "MIN_BPM",
     "MAX_BPM",
-    "SILENCE_PEAK",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
@@ -60,8 +59,6 @@ MIN_PLAUSIBLE_SR = 1000.0
 #: per second was likely given, above it a rate in beats per minute of a sub-beat.
 MIN_BPM = 20.0
 MAX_BPM = 400.0
-#: Audio whose peak magnitude is below this (re full scale 1.0, -140 dBFS) is silent.
-SILENCE_PEAK = 1e-7
 
 
 def _unit(unit: str) -> str:

@@ -25,13 +25,17 @@ The front-end parameters (window, hop, FFT size, band edges) are not published i
 paper; the defaults are swept in ``notebooks/paper_a_sec4_beat_tracking.ipynb``.
 """
 
-from ..units import MAX_BPM, MIN_BPM, SILENCE_PEAK, check_audio, check_bpm
+from ..units import check_bpm
 from .onset import FRONTEND_DEFAULTS, FrontEnd, OnsetSignal, onset_strength_psf, phase_slope
 from .tracker import (
+    MAX_SANE_BPM,
     MIN_DURATION_S,
     MIN_PULSE_CLARITY,
+    MIN_SANE_BPM,
+    SILENCE_PEAK,
     BeatTrack,
     beat_tempo,
+    check_audio,
     check_duration,
     track_beats,
 )
@@ -48,8 +52,8 @@ __all__ = [
     "check_duration",
     "beat_tempo",
     "FRONTEND_DEFAULTS",
-    "MIN_BPM",
-    "MAX_BPM",
+    "MIN_SANE_BPM",
+    "MAX_SANE_BPM",
     "MIN_DURATION_S",
     "SILENCE_PEAK",
     "MIN_PULSE_CLARITY",

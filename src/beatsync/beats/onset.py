@@ -27,9 +27,10 @@ import scipy.fft
 import scipy.ndimage
 
 from ..errors import ParameterError
-from ..units import SILENCE_PEAK, check_audio, check_positive, frames_to_time, time_to_frames
+from ..units import check_audio, check_positive, frames_to_time, time_to_frames
 
 __all__ = [
+    "SILENCE_PEAK",
     "FRONTEND_DEFAULTS",
     "FrontEnd",
     "OnsetSignal",
@@ -38,6 +39,9 @@ __all__ = [
     "onset_strength_psf",
     "compute_onsets",
 ]
+
+#: Audio whose peak magnitude is below this (re full scale 1.0, -140 dBFS) is silent.
+SILENCE_PEAK = 1e-7
 
 #: Defaults of the phase-slope front end (all swept in the notebook).
 FRONTEND_DEFAULTS: dict[str, Any] = {

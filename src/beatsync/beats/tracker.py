@@ -14,20 +14,25 @@ import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from ..units import (
-    SILENCE_PEAK,
-    check_audio,
+    MAX_BPM,
+    MIN_BPM,
     check_bpm,
     check_positive,
     check_range,
     check_times,
     frames_to_time,
 )
+from ..units import check_audio as _units_check_audio
 from .metrical import level_factor
-from .onset import OnsetSignal, compute_onsets, frontend_settings
+from .onset import SILENCE_PEAK, OnsetSignal, compute_onsets, frontend_settings
 from .phase import place_beats
 from .tempo import analysis_windows, period_grid, tempo_hmm, tempo_salience
 
 __all__ = [
+    "check_audio",
+    "SILENCE_PEAK",
+    "MIN_SANE_BPM",
+    "MAX_SANE_BPM",
     "BeatTrack",
     "track_beats",
     "beat_tempo",
@@ -36,6 +41,9 @@ __all__ = [
     "MIN_PULSE_CLARITY",
 ]
 
+#: The plausible tempo range [bpm] (:data:`beatsync.units.MIN_BPM`, ``MAX_BPM``).
+MIN_SANE_BPM = MIN_BPM
+MAX_SANE_BPM = MAX_BPM
 #: Audio shorter than this is refused [s] (:func:`check_duration`): two beat periods
 #: at 80 BPM, three at 120 BPM. A shorter clip cannot show a pulse (two beat periods)
 #: at any but the fastest tempi, and the tracker would return a tempo made up by its
@@ -70,6 +78,22 @@ class BeatTrack:
     tempo_times: np.ndarray
     tempo_curve: np.ndarray
     method: str
+
+
+def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndarray, float]:
+    """Validate mono audio for the tracker; return ``(y float64, sr float)``.
+
+    :func:`beatsync.units.check_audio` with the silence threshold :data:`SILENCE_PEAK`
+    (``allow_silent=True``: no silence check, e.g. to measure a level).
+
+    Raises
+    ------
+    ParameterError
+        Empty, multi-channel, non-finite or (unless ``allow_silent``) all-silent
+        audio, or an implausible ``sr``.
+    """
+    arr, sr_f = _units_check_audio(y, sr, silence_peak=None if allow_silent else SILENCE_PEAK)
+    return np.asarray(arr, dtype=np.float64), sr_f
 
 
 def check_duration(n_samples: int, sr: float, *, bpm: float | None = None) -> float:
@@ -190,8 +214,7 @@ def track_beats(
     >>> round(bt.tempo)
     120
     """
-    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
-    y = np.asarray(y, dtype=np.float64)
+    y, sr = check_audio(y, sr)
     min_bpm, max_bpm = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="bpm")
     check_bpm(min_bpm, name="min_bpm")
     check_bpm(max_bpm, name="max_bpm")
