@@ -4,6 +4,8 @@
   ``mir_eval.beat`` metric with an explicit ``min_beat_time``.
 - :mod:`beatsync.evaluate.alignment`: dance-music beat alignment, both published
   scores (averaged over motion beats, or over music beats; Gaussian sigma in seconds).
+- :mod:`beatsync.evaluate.segmentation`: period boundaries against ground truth
+  (boundary error in frames, count error).
 """
 
 from .alignment import (
@@ -16,6 +18,7 @@ from .alignment import (
     offset_control,
 )
 from .beats import METRICS, evaluate_beats, octave_relation
+from .segmentation import boundary_errors
 
 __all__ = [
     "evaluate_beats",
@@ -28,4 +31,5 @@ __all__ = [
     "kinematic_phase_offset",
     "offset_control",
     "evaluate_sync",
+    "boundary_errors",
 ]
