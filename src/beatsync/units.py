@@ -210,3 +210,32 @@ def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float
             f"smaller than the upper bound [{unit}]"
         )
     return lo_f, hi_f
+
+
+def check_whole(value: Any, *, name: str, minimum: int = 0) -> int:
+    """Return ``value`` as an int after checking it is a whole number >= ``minimum``.
+
+    Refuses bools, strings and non-integral floats (``2.5`` beats is a mistake, not 2).
+    """
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+    if not ok or not np.isfinite(value) or not float(value).is_integer():
+        raise ParameterError(f"{name}={value!r} must be a whole number >= {minimum}")
+    if value < minimum:
+        raise ParameterError(f"{name}={value!r} must be a whole number >= {minimum}")
+    return int(value)
+
+
+def beat_phase(events: Any, beats: Any) -> np.ndarray:
+    """Phase of each event inside the beat interval that holds it, in ``[0, 1)``.
+
+    0 is on a beat, 0.5 half-way to the next. Events before the first beat or at/after
+    the last one have no interval and are dropped. Inputs are event times [s], 1-D
+    and increasing (checked by the caller: this is a unit conversion, seconds to beats).
+    """
+    e = np.asarray(events, dtype=np.float64)
+    b = np.asarray(beats, dtype=np.float64)
+    e = e[(e >= b[0]) & (e < b[-1])]
+    i = np.searchsorted(b, e, side="right") - 1
+    return (e - b[i]) / (b[i + 1] - b[i])
