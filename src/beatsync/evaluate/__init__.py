@@ -13,9 +13,8 @@ from .alignment import (
     beat_alignment_motion,
     beat_alignment_music,
     beat_phase_consistency,
-    evaluate_sync,
-    kinematic_phase_offset,
     offset_control,
+    sync_residuals,
 )
 from .beats import METRICS, evaluate_beats, octave_relation
 from .segmentation import boundary_errors
@@ -28,8 +27,7 @@ __all__ = [
     "beat_alignment_motion",
     "beat_alignment_music",
     "beat_phase_consistency",
-    "kinematic_phase_offset",
     "offset_control",
-    "evaluate_sync",
+    "sync_residuals",
     "boundary_errors",
 ]
