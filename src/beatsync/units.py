@@ -49,6 +49,8 @@ __all__ = [
     "MIN_PLAUSIBLE_SR",
     "MIN_BPM",
     "MAX_BPM",
+    "check_whole",
+    "beat_phase",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
@@ -517,3 +519,25 @@ def check_audio(
             f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
         )
     return arr, sr_f
+
+
+def check_whole(value: Any, *, name: str, minimum: int = 0) -> int:
+    """Return ``value`` as an int >= ``minimum`` (``2.5`` beats is a mistake, not 2).
+
+    The same check as :func:`as_int`, with a lower bound that defaults to 0.
+    """
+    return as_int(value, name=name, minimum=minimum)
+
+
+def beat_phase(events: Any, beats: Any) -> np.ndarray:
+    """Phase of each event inside the beat interval that holds it, in ``[0, 1)``.
+
+    0 is on a beat, 0.5 half-way to the next. Events before the first beat or at/after
+    the last one have no interval and are dropped. Inputs are event times [s], 1-D
+    and increasing (checked by the caller: this is a unit conversion, seconds to beats).
+    """
+    e = np.asarray(events, dtype=np.float64)
+    b = np.asarray(beats, dtype=np.float64)
+    e = e[(e >= b[0]) & (e < b[-1])]
+    i = np.searchsorted(b, e, side="right") - 1
+    return (e - b[i]) / (b[i + 1] - b[i])
