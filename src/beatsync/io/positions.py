@@ -44,7 +44,7 @@ from ..motion import (
     fill_joint_gaps,
 )
 from ..units import check_fps, check_positive
-from ._files import check_input_file, atomic_write
+from ._files import atomic_write, check_input_file
 
 __all__ = [
     "read_positions_json",
