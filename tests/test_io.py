@@ -170,7 +170,7 @@ def test_beats_files(tmp_path):
     with pytest.raises(ParameterError, match="increasing"):
         io.read_beats(tmp_path / "bad.beats")
     (tmp_path / "ms.beats").write_text("abc\n")
-    with pytest.raises(ParameterError, match="not a time"):
+    with pytest.raises(ParameterError, match=r"line 1: time='abc' is not a number \[s\]"):
         io.read_beats(tmp_path / "ms.beats")
     with pytest.raises(ParameterError, match="increasing"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
@@ -195,3 +195,90 @@ def test_atomic_write_respects_umask_and_existing_mode(tmp_path):
     p.chmod(0o640)
     io.write_beats(p, [0.5, 1.5])
     assert p.stat().st_mode & 0o777 == 0o640
+
+
+# ------------------------------------------------------------ hardened readers
+
+
+def _wav_with_header_rate(tmp_path: Path, rate: int) -> Path:
+    import struct
+
+    p = io.write_audio(tmp_path / "a.wav", np.full(4410, 0.1, dtype=np.float32), 44100)
+    data = bytearray(p.read_bytes())
+    assert data[:4] == b"RIFF" and data[12:16] == b"fmt "
+    data[24:28] = struct.pack("<I", rate)  # sample rate field of the fmt chunk
+    p.write_bytes(bytes(data))
+    return p
+
+
+def test_wav_with_sample_rate_zero_refused(tmp_path):
+    p = _wav_with_header_rate(tmp_path, 0)
+    with pytest.raises(ParameterError, match=r"broken header: sample rate=0 must be a finite"):
+        io.read_audio(p)
+
+
+def test_wav_with_valid_header_rate_read(tmp_path):
+    y, sr = io.read_audio(_wav_with_header_rate(tmp_path, 8000))
+    assert sr == 8000 and y.dtype == np.float32 and y.size == 4410
+
+
+@pytest.mark.parametrize(
+    "sr, match", [(0, r"sr=0 must be a finite sample rate"), (22050.5, "whole number of Hz")]
+)
+def test_read_and_write_audio_bad_sr(tmp_path, sr, match):
+    p = io.write_audio(tmp_path / "a.wav", np.full(4410, 0.1, dtype=np.float32), 44100)
+    with pytest.raises(ParameterError, match=match):
+        io.read_audio(p, sr=sr)
+    with pytest.raises(ParameterError, match=match):
+        io.write_audio(tmp_path / "b.wav", np.zeros(10), sr)
+    assert not (tmp_path / "b.wav").exists()
+
+
+def test_npz_renamed_npy_refused(tmp_path):
+    np.savez(tmp_path / "m.npz", values=np.zeros((5, 2)))
+    p = (tmp_path / "m.npz").rename(tmp_path / "m.npy")
+    with pytest.raises(ParameterError, match=r"is an \.npz archive .*not a \.npy array"):
+        io.read_motion(p, fps=25)
+
+
+@pytest.mark.parametrize(
+    "array, match",
+    [
+        (np.array([["a", "b"]] * 4), "holds strings"),
+        (np.array([[b"a", b"b"]] * 4), "holds bytes"),
+        (np.zeros((4, 2), dtype=[("x", "f8"), ("y", "f8")]), "structured array"),
+        (np.zeros(4, dtype=[("x", "f8"), ("y", "f8")]), "structured array"),
+        (np.ones((4, 2)) * (1 + 1j), "complex"),
+        (np.zeros((4, 2), dtype="datetime64[s]"), "dates"),
+        (np.zeros((4, 2), dtype="timedelta64[s]"), "time deltas"),
+        (np.ones((4, 2), dtype=bool), "booleans"),
+        (np.array([[1.0, None]] * 4, dtype=object), "Python objects"),
+        (np.zeros((4, 2, 3)), r"shape \(4, 2, 3\); need 2-D"),
+    ],
+)
+def test_npy_dtype_and_shape_checks(tmp_path, array, match):
+    p = tmp_path / "t.npy"
+    np.save(p, array, allow_pickle=True)
+    with pytest.raises(ParameterError, match=match):
+        io.read_motion(p, fps=25)
+
+
+def test_npy_numeric_kinds_read(tmp_path):
+    for dtype in (np.int16, np.float32, np.float16):
+        np.save(tmp_path / "t.npy", np.arange(8).reshape(4, 2).astype(dtype))
+        m = io.read_motion(tmp_path / "t.npy", fps=25)
+        assert m.values.dtype == np.float64 and m.values[3, 1] == 7.0
+
+
+def test_mat_struct_without_freq_refused(tmp_path):
+    import scipy.io
+
+    rec = {"data": np.zeros((10, 3)), "markerName": np.array(["Head"], dtype=object)}
+    scipy.io.savemat(tmp_path / "m.mat", {"rec": rec})
+    with pytest.raises(ParameterError, match=r"recording 'rec' has no 'freq' field"):
+        io.read_mocap_mat(tmp_path / "m.mat")
+    scipy.io.savemat(tmp_path / "m0.mat", {"rec": {**rec, "freq": 0.0}})
+    with pytest.raises(ParameterError, match=r"freq=0.0 must be a finite frame rate"):
+        io.read_mocap_mat(tmp_path / "m0.mat")
+    scipy.io.savemat(tmp_path / "ok.mat", {"rec": {**rec, "freq": 100.0}})
+    assert io.read_mocap_mat(tmp_path / "ok.mat").fps == 100.0

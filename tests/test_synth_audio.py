@@ -118,8 +118,13 @@ def test_drum_song_bad_input(kwargs):
         drum_song(10.0, **kwargs)
 
 
-def test_music_drum_song_is_a_reexport():
-    from beatsync import music
-    from beatsync.synth import audio
+def test_music_stage_does_not_import_synth():
+    import ast
+    import inspect
 
-    assert music.drum_song is audio.drum_song and music.DrumSong is audio.DrumSong
+    from beatsync import music
+
+    tree = ast.parse(inspect.getsource(music))
+    names = [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    assert not any("synth" in name for name in names)
+    assert not hasattr(music, "drum_song")

@@ -28,6 +28,7 @@ from ..errors import ParameterError
 from ..motion import Motion
 from ._files import (
     atomic_write,
+    check_input_file,
     check_output_folder,
     sha256_file,
     to_jsonable,
@@ -49,6 +50,7 @@ from .tables import read_mocap_mat, read_npz, read_table, write_npz, write_table
 
 __all__ = [
     "atomic_write",
+    "check_input_file",
     "check_output_folder",
     "read_motion",
     "write_motion",

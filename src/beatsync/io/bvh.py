@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
 from ..units import check_finite, check_fps
-from ._files import _existing_file, atomic_write
+from ._files import atomic_write, check_input_file
 
 
 def _parse_hierarchy(tokens: list[str], path: Path) -> tuple[Skeleton, int]:
@@ -119,7 +119,7 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
         Missing, truncated or malformed file; frame lines with the wrong number of
         values; a frame count that does not match; NaN/inf values; a bad frame time.
     """
-    p = _existing_file(path, "BVH")
+    p = check_input_file(path, "BVH")
     try:
         text = p.read_text()
     except (UnicodeDecodeError, OSError) as exc:

@@ -44,7 +44,7 @@ from ..motion import (
     fill_joint_gaps,
 )
 from ..units import check_fps, check_positive
-from ._files import _existing_file, atomic_write
+from ._files import atomic_write, check_input_file
 
 __all__ = [
     "read_positions_json",
@@ -262,7 +262,7 @@ def read_positions_json(
         Absolute joint positions (``skeletons + center``) in metres, z up, joints
         ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
     """
-    p = _existing_file(path, "JSON motion")
+    p = check_input_file(path, "JSON motion")
     up = _check_choice(up, "up", ("y", "z"))
     units = _check_choice(units, "units", tuple(UNIT_METRES))
     rate = _need_fps(
@@ -380,7 +380,7 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
 
 def is_position_array(path: str | os.PathLike[str]) -> bool:
     """True if an ``.npy`` file holds a ``(n_frames, n_joints, 3)`` array (header only)."""
-    p = _existing_file(path, ".npy")
+    p = check_input_file(path, ".npy")
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
     except Exception as exc:
@@ -414,7 +414,7 @@ def read_positions_array(
     joint_names : sequence of str, optional
         Default ``j0``, ``j1``, ...
     """
-    p = _existing_file(path, "array")
+    p = check_input_file(path, "array")
     up = _check_choice(up, "up", ("y", "z"))
     units = _check_choice(units, "units", tuple(UNIT_METRES))
     suffix = p.suffix.lower()
@@ -515,7 +515,7 @@ def read_c3d(
     """
     import c3d
 
-    p = _existing_file(path, "C3D")
+    p = check_input_file(path, "C3D")
     up = _check_choice(up, "up", ("y", "z"))
     units = _check_choice(units, "units", tuple(UNIT_METRES))
     try:
