@@ -6,4 +6,4 @@ text via :func:`beatsync.commands._common.emit`.
 """
 
 # Order shown in ``beatsync --help``.
-COMMAND_MODULES = ("segment", "beats", "sync", "compose", "batch", "reproduce", "data")
+COMMAND_MODULES = ("segment", "beats", "sync", "compose", "batch", "evaluate", "reproduce", "data")
