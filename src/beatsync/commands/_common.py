@@ -192,13 +192,12 @@ def check_output(
                 f"{name} is the same file as the input {str(inp)!r}; beatsync never overwrites its "
                 "input: choose another output name"
             )
-    folder = p.resolve().parent
-    if not folder.is_dir():
-        raise ParameterError(
-            f"the folder {str(folder)!r} of {name} does not exist; create it first"
-        )
-    if not _writable_folder(folder):
-        raise ParameterError(f"the folder {str(folder)!r} of {name} is not writable")
+    from ..io import check_output_folder
+
+    try:
+        check_output_folder(p)
+    except ParameterError as exc:
+        raise ParameterError(f"{name}: {exc}") from None
     return p
 
 
