@@ -44,7 +44,7 @@ from ..motion import (
     fill_joint_gaps,
 )
 from ..units import check_fps, check_positive
-from ._files import _existing_file, atomic_write
+from ._files import atomic_write, check_input_file
 
 __all__ = [
     "read_positions_json",
@@ -262,7 +262,7 @@ def read_positions_json(
         Absolute joint positions (``skeletons + center``) in metres, z up, joints
         ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
     """
-    p = _existing_file(path, "JSON motion")
+    p = check_input_file(path, "JSON motion")
     up = _check_choice(up, "up", ("y", "z"))
     units = _check_choice(units, "units", tuple(UNIT_METRES))
     rate = _need_fps(
@@ -380,12 +380,15 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
 
 def is_position_array(path: str | os.PathLike[str]) -> bool:
     """True if an ``.npy`` file holds a ``(n_frames, n_joints, 3)`` array (header only)."""
-    p = _existing_file(path, ".npy")
+    p = check_input_file(path, ".npy")
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
-    except Exception as exc:
-        raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
-    return arr.ndim == 3
+    except Exception:  # not a plain numeric .npy array: the table reader says why
+        return False
+    if not isinstance(arr, np.ndarray):  # an .npz archive renamed .npy
+        arr.close()
+        return False
+    return arr.ndim == 3 and arr.shape[-1] == 3 and arr.dtype.kind in "iuf"
 
 
 def read_positions_array(
@@ -414,7 +417,7 @@ def read_positions_array(
     joint_names : sequence of str, optional
         Default ``j0``, ``j1``, ...
     """
-    p = _existing_file(path, "array")
+    p = check_input_file(path, "array")
     up = _check_choice(up, "up", ("y", "z"))
     units = _check_choice(units, "units", tuple(UNIT_METRES))
     suffix = p.suffix.lower()
@@ -515,7 +518,7 @@ def read_c3d(
     """
     import c3d
 
-    p = _existing_file(path, "C3D")
+    p = check_input_file(path, "C3D")
     up = _check_choice(up, "up", ("y", "z"))
     units = _check_choice(units, "units", tuple(UNIT_METRES))
     try:

@@ -183,7 +183,8 @@ def _read_npy(p: Path) -> np.ndarray:
         raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
     if values.ndim != 2:
         raise ParameterError(
-            f"{str(p)!r} holds an array of shape {values.shape}; need 2-D (frames, channels)"
+            f"{str(p)!r} holds an array of shape {values.shape}; need 2-D (frames, channels) "
+            "angles, or 3-D (frames, joints, 3) joint positions"
         )
     return values.astype(np.float64, copy=False)
 
