@@ -106,7 +106,7 @@ def test_batch_refuses_to_overwrite_inputs(inputs, tmp_path):
             str(songs[0]),
         ]
     )
-    assert code == 2
+    assert code == 3
     assert songs[0].read_bytes() == before
 
 

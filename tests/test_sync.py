@@ -232,6 +232,16 @@ def test_no_warning_in_normal_case():
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"phase_offset": "x"}, "phase"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"delta": -1.0}, "delta"),
         (np.arange(0.0, 5.5, 1.0), np.array([0.0, np.nan, 1.0]), {}, "NaN"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"mode": "bars"}, "mode="),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"land": "feet"}, "land="),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"fill": "repeat"}, "fill="),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_bar": 0}, "beats_per_bar"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"dance_beats_per_period": 2.5},
+         "dance_beats_per_period"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"land": "accents", "phase_offset": 0.1},
+         "accents.*phase_offset"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"period_range": (1.0, 0.5)},
+         "period_range"),
     ],
 )
 def test_bad_inputs_raise(bounds, beats, kwargs, match):
@@ -245,3 +255,52 @@ def test_time_warp_bad_inputs():
         time_warp([0.0, 1.0, 2.0], [0.0, 1.0])
     with pytest.raises(ParameterError, match="at least 2"):
         time_warp([0.0], [0.0])
+
+
+# ---------------------------------------------------------------- accents
+
+
+def test_accent_lag():
+    from beatsync.sync import accent_lag
+
+    music = np.arange(0.5, 20.0, 0.5)
+    assert np.isclose(accent_lag(music + 0.1, music), 0.1)
+    assert np.isclose(accent_lag(music[1:] - 0.1, music), -0.1)
+    with pytest.raises(ParameterError, match="no motion beat"):
+        accent_lag([30.0], music)
+    with pytest.raises(ParameterError, match="at least 2 music beats"):
+        accent_lag([1.0], [0.5])
+
+
+def _bounce(fps: float = 60.0, seconds: float = 12.0, period: float = 1.1) -> Motion:
+    skel = Skeleton((
+        Joint("hip", -1, np.zeros(3), ("Xposition", "Yposition", "Zposition")),
+        Joint("end", 0, np.array([0.0, 0.5, 0.0]), (), True),
+    ))
+    t = np.arange(int(seconds * fps)) / fps
+    v = np.zeros((t.size, 3))
+    v[:, 1] = np.cos(2 * np.pi * (t / period - 0.3))  # speed minima at phase 0.3 and 0.8
+    return Motion(v, fps, skel.channel_names(), skel, "bounce")
+
+
+def test_land_accents_puts_motion_beats_on_the_beats():
+    from beatsync.motion_beats import kinematic_beats
+
+    m = _bounce()
+    bounds = np.arange(0.0, 11.9, 1.1)
+    beats = 0.5 + np.arange(40) * 0.5
+    plain = synchronize(m, bounds, beats)
+    acc = synchronize(m, bounds, beats, land="accents")
+    assert acc.report["land"] == "accents" and plain.report["land"] == "boundaries"
+    # boundaries on beats: the accents sit at phase 0.3 of a 2-beat period, off the beat
+    d_plain = np.abs(np.subtract.outer(kinematic_beats(plain.motion), beats)).min(axis=1)
+    d_acc = np.abs(np.subtract.outer(kinematic_beats(acc.motion), beats)).min(axis=1)
+    assert np.median(d_plain) > 0.08
+    assert np.median(d_acc) < 1.5 / 60
+    assert acc.report["phase_offset_s"] == pytest.approx(-acc.report["accent_lag_s"])
+
+
+def test_land_accents_needs_positions():
+    m = _periodic_motion().select(["hip_Zrotation", "knee_Xrotation"])
+    with pytest.raises(ParameterError, match="accents.*positions"):
+        synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), land="accents")
