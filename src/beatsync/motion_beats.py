@@ -68,8 +68,9 @@ _METHODS = ("speed", "pca")
 def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     """World joint positions of a motion, ``(n_frames, n_joints, 3)`` [position unit].
 
-    Uses forward kinematics (:meth:`Motion.positions`) when the motion has a skeleton;
-    a marker table (channels ``<name>_x``, ``<name>_y``, ``<name>_z``) is reshaped.
+    Uses :meth:`Motion.positions` (forward kinematics for a skeleton, the stored joint
+    positions for a position-only motion); a plain marker table without such a method
+    (channels ``<name>_x``, ``<name>_y``, ``<name>_z``) is reshaped.
 
     Parameters
     ----------
@@ -82,10 +83,17 @@ def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     ParameterError
         No skeleton and no marker triples, unknown joint names, NaN gaps.
     """
-    if getattr(motion, "skeleton", None) is not None:
-        pos = np.asarray(motion.positions(), dtype=np.float64)
-        names = list(getattr(motion, "joint_names", []))
-    else:
+    pos = None
+    if hasattr(motion, "positions"):
+        # skeletal (forward kinematics) and position-only motions give joint positions
+        try:
+            pos = np.asarray(motion.positions(), dtype=np.float64)
+            names = list(getattr(motion, "joint_names", []))
+        except ParameterError:
+            if getattr(motion, "skeleton", None) is not None:
+                raise
+            pos = None
+    if pos is None:
         channels = list(getattr(motion, "channels", ()))
         vals = np.asarray(getattr(motion, "values", np.empty((0, 0))), dtype=np.float64)
         if len(channels) == 0 or len(channels) % 3 != 0:

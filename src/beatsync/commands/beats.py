@@ -69,7 +69,8 @@ def register(subparsers: Any) -> None:
 
 def run(args: Any) -> int:
     from .. import io
-    from ..beats import check_bpm, track_beats
+    from ..beats import track_beats
+    from ..units import check_bpm
 
     # cheap checks first, so that nothing is read or written on bad options
     if args.bpm is not None:

@@ -7,36 +7,28 @@ programming, synthesizes the dance (every motion beat on a music beat, blended
 transitions) and writes it as BVH, optionally a video with the music and a JSON
 report (path, number of transitions, graph-build and search times).
 
-Graph cache (on by default): built graphs are stored as ``graph-<key>.npz`` in
+Graph cache (on by default, :mod:`beatsync.graph.cache`): built graphs are stored in
 ``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else in
-``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it, and deleting the
-folder is always safe. An entry is keyed by the SHA-256 of the library files'
-content, their order, the frame-rate override, every graph parameter, the package
-version and the source code of the modules that determine the graph
-(``beatsync/graph/build.py`` and ``beatsync/motion_beats.py``), so editing a clip, a
-parameter or the graph code (also in an editable install) rebuilds the graph.
+``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it.
 """
 
 from __future__ import annotations
 
 import argparse
-import hashlib
-import json
-import os
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import BeatsyncWarning, ParameterError
 from ._common import add_json_flag, check_output_path, check_side_outputs, emit
 
-__all__ = ["register", "run", "cache_dir", "graph_cache_key", "graph_source_hash"]
+__all__ = ["register", "run"]
 
 _AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
-_CACHE_VERSION = 1
 
 
 def register(subparsers: Any) -> None:
@@ -130,49 +122,6 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def cache_dir() -> Path:
-    """The graph cache folder: ``$BEATSYNC_CACHE_DIR`` or ``~/.cache/beatsync``."""
-    env = os.environ.get("BEATSYNC_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "beatsync"
-
-
-def graph_source_hash() -> str:
-    """SHA-256 of the source of the modules that determine a graph.
-
-    ``beatsync/graph/build.py`` and ``beatsync/motion_beats.py`` (beat frames,
-    intensities, distances) and the foundation they rest on: ``io.py`` (BVH
-    reading), ``motion.py`` (forward kinematics) and ``units.py``. Part of
-    :func:`graph_cache_key`, so a code change (also in an editable install, where
-    ``__version__`` does not move) rebuilds cached graphs.
-    """
-    from .. import io, motion, motion_beats, units
-    from ..graph import build
-    from ..io import sha256_file
-
-    h = hashlib.sha256()
-    for module in (build, motion_beats, io, motion, units):
-        h.update(sha256_file(Path(module.__file__)).encode())
-    return h.hexdigest()
-
-
-def graph_cache_key(files: list[Path], params: dict[str, Any]) -> str:
-    """Hash of the library files' content (in order), the graph parameters and code.
-
-    The code part is the package version, ``_CACHE_VERSION`` (the cache file layout)
-    and :func:`graph_source_hash`.
-    """
-    from .. import __version__
-    from ..io import sha256_file
-
-    h = hashlib.sha256()
-    h.update(f"beatsync-graph-v{_CACHE_VERSION}-{__version__}".encode())
-    h.update(graph_source_hash().encode())
-    for f in files:
-        h.update(sha256_file(f).encode())
-    h.update(json.dumps(params, sort_keys=True, default=str).encode())
-    return h.hexdigest()[:32]
-
-
 def _library_files(entries: list[str]) -> list[Path]:
     files: list[Path] = []
     for e in entries:
@@ -225,37 +174,9 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     return {"audio": audio, "files": files, "out": out, "video": video, "report": report, "th": th}
 
 
-def _load_or_build(files, clips, params, use_cache):
-    from .. import io
-    from ..graph import build_graph
-    from ..graph.build import WeightedMotionGraph
-
-    key = graph_cache_key(files, params) if use_cache else None
-    path = cache_dir() / f"graph-{key}.npz" if key else None
-    if path is not None and path.is_file():
-        try:
-            g = WeightedMotionGraph.from_arrays(io.read_npz(path), clips, params)
-            if int(g.node_clip.max(initial=-1)) < len(clips):
-                return g, True, path
-        except (ParameterError, ValueError, KeyError):
-            pass  # a damaged cache entry is rebuilt
-    g = build_graph(
-        clips,
-        th=params["th"],
-        weight_rule=params["weight_rule"],
-    )
-    if path is not None:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            io.write_npz(path, g.to_arrays())
-        except OSError:
-            path = None  # an unwritable cache is not an error
-    return g, False, path
-
-
 def run(args: argparse.Namespace) -> int:
     from .. import io
-    from ..graph.compose import compose_music
+    from ..graph.compose import check_music_beats, compose_music
 
     chk = _check_inputs(args)
     if not (np.isfinite(args.tempo_weight) and args.tempo_weight >= 0):
@@ -264,25 +185,35 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
     files = chk["files"]
     t_read = time.perf_counter()
-    clips = [io.read_bvh(f, fps=args.fps) for f in files]
     y, sr = io.read_audio(chk["audio"])
-    beats = io.read_beats(args.beats) if args.beats is not None else None
+    beats = None
+    if args.beats is not None:  # cheap checks first: the beats file before the clips
+        try:
+            beats = check_music_beats(io.read_beats(args.beats), duration=y.size / float(sr))
+        except ParameterError as exc:
+            raise ParameterError(f"beats file {args.beats!r}: {exc}") from None
+    clips = [io.read_bvh(f, fps=args.fps) for f in files]
     read_s = time.perf_counter() - t_read
-    if beats is not None and beats.size < 2:
-        raise ParameterError(f"beats file {args.beats!r} has {beats.size} beat(s); need >= 2")
     from ..graph import check_library
+    from ..graph.cache import load_or_build
     from ..music import track_music_beats
 
     check_library(clips)
+    notes: list[str] = []
     if beats is None:
-        beats = track_music_beats(y, sr, bpm=args.bpm)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            beats = track_music_beats(y, sr, bpm=args.bpm)
+        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        for note in notes:
+            print(f"beatsync compose: warning: {note}", file=sys.stderr)
     params = {
         "th": chk["th"],
         "weight_rule": args.weight_rule,
         "fps": args.fps,
     }
     t0 = time.perf_counter()
-    graph, cached, cache_path = _load_or_build(files, clips, params, not args.no_cache)
+    graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
     build_s = time.perf_counter() - t0
     kw = {"tempo_weight": args.tempo_weight} if args.method == "dp" and args.tempo_weight else {}
     comp = compose_music(graph, y, sr, beats=beats, method=args.method, blend=args.blend, **kw)
@@ -319,6 +250,7 @@ def run(args: argparse.Namespace) -> int:
         "n_frames": comp.motion.n_frames,
         "fps": comp.motion.fps,
         "transition_times_s": comp.synthesis.transition_times,
+        "warnings": notes,
     }
     if chk["report"] is not None:
         io.write_json(chk["report"], result)

@@ -26,12 +26,10 @@ from ..motion import Motion
 from ..motion_beats import zscore
 from ..units import check_finite, check_times
 from .build import WeightedMotionGraph
-from .search import SearchResult, conventional_search, dp_search, random_walk
-from .synthesis import SynthesisResult, synthesize
+from .search import SearchResult, search
+from .warp import SynthesisResult, synthesize
 
-__all__ = ["Composition", "compose", "compose_music", "search", "METHODS"]
-
-METHODS = ("dp", "conventional", "random")
+__all__ = ["Composition", "compose", "compose_music", "check_music_beats"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,24 +81,27 @@ class Composition:
         }
 
 
-def search(
-    graph: WeightedMotionGraph,
-    music_z: Any,
-    music_durations: Any,
-    *,
-    method: str = "dp",
-    lam: float = 1.0,
-    seed: int = 0,
-    **kwargs: Any,
-) -> SearchResult:
-    """Dispatch to :func:`dp_search`, :func:`conventional_search` or :func:`random_walk`."""
-    if method == "dp":
-        return dp_search(graph, music_z, lam=lam, music_durations=music_durations, **kwargs)
-    if method == "conventional":
-        return conventional_search(graph, music_z, music_durations, lam=lam, **kwargs)
-    if method == "random":
-        return random_walk(graph, len(music_z), seed=seed)
-    raise ParameterError(f"method={method!r} is not one of {METHODS}")
+def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
+    """The one check of music beats on the compose path: seconds, increasing, at least two.
+
+    Parameters
+    ----------
+    beats : array_like [s]
+    duration : float, optional [s]
+        Length of the audio the beats belong to (beats after it are refused).
+
+    Raises
+    ------
+    ParameterError
+        Fewer than two beats, non-finite, not increasing, or after the audio.
+    """
+    n = 0 if beats is None else int(np.asarray(beats).size)
+    if n < 2:
+        raise ParameterError(
+            f"the music has {n} beat(s): at least two are needed to compose a dance "
+            "(is the beats file empty, or the music silent?)"
+        )
+    return check_times(beats, name="music beats", duration=duration)
 
 
 def compose(
@@ -137,7 +138,7 @@ def compose(
     seed : int
         Random walk seed.
     warp : {"pchip", "linear"}
-        Time warp inside runs (see :func:`beatsync.graph.synthesis.synthesize`).
+        Time warp inside runs (see :func:`beatsync.graph.warp.synthesize`).
     **search_kwargs
         Passed to the search (``segment_beats``, ``tempo_weight``, ...).
 
@@ -146,12 +147,7 @@ def compose(
     ParameterError
         Fewer than two music beats, level/beat count mismatch.
     """
-    if music_beats is None or np.asarray(music_beats).size < 2:
-        n = 0 if music_beats is None else int(np.asarray(music_beats).size)
-        raise ParameterError(
-            f"the music has {n} beat(s): at least two are needed to compose a dance"
-        )
-    beats = check_times(music_beats, name="music beats")
+    beats = check_music_beats(music_beats)
     level = check_finite(music_level, name="music level")
     if level.shape != (beats.size - 1,):
         raise ParameterError(
@@ -193,12 +189,9 @@ def compose_music(
 
     y_arr = np.asarray(y)
     if beats is None:
-        beats = track_music_beats(y_arr, sr, bpm=bpm)
-    beats = check_times(beats, name="music beats", duration=y_arr.size / float(sr))
-    if beats.size < 2:
-        raise ParameterError(
-            f"the music has {beats.size} beat(s): at least two are needed to compose a dance"
-        )
+        beats = track_music_beats(y_arr, sr, bpm=bpm)  # validates the audio
+    else:
+        beats = check_music_beats(beats, duration=y_arr.size / float(sr))
     level = beat_rms_db(y_arr, sr, beats)
     kwargs.setdefault("end_time", y_arr.size / float(sr))
     return compose(graph, beats, level, **kwargs)

@@ -50,6 +50,8 @@ from ..units import check_finite
 from .build import WeightedMotionGraph
 
 __all__ = [
+    "METHODS",
+    "search",
     "SearchResult",
     "dp_search",
     "conventional_search",
@@ -57,6 +59,10 @@ __all__ = [
     "path_cost",
     "node_costs",
 ]
+
+
+#: Search methods of :func:`search`.
+METHODS = ("dp", "conventional", "random")
 
 
 @dataclass(frozen=True)
@@ -483,3 +489,26 @@ def random_walk(graph: WeightedMotionGraph, n_intervals: int, *, seed: int = 0) 
         search_time=time.perf_counter() - t0,
         info={"seed": seed},
     )
+
+
+def search(
+    graph: WeightedMotionGraph,
+    music_z: Any,
+    music_durations: Any,
+    *,
+    method: str = "dp",
+    lam: float = 1.0,
+    seed: int = 0,
+    **kwargs: Any,
+) -> SearchResult:
+    """Search a path with ``method``.
+
+    Dispatches to :func:`dp_search`, :func:`conventional_search` or :func:`random_walk`.
+    """
+    if method == "dp":
+        return dp_search(graph, music_z, lam=lam, music_durations=music_durations, **kwargs)
+    if method == "conventional":
+        return conventional_search(graph, music_z, music_durations, lam=lam, **kwargs)
+    if method == "random":
+        return random_walk(graph, len(music_z), seed=seed)
+    raise ParameterError(f"method={method!r} is not one of {METHODS}")

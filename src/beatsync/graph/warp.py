@@ -47,7 +47,7 @@ from ..rotations import (
     sample_motion,
 )
 from ..units import check_fps, check_times, frames_to_time, time_to_frames
-from .build import WeightedMotionGraph, _ground_axes
+from .build import WeightedMotionGraph, ground_axes
 
 __all__ = ["SynthesisResult", "synthesize", "beat_warp", "smoothstep"]
 
@@ -129,7 +129,7 @@ def _root_layout(template: Motion, up: int) -> tuple[list[int], tuple[int, int, 
 
 def _heading(rot: Rotation, up: int) -> np.ndarray:
     """Heading angle [rad] about the up axis of the root's local forward axis."""
-    g0, g1 = _ground_axes(up)
+    g0, g1 = ground_axes(up)
     fwd = np.zeros(3)
     fwd[g0] = 1.0  # local axis lying on the floor in the rest pose (z for y-up)
     v = rot.apply(fwd)
@@ -191,7 +191,7 @@ def synthesize(
     if not end_time > start_time >= 0:
         raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
     up = "xyz".index(graph.params.get("up_axis", "y"))
-    g0, g1 = _ground_axes(up)
+    g0, g1 = ground_axes(up)
     pos_cols, rot_cols, order = _root_layout(template, up)
     rot_cols = list(rot_cols)
 
