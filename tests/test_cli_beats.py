@@ -106,7 +106,7 @@ def test_bad_input_exit_2_nothing_written(case, song, tmp_path, capsys):
     click = tmp_path / "out_click.wav"
     if "--out" not in argv and "--click" not in argv:
         argv += ["--out", str(out), "--click", str(click)]
-    assert main(argv) == 2
+    assert main(argv) == 3
     err = capsys.readouterr().err
     assert err.startswith("beatsync beats: error:")
     if case == "short":

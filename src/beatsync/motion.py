@@ -145,8 +145,9 @@ class PositionInfo:
         Length unit of that file (the motion itself is in metres).
     up : {"y", "z"}
         Vertical axis of that file (the motion itself is z up).
-    units_detected, up_detected : bool
-        True if the unit / axis was detected from the data rather than given.
+    units_source, up_source : {"given", "detected", "file"}
+        Whether the unit / axis was given by the caller, detected from the body's
+        size and shape, or read from the file's own parameters.
     center : np.ndarray [shape=(n_frames, 3)] [m], optional
         The JSON layout's per-frame root track, in the canonical frame; joint
         positions of the motion are absolute (file ``skeletons`` + ``center``).
@@ -158,17 +159,16 @@ class PositionInfo:
     layout: str = "array"
     units: str = CANONICAL_UNITS
     up: str = CANONICAL_UP
-    units_detected: bool = False
-    up_detected: bool = False
+    units_source: str = "given"
+    up_source: str = "given"
     center: np.ndarray | None = None
     key: str | None = None
 
     def describe(self) -> str:
         """One line stating units and vertical axis and whether they were detected."""
-        u = "detected" if self.units_detected else "given"
-        a = "detected" if self.up_detected else "given"
         return (
-            f"{self.layout} file in {self.units} ({u}), {self.up} up ({a}); "
+            f"{self.layout} file in {self.units} ({self.units_source}), {self.up} up "
+            f"({self.up_source}); "
             f"read as {CANONICAL_UNITS}, {CANONICAL_UP} up"
         )
 

@@ -49,6 +49,8 @@ __all__ = [
     "MIN_PLAUSIBLE_SR",
     "MIN_BPM",
     "MAX_BPM",
+    "check_whole",
+    "beat_phase",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
@@ -65,19 +67,24 @@ def _unit(unit: str) -> str:
     return f" [{unit}]" if unit else ""
 
 
-def as_float(value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False) -> float:
+def as_float(
+    value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False, text: bool = False
+) -> float:
     """Return ``value`` as a Python float, refusing what is not one finite number.
 
     Parameters
     ----------
-    value : number or numeric string
-        A bool or an array (even of one element) is refused: both are likely mistakes.
+    value : number
+        A bool, a string or an array (even of one element) is refused: all are likely
+        mistakes in a call.
     name : str
         The parameter's name, used in messages.
     unit : str
         Its unit (``"s"``, ``"Hz"``, ``"bpm"``), used in messages.
     allow_nonfinite : bool
         Accept NaN and +-inf (default: refused).
+    text : bool
+        Accept a number written as text (``"0.5"``), as when reading a file.
 
     Raises
     ------
@@ -86,11 +93,18 @@ def as_float(value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = F
 
     Examples
     --------
-    >>> as_float("0.5", name="delta", unit="s")
+    >>> as_float(0.5, name="delta", unit="s")
+    0.5
+    >>> as_float("0.5", name="delta", unit="s", text=True)
     0.5
     """
     if isinstance(value, (bool, np.bool_)):
         raise ParameterError(f"{name}={value!r} is a bool, not a number{_unit(unit)}")
+    if not text and isinstance(value, (str, bytes, np.str_, np.bytes_)):
+        raise ParameterError(
+            f"{name}={value!r} is text, not a number{_unit(unit)}; pass a number (convert "
+            "values read from text first)"
+        )
     if isinstance(value, np.ndarray) and value.ndim > 0:
         raise ParameterError(
             f"{name} must be a single number{_unit(unit)}, got an array of shape {value.shape}"
@@ -108,12 +122,15 @@ def as_float(value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = F
     return v
 
 
-def as_int(value: Any, *, name: str, unit: str = "", minimum: int | None = None) -> int:
+def as_int(
+    value: Any, *, name: str, unit: str = "", minimum: int | None = None, text: bool = False
+) -> int:
     """Return ``value`` as an int, refusing fractions (``2.5``) and values below ``minimum``.
 
-    Integral floats (``3.0``) are accepted. Raises :class:`ParameterError`.
+    Integral floats (``3.0``) are accepted; text only with ``text=True`` (see
+    :func:`as_float`). Raises :class:`ParameterError`.
     """
-    v = as_float(value, name=name, unit=unit)
+    v = as_float(value, name=name, unit=unit, text=text)
     if v != np.floor(v):
         raise ParameterError(f"{name}={value!r} must be a whole number{_unit(unit)}")
     i = int(v)
@@ -517,3 +534,25 @@ def check_audio(
             f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
         )
     return arr, sr_f
+
+
+def check_whole(value: Any, *, name: str, minimum: int = 0) -> int:
+    """Return ``value`` as an int >= ``minimum`` (``2.5`` beats is a mistake, not 2).
+
+    The same check as :func:`as_int`, with a lower bound that defaults to 0.
+    """
+    return as_int(value, name=name, minimum=minimum)
+
+
+def beat_phase(events: Any, beats: Any) -> np.ndarray:
+    """Phase of each event inside the beat interval that holds it, in ``[0, 1)``.
+
+    0 is on a beat, 0.5 half-way to the next. Events before the first beat or at/after
+    the last one have no interval and are dropped. Inputs are event times [s], 1-D
+    and increasing (checked by the caller: this is a unit conversion, seconds to beats).
+    """
+    e = np.asarray(events, dtype=np.float64)
+    b = np.asarray(beats, dtype=np.float64)
+    e = e[(e >= b[0]) & (e < b[-1])]
+    i = np.searchsorted(b, e, side="right") - 1
+    return (e - b[i]) / (b[i + 1] - b[i])
