@@ -306,3 +306,16 @@ def test_meter_estimate_on_synthetic_meters(meter, bpm):
     ref = beat_times(bpm, duration=20.0, start=0.4)
     bt = track_beats(meter_pattern(ref, meter=meter, duration=20.0, seed=3), SR)
     assert bt.beats_per_bar == METERS[meter][0]
+
+
+def test_mix_clicks_puts_a_click_on_each_beat():
+    from beatsync.beats import mix_clicks
+
+    y = np.zeros(2 * SR)
+    y[0] = 1e-3  # near silence: the clicks dominate
+    mix = mix_clicks(y, SR, np.array([0.5, 1.5]))
+    assert mix.dtype == np.float32 and mix.size == y.size
+    assert np.max(np.abs(mix)) <= 1.0
+    env = np.abs(mix.astype(np.float64))
+    assert env[int(0.5 * SR) : int(0.52 * SR)].max() > 0.3
+    assert env[int(1.0 * SR) : int(1.4 * SR)].max() < 1e-3

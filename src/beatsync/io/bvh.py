@@ -96,7 +96,9 @@ class _HierarchyParser:
             try:
                 self.lineno, line = next(self.lines)
             except StopIteration:
-                raise self.err(f"file ends where {what} was expected (truncated?)") from None
+                raise self.err(
+                    f"file ends where {what} was expected: no MOTION section (truncated?)"
+                ) from None
             self.pending = line.split()[::-1]
         return self.pending.pop()
 
@@ -185,7 +187,7 @@ class _HierarchyParser:
                     raise self.err(f"a second CHANNELS line in {self.label(top)}")
                 k = self.numbers(1, "CHANNELS")[0]
                 try:
-                    count = as_int(k, name="CHANNELS count", minimum=0)
+                    count = as_int(k, name="CHANNELS count", minimum=0, text=True)
                 except ParameterError as exc:
                     raise self.err(str(exc)) from None
                 chans = tuple(self.numbers(count, f"CHANNELS {count}"))
@@ -304,11 +306,17 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
             try:
                 if not _is_plain_number(n_text):
                     raise ParameterError(f"line {frames_line}: Frames={n_text!r} is not a number")
-                n_declared = as_int(n_text, name=f"line {frames_line}: Frames", minimum=0)
+                n_declared = as_int(
+                    n_text, name=f"line {frames_line}: Frames", minimum=0, text=True
+                )
                 if not _is_plain_number(t_text):
                     raise ParameterError(f"line {t_line}: Frame Time={t_text!r} is not a number")
                 frame_time = as_float(
-                    t_text, name=f"line {t_line}: Frame Time", unit="s", allow_nonfinite=True
+                    t_text,
+                    name=f"line {t_line}: Frame Time",
+                    unit="s",
+                    allow_nonfinite=True,
+                    text=True,
                 )
             except ParameterError as exc:
                 raise ParameterError(f"malformed BVH {str(p)!r}: {exc}") from None
