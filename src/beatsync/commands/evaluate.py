@@ -18,7 +18,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     p = subparsers.add_parser(
         "evaluate",
-        help="score a beat tracker over a folder of songs with annotations (mir_eval, on Dask)",
+        help="score beat trackers against annotations over a dataset (on Dask)",
         description="Score a method over a dataset of files. WHAT is what is scored.",
         epilog="`beatsync evaluate WHAT --help` lists the options of WHAT (each accepts "
         "--json for machine-readable output).",
