@@ -253,7 +253,7 @@ def test_npz_renamed_npy_refused(tmp_path):
         (np.zeros((4, 2), dtype="timedelta64[s]"), "time deltas"),
         (np.ones((4, 2), dtype=bool), "booleans"),
         (np.array([[1.0, None]] * 4, dtype=object), "Python objects"),
-        (np.zeros((4, 2, 3)), r"shape \(4, 2, 3\); need 2-D"),
+        (np.zeros((4, 2, 5)), r"shape \(4, 2, 5\); need 2-D"),  # (n, J, 3): positions
     ],
 )
 def test_npy_dtype_and_shape_checks(tmp_path, array, match):

@@ -379,13 +379,19 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
 
 
 def is_position_array(path: str | os.PathLike[str]) -> bool:
-    """True if an ``.npy`` file holds a ``(n_frames, n_joints, 3)`` array (header only)."""
+    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only).
+
+    Other shapes are left to the table reader, which explains what it needs.
+    """
     p = check_input_file(path, ".npy")
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
     except Exception as exc:
         raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
-    return arr.ndim == 3
+    if not isinstance(arr, np.ndarray):  # an .npz renamed .npy: read_table explains
+        arr.close()
+        return False
+    return arr.ndim == 3 and arr.shape[-1] == 3
 
 
 def read_positions_array(
