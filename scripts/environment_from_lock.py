@@ -19,8 +19,11 @@ CONDA_NAMES = {
     "soundfile": ["pysoundfile"],
     "dask": ["dask", "distributed"],
 }
-#: Extras whose packages go into the conda environment (``peers`` stays optional).
+#: Extras whose packages go into the conda environment.
 EXTRAS = ("test", "dev", "lab")
+#: Extras installed with pip inside the conda environment (not on conda-forge for every
+#: platform): ``peers``, the essentia beat trackers (AGPL-3.0; optional).
+PIP_EXTRAS = ("peers",)
 PYTHON = "3.11"
 
 
@@ -56,7 +59,12 @@ def render() -> str:
         for conda_name in CONDA_NAMES.get(name, [name]):
             version = versions.get(conda_name, versions[name])
             lines.append(f"  - {conda_name}={version}")
-    lines += ["  - pip", "  - pip:", "      - -e ."]
+    lines += ["  - pip", "  - pip:"]
+    for extra in PIP_EXTRAS:
+        for req in project.get("optional-dependencies", {}).get(extra, []):
+            name = _name(req)
+            lines.append(f"      - {name}=={versions[name]}  # optional extra {extra!r}")
+    lines.append("      - -e .")
     return "\n".join(lines) + "\n"
 
 

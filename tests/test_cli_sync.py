@@ -208,7 +208,7 @@ def test_sync_bad_inputs(inputs, tmp_path, capsys, argv, match):
     before = sorted(p.name for p in d.iterdir())
     argv = [a.format(d=d, o=tmp_path) for a in argv]
     code, stdout, err = _run(["sync", *argv], capsys)
-    assert code == 2
+    assert code == 3
     assert re.search(match, err, flags=re.IGNORECASE), err
     assert "Traceback" not in err
     assert list(tmp_path.iterdir()) == []  # nothing written

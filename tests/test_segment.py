@@ -272,8 +272,12 @@ def _with_inf():
         (_vals(), {"alpha": -0.1}, "alpha"),
         (_vals(), {"period_range": (1.25, 0.25)}, "reversed"),
         (_vals(), {"period_range": (0.0, 1.0)}, "> 0"),
-        (_vals()[:12], {}, "shorter than two periods"),
-        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "shorter than two periods"),
+        (_vals()[:12], {}, "shorter than 3 periods of the shortest"),
+        (_vals()[:19], {}, "shorter than 3 periods of the shortest"),
+        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "shorter than 3 periods"),
+        (_vals(), {"period_range": (0.25, 1.25, 2.0)}, "two numbers"),
+        (_vals(), {"period_range": (0.25, 0.06)}, "reversed"),
+        (_vals(), {"n_periods": 10, "period_method": "wavelet"}, "period_method"),
         (_vals(), {"n_periods": 1}, "n_periods"),
         (_vals(), {"n_periods": 2.5}, "n_periods"),
         (_vals(), {"n_periods": 200}, "too short"),
@@ -289,6 +293,30 @@ def test_bad_input_raises(values, kwargs, match):
     kw = {"fps": 25.0} | kwargs
     with pytest.raises(ParameterError, match=match):
         segment_values(values, **kw)
+
+
+def test_clip_shorter_than_three_own_periods_is_refused():
+    """A 1 s excerpt of salsa (period ~1 s) from 10 s used to come back as 2 periods of 0.45 s."""
+    m = datasets.load_salsa("60_01")
+    start = int(10.0 * m.fps)
+    clip = m.slice_frames(start, start + int(m.fps))  # 1 s
+    with pytest.raises(ParameterError, match=r"holds only 2\.\d periods of its estimated"):
+        segment(clip)
+    # the same dance, long enough, is segmented at its period
+    longer = m.slice_frames(start, start + int(16 * m.fps))
+    assert 0.8 <= segment(longer).mean_period <= 1.2
+
+
+def test_short_clip_of_clearly_alike_periods_is_kept():
+    """2-2.5 periods of a clean 1 s cycle: one pair, clearly alike, so segmented."""
+    s = periodic_motion(n_frames=251, n_periods=10, fps=25.0, snr_db=30, seed=0)
+    for seconds in (2.0, 2.5):
+        seg = segment_values(s.motion.values[: int(seconds * 25) + 1], fps=25.0)
+        assert seg.n_periods == 2
+        assert seg.normalised_energy < 0.5
+        assert seg.mean_period == pytest.approx(1.0, abs=0.06)
+    # a given count is the caller's word: two periods are allowed
+    assert segment_values(s.motion.values[:51], fps=25.0, n_periods=2).n_periods == 2
 
 
 def test_channel_name_count_mismatch():

@@ -30,6 +30,8 @@ __all__ = [
     "load_mocap_toolbox",
     "load_madmom_sample",
     "load_click_808",
+    "load_real_dev",
+    "REAL_DEV_ITEMS",
     "SALSA_CLIPS",
     "WALK_CLIPS",
     "DANCE_PAIRS",
@@ -64,12 +66,24 @@ CHECKSUMS: dict[str, str] = {
     "motion/dance_with_melody/DANCE_W_10/skeletons.json": "41177133f31c9532778ffa35e9ff8cd8426ef14147babc0ac57ff3bc26651cc6",
     "motion/dance_with_melody/DANCE_W_10/audio.ogg": "71aec927fb9b118dc06a316a9a038b61dba04be30f9d136fc47479e108362944",
     "motion/dance_with_melody/DANCE_W_10/excerpt.json": "f6ba540ecc63a839323e79916b7b6f3a4ed753863da64ab3817e03bf534586bc",
+    "audio/real_dev/ballroom_Media-105901.beats": "cf6bcda78741daf5e372cfe451a7665882ceeee60ca51052188efd371b12b91b",
+    "audio/real_dev/ballroom_Media-105901.wav": "284c02994f065b0323d68752dbbe5491a3102dba13c5495ddeaed84b7b489780",
+    "audio/real_dev/beat_this_annotations_LICENSE.txt": "5476ec1e3de92a2ff96356452c324dc2a566e48d8c98a22503aab88763798aaa",
+    "audio/real_dev/hainsworth_001.beats": "114fd1a3c8eb3bfec5ede3975a3fc70e2a91e272878be74984f7026959393437",
+    "audio/real_dev/hainsworth_001.flac": "1e8a5d9b959e02d2a85ab3ad8f29c5103794bb77c3b03eaa0458ae26d5a5e1d4",
+    "audio/real_dev/mirdata_LICENSE.txt": "acde8606934649e3b903e725f99788a8e2efb2a51437d12f228f31a584b954f6",
 }
 
 #: CMU salsa takes (subject_take); BVH header says 120 fps, the data is 60 fps.
 SALSA_CLIPS = ("60_01", "61_01", "60_04", "61_04")
 #: CMU subject 7 walking (periodic) and subject 5 pirouette (not periodic).
 WALK_CLIPS = ("007_01", "007_02", "007_12", "005_02")
+#: Real recordings with human beat annotations (the beat tracker's development set):
+#: name -> (audio file, beat file) under ``audio/real_dev/``.
+REAL_DEV_ITEMS = {
+    "hainsworth_001": ("hainsworth_001.flac", "hainsworth_001.beats"),
+    "ballroom_waltz": ("ballroom_Media-105901.wav", "ballroom_Media-105901.beats"),
+}
 #: Frame rate of every bundled CMU clip [Hz].
 CMU_FPS = 60.0
 
@@ -239,3 +253,19 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
         audio_offset=float(excerpt["audio_offset_s"]),
         excerpt=excerpt,
     )
+def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
+    """A real development recording and its human beat annotations [s].
+
+    ``"hainsworth_001"`` (Hainsworth dataset excerpt 001, 56.5 s, about 100 BPM, 4/4) or
+    ``"ballroom_waltz"`` (Ballroom dataset, Waltz, Media-105901, 31.8 s, about 84 BPM,
+    3/4); both 44.1 kHz. Returns ``(y, sr, beats)``.
+    """
+    from . import io
+
+    if name not in REAL_DEV_ITEMS:
+        raise ParameterError(
+            f"unknown development recording {name!r}; choose from {sorted(REAL_DEV_ITEMS)}"
+        )
+    audio, beats = REAL_DEV_ITEMS[name]
+    y, sr = io.read_audio(path(f"audio/real_dev/{audio}"))
+    return y, sr, io.read_beats(path(f"audio/real_dev/{beats}"))

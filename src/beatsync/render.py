@@ -60,13 +60,18 @@ def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
     -------
     positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
     bones : np.ndarray [shape=(n_bones, 2)], int
-        Pairs of joint indices (child, parent); empty for marker data.
+        Pairs of joint indices: (child, parent) for a skeleton; the motion's bones
+        (given, or inferred from steady joint distances) for position-only motion;
+        empty for a table whose bones are unknown (drawn as dots).
     """
     from .motion_beats import motion_positions
 
     pos = motion_positions(motion)
     skel = getattr(motion, "skeleton", None)
     if skel is None:
+        if getattr(motion, "is_positional", False):
+            bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
+            return pos, bones
         return pos, np.zeros((0, 2), dtype=np.int64)
     bones = np.array(
         [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0], dtype=np.int64

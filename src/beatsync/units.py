@@ -67,19 +67,24 @@ def _unit(unit: str) -> str:
     return f" [{unit}]" if unit else ""
 
 
-def as_float(value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False) -> float:
+def as_float(
+    value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False, text: bool = False
+) -> float:
     """Return ``value`` as a Python float, refusing what is not one finite number.
 
     Parameters
     ----------
-    value : number or numeric string
-        A bool or an array (even of one element) is refused: both are likely mistakes.
+    value : number
+        A bool, a string or an array (even of one element) is refused: all are likely
+        mistakes in a call.
     name : str
         The parameter's name, used in messages.
     unit : str
         Its unit (``"s"``, ``"Hz"``, ``"bpm"``), used in messages.
     allow_nonfinite : bool
         Accept NaN and +-inf (default: refused).
+    text : bool
+        Accept a number written as text (``"0.5"``), as when reading a file.
 
     Raises
     ------
@@ -88,11 +93,18 @@ def as_float(value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = F
 
     Examples
     --------
-    >>> as_float("0.5", name="delta", unit="s")
+    >>> as_float(0.5, name="delta", unit="s")
+    0.5
+    >>> as_float("0.5", name="delta", unit="s", text=True)
     0.5
     """
     if isinstance(value, (bool, np.bool_)):
         raise ParameterError(f"{name}={value!r} is a bool, not a number{_unit(unit)}")
+    if not text and isinstance(value, (str, bytes, np.str_, np.bytes_)):
+        raise ParameterError(
+            f"{name}={value!r} is text, not a number{_unit(unit)}; pass a number (convert "
+            "values read from text first)"
+        )
     if isinstance(value, np.ndarray) and value.ndim > 0:
         raise ParameterError(
             f"{name} must be a single number{_unit(unit)}, got an array of shape {value.shape}"
@@ -110,12 +122,15 @@ def as_float(value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = F
     return v
 
 
-def as_int(value: Any, *, name: str, unit: str = "", minimum: int | None = None) -> int:
+def as_int(
+    value: Any, *, name: str, unit: str = "", minimum: int | None = None, text: bool = False
+) -> int:
     """Return ``value`` as an int, refusing fractions (``2.5``) and values below ``minimum``.
 
-    Integral floats (``3.0``) are accepted. Raises :class:`ParameterError`.
+    Integral floats (``3.0``) are accepted; text only with ``text=True`` (see
+    :func:`as_float`). Raises :class:`ParameterError`.
     """
-    v = as_float(value, name=name, unit=unit)
+    v = as_float(value, name=name, unit=unit, text=text)
     if v != np.floor(v):
         raise ParameterError(f"{name}={value!r} must be a whole number{_unit(unit)}")
     i = int(v)

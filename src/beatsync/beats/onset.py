@@ -13,7 +13,7 @@
 
 The front-end settings (window, hop, FFT size, band edges) are not published in the
 paper; :data:`FRONTEND_DEFAULTS` are swept in
-``notebooks/paper_a_sec4_beat_tracking.ipynb``. Only numpy and scipy are used (no
+``notebooks/paper_a_sec4_beat_tracking.ipynb``. numpy and scipy only (no
 JIT compilation on the first call).
 """
 
@@ -23,11 +23,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.fft
-import scipy.ndimage
 
 from ..errors import ParameterError
 from ..units import check_audio, check_positive, frames_to_time, time_to_frames
+from .filters import moving_max, moving_mean
 
 __all__ = [
     "SILENCE_PEAK",
@@ -147,10 +146,6 @@ class OnsetSignal:
         Weight ``6 - c`` of each band (normalised to sum 1).
     psf : np.ndarray [shape=(n_bands, n_frames)] [s]
         Phase-slope function per band (NaN where the band is silent).
-    energy_flux : np.ndarray [shape=(n_frames,)]
-        Square root of the half-wave rectified increase of the band energies, summed
-        over the bands, minus its local mean: a loudness-proportional onset signal
-        (unlike the log-compressed flux).
     """
 
     envelope: np.ndarray
@@ -160,7 +155,6 @@ class OnsetSignal:
     onset_strengths: np.ndarray
     band_weights: np.ndarray
     psf: np.ndarray = field(repr=False)
-    energy_flux: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
 
 
 # --------------------------------------------------------------------------- STFT
@@ -184,6 +178,8 @@ def _stft(y32: np.ndarray, window: np.ndarray, n_fft: int, hop: int) -> np.ndarr
     pad = n_fft // 2
     yp = np.pad(y32, (pad, pad))
     frames = np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]
+    import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
+
     return scipy.fft.rfft(frames * w, axis=1)
 
 
@@ -338,12 +334,19 @@ def onset_strength_psf(
 
 
 def _resample(y: np.ndarray, sr: float, target: float) -> np.ndarray:
-    """Polyphase resampling (scipy) from ``sr`` to ``target`` [Hz]."""
-    import scipy.signal  # noqa: PLC0415 (only needed above the analysis rate)
+    """Band-limited resampling from ``sr`` to ``target`` [Hz] (``target < sr``) by FFT.
 
-    a, b = int(round(target)), int(round(sr))
-    g = np.gcd(a, b)
-    return scipy.signal.resample_poly(y, a // g, b // g)
+    The spectrum is truncated at the new Nyquist frequency (ideal low-pass) after
+    zero-padding to a fast FFT length; scipy.fft only (scipy.signal's import alone
+    costs more than tracking a song).
+    """
+    import scipy.fft  # noqa: PLC0415
+
+    n_out = int(round(y.size * target / sr))
+    m = scipy.fft.next_fast_len(y.size, real=True)
+    m_out = int(round(m * target / sr))
+    spec = scipy.fft.rfft(y, n=m)[: m_out // 2 + 1]
+    return scipy.fft.irfft(spec, n=m_out)[:n_out] * (m_out / m)
 
 
 def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
@@ -351,7 +354,7 @@ def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     if fe.analysis_sr != sr:
         y, sr = _resample(y, sr, fe.analysis_sr), fe.analysis_sr
     y = y / np.max(np.abs(y))
-    psf, energy, fps, mag, member = _phase_slope(y, sr, fe)
+    psf, _, fps, mag, member = _phase_slope(y, sr, fe)
     n_bands, n_frames = psf.shape
     logmag = np.log1p(np.float32(100.0) * mag)
     diff = np.diff(logmag, axis=0, prepend=logmag[:1])
@@ -359,24 +362,13 @@ def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     counts = np.maximum(member.sum(axis=0)[:, None], 1.0)
     flux = (diff @ member).T.astype(np.float64) / counts  # mean over the band's bins
     del diff, logmag
-    # loudness-proportional onset signal: rectified increase of each band's energy
-    # (band sums first, so the bin-to-bin beating of sustained low tones cancels),
-    # smoothed over one window length first: the windowed energy of a low tone (an 808
-    # kick's boom) oscillates from frame to frame with its phase
-    span = max(int(round(fe.win_length / fe.hop_length)), 2)
-    smooth = scipy.ndimage.uniform_filter1d(energy, span, axis=1)
-    d_energy = np.diff(smooth, axis=1, prepend=smooth[:, :1])
-    energy_flux = np.sqrt(np.maximum(d_energy, 0.0).sum(axis=0))
     if fe.flux_norm_s > 0:  # remove the fluctuation floor of sustained sounds
         size = max(int(time_to_frames(fe.flux_norm_s, fps=fps)), 3)
-        energy_flux = np.maximum(
-            energy_flux - scipy.ndimage.uniform_filter1d(energy_flux, size), 0.0
-        )
-        flux = np.maximum(flux - scipy.ndimage.uniform_filter1d(flux, size, axis=1), 0.0)
+        flux = np.maximum(flux - moving_mean(flux, size), 0.0)
     # the flux peaks when the onset enters the window, up to half a window before the
     # phase-slope zero crossing: take its maximum over a window-long neighbourhood
     reach = int(np.ceil(fe.win_length / fe.hop_length / 2)) + 1
-    flux = scipy.ndimage.maximum_filter1d(flux, 2 * reach + 1, axis=1, origin=reach // 2)
+    flux = moving_max(flux, 2 * reach + 1, origin=reach // 2)
     weights = np.maximum(6.0 - np.arange(1, n_bands + 1, dtype=np.float64), 1.0)
     weights = weights / weights.sum()
     bands = np.zeros((n_bands, n_frames))
@@ -406,4 +398,4 @@ def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
         t, s = t[order], s[order]
     else:
         t = s = np.empty(0)
-    return OnsetSignal(envelope, bands, fps, t, s, weights, psf, energy_flux)
+    return OnsetSignal(envelope, bands, fps, t, s, weights, psf)

@@ -101,35 +101,3 @@ def tempo_hmm(
     trans /= trans.sum(axis=1, keepdims=True)
     trans = (1 - p_jump) * trans + p_jump / periods.size
     return viterbi(log_obs, np.log(trans), log_prior)
-
-
-def tempo_salience(
-    env: np.ndarray, fps: float, starts, stops, periods: np.ndarray, n_harm: int
-) -> np.ndarray:
-    """Harmonic-sum autocorrelation salience, shape (n_periods, n_windows)."""
-    import scipy.ndimage
-
-    n_win = len(starts)
-    L = int(max(stops - starts))
-    seg = np.zeros((n_win, L))
-    for i, (a, b) in enumerate(zip(starts, stops, strict=True)):
-        x = env[a:b]
-        seg[i, : b - a] = x - x.mean()
-    spec = np.fft.rfft(seg, n=2 * L, axis=1)
-    acf = np.fft.irfft(np.abs(spec) ** 2, axis=1)[:, :L]
-    # unbiased: divide by the overlap, so that all multiples of a period count alike
-    overlap = np.maximum((stops - starts)[:, None] - np.arange(L)[None, :], 1)
-    acf = acf / overlap
-    acf[:, L // 2 :] = 0.0  # too few products to trust
-    acf0 = acf[:, :1]
-    acf = np.divide(acf, acf0, out=np.zeros_like(acf), where=acf0 > 0)
-    sal = np.zeros((periods.size, n_win))
-    step = float(np.log(periods[1] / periods[0])) if periods.size > 1 else 0.0
-    for k in range(1, n_harm + 1):
-        lags = k * periods * fps
-        ok = lags < L // 2 - 1
-        # tolerance of half a grid step around each multiple (peaks are narrow)
-        width = 2 * int(np.ceil(0.5 * step * lags[ok].max())) + 1 if ok.any() else 1
-        acf_k = scipy.ndimage.maximum_filter1d(acf, width, axis=1) if width > 1 else acf
-        sal[ok] += acf_k[:, np.rint(lags[ok]).astype(np.int64)].T
-    return sal

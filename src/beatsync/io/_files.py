@@ -124,3 +124,7 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
             h.update(chunk)
     return h.hexdigest()
+
+
+# The former private name, still imported by io.positions; new code uses check_input_file.
+_existing_file = check_input_file

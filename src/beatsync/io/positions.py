@@ -386,12 +386,12 @@ def is_position_array(path: str | os.PathLike[str]) -> bool:
     p = check_input_file(path, ".npy")
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
-    except Exception as exc:
-        raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
-    if not isinstance(arr, np.ndarray):  # an .npz renamed .npy: read_table explains
+    except Exception:  # not a plain numeric .npy array: the table reader says why
+        return False
+    if not isinstance(arr, np.ndarray):  # an .npz archive renamed .npy
         arr.close()
         return False
-    return arr.ndim == 3 and arr.shape[-1] == 3
+    return arr.ndim == 3 and arr.shape[-1] == 3 and arr.dtype.kind in "iuf"
 
 
 def read_positions_array(

@@ -47,6 +47,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_PERIOD_RANGE",
+    "MIN_CLIP_PERIODS",
+    "SHORT_CLIP_MAX_ENERGY",
     "Segmentation",
     "segment",
     "segment_values",
@@ -55,6 +57,20 @@ __all__ = [
 
 DEFAULT_PERIOD_RANGE = (0.25, 1.25)
 """Shortest and longest period [s] searched when the count is estimated."""
+
+MIN_CLIP_PERIODS = 3
+"""A clip shorter than this many of its estimated periods needs :data:`SHORT_CLIP_MAX_ENERGY`.
+
+Below three periods the optimum has a single pair of consecutive periods to compare,
+which a short clip of one movement can fake (a 1 s salsa excerpt, period ~1 s, was
+cut into two "periods" of 0.45 s whose halves were barely alike); from three on
+there are two pairs and the periodicity test can compare with longer periods."""
+
+SHORT_CLIP_MAX_ENERGY = 0.5
+"""Largest mean Pearson distance of a clip shorter than :data:`MIN_CLIP_PERIODS` periods.
+
+A clip that short is accepted only if its periods are clearly alike (mean r >= 0.5,
+halfway between uncorrelated and identical); otherwise it is refused as too short."""
 
 
 @dataclass(frozen=True)
@@ -122,17 +138,19 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
     """Candidate periods [frames] for estimating the count, or a ParameterError."""
     lo_p, hi_p = time_to_frames(period_range, fps=fps, round_to_int=False)
     lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
-    if hi_f < lo_f:
-        span = float(frames_to_time(n - 1, fps=fps))
-        if span < 2 * period_range[0]:
-            raise ParameterError(
-                f"clip of {n} frames lasts {span:.3f} s at fps={fps:g}, shorter than two "
-                f"periods of the shortest requested period {period_range[0]:g} s; give a "
-                "longer clip, a shorter --period-range, or check fps (frames vs seconds)"
-            )
+    span = float(frames_to_time(n - 1, fps=fps))
+    if span < MIN_CLIP_PERIODS * period_range[0]:
         raise ParameterError(
-            f"period_range={period_range[0]:g}-{period_range[1]:g} s is shorter than two "
-            f"frames at fps={fps:g}; give a longer period range or check fps"
+            f"clip of {n} frames lasts {span:.3f} s at fps={fps:g}, shorter than "
+            f"{MIN_CLIP_PERIODS} periods of the shortest requested period "
+            f"{period_range[0]:g} s; give a longer clip, a shorter --period-range, or check "
+            "fps (frames vs seconds)"
+        )
+    if hi_f < lo_f:
+        raise ParameterError(
+            f"no period of {period_range[0]:g}-{period_range[1]:g} s spans two frames and fits "
+            f"twice in {n} frames at fps={fps:g}; give a longer period range or clip, or "
+            "check fps"
         )
     return lo_f, hi_f
 
@@ -152,12 +170,13 @@ def _segment(
 ) -> Segmentation:
     """Segmentation of validated values (finite, 2-D, named); data checks and the search."""
     n = vals.shape[0]
+    if n_periods is None:
+        lo_f, hi_f = _frame_band(n, fps, period_range)  # the clip's length first (cheap)
     x, used = _motion_channels(vals, names)
     if n_periods is not None:
         p = n_periods
         nominal = (n - 1) / p  # [frames]
     else:
-        lo_f, hi_f = _frame_band(n, fps, period_range)
         nominal = estimate_period(x, lo_f, hi_f, method)
         p = max(2, int(np.floor((n - 1) / nominal + 1e-9)))
     lo, hi = period_band(nominal, alpha)
@@ -182,6 +201,17 @@ def _segment(
     frames, energy = optimum(x, lo, hi, count, factor)
     n_found = frames.size - 1
     e_norm = energy / (x.shape[0] * max(n_found - 1, 1))
+    if count is None and (n - 1) < MIN_CLIP_PERIODS * nominal and e_norm >= SHORT_CLIP_MAX_ENERGY:
+        per = float(frames_to_time(nominal, fps=fps))
+        span = float(frames_to_time(n - 1, fps=fps))
+        raise ParameterError(
+            f"clip of {span:.3f} s holds only {(n - 1) / nominal:.1f} periods of its "
+            f"estimated period {per:.3f} s, and they are not clearly alike (mean Pearson "
+            f"distance {e_norm:.3f} >= {SHORT_CLIP_MAX_ENERGY}): too short to tell a "
+            "repeating movement from a single one. Give a clip of at least "
+            f"{MIN_CLIP_PERIODS} periods ({MIN_CLIP_PERIODS * per:.1f} s), or the period count "
+            "(n_periods / --periods) if you know it"
+        )
     contrast = periodicity_contrast(x, frames)
     if e_norm >= MAX_NORMALISED_ENERGY or (
         np.isfinite(contrast) and contrast < MIN_PERIODICITY_CONTRAST
@@ -264,10 +294,11 @@ def segment_values(
     ------
     ParameterError
         NaN/inf values, ``fps <= 0``, alpha outside (0, 0.5), reversed period range, a
-        clip shorter than two periods of the requested range, all channels constant,
-        ``n_periods`` periods that do not fit the clip within the alpha band, or a
-        clip that is not periodic (normalised energy above
-        :data:`MAX_NORMALISED_ENERGY`; with ``n_periods`` given, often a wrong count).
+        clip shorter than :data:`MIN_CLIP_PERIODS` (3) of the shortest period of the
+        range or of its own estimated period (with the count estimated), all channels
+        constant, ``n_periods`` too many for the frames, or a clip that is not
+        periodic (normalised energy above :data:`MAX_NORMALISED_ENERGY` or too little
+        periodicity contrast; with ``n_periods`` given, often a wrong count).
 
     Examples
     --------
@@ -393,8 +424,8 @@ def estimate_period_count(
     Raises
     ------
     ParameterError
-        Bad ``fps``/range/values/method, or a clip shorter than two of the shortest
-        periods.
+        Bad ``fps``/range/values/method, or a clip shorter than
+        :data:`MIN_CLIP_PERIODS` of the shortest periods.
     """
     fps = check_fps(fps)
     lo_s, hi_s = check_period_range(period_range)

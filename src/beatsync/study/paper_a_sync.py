@@ -90,6 +90,12 @@ ALIGNMENT_COLUMNS = [
     "after_phase",
 ]
 
+# score columns in the order of the published CSV
+_TABLE_SCORES = [
+    "before_motion", "after_motion", "control_motion", "before_music", "after_music",
+    "control_music", "before_phase", "after_phase", "aligned_motion", "aligned_music",
+]  # fmt: skip
+
 
 # ------------------------------------------------------------------------ inputs
 
@@ -556,8 +562,9 @@ def sync_table(
                     "output frames": r["output_frames"],
                     "paper output frames": paper_frames.get((cname, sname), "n/a"),
                     "max residual [frames]": r["max_residual_frames"],
-                    **{k: r[k] for k in ALIGNMENT_COLUMNS[2:]},
+                    **{k: r[k] for k in _TABLE_SCORES[:8]},
                     "phase offset [s]": r["phase_offset_s"],
+                    **{k: r[k] for k in _TABLE_SCORES[8:]},
                     "note": "",
                 }
             )

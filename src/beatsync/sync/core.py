@@ -12,9 +12,10 @@ from ..errors import BeatsyncWarning, ParameterError
 from ..units import check_fps, check_range, check_times, check_whole, frames_to_time, time_to_frames
 from .fill import LoopedClip, loop_events
 from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
+from .positions import restore_bone_lengths
 from .warp import TimeWarp, integrate_warp
 
-__all__ = ["MODES", "LANDINGS", "FILLS", "SyncResult", "synchronize"]
+__all__ = ["MODES", "LANDINGS", "FILLS", "SyncResult", "position_bones", "synchronize"]
 
 MODES = ("periods", "beats", "auto")
 LANDINGS = ("boundaries", "accents")
@@ -61,6 +62,14 @@ class SyncResult:
     warp_src_times: np.ndarray
     report: dict = field(default_factory=dict)
     warp: TimeWarp | None = None
+
+
+def position_bones(motion: Any) -> np.ndarray | None:
+    """Bones of a position-only motion (joint-index pairs), None for other motions."""
+    if not getattr(motion, "is_positional", False):
+        return None
+    bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
+    return bones if bones.size else None
 
 
 def _choice(value: Any, options: tuple[str, ...], name: str) -> str:
@@ -422,6 +431,13 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         values = sample_motion(motion, src_times)
     else:
         values = looped.sample(motion, src_times)
+    bones = position_bones(motion)
+    if bones is not None:  # position-only: linear resampling, then bone lengths restored
+        a, b, w = (src_times, None, None) if looped is None else looped.source_times(src_times)
+        pos = restore_bone_lengths(
+            values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
+        )
+        values = pos.reshape(n_out, -1)
     out_motion = motion.with_values(values, fps=out_fps)
 
     # residuals: realised warp (interpolated between output frames) and nearest frame

@@ -49,9 +49,14 @@ __all__ = [
     "drum_song",
     "GROUPS",
     "KINDS",
+    "METERS",
+    "meter_pattern",
 ]
 
 GROUPS = ("clean", "drift", "swing", "noise", "change")
+#: Meters of :func:`meter_pattern`: beats per bar and eighth notes per beat (2/4 and
+#: 3/4 simple, beat = quarter note; 6/8 compound, beat = dotted quarter).
+METERS = {"2/4": (2, 2), "3/4": (3, 2), "6/8": (2, 3)}
 KINDS = ("click", "drums")
 
 
@@ -263,6 +268,50 @@ def drum_pattern(
     hat = _hihat(sr, rng)
     y += _render(beats, hat, n, sr, 1.0)
     y += _render(_offbeats(beats, swing), hat, n, sr, offbeat_gain)
+    return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
+
+
+def meter_pattern(
+    beats: np.ndarray,
+    *,
+    meter: str,
+    sr: int = 22050,
+    duration: float,
+    seed: int = 0,
+) -> np.ndarray:
+    """Render a drum pattern in a meter, with eighth-note subdivisions and exact beats.
+
+    The first beat of every bar gets a kick (gain 1), the other beats a snare (0.6);
+    a hi-hat plays every eighth note: on the beats at gain 0.5, between them at 0.3
+    (``METERS[meter][1]`` eighths per beat: 2 in 2/4 and 3/4, 3 in 6/8). ``beats`` are
+    the beat (tactus) times: quarter notes in 2/4 and 3/4, dotted quarters in 6/8.
+
+    Parameters
+    ----------
+    beats : np.ndarray [s]
+    meter : {"2/4", "3/4", "6/8"}
+    sr : int > 0 [Hz]
+    duration : float > 0 [s]
+    seed : int
+        Seed of the noise in the snare and hi-hat sounds.
+
+    Returns
+    -------
+    y : np.ndarray [shape=(round(duration * sr),)], float32
+    """
+    if meter not in METERS:
+        raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")
+    beats, sr, duration = _check_common(beats, sr, duration)
+    per_bar, eighths = METERS[meter]
+    rng = np.random.default_rng(seed)
+    n = int(round(duration * sr))
+    down = np.arange(beats.size) % per_bar == 0
+    y = _render(beats[down], _kick(sr), n, sr, 1.0)
+    y += _render(beats[~down], _snare(sr, rng), n, sr, 0.6)
+    hat = _hihat(sr, rng)
+    y += _render(beats, hat, n, sr, 0.5)
+    for k in range(1, eighths):
+        y += _render(_offbeats(beats, k / eighths), hat, n, sr, 0.3)
     return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
 
 
