@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 from beatsync.graph import build_graph
-from beatsync.graph.study import LIBRARIES, PAPER_B_TABLE1, load_library, ratio_table, speed_table
+from beatsync.study.paper_b import LIBRARIES, PAPER_B_TABLE1, load_library, ratio_table, speed_table
 
 HERE = Path(__file__).resolve().parent
 

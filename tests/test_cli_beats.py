@@ -117,7 +117,7 @@ def test_bad_input_exit_2_nothing_written(case, song, tmp_path, capsys):
 
 def test_noise_warns_on_stderr(tmp_path, capsys):
     path = tmp_path / "noise.wav"
-    y = np.random.default_rng(0).standard_normal(5 * SR).astype(np.float32) * 0.3
+    y = np.random.default_rng(0).standard_normal(30 * SR).astype(np.float32) * 0.3
     io.write_audio(path, y, SR)
     assert main(["beats", str(path), "--json"]) == 0
     captured = capsys.readouterr()

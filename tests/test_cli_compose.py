@@ -10,9 +10,9 @@ import pytest
 
 from beatsync import io
 from beatsync.cli import main
-from beatsync.graph.synthetic import synthetic_dance
 from beatsync.motion import Joint, Motion, Skeleton
-from beatsync.music import drum_song
+from beatsync.synth.audio import drum_song
+from beatsync.synth.library import synthetic_dance
 
 
 @pytest.fixture
@@ -104,7 +104,7 @@ def test_compose_end_to_end_with_beats(workdir, capsys):
 
 
 def test_cache_key_changes_with_content_and_params(workdir):
-    from beatsync.commands.compose import graph_cache_key
+    from beatsync.graph.cache import graph_cache_key
 
     files = sorted((workdir / "lib").glob("*.bvh"))
     k1 = graph_cache_key(files, {"th": 3.0})
@@ -118,8 +118,8 @@ def test_cache_key_changes_with_content_and_params(workdir):
 def test_cache_key_changes_with_graph_code(workdir, monkeypatch, tmp_path):
     # an editable install keeps __version__ when build_graph changes: the key must not
     from beatsync import motion_beats
-    from beatsync.commands import compose as cmd
     from beatsync.graph import build
+    from beatsync.graph import cache as cmd
 
     files = sorted((workdir / "lib").glob("*.bvh"))
     k1 = cmd.graph_cache_key(files, {"th": 3.0})
@@ -133,7 +133,7 @@ def test_cache_key_changes_with_graph_code(workdir, monkeypatch, tmp_path):
 
 
 def test_stale_cache_entry_is_not_served(workdir, monkeypatch, capsys):
-    from beatsync.commands import compose as cmd
+    from beatsync.graph import cache as cmd
 
     argv = [
         "compose",
@@ -187,7 +187,7 @@ def _odd_clip(path):
         ("skeletons", "different skeletons"),
         ("empty_folder", "no .bvh"),
         ("silent", "silent"),
-        ("one_beat", "need >= 2"),
+        ("one_beat", "at least two are needed"),
         ("missing_clip", "does not exist"),
         ("tempo_neg", "--tempo-weight"),
         ("not_bvh_out", "must end in .bvh"),

@@ -71,6 +71,53 @@ def test_sync_end_to_end_with_beats_file(inputs, tmp_path, capsys):
     assert np.all(np.isin(np.round(r["target_beats_s"], 6), np.round(beats, 6)))
 
 
+def test_sync_default_loops_over_the_whole_song(inputs, tmp_path, capsys):
+    d, _, beats = inputs  # a 12 s dance on a 20 s song
+    out = tmp_path / "out.bvh"
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    r = json.loads(stdout)["report"]
+    assert r["mode"] == "periods" and r["fill"] == "loop" and r["repetitions"] >= 2
+    assert r["output_duration_s"] >= beats[-1] - 1 / 60  # covers the song to its last beat
+    assert r["max_abs_residual_frames"] <= 1.0
+    # --fill stop: the paper's behaviour, the dance ends with its last period
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json", "--fill", "stop"],
+        capsys,
+    )
+    r = json.loads(stdout)["report"]
+    assert code == 0 and r["repetitions"] == 1 and r["output_duration_s"] < beats[-1] - 1.0
+
+
+def test_sync_mode_beats_and_auto_fallback(inputs, tmp_path, capsys):
+    d, _, beats = inputs
+    out = tmp_path / "out.bvh"
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--mode", "beats", "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    r = json.loads(stdout)["report"]
+    assert r["mode"] == "beats" and r["max_abs_residual_frames"] <= 1.0
+    # not periodic: auto falls back to motion beats and says so
+    code, stdout, err = _run(
+        ["sync", str(d / "noise.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    result = json.loads(stdout)
+    assert result["report"]["mode"] == "beats" and result["report"]["mode_requested"] == "auto"
+    assert "fell back" in result["report"]["mode_note"]
+    assert any("fell back" in w for w in result["warnings"]) and "fell back" in err
+
+
 def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.bvh"
@@ -136,8 +183,12 @@ BAD = [
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.mp3"], ".bvh or .csv"),
     (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "60"], "skeleton"),
-    (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats"],
-     "periodic"),
+    (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--mode", "periods"], "periodic.*--mode beats"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--beats-per-bar", "0"], "beats_per_bar"),
+    (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.csv", "--fps", "60", "--beats",
+      "{d}/song.beats", "--mode", "beats"], "positions"),
     (["{d}/salsa.bvh", "{d}/silence.wav", "-o", "{o}/x.bvh"], "silen"),
     (["{d}/salsa.bvh", "{d}/short.wav", "-o", "{o}/x.bvh"], "shorter"),
     (["{d}/salsa.bvh", "{d}/tone.wav", "-o", "{o}/x.bvh"], "no detectable beats"),
@@ -162,3 +213,14 @@ def test_sync_bad_inputs(inputs, tmp_path, capsys, argv, match):
     assert "Traceback" not in err
     assert list(tmp_path.iterdir()) == []  # nothing written
     assert sorted(p.name for p in d.iterdir()) == before
+
+
+@pytest.mark.parametrize("option, value", [("--mode", "bars"), ("--fill", "repeat")])
+def test_sync_unknown_choice_is_a_usage_error(inputs, tmp_path, capsys, option, value):
+    d, _, _ = inputs
+    with pytest.raises(SystemExit) as exc:
+        main(["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(tmp_path / "x.bvh"),
+              option, value])
+    assert exc.value.code == 2
+    assert "invalid choice" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

@@ -10,8 +10,10 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.evaluate.composition import foot_sliding, intensity_correlation, transition_jumps
 from beatsync.graph import (
     aligned_distance_matrix,
+    aligned_pair_distance,
     beat_warp,
     build_graph,
     conventional_search,
@@ -22,11 +24,11 @@ from beatsync.graph import (
     transition_weight,
 )
 from beatsync.graph.compose import compose
-from beatsync.graph.quality import foot_sliding, quality_proxies, transition_jumps
-from beatsync.graph.synthetic import dance_skeleton, synthetic_dance, synthetic_library
 from beatsync.motion import Motion
-from beatsync.motion_beats import beat_interval_intensity, kinematic_beats
+from beatsync.motion_beats import beat_interval_intensity, kinematic_beats, motion_positions
 from beatsync.rotations import euler_to_rotation
+from beatsync.study.paper_b import composition_proxies
+from beatsync.synth.library import dance_skeleton, synthetic_dance, synthetic_library
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +85,7 @@ def test_identical_clips_are_connected_at_zero_distance():
     for i in range(n):
         assert (i, i + n) in pairs and (i + n, i) in pairs  # two-way
     same = (g.trans_src % n) == (g.trans_dst % n)
-    np.testing.assert_allclose(g.trans_rd[same], 0.0, atol=1e-6)
+    np.testing.assert_allclose(g.trans_rd[same], 0.0, atol=1e-6)  # stable distance formula
     assert np.all(g.trans_weight[same] == 2.0)  # eq. 2 as written: at least 2
 
 
@@ -103,6 +105,16 @@ def test_aligned_distance_invariant_to_floor_rigid_motion(rng):
     assert d[0, 0] < 1e-6  # sqrt of a difference of sums: ~1e-8 round-off
     c = b + np.array([0.0, 0.1, 0.0])  # vertical offsets are not aligned away
     np.testing.assert_allclose(aligned_distance_matrix(a, c[None])[0, 0], 0.1, rtol=1e-9)
+
+
+@pytest.mark.parametrize("height", [0.0, 100.0, 1e4])
+def test_identical_clouds_at_zero_distance_far_from_the_floor(rng, height):
+    # the closed form subtracts sums of squares of the heights: far from the floor the
+    # old formula returned 1.8e-6 (100 units) and 1.6e-4 (1e4 units) for identical clouds
+    a = rng.normal(size=(3, 300, 3)) * 0.3
+    a[:, :, 1] += height
+    assert np.diag(aligned_distance_matrix(a, a)).max() < 1e-9 * max(1.0, height)
+    assert aligned_pair_distance(a, a).max() < 1e-9 * max(1.0, height)
 
 
 def test_rd_is_scale_free():
@@ -386,14 +398,14 @@ def test_quality_known_answer_exact_composition():
     np.testing.assert_array_equal(comp.search.path, np.arange(1, b.size - 2))
     assert comp.n_transitions == 0
     np.testing.assert_allclose(comp.motion.values, m.values[: comp.motion.n_frames], atol=1e-9)
-    q = quality_proxies(comp, beat_smooth=0.0)
+    q = composition_proxies(comp, beat_smooth=0.0)
     assert q["alignment_motion"] == pytest.approx(1.0, abs=1e-9)
     assert q["alignment_music"] == pytest.approx(1.0, abs=1e-9)
     assert q["intensity_r"] == pytest.approx(1.0, abs=1e-9)
     assert q["n_transitions"] == 0 and np.isnan(q["transition_jump_max"])
     # the same dance against music beats half a beat off scores near zero
     off = dataclasses.replace(comp, music_beats=music[:-1] + 0.3)
-    q_off = quality_proxies(off, beat_smooth=0.0)
+    q_off = composition_proxies(off, beat_smooth=0.0)
     assert q_off["alignment_motion"] < 0.01 and q_off["alignment_music"] < 0.01
 
 
@@ -401,9 +413,9 @@ def test_dp_beats_random_walk_on_intensity_correlation(graph):
     rng = np.random.default_rng(2)
     beats = 0.5 + 0.55 * np.arange(15)
     level = rng.uniform(-30, -5, size=14)
-    r_dp = quality_proxies(compose(graph, beats, level))["intensity_r"]
+    r_dp = composition_proxies(compose(graph, beats, level))["intensity_r"]
     r_rand = [
-        quality_proxies(compose(graph, beats, level, method="random", seed=s))["intensity_r"]
+        composition_proxies(compose(graph, beats, level, method="random", seed=s))["intensity_r"]
         for s in range(5)
     ]
     assert r_dp > 0.5
@@ -418,7 +430,7 @@ def test_compose_and_quality(graph):
     comp = compose(graph, beats, level)
     assert comp.motion.skeleton is graph.clips[0].skeleton
     assert comp.motion.n_frames == int(np.floor(beats[-1] * comp.motion.fps)) + 1
-    q = quality_proxies(comp)
+    q = composition_proxies(comp)
     assert 0.0 <= q["alignment_motion"] <= 1.0 and 0.0 <= q["alignment_music"] <= 1.0
     assert -1.0 <= q["intensity_r"] <= 1.0
     assert q["foot_sliding"] >= 0
@@ -430,7 +442,7 @@ def test_compose_and_quality(graph):
 
 def test_transition_jumps_and_foot_sliding_known():
     m, _ = synthetic_dance(duration=4, seed=0)
-    assert transition_jumps(m, []).size == 0
+    assert transition_jumps(motion_positions(m), [], fps=m.fps).size == 0
     # upper body dancing, legs and hip still: the feet do not slide
     vals = m.values.copy()
     legs = [
@@ -440,10 +452,12 @@ def test_transition_jumps_and_foot_sliding_known():
     ]
     vals[:, legs] = m.values[0, legs]
     m = m.with_values(vals)
-    assert foot_sliding(m) < 1e-9
+    feet = ["lFoot", "rFoot"]
+    assert foot_sliding(motion_positions(m, joints=feet), fps=m.fps) < 1e-9
     vals = m.values.copy()
     vals[:, 0] += 1.0 * m.times  # whole body glides at 1 m/s
-    assert foot_sliding(m.with_values(vals)) == pytest.approx(1.0, rel=0.05)
+    glide = motion_positions(m.with_values(vals), joints=feet)
+    assert foot_sliding(glide, fps=m.fps) == pytest.approx(1.0, rel=0.05)
 
 
 def test_brute_force_enumeration_sane(tiny_graph):
@@ -472,10 +486,9 @@ def test_root_euler_curves_stay_continuous_after_heading_alignment():
 
 
 def test_intensity_correlation_known_answers():
-    from beatsync.graph.quality import intensity_correlation
-    from beatsync.motion_beats import beat_interval_intensity
-
     m, b = synthetic_dance(duration=8, seed=0)
     inten = beat_interval_intensity(m, b)
-    assert intensity_correlation(m, b, inten) == pytest.approx(1.0)
-    assert intensity_correlation(m, b, -inten) == pytest.approx(-1.0)
+    assert intensity_correlation(inten, inten * 3 - 1) == pytest.approx(1.0)
+    assert intensity_correlation(inten, -inten) == pytest.approx(-1.0)
+    with pytest.warns(BeatsyncWarning, match="fewer than two"):
+        assert np.isnan(intensity_correlation(inten[:1], inten[:1]))

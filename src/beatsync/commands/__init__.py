@@ -10,7 +10,16 @@ lists the subcommands from :data:`COMMAND_HELP` without importing any of them.
 """
 
 # Order shown in ``beatsync --help``.
-COMMAND_MODULES = ("segment", "beats", "sync", "compose", "batch", "reproduce", "data")
+COMMAND_MODULES = (
+    "segment",
+    "beats",
+    "sync",
+    "compose",
+    "batch",
+    "evaluate",
+    "reproduce",
+    "data",
+)
 
 # One-line help of each subcommand, shown by ``beatsync --help`` (a module's own
 # ``register`` uses the same text; a subcommand missing here is imported to list it).
@@ -20,6 +29,7 @@ COMMAND_HELP = {
     "sync": "resample a periodic dance so that its periods land on the beats of a song",
     "compose": "compose a dance for a song from a library of motion clips (motion graph + DP)",
     "batch": "sync every motion clip with every song, in parallel on Dask",
+    "evaluate": "score beat trackers against annotations over a dataset (on Dask)",
     "reproduce": "run the study's notebooks with papermill from a parameter file",
     "data": "list the bundled data files and verify their SHA-256 checksums",
 }

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ._common import add_json_flag, add_period_range, emit
 
@@ -38,8 +39,10 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import io
     from ..batch import sync_grid
+    from ..cluster import check_cluster_options
     from ._common import check_output_path
 
+    workers = check_cluster_options(args.scheduler, args.workers)
     summary = Path(args.summary) if args.summary else Path(args.out_dir) / "summary.csv"
     check_output_path(summary, *args.clips, *args.songs)
     table = sync_grid(
@@ -47,10 +50,11 @@ def run(args: argparse.Namespace) -> int:
         args.songs,
         args.out_dir,
         scheduler=args.scheduler,
-        n_workers=args.workers,
+        n_workers=workers,
         fps=args.fps,
         bpm=args.bpm,
         period_range=tuple(args.period_range),
+        progress=sys.stderr.isatty() and not args.json and not getattr(args, "quiet", False),
     )
     io.write_csv(summary, table)
     n_ok = int((table["status"] == "ok").sum())

@@ -7,36 +7,28 @@ programming, synthesizes the dance (every motion beat on a music beat, blended
 transitions) and writes it as BVH, optionally a video with the music and a JSON
 report (path, number of transitions, graph-build and search times).
 
-Graph cache (on by default): built graphs are stored as ``graph-<key>.npz`` in
+Graph cache (on by default, :mod:`beatsync.graph.cache`): built graphs are stored in
 ``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else in
-``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it, and deleting the
-folder is always safe. An entry is keyed by the SHA-256 of the library files'
-content, their order, the frame-rate override, every graph parameter, the package
-version and the source code of the modules that determine the graph
-(``beatsync/graph/build.py`` and ``beatsync/motion_beats.py``), so editing a clip, a
-parameter or the graph code (also in an editable install) rebuilds the graph.
+``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it.
 """
 
 from __future__ import annotations
 
 import argparse
-import hashlib
-import json
-import os
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import BeatsyncWarning, ParameterError
 from ._common import add_json_flag, check_output_path, check_side_outputs, emit
 
-__all__ = ["register", "run", "cache_dir", "graph_cache_key", "graph_source_hash"]
+__all__ = ["register", "run"]
 
 _AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
-_CACHE_VERSION = 1
 
 
 def register(subparsers: Any) -> None:
@@ -111,6 +103,32 @@ def register(subparsers: Any) -> None:
         help="weight of a tempo term against strong time warps (0 = paper B, intensity only)",
     )
     p.add_argument(
+        "--scale-bound",
+        type=float,
+        nargs=2,
+        default=[0.8, 1.25],
+        metavar=("LO", "HI"),
+        help="bound on every interval's time-scale factor, music duration / natural "
+        "duration (default 0.8 1.25: at most 25%% faster or slower than captured)",
+    )
+    p.add_argument(
+        "--no-scale-bound",
+        action="store_true",
+        help="no bound: any interval may be warped onto any beat (paper B as written)",
+    )
+    p.add_argument(
+        "--multiplicity",
+        default="auto",
+        metavar="M[,M...]",
+        help="music beats one motion-beat interval may cover, e.g. 1,2 or 0.5,1 "
+        "(default auto: chosen from the library's and the song's tempo)",
+    )
+    p.add_argument(
+        "--all-clips",
+        action="store_true",
+        help="use every clip, not only the tempo group that suits the song",
+    )
+    p.add_argument(
         "--blend", type=float, default=1.0 / 3.0, help="transition blend length [s] (default 1/3)"
     )
     p.add_argument(
@@ -128,49 +146,6 @@ def register(subparsers: Any) -> None:
     )
     add_json_flag(p)
     p.set_defaults(func=run)
-
-
-def cache_dir() -> Path:
-    """The graph cache folder: ``$BEATSYNC_CACHE_DIR`` or ``~/.cache/beatsync``."""
-    env = os.environ.get("BEATSYNC_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "beatsync"
-
-
-def graph_source_hash() -> str:
-    """SHA-256 of the source of the modules that determine a graph.
-
-    ``beatsync/graph/build.py`` and ``beatsync/motion_beats.py`` (beat frames,
-    intensities, distances) and the foundation they rest on: ``io.py`` (BVH
-    reading), ``motion.py`` (forward kinematics) and ``units.py``. Part of
-    :func:`graph_cache_key`, so a code change (also in an editable install, where
-    ``__version__`` does not move) rebuilds cached graphs.
-    """
-    from .. import io, motion, motion_beats, units
-    from ..graph import build
-    from ..io import sha256_file
-
-    h = hashlib.sha256()
-    for module in (build, motion_beats, io, motion, units):
-        h.update(sha256_file(Path(module.__file__)).encode())
-    return h.hexdigest()
-
-
-def graph_cache_key(files: list[Path], params: dict[str, Any]) -> str:
-    """Hash of the library files' content (in order), the graph parameters and code.
-
-    The code part is the package version, ``_CACHE_VERSION`` (the cache file layout)
-    and :func:`graph_source_hash`.
-    """
-    from .. import __version__
-    from ..io import sha256_file
-
-    h = hashlib.sha256()
-    h.update(f"beatsync-graph-v{_CACHE_VERSION}-{__version__}".encode())
-    h.update(graph_source_hash().encode())
-    for f in files:
-        h.update(sha256_file(f).encode())
-    h.update(json.dumps(params, sort_keys=True, default=str).encode())
-    return h.hexdigest()[:32]
 
 
 def _library_files(entries: list[str]) -> list[Path]:
@@ -225,67 +200,75 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     return {"audio": audio, "files": files, "out": out, "video": video, "report": report, "th": th}
 
 
-def _load_or_build(files, clips, params, use_cache):
-    from .. import io
-    from ..graph import build_graph
-    from ..graph.build import WeightedMotionGraph
-
-    key = graph_cache_key(files, params) if use_cache else None
-    path = cache_dir() / f"graph-{key}.npz" if key else None
-    if path is not None and path.is_file():
-        try:
-            g = WeightedMotionGraph.from_arrays(io.read_npz(path), clips, params)
-            if int(g.node_clip.max(initial=-1)) < len(clips):
-                return g, True, path
-        except (ParameterError, ValueError, KeyError):
-            pass  # a damaged cache entry is rebuilt
-    g = build_graph(
-        clips,
-        th=params["th"],
-        weight_rule=params["weight_rule"],
-    )
-    if path is not None:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            io.write_npz(path, g.to_arrays())
-        except OSError:
-            path = None  # an unwritable cache is not an error
-    return g, False, path
-
-
 def run(args: argparse.Namespace) -> int:
     from .. import io
-    from ..graph.compose import compose_music
+    from ..graph.compose import check_music_beats, compose_music
 
     chk = _check_inputs(args)
     if not (np.isfinite(args.tempo_weight) and args.tempo_weight >= 0):
         raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
     if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
+    from ..graph.timescale import check_multiplicity, check_scale_bound
+
+    bound = (
+        None if args.no_scale_bound else check_scale_bound(args.scale_bound, name="--scale-bound")
+    )
+    mult = args.multiplicity
+    if mult != "auto":
+        mult = mult.split(",")
+    mult = check_multiplicity(mult)
     files = chk["files"]
     t_read = time.perf_counter()
-    clips = [io.read_bvh(f, fps=args.fps) for f in files]
     y, sr = io.read_audio(chk["audio"])
-    beats = io.read_beats(args.beats) if args.beats is not None else None
+    beats = None
+    if args.beats is not None:  # cheap checks first: the beats file before the clips
+        try:
+            beats = check_music_beats(io.read_beats(args.beats), duration=y.size / float(sr))
+        except ParameterError as exc:
+            raise ParameterError(f"beats file {args.beats!r}: {exc}") from None
+    clips = [io.read_bvh(f, fps=args.fps) for f in files]
     read_s = time.perf_counter() - t_read
-    if beats is not None and beats.size < 2:
-        raise ParameterError(f"beats file {args.beats!r} has {beats.size} beat(s); need >= 2")
     from ..graph import check_library
+    from ..graph.cache import load_or_build
     from ..music import track_music_beats
 
     check_library(clips)
+    notes: list[str] = []
     if beats is None:
-        beats = track_music_beats(y, sr, bpm=args.bpm)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            beats = track_music_beats(y, sr, bpm=args.bpm)
+        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        for note in notes:
+            print(f"beatsync compose: warning: {note}", file=sys.stderr)
     params = {
         "th": chk["th"],
         "weight_rule": args.weight_rule,
         "fps": args.fps,
     }
     t0 = time.perf_counter()
-    graph, cached, cache_path = _load_or_build(files, clips, params, not args.no_cache)
+    graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
     build_s = time.perf_counter() - t0
     kw = {"tempo_weight": args.tempo_weight} if args.method == "dp" and args.tempo_weight else {}
-    comp = compose_music(graph, y, sr, beats=beats, method=args.method, blend=args.blend, **kw)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BeatsyncWarning)
+        comp = compose_music(
+            graph,
+            y,
+            sr,
+            beats=beats,
+            method=args.method,
+            blend=args.blend,
+            scale_bound=bound,
+            multiplicity=mult,
+            tempo_select=not args.all_clips,
+            **kw,
+        )
+    for w in caught:
+        if issubclass(w.category, BeatsyncWarning):
+            notes.append(str(w.message))
+            print(f"beatsync compose: warning: {w.message}", file=sys.stderr)
     out = io.write_bvh(chk["out"], comp.motion)
     video_path = None
     if chk["video"] is not None:
@@ -319,6 +302,10 @@ def run(args: argparse.Namespace) -> int:
         "n_frames": comp.motion.n_frames,
         "fps": comp.motion.fps,
         "transition_times_s": comp.synthesis.transition_times,
+        "tempo": comp.tempo.report(),
+        "multiplicity_used": comp.report()["multiplicity_used"],
+        "plausibility": comp.plausibility,
+        "warnings": notes,
     }
     if chk["report"] is not None:
         io.write_json(chk["report"], result)
@@ -331,10 +318,32 @@ def run(args: argparse.Namespace) -> int:
         f"{' (graph from cache)' if cached else ''}\n"
         f"music: {comp.music_beats.size} beats (~{result['tempo_bpm']:.1f} BPM)\n"
         f"path: {comp.search.path.size} intervals, {comp.n_transitions} transition(s); "
-        f"graph build {build_s:.3f} s, search ({args.method}) {comp.search.search_time:.4f} s"
+        f"graph build {build_s:.3f} s, search ({args.method}) {comp.search.search_time:.4f} s\n"
+        + _tempo_text(comp)
     )
     if video_path:
         text += f"\nvideo: {video_path}"
     if chk["report"] is not None:
         text += f"\nreport: {chk['report']}"
     return emit(result, text, args)
+
+
+def _tempo_text(comp: Any) -> str:
+    """Eligible clips, multiplicities and plausibility, for the terminal."""
+    plan = comp.tempo
+    p = comp.plausibility
+    bound = "none" if plan.bound is None else f"{plan.bound[0]:g}-{plan.bound[1]:g}"
+    used = ", ".join(f"{k} beat(s) x{v}" for k, v in comp.report()["multiplicity_used"].items())
+    lines = [
+        f"tempo: song {plan.song_bpm:.0f} BPM, library {plan.library_bpm:.0f} BPM; "
+        f"time-scale bound {bound}; intervals covering {used}"
+    ]
+    for row in plan.clip_table:
+        mark = "used" if row["eligible"] else "not used"
+        lines.append(f"  {row['clip']}: {mark}: {row['reason']}")
+    lines.append(
+        f"speed: root p99 {p['root_speed_p99']:.3g} ({p['root_speed_ratio']:.2f}x the fastest "
+        f"clip), joint rotation p99 {p['rotation_speed_p99']:.0f} deg/s "
+        f"({p['rotation_speed_ratio']:.2f}x); time-scale {p['scale_min']:.2f}-{p['scale_max']:.2f}"
+    )
+    return "\n".join(lines)

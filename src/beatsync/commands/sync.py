@@ -25,6 +25,8 @@ from ._common import add_json_flag, add_period_range, check_output_path, check_s
 __all__ = ["register", "run"]
 
 _MOTION_OUT = (".bvh", ".csv")
+#: shortest song the beat tracker is asked about [s]
+MIN_MUSIC_S = 1.0
 
 
 def register(subparsers: Any) -> None:
@@ -72,7 +74,8 @@ def register(subparsers: Any) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="music beats per motion period (default: round(motion period / beat))",
+        help="music beats per motion period, or per motion beat with --mode beats "
+        "(default: round(motion period / beat), respecting the meters)",
     )
     p.add_argument(
         "--first-beat",
@@ -93,6 +96,28 @@ def register(subparsers: Any) -> None:
         action="store_true",
         help="put the dancer's accents (kinematic beats: minima of joint speed) "
         "on the beats instead of the period boundaries",
+    )
+    p.add_argument(
+        "--mode",
+        choices=("auto", "periods", "beats"),
+        default="auto",
+        help="what lands on the beats: 'periods' (paper A: the motion's periods), 'beats' "
+        "(the dancer's own motion beats, for dances that are not strictly periodic), or "
+        "'auto' (periods if the motion is periodic, else beats, with a warning; default)",
+    )
+    p.add_argument(
+        "--fill",
+        choices=("loop", "stop"),
+        default="loop",
+        help="'loop' (default): repeat whole periods, with blended joins, until the dance "
+        "covers the song to its last beat; 'stop': end with the clip's last period",
+    )
+    p.add_argument(
+        "--beats-per-bar",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the music's meter (3 for a waltz); beats per period then respect it",
     )
     add_period_range(p)
     p.add_argument(
@@ -181,7 +206,7 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     from ..sync import synchronize
 
     t_start = time.perf_counter()
-    steps = _Steps(5 + (video is not None))
+    steps = _Steps(4 + (video is not None))
     timings: dict[str, float] = {}
     try:
         steps.step("reading motion")
@@ -196,28 +221,7 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         timings["read_s"] = time.perf_counter() - t0
         steps.done()
 
-        steps.step("segmenting periods")
-        t0 = time.perf_counter()
-        from ..motion import segmentation_view
-        from ..segment import segment
-
-        lo, hi = args.period_range
-        seg = segment(segmentation_view(motion), period_range=(lo, hi))
-        if seg.n_periods < 1 or len(seg.boundaries) < 2:
-            raise ParameterError(
-                f"{args.motion!r} does not look periodic: no full motion period found "
-                f"in {lo}-{hi} s (try --period-range, or a periodic dance clip)"
-            )
-        timings["segment_s"] = time.perf_counter() - t0
-        steps.done()
-
         music_s = y.size / sr
-        if music_s < seg.mean_period:
-            raise ParameterError(
-                f"the music ({music_s:.2f} s) is shorter than one motion period "
-                f"({seg.mean_period:.2f} s): use a longer song"
-            )
-
         steps.step("finding beats")
         t0 = time.perf_counter()
         if args.beats is not None:
@@ -226,6 +230,11 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         else:
             from ..beats import track_beats
 
+            if music_s < MIN_MUSIC_S:
+                raise ParameterError(
+                    f"the music ({music_s:.2f} s) is shorter than {MIN_MUSIC_S:g} s: too short "
+                    "to find beats in; use a longer song"
+                )
             track = track_beats(y, sr, bpm=args.bpm)
             beats = np.asarray(track.beats, dtype=np.float64)
             beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
@@ -237,19 +246,22 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         timings["beats_s"] = time.perf_counter() - t0
         steps.done()
 
-        steps.step("resampling motion")
+        steps.step("synchronising motion")
         t0 = time.perf_counter()
         res = synchronize(
             motion,
-            seg.boundaries,
+            None,
             beats,
+            mode=args.mode,
+            land="accents" if args.align_accents else "boundaries",
+            fill=args.fill,
             beats_per_period=args.beats_per_period,
+            beats_per_bar=args.beats_per_bar,
             first_beat=args.first_beat,
             out_fps=args.out_fps,
             phase_offset=args.phase_offset,
+            period_range=tuple(args.period_range),
         )
-        if args.align_accents:
-            res = _align_accents(res, motion, seg.boundaries, beats, args)
         timings["sync_s"] = time.perf_counter() - t0
         steps.done()
 
@@ -258,7 +270,8 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
             steps.step("writing video")
             t0 = time.perf_counter()
             vid = _render_video(
-                res.motion, video, (y, sr), beats, args.video_fps, steps.interactive
+                res.motion, video, (y, sr), beats, args.video_fps, steps.interactive,
+                music_s if args.fill == "loop" else None,
             )
             written["video"] = str(vid)
             timings["video_s"] = time.perf_counter() - t0
@@ -283,9 +296,9 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         "n_music_beats": int(beats.size),
         "music_duration_s": music_s,
         "segmentation": {
-            "n_periods": int(seg.n_periods),
-            "mean_period_s": float(seg.mean_period),
-            "boundaries_s": np.asarray(seg.boundaries),
+            "mode": rep["mode"],
+            "n_periods": int(rep["periods_available"]),
+            "mean_period_s": float(rep["mean_motion_period_s"]),
         },
         "report": rep,
         "outputs": written,
@@ -294,57 +307,45 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     return result
 
 
-def _align_accents(
-    res: Any, motion: Any, boundaries: Any, beats: np.ndarray, args: argparse.Namespace
-) -> Any:
-    """Synchronise again so that the kinematic beats, not the boundaries, hit the beats."""
-    from ..evaluate.alignment import kinematic_phase_offset
-    from ..motion_beats import kinematic_beats
-    from ..sync import synchronize
-
-    try:
-        mb = kinematic_beats(res.motion)
-    except ParameterError as exc:
-        raise ParameterError(
-            f"--align-accents needs joint positions (a BVH skeleton or markers): {exc}"
-        ) from None
-    lag = kinematic_phase_offset(mb, beats)
-    first = args.first_beat
-    if beats[first] - lag < 0:
-        first += 1
-    return synchronize(
-        motion,
-        boundaries,
-        beats,
-        beats_per_period=args.beats_per_period,
-        first_beat=first,
-        out_fps=args.out_fps,
-        phase_offset=-lag,
-    )
-
-
 def _render_video(
-    motion: Any, path: Path, audio: Any, beats: np.ndarray, fps: float, progress: bool
+    motion: Any,
+    path: Path,
+    audio: Any,
+    beats: np.ndarray,
+    fps: float,
+    progress: bool,
+    duration: float | None,
 ) -> Path:
     from .. import render
 
-    return render.write_video(motion, path, audio=audio, fps=fps, beats=beats, progress=progress)
+    return render.write_video(
+        motion, path, audio=audio, fps=fps, beats=beats, progress=progress, duration=duration
+    )
 
 
 def _text(result: dict[str, Any]) -> str:
     r = result["report"]
     res = np.abs(np.asarray(r["residual_ms"]))
     near = np.abs(np.asarray(r["residual_nearest_frame_ms"]))
+    unit = "periods" if r["mode"] == "periods" else "motion beats"
+    meter = ""
+    if r.get("meter_fit") is False:
+        meter = " (meters do not fit)"
     lines = [
         f"motion   {result['motion']}: {r['input_frames']} frames at {r['input_fps']:g} fps, "
-        f"{result['segmentation']['n_periods']} periods of "
-        f"{result['segmentation']['mean_period_s']:.3f} s (mean)",
+        f"{result['segmentation']['n_periods']} {unit} of "
+        f"{result['segmentation']['mean_period_s']:.3f} s "
+        f"({'mean' if r['mode'] == 'periods' else 'median'})",
         f"music    {result['audio']}: {result['music_duration_s']:.2f} s, "
         f"{result['n_music_beats']} beats ({result['beats_source']}), "
         f"beat period {r['beat_period_s']:.3f} s",
-        f"mapping  {r['periods_used']} of {r['periods_available']} periods, "
-        f"{r['beats_per_period']} beat(s) per period ({r['beats_per_period_rule']}), "
-        f"first period on beat {r['first_beat']}"
+        f"mode     {r['mode']}"
+        + (f" (asked {r['mode_requested']}: not periodic, fell back)"
+           if r["mode"] != r["mode_requested"] else "")
+        + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
+        f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "
+        f"{r['beats_per_period']} beat(s) per {unit[:-1]} ({r['beats_per_period_rule']})"
+        f"{meter}, first on beat {r['first_beat']}"
         + (f", {r['phase_offset_s'] * 1000:+.0f} ms after it" if r["phase_offset_s"] else ""),
         f"tempo    playback speed x{r['tempo_ratio_range'][0]:.3f} .. "
         f"x{r['tempo_ratio_range'][1]:.3f}",

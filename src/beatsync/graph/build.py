@@ -19,13 +19,9 @@ Following Kovar, Gleicher and Pighin (2002, "Motion graphs"), each beat frame ``
 is represented by the point cloud of all joint positions (end sites included) over a
 window of frames ``f - h .. f + h`` (``window`` [s] long, clipped at the clip ends).
 Two clouds are compared after the rigid 2-D transform (rotation about the vertical
-axis, translation on the floor) that best aligns them, which has a closed form:
-with both clouds centred on the floor plane,
-``D^2 = (S_i + S_j - 2 sqrt(a^2 + b^2) - 2 Y_ij) / M`` where ``S`` are the summed
-squared centred coordinates, ``a = sum(x_i x_j + z_i z_j)``,
-``b = sum(x_i z_j - z_i x_j)``, ``Y_ij = sum(y_i y_j)`` and ``M`` the number of points.
-``D`` is the RMS joint distance [position unit] after aligning root position and
-heading.
+axis, translation on the floor) that best aligns them (closed form, computed stably:
+:mod:`beatsync.graph.distance`). ``D`` is the RMS joint distance [position unit]
+after aligning root position and heading.
 
 ``D`` has the units of the data, so a fixed ``TH`` would mean different things on
 different libraries. We make it scale-free::
@@ -63,6 +59,7 @@ import numpy as np
 from ..errors import BeatsyncWarning, ParameterError
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
 from ..units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
+from .distance import aligned_distance_matrix, point_clouds, typical_speed
 
 __all__ = [
     "WeightedMotionGraph",
@@ -70,96 +67,10 @@ __all__ = [
     "check_library",
     "check_th",
     "transition_weight",
-    "aligned_distance_matrix",
-    "aligned_pair_distance",
-    "typical_speed",
     "WEIGHT_RULES",
 ]
 
 WEIGHT_RULES = ("paper", "rd")
-
-
-# --------------------------------------------------------------------------- distances
-
-
-def _clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.ndarray:
-    """Point clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` around each frame."""
-    n = positions.shape[0]
-    idx = np.clip(frames[:, None] + np.arange(-half, half + 1)[None, :], 0, n - 1)
-    c = positions[idx]  # (m, w, J, 3)
-    return c.reshape(c.shape[0], -1, 3)
-
-
-def _center(c: np.ndarray, up: int) -> np.ndarray:
-    c = c.copy()
-    for ax in range(3):
-        if ax != up:
-            c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
-    return c
-
-
-def _ground_axes(up: int) -> tuple[int, int]:
-    # right-handed order so that (g0, up, g1) is a rotation of (x, y, z)
-    return {0: (1, 2), 1: (2, 0), 2: (0, 1)}[up]
-
-
-def aligned_distance_matrix(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
-    """RMS distance between point clouds after the best floor-plane rigid alignment.
-
-    Parameters
-    ----------
-    a : np.ndarray [shape=(na, m, 3)] [position unit]
-    b : np.ndarray [shape=(nb, m, 3)]
-    up : int
-        Index of the vertical axis (1 = y, the BVH convention).
-
-    Returns
-    -------
-    d : np.ndarray [shape=(na, nb)] [position unit]
-    """
-    g0, g1 = _ground_axes(up)
-    a = _center(a, up)
-    b = _center(b, up)
-    m = a.shape[1]
-    sa = np.sum(a * a, axis=(1, 2))
-    sb = np.sum(b * b, axis=(1, 2))
-    dot = a[:, :, g0] @ b[:, :, g0].T + a[:, :, g1] @ b[:, :, g1].T
-    crs = a[:, :, g0] @ b[:, :, g1].T - a[:, :, g1] @ b[:, :, g0].T
-    yy = a[:, :, up] @ b[:, :, up].T
-    d2 = sa[:, None] + sb[None, :] - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * yy
-    return np.sqrt(np.maximum(d2, 0.0) / m)
-
-
-def aligned_pair_distance(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
-    """Row-wise version of :func:`aligned_distance_matrix` (``a[k]`` vs ``b[k]``)."""
-    g0, g1 = _ground_axes(up)
-    a = _center(a, up)
-    b = _center(b, up)
-    m = a.shape[1]
-    sa = np.sum(a * a, axis=(1, 2))
-    sb = np.sum(b * b, axis=(1, 2))
-    dot = np.sum(a[:, :, g0] * b[:, :, g0] + a[:, :, g1] * b[:, :, g1], axis=1)
-    crs = np.sum(a[:, :, g0] * b[:, :, g1] - a[:, :, g1] * b[:, :, g0], axis=1)
-    yy = np.sum(a[:, :, up] * b[:, :, up], axis=1)
-    d2 = sa + sb - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * yy
-    return np.sqrt(np.maximum(d2, 0.0) / m)
-
-
-def typical_speed(
-    positions_list: Sequence[np.ndarray], fps_list: Sequence[float], *, half: int, up: int = 1
-) -> float:
-    """Median aligned window distance between consecutive frames, times fps [unit / s]."""
-    vals = []
-    for pos, fps in zip(positions_list, fps_list, strict=True):
-        n = pos.shape[0]
-        step = max(1, n // 2000)  # subsample very long clips
-        f = np.arange(0, n - 1, step)
-        for s in range(0, f.size, 500):
-            ff = f[s : s + 500]
-            d = aligned_pair_distance(_clouds(pos, ff, half), _clouds(pos, ff + 1, half), up=up)
-            vals.append(d * fps)
-    v = float(np.median(np.concatenate(vals))) if vals else 0.0
-    return v
 
 
 def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
@@ -629,7 +540,7 @@ def build_graph(
     if not speed > 0:
         raise ParameterError("the library does not move (zero typical speed): rd is undefined")
     clouds = np.concatenate(
-        [_clouds(p, f, half) for p, f in zip(positions, frames_list, strict=True) if f.size]
+        [point_clouds(p, f, half) for p, f in zip(positions, frames_list, strict=True) if f.size]
     )
     src_l, dst_l, rd_l = [], [], []
     min_rd = np.inf

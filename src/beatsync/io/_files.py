@@ -15,7 +15,11 @@ import numpy as np
 from ..errors import ParameterError
 
 
-def _existing_file(path: str | os.PathLike[str], what: str) -> Path:
+def check_input_file(path: str | os.PathLike[str], what: str) -> Path:
+    """Return ``path`` as a Path after checking it is an existing, non-empty file.
+
+    ``what`` names the kind of file in messages (``"BVH"``, ``"audio"``).
+    """
     p = Path(path)
     if not p.exists():
         raise ParameterError(f"{what} file {str(p)!r} does not exist")
@@ -114,9 +118,13 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
     """SHA-256 hex digest of a file's bytes."""
     import hashlib
 
-    p = _existing_file(path, "input")
+    p = check_input_file(path, "input")
     h = hashlib.sha256()
     with open(p, "rb") as fh:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
             h.update(chunk)
     return h.hexdigest()
+
+
+# The former private name, still imported by io.positions; new code uses check_input_file.
+_existing_file = check_input_file

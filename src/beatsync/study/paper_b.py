@@ -1,20 +1,22 @@
-"""Study helpers for paper B's tables: libraries, timing and quality tables, artefacts.
+"""Paper B's study: libraries, timing and quality tables, figures (the notebooks' calls).
 
 The notebooks only call these functions.
 
 - :func:`load_library` returns the motion libraries that stand in for paper B's
   (their Break dance and Indian dance captures are not available): the four CMU
-  salsa takes, the CMU walking clips of one skeleton, or :mod:`synthetic` dances.
+  salsa takes, the CMU walking clips of one skeleton, or synthetic dances
+  (:mod:`beatsync.synth.library`).
 - :func:`speed_table` times the DP (proposed) and the multi-stage search
   (conventional) on synthetic drum songs of the given lengths
-  (:func:`beatsync.music.drum_song`), side by side in the same run, graph build
+  (:func:`beatsync.synth.audio.drum_song`), side by side in the same run, graph build
   excluded, and :func:`ratio_table` derives the speedups and the time ratios when
   the music doubles, with paper B's reported values beside ours.
 - :func:`threshold_table` counts transition edges for several TH under two
   normalisations of ``rd`` (per frame-to-frame distance, and per 0.1 s of typical
   movement, our default).
 - :func:`quality_table` scores compositions with the proxies of
-  :mod:`beatsync.graph.quality`.
+  :mod:`beatsync.evaluate.composition` (:func:`composition_proxies` computes the
+  arrays they need: kinematic beats, positions, intensities).
 - :func:`write_artifacts` writes tables (CSV), figures (PNG) and the parameters with
   the package version (JSON) under ``results/<notebook>/``.
 
@@ -31,10 +33,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ..study.artifacts import write_artifacts  # noqa: F401 (re-exported for the notebooks)
-from .build import WeightedMotionGraph, build_graph
-from .compose import compose
-from .search import conventional_search, dp_search
+from ..graph.build import WeightedMotionGraph, build_graph
+from ..graph.compose import compose
+from ..graph.search import conventional_search, dp_search
+from .artifacts import write_artifacts
 
 __all__ = [
     "LIBRARIES",
@@ -45,6 +47,7 @@ __all__ = [
     "ratio_table",
     "threshold_table",
     "quality_table",
+    "composition_proxies",
     "library_reference",
     "summary_graphs",
     "plot_speed",
@@ -60,7 +63,7 @@ LIBRARIES = {
     ),
     "synthetic": (
         "paper B's Indian dance library",
-        "4 synthetic in-place dances, 90-130 BPM, 3-move vocabulary (beatsync.graph.synthetic)",
+        "4 synthetic in-place dances, 90-130 BPM, 3-move vocabulary (beatsync.synth.library)",
     ),
     "walk": (
         "paper B's Indian dance library",
@@ -98,7 +101,7 @@ def load_library(
     if name == "walk":
         return [datasets.load_walk(c) for c in ("007_02", "007_12")], None
     if name == "synthetic":
-        from .synthetic import synthetic_library
+        from ..synth.library import synthetic_library
 
         clips, beats = synthetic_library(n_clips, duration=duration, seed=seed)
         return clips, beats
@@ -107,7 +110,8 @@ def load_library(
 
 def song(duration: float, *, bpm: float = 100.0, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Beats [s] and level per beat interval [dB] of a synthetic drum song."""
-    from ..music import beat_rms_db, drum_song
+    from ..music import beat_rms_db
+    from ..synth.audio import drum_song
 
     s = drum_song(duration, bpm=bpm, seed=seed, sr=22050)
     return s.beats, beat_rms_db(s.y, s.sr, s.beats)
@@ -260,8 +264,6 @@ def quality_table(
     """
     import pandas as pd
 
-    from .quality import quality_proxies
-
     labels = {
         "dp": "proposed DP (w2 = max(rd, 2))",
         "dp_rd": "proposed DP (w2 = rd)",
@@ -285,9 +287,54 @@ def quality_table(
                 if m == "dp_tempo":
                     kw["tempo_weight"] = 1.0
                 comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
-                q = quality_proxies(comp, sigma=sigma)
+                q = composition_proxies(comp, sigma=sigma)
                 rows.append({"method": labels[m], "music_s": float(dur), "seed": int(seed), **q})
     return pd.DataFrame(rows)
+
+
+def composition_proxies(
+    comp: Any, *, sigma: float = 0.05, blend: float = 1.0 / 3.0, beat_smooth: float = 0.1
+) -> dict[str, float]:
+    """Quality proxies of a :class:`~beatsync.graph.compose.Composition`.
+
+    Runs the stages the proxies need on the composed motion (kinematic beats with
+    ``beat_smooth`` [s] smoothing, joint positions, intensity per music beat interval)
+    and scores them with :func:`beatsync.evaluate.composition.quality_proxies`. On
+    noise-free motion the default smoothing can move a speed minimum by a frame or
+    two, so motion whose beats land exactly scores alignment 1 only with 0.
+
+    Returns
+    -------
+    dict
+        The proxies plus ``n_transitions``.
+    """
+    from ..evaluate.composition import foot_joints, quality_proxies
+    from ..motion_beats import beat_interval_intensity, kinematic_beats, motion_positions
+    from ..units import frames_to_time
+
+    m = comp.motion
+    beats = comp.music_beats
+    last = float(frames_to_time(m.n_frames - 1, fps=m.fps))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        mb = kinematic_beats(m, smooth=beat_smooth)
+        inside = beats[beats <= last + 1e-9]
+        inten = beat_interval_intensity(m, inside) if inside.size >= 2 else np.empty(0)
+    pos = motion_positions(m)
+    q = quality_proxies(
+        motion_beats=mb,
+        music_beats=beats,
+        span=(float(beats[0]), float(min(beats[-1], last))),
+        positions=pos,
+        foot_positions=motion_positions(m, joints=foot_joints(m)),
+        fps=m.fps,
+        transition_times=comp.synthesis.transition_times,
+        motion_intensity=inten,
+        music_level=comp.music_level,
+        sigma=sigma,
+        blend=blend,
+    )
+    return {**q, "n_transitions": int(comp.search.n_transitions)}
 
 
 def library_reference(clips: Sequence[Any]) -> Any:
@@ -297,15 +344,17 @@ def library_reference(clips: Sequence[Any]) -> Any:
     """
     import pandas as pd
 
-    from .quality import _velocity_change, foot_sliding
+    from ..evaluate.composition import foot_joints, foot_sliding, velocity_change
+    from ..motion_beats import motion_positions
 
     rows = []
     for c in clips:
-        dv = _velocity_change(c)
+        dv = velocity_change(motion_positions(c), fps=c.fps)
+        feet = motion_positions(c, joints=foot_joints(c))
         rows.append(
             {
                 "clip": c.name,
-                "foot_sliding": foot_sliding(c),
+                "foot_sliding": foot_sliding(feet, fps=c.fps),
                 "velocity_change_p99_over_median": float(np.percentile(dv, 99) / np.median(dv)),
             }
         )

@@ -1,0 +1,215 @@
+"""Objective quality proxies of a composed dance (stand-ins for paper B's user study).
+
+Paper B's Table 2 is a user study; we cannot repeat it. These numbers are *proxies*
+for what viewers judged, not a replacement. Every function takes arrays (beat times,
+joint positions, intensities) computed by the caller (:mod:`beatsync.study.paper_b`
+runs the stages); nothing here runs a stage.
+
+- **Beat alignment** (:mod:`beatsync.evaluate.alignment`): both published scores,
+  averaged over motion beats (Siyao et al. 2022) and over music beats (Li et al.
+  2021), Gaussian sigma 0.05 s, on the kinematic beats of the composed motion.
+- **Intensity correlation** (:func:`intensity_correlation`): Pearson r between the
+  composed motion's intensity per music beat interval (mean joint kinetic energy) and
+  the music level (RMS dB).
+- **Transition smoothness** (:func:`transition_jumps`): the largest frame-to-frame
+  change of joint velocity (mean over joints, :func:`velocity_change`) within
+  ``[T - 1 frame, T + blend]`` of each transition, divided by the median of that
+  change over the whole dance: 1 means a transition is as smooth as ordinary
+  movement, large values mean a visible jerk.
+- **Foot sliding** (:func:`foot_sliding`): mean horizontal speed [position unit / s]
+  of the feet while they are in contact with the floor (height below the foot's 5th
+  percentile plus 10 % of its height range), averaged over feet.
+
+Physical plausibility (root speed and joint rotation speed against the library's) is
+part of the composition's own report (:mod:`beatsync.graph.plausibility`).
+
+Data contract: times in seconds (1-D, increasing); positions ``(n_frames, n_joints,
+3)`` [position unit] at ``fps`` [Hz].
+
+Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 4 (Table 2).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..errors import BeatsyncWarning, ParameterError
+from ..units import time_to_frames
+from .alignment import alignment_scores
+
+__all__ = [
+    "intensity_correlation",
+    "velocity_change",
+    "transition_jumps",
+    "foot_sliding",
+    "foot_joints",
+    "quality_proxies",
+]
+
+
+def intensity_correlation(motion_intensity: Any, music_level: Any) -> float:
+    """Pearson r between motion intensity and music level per music beat interval.
+
+    Parameters
+    ----------
+    motion_intensity : np.ndarray [shape=(K',)]
+        The composed motion's intensity per music beat interval (``K' <= K``: the
+        intervals the motion covers).
+    music_level : np.ndarray [shape=(K,)] [dB]
+
+    Returns
+    -------
+    r : float
+        NaN (with a warning for fewer than two intervals) when undefined.
+    """
+    inten = np.asarray(motion_intensity, dtype=np.float64)
+    level = np.asarray(music_level, dtype=np.float64)[: inten.size]
+    if inten.size < 2:
+        warnings.warn(
+            "fewer than two beat intervals: correlation set to NaN", BeatsyncWarning, stacklevel=2
+        )
+        return float("nan")
+    if np.std(inten) == 0 or np.std(level) == 0:
+        return float("nan")
+    return float(np.corrcoef(inten, level)[0, 1])
+
+
+def velocity_change(positions: Any, *, fps: float) -> np.ndarray:
+    """Mean over joints of ``|v_{j+1} - v_j|`` between successive frames [unit / s].
+
+    Parameters
+    ----------
+    positions : np.ndarray [shape=(n_frames, n_joints, 3)]
+    fps : float > 0 [Hz]
+
+    Returns
+    -------
+    dv : np.ndarray [shape=(n_frames - 1,)]
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    vel = np.gradient(pos, axis=0) * fps
+    return np.linalg.norm(np.diff(vel, axis=0), axis=2).mean(axis=1)
+
+
+def transition_jumps(
+    positions: Any, transition_times: Any, *, fps: float, blend: float = 1.0 / 3.0
+) -> np.ndarray:
+    """Velocity-jump ratio at each transition (see module docstring); empty if none."""
+    tt = np.asarray(transition_times, dtype=np.float64)
+    dv = velocity_change(positions, fps=fps)
+    med = float(np.median(dv))
+    if tt.size == 0:
+        return np.empty(0)
+    if med <= 0:
+        raise ParameterError("the motion does not move: velocity changes are all zero")
+    out = []
+    first = time_to_frames(tt, fps=fps, mode="floor") - 1
+    after = time_to_frames(tt + blend, fps=fps, mode="ceil") + 1
+    for f0, f1 in zip(first, after, strict=True):
+        j0 = max(0, int(f0))
+        j1 = min(dv.size, int(f1))
+        out.append(dv[j0:j1].max() / med if j1 > j0 else np.nan)
+    return np.asarray(out)
+
+
+def foot_joints(motion: Any) -> list[str]:
+    """Names of the most distal foot/toe joints (end sites excluded), found by name."""
+    skel = motion.skeleton
+    cand = [
+        j.name
+        for j in skel.joints
+        if not j.is_end_site and any(k in j.name.lower() for k in ("toe", "foot", "ankle"))
+    ]
+    if not cand:
+        raise ParameterError(
+            f"no foot joint (name with 'foot', 'toe' or 'ankle') among "
+            f"{motion.joint_names[:10]}...; pass feet=[...] explicitly"
+        )
+    # keep the most distal per side: joints that are nobody's parent among candidates
+    idx = {skel.index(n) for n in cand}
+    parents = {skel.joints[i].parent for i in idx}
+    return [skel.joints[i].name for i in sorted(idx) if i not in parents] or cand
+
+
+def foot_sliding(foot_positions: Any, *, fps: float, up_axis: str = "y") -> float:
+    """Mean horizontal foot speed during floor contact [position unit / s].
+
+    Parameters
+    ----------
+    foot_positions : np.ndarray [shape=(n_frames, n_feet, 3)]
+    fps : float > 0 [Hz]
+    up_axis : {"y", "z"}
+    """
+    pos = np.asarray(foot_positions, dtype=np.float64)
+    up = "xyz".index(up_axis)
+    ground = [a for a in range(3) if a != up]
+    vel = np.gradient(pos, axis=0) * fps
+    hspeed = np.linalg.norm(vel[:, :, ground], axis=2)
+    h = pos[:, :, up]
+    lo = np.percentile(h, 5, axis=0)
+    rng = np.percentile(h, 95, axis=0) - lo
+    contact = h <= lo + 0.1 * np.maximum(rng, 1e-9)
+    if not contact.any():
+        return float("nan")
+    return float(hspeed[contact].mean())
+
+
+def quality_proxies(
+    *,
+    motion_beats: Any,
+    music_beats: Any,
+    span: tuple[float, float],
+    positions: Any,
+    foot_positions: Any,
+    fps: float,
+    transition_times: Any,
+    motion_intensity: Any,
+    music_level: Any,
+    sigma: float = 0.05,
+    blend: float = 1.0 / 3.0,
+    up_axis: str = "y",
+) -> dict[str, float]:
+    """Every proxy of one composed dance (mir_eval style ``evaluate``).
+
+    Parameters
+    ----------
+    motion_beats : np.ndarray [s]
+        Kinematic beats of the composed motion.
+    music_beats : np.ndarray [s]
+    span : (float, float) [s]
+        Time both the dance and the music play (beats outside are not scored).
+    positions, foot_positions : np.ndarray [shape=(n_frames, n, 3)]
+        All joints, and the feet, of the composed motion.
+    fps : float > 0 [Hz]
+    transition_times : np.ndarray [s]
+    motion_intensity, music_level : np.ndarray
+        Per music beat interval (see :func:`intensity_correlation`).
+    sigma : float > 0 [s]
+        Gaussian width of the beat-alignment scores.
+    blend : float >= 0 [s]
+        Transition blend length (window of the velocity-jump ratio).
+    up_axis : {"y", "z"}
+
+    Returns
+    -------
+    dict
+        ``alignment_motion``, ``alignment_music`` (beat alignment averaged over motion
+        beats / music beats), ``intensity_r``, ``transition_jump_mean``,
+        ``transition_jump_max``, ``foot_sliding``.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        al = alignment_scores(motion_beats, music_beats, sigma=sigma, span=span)
+        jumps = transition_jumps(positions, transition_times, fps=fps, blend=blend)
+        r = intensity_correlation(motion_intensity, music_level)
+    return {
+        "alignment_motion": al["alignment_motion"],
+        "alignment_music": al["alignment_music"],
+        "intensity_r": r,
+        "transition_jump_mean": float(np.mean(jumps)) if jumps.size else float("nan"),
+        "transition_jump_max": float(np.max(jumps)) if jumps.size else float("nan"),
+        "foot_sliding": foot_sliding(foot_positions, fps=fps, up_axis=up_axis),
+    }
