@@ -397,8 +397,11 @@ def _text(result: dict[str, Any]) -> str:
         f"{result['n_music_beats']} beats ({result['beats_source']}), "
         f"beat period {r['beat_period_s']:.3f} s",
         f"mode     {r['mode']}"
-        + (f" (asked {r['mode_requested']}: not periodic, fell back)"
-           if r["mode"] != r["mode_requested"] else "")
+        + (
+            (" (auto: not periodic, fell back to motion beats)" if r["mode"] == "beats"
+             else " (auto: periodic)")
+            if r["mode_requested"] == "auto" else ""
+        )
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
         f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "
         f"{r['beats_per_period']} beat(s) per {unit[:-1]} ({r['beats_per_period_rule']})"
