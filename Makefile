@@ -1,32 +1,49 @@
 # beatsync: the two commands are `make reproduce` and `make test`.
-# Both create .venv (Python >= 3.11) and install the package with pinned-range
-# dependencies first; nothing else needs to be installed by hand.
+# Both set up .venv from the committed lock (uv.lock) with Python 3.11 first;
+# nothing else needs to be installed by hand. `make lock` refreshes the lock.
 
-PYTHON ?= python3
-VENV   ?= .venv
-BIN     = $(VENV)/bin
-STAMP   = $(VENV)/.installed
-PARAMS ?= params/paper.yaml
+PYTHON     ?= python3.11
+VENV       ?= .venv
+BIN         = $(VENV)/bin
+STAMP       = $(VENV)/.installed
+# uv itself is pinned and installed into .uv/ with pip (the only unpinned step is pip).
+UV_VERSION  = 0.13.8
+UV_DIR      = .uv
+UV          = $(UV_DIR)/bin/uv
+EXTRAS     ?= --extra test --extra dev --extra peers
+PARAMS     ?= params/paper.yaml
 # Pass e.g. PYTEST_ARGS="-x -q" to change pytest's options.
 PYTEST_ARGS ?= -q
 
-.PHONY: setup reproduce test test-unit test-notebooks bench notebooks lint clean help
+# uv never downloads a Python of its own: the machine's Python 3.11 is used.
+export UV_PYTHON_DOWNLOADS = never
+export UV_PROJECT_ENVIRONMENT = $(VENV)
+
+.PHONY: setup lock reproduce test test-unit test-notebooks bench notebooks lint clean help
 
 help:
-	@echo "make reproduce   set up .venv and run the whole study into results/"
-	@echo "make test        set up .venv and run unit tests + nbval on the notebooks"
+	@echo "make reproduce   set up .venv from uv.lock and run the whole study into results/"
+	@echo "make test        set up .venv from uv.lock and run unit tests + nbval on the notebooks"
+	@echo "make lock        re-resolve the newest allowed versions into uv.lock (and environment.yml)"
 	@echo "make bench       run the benchmarks into benchmarks/RESULTS.md"
 	@echo "make notebooks   re-execute the committed notebooks with params/ci.yaml"
 	@echo "make lint        ruff on src/ tests/ benchmarks/"
 
-$(STAMP): pyproject.toml
-	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "beatsync needs Python >= 3.11, found " + sys.version' 
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test,dev]"
+$(UV):
+	@$(PYTHON) -c 'import sys; assert sys.version_info[:2] == (3, 11), "beatsync is locked for Python 3.11, found " + sys.version' 
+	$(PYTHON) -m venv $(UV_DIR)
+	$(UV_DIR)/bin/python -m pip install --quiet --disable-pip-version-check "uv==$(UV_VERSION)"
+
+# --locked: refuse a uv.lock that does not match pyproject.toml (run `make lock`).
+$(STAMP): uv.lock pyproject.toml | $(UV)
+	$(UV) sync --locked --python $(PYTHON) $(EXTRAS)
 	@touch $(STAMP)
 
 setup: $(STAMP)
+
+lock: | $(UV)
+	$(UV) lock --upgrade --python $(PYTHON)
+	$(UV) run --no-project --python $(PYTHON) python scripts/environment_from_lock.py
 
 reproduce: setup
 	$(BIN)/beatsync reproduce --params $(PARAMS) --output results/notebooks
@@ -53,4 +70,4 @@ lint: setup
 	$(BIN)/ruff check src tests benchmarks
 
 clean:
-	rm -rf $(VENV) .pytest_cache results/ci
+	rm -rf $(VENV) $(UV_DIR) .pytest_cache results/ci

@@ -1,5 +1,7 @@
 """The Dask study runner: every clip x song, errors recorded per pair."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -7,23 +9,37 @@ from beatsync import datasets, io
 from beatsync.batch import sync_grid
 from beatsync.cli import main
 from beatsync.errors import ParameterError
+from beatsync.synth.audio import beat_times, click_track
+
+SR = 22050
 
 
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory):
-    import librosa
-
     d = tmp_path_factory.mktemp("batch")
-    salsa = datasets.load_salsa("60_01")
-    io.write_bvh(d / "salsa.bvh", salsa.rename("salsa"))
-    io.write_bvh(d / "pirouette.bvh", datasets.load_walk("005_02"))
-    sr = 22050
+    # 12 s of salsa made exactly periodic: one 1 s step of 60_01 repeated (root held),
+    # so segmentation is fast and certain; the skeleton and the step are real
+    real = datasets.load_salsa("60_01")
+    step = real.values[60:120].copy()
+    step[:, :3] = step[0, :3]
+    io.write_bvh(d / "salsa.bvh", real.with_values(np.tile(step, (12, 1))).rename("salsa"))
+    io.write_bvh(d / "pirouette.bvh", datasets.load_walk("005_02"))  # 9 s, not periodic
     songs = []
     for bpm in (100, 125):
-        beats = np.arange(0.5, 30.0, 60.0 / bpm)
-        y = librosa.clicks(times=beats, sr=sr, length=30 * sr)
-        songs.append(io.write_audio(d / f"click{bpm}.wav", y, sr))
+        beats = beat_times(bpm, duration=14.0, start=0.5)
+        songs.append(
+            io.write_audio(d / f"click{bpm}.wav", click_track(beats, sr=SR, duration=14.0), SR)
+        )
     return d, [d / "salsa.bvh", d / "pirouette.bvh"], songs
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """An existing cluster (threads of this process: no start-up or compilation per worker)."""
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, processes=False, dashboard_address=":0") as lc:
+        yield lc.scheduler_address
 
 
 def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
@@ -51,7 +67,7 @@ def test_grid_bad_arguments(inputs, tmp_path):
         sync_grid([], songs, tmp_path)
 
 
-def test_batch_cli_writes_summary(inputs, tmp_path, capsys):
+def test_batch_cli_writes_summary(inputs, scheduler, tmp_path, capsys):
     _, clips, songs = inputs
     code = main(
         [
@@ -64,12 +80,12 @@ def test_batch_cli_writes_summary(inputs, tmp_path, capsys):
             str(tmp_path),
             "--fps",
             "60",
-            "--workers",
-            "1",
+            "--scheduler",
+            scheduler,
             "--json",
         ]
     )
-    assert code == 0
+    assert code == 0, capsys.readouterr().err
     assert (tmp_path / "summary.csv").is_file()
     assert (tmp_path / "salsa__click100.bvh").is_file()
 
@@ -90,7 +106,7 @@ def test_batch_refuses_to_overwrite_inputs(inputs, tmp_path):
             str(songs[0]),
         ]
     )
-    assert code == 2
+    assert code == 3
     assert songs[0].read_bytes() == before
 
 
@@ -103,3 +119,64 @@ def test_batch_refuses_duplicate_song_names(inputs, tmp_path):
         t.write_bytes(songs[0].read_bytes())
     with pytest.raises(ParameterError, match="song file names must differ"):
         sync_grid(clips[:1], twins, tmp_path)
+
+
+def _batch_args(inputs, out, *extra):
+    _, clips, songs = inputs
+    return [
+        "batch",
+        "--clips",
+        str(clips[0]),
+        "--songs",
+        str(songs[0]),
+        "--out-dir",
+        str(out),
+        *extra,
+    ]
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        (["--workers", "-1"], "whole number of workers >= 1"),
+        (["--workers", "0"], "whole number of workers >= 1"),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "give one or the other"),
+        (["--scheduler", "tcp://127.0.0.1:9"], "could not connect to the Dask scheduler"),
+        (["--scheduler", "nonsense"], "not a Dask scheduler address"),
+    ],
+)
+def test_batch_bad_cluster_options_fail_fast(inputs, tmp_path, monkeypatch, extra, match):
+    """Once: --workers -1 hung forever; an unreachable scheduler waited 30 s, then a traceback."""
+    from beatsync import cluster
+    from beatsync.cli import build_parser
+
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
+    args = build_parser().parse_args(_batch_args(inputs, tmp_path, *extra))
+    t0 = time.perf_counter()
+    with pytest.raises(ParameterError, match=match):
+        args.func(args)
+    assert time.perf_counter() - t0 < 10.0
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_batch_cli_bad_cluster_option_exit_code(inputs, tmp_path, capsys):
+    code = main(_batch_args(inputs, tmp_path, "--workers", "-1"))
+    assert code == 3
+    assert "--workers=-1 must be a whole number of workers >= 1" in capsys.readouterr().err
+
+
+def test_batch_writes_all_or_nothing(inputs, scheduler, tmp_path, monkeypatch, capsys):
+    """A failure after the pairs were synchronised (here: writing the summary) leaves
+    the output folder as it was: no pair's BVH behind, no staging folder."""
+    from beatsync.io import _files
+
+    (tmp_path / "keep.txt").write_text("before")
+
+    def fail(*a, **k):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(_files, "write_csv", fail)
+    monkeypatch.setattr(io, "write_csv", fail)
+    code = main(_batch_args(inputs, tmp_path, "--fps", "60", "--scheduler", scheduler))
+    assert code == 4, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]

@@ -7,6 +7,7 @@ import sys
 import pytest
 
 from beatsync.cli import build_parser, main
+from beatsync.datasets import CHECKSUMS
 
 
 def _subcommands():
@@ -31,7 +32,7 @@ def test_every_subcommand_has_help(capsys):
 def test_data_command_json(capsys):
     assert main(["data", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
-    assert all(res["files"].values()) and len(res["files"]) == 14
+    assert all(res["files"].values()) and len(res["files"]) == len(CHECKSUMS)
 
 
 def test_console_script_runs():

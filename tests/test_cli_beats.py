@@ -106,7 +106,7 @@ def test_bad_input_exit_2_nothing_written(case, song, tmp_path, capsys):
     click = tmp_path / "out_click.wav"
     if "--out" not in argv and "--click" not in argv:
         argv += ["--out", str(out), "--click", str(click)]
-    assert main(argv) == 2
+    assert main(argv) == 3
     err = capsys.readouterr().err
     assert err.startswith("beatsync beats: error:")
     if case == "short":
@@ -117,7 +117,7 @@ def test_bad_input_exit_2_nothing_written(case, song, tmp_path, capsys):
 
 def test_noise_warns_on_stderr(tmp_path, capsys):
     path = tmp_path / "noise.wav"
-    y = np.random.default_rng(0).standard_normal(5 * SR).astype(np.float32) * 0.3
+    y = np.random.default_rng(0).standard_normal(30 * SR).astype(np.float32) * 0.3
     io.write_audio(path, y, SR)
     assert main(["beats", str(path), "--json"]) == 0
     captured = capsys.readouterr()

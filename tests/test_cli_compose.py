@@ -231,7 +231,7 @@ def test_bad_inputs_write_nothing(workdir, capsys, case, message):
         str(workdir / "r.json"),
         *extra,
     ]
-    assert main(argv) == 2
+    assert main(argv) == 3
     err = capsys.readouterr().err
     assert message in err
     assert "Traceback" not in err

@@ -36,6 +36,9 @@ def inputs(tmp_path_factory):
     rng = np.random.default_rng(0)
     noise = salsa.with_values(rng.normal(0, 30.0, salsa.values.shape))
     io.write_bvh(d / "noise.bvh", noise)
+    # a real dancer (Dance-with-Melody waltz excerpt, joint positions, 25 fps), 12 s of it
+    dancer = datasets.load_dance_pair("DANCE_W_5").motion
+    io.write_motion(d / "dancer.json", dancer.slice_frames(0, 300))
     return d, salsa, beats
 
 
@@ -69,6 +72,53 @@ def test_sync_end_to_end_with_beats_file(inputs, tmp_path, capsys):
     assert result["warnings"] == []
     # target beats are beats of the file
     assert np.all(np.isin(np.round(r["target_beats_s"], 6), np.round(beats, 6)))
+
+
+def test_sync_default_loops_over_the_whole_song(inputs, tmp_path, capsys):
+    d, _, beats = inputs  # a 12 s dance on a 20 s song
+    out = tmp_path / "out.bvh"
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    r = json.loads(stdout)["report"]
+    assert r["mode"] == "periods" and r["fill"] == "loop" and r["repetitions"] >= 2
+    assert r["output_duration_s"] >= beats[-1] - 1 / 60  # covers the song to its last beat
+    assert r["max_abs_residual_frames"] <= 1.0
+    # --fill stop: the paper's behaviour, the dance ends with its last period
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json", "--fill", "stop"],
+        capsys,
+    )
+    r = json.loads(stdout)["report"]
+    assert code == 0 and r["repetitions"] == 1 and r["output_duration_s"] < beats[-1] - 1.0
+
+
+def test_sync_mode_beats_and_auto_fallback(inputs, tmp_path, capsys):
+    d, _, beats = inputs
+    out = tmp_path / "out.bvh"
+    code, stdout, err = _run(
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--mode", "beats", "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    r = json.loads(stdout)["report"]
+    assert r["mode"] == "beats" and r["max_abs_residual_frames"] <= 1.0
+    # not periodic: auto falls back to motion beats and says so
+    code, stdout, err = _run(
+        ["sync", str(d / "noise.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json"],
+        capsys,
+    )
+    assert code == 0, err
+    result = json.loads(stdout)
+    assert result["report"]["mode"] == "beats" and result["report"]["mode_requested"] == "auto"
+    assert "fell back" in result["report"]["mode_note"]
+    assert any("fell back" in w for w in result["warnings"]) and "fell back" in err
 
 
 def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
@@ -136,8 +186,18 @@ BAD = [
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.mp3"], ".bvh or .csv"),
     (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "60"], "skeleton"),
-    (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats"],
-     "periodic"),
+    (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--mode", "periods"], "periodic.*--mode beats"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--beats-per-bar", "0"], "beats-per-bar"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--period-range", "2", "1"],
+     "period-range"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--dance-beats", "-3"], "dance-beats"),
+    (["{d}/dancer.json", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "25"], "json.*npy"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.json", "--beats", "{d}/song.beats"],
+     "not joint positions"),
+    (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.csv", "--fps", "60", "--beats",
+      "{d}/song.beats", "--mode", "beats"], "positions"),
     (["{d}/salsa.bvh", "{d}/silence.wav", "-o", "{o}/x.bvh"], "silen"),
     (["{d}/salsa.bvh", "{d}/short.wav", "-o", "{o}/x.bvh"], "shorter"),
     (["{d}/salsa.bvh", "{d}/tone.wav", "-o", "{o}/x.bvh"], "no detectable beats"),
@@ -157,8 +217,46 @@ def test_sync_bad_inputs(inputs, tmp_path, capsys, argv, match):
     before = sorted(p.name for p in d.iterdir())
     argv = [a.format(d=d, o=tmp_path) for a in argv]
     code, stdout, err = _run(["sync", *argv], capsys)
-    assert code == 2
+    assert code == 3
     assert re.search(match, err, flags=re.IGNORECASE), err
     assert "Traceback" not in err
     assert list(tmp_path.iterdir()) == []  # nothing written
     assert sorted(p.name for p in d.iterdir()) == before
+
+
+@pytest.mark.parametrize("option, value", [("--mode", "bars"), ("--fill", "repeat")])
+def test_sync_unknown_choice_is_a_usage_error(inputs, tmp_path, capsys, option, value):
+    d, _, _ = inputs
+    code = main(["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(tmp_path / "x.bvh"),
+                 option, value])
+    assert code == 2  # usage error
+    assert "invalid choice" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
+    d, _, beats = inputs  # 12 s of a real waltz dancer on a 20 s song
+    out = tmp_path / "out.json"
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(out), "--fps", "25",
+            "--beats", str(d / "song.beats"), "--json", "--beats-per-bar", "3"]
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    result = json.loads(stdout)
+    r = result["report"]
+    assert r["fill"] == "loop" and r["output_duration_s"] >= beats[-1] - 1 / 25
+    assert r["max_abs_residual_frames"] <= 1.0
+    assert result["beats_per_bar"] == 3 and r["meter_fit"] is not False
+    assert r["beats_per_period"] in (1, 3, 6, 9)  # never 4 or 5 on a 3/4 song
+    back = io.read_motion(out, fps=25)
+    assert back.is_positional and back.n_frames == r["output_frames"]
+    src = io.read_motion(d / "dancer.json", fps=25)
+    bones = src.bones
+
+    def lengths(m):
+        p = m.positions()
+        return np.linalg.norm(p[:, bones[:, 0]] - p[:, bones[:, 1]], axis=-1)
+
+    # bone lengths through resampling: within 1 % of the source's range per bone
+    lo, hi = lengths(src).min(axis=0), lengths(src).max(axis=0)
+    got = lengths(back)
+    assert np.all(got >= 0.99 * lo) and np.all(got <= 1.01 * hi)

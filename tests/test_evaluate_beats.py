@@ -1,4 +1,4 @@
-"""Tests of the mir_eval.beat wrapper (beatsync.evaluate.beats)."""
+"""Tests of the beat metrics on arrays (beatsync.evaluate.beats) and the study tables."""
 
 import warnings
 
@@ -7,7 +7,19 @@ import pandas as pd
 import pytest
 
 from beatsync.errors import BeatsyncWarning, ParameterError
-from beatsync.evaluate.beats import METRICS, evaluate_beats, octave_relation, summarize_scores
+from beatsync.evaluate import beats as ev
+from beatsync.evaluate.beats import (
+    METRICS,
+    count_octave_errors,
+    count_other_tempo,
+    diagnose_times,
+    evaluate,
+    evaluate_beats,
+    octave_relation,
+    tempo_octave,
+    validate,
+)
+from beatsync.study.beat_evaluation import summarize_scores
 
 REF = np.arange(0.5, 20.0, 0.5)
 
@@ -66,6 +78,71 @@ def test_empty_estimate_warns_zero():
 def test_bad_input_raises(ref, est, mbt):
     with pytest.raises(ParameterError):
         evaluate_beats(ref, est, min_beat_time=mbt)
+
+
+@pytest.mark.parametrize(
+    "est, match",
+    [
+        (np.round(REF * 100), "looks like frame indices"),  # frames at 100 frames/s
+        (np.round(REF * 86.13), "looks like frame indices"),  # librosa frames (hop 512)
+        (REF * 1000, "looks like milliseconds"),
+        (REF * 1000 + 0.25, "looks like milliseconds"),
+        (REF * 100000, "looks like not beat times"),
+        (np.array([50000.0, 60000.0]), "milliseconds or frame indices"),
+    ],
+)
+def test_validate_says_what_the_times_look_like(est, match):
+    with pytest.raises(ParameterError, match=match):
+        validate(REF, est)
+    with pytest.raises(ParameterError, match="estimated beats are not times in seconds"):
+        evaluate(REF, est, min_beat_time=0.0)
+
+
+def test_diagnose_accepts_seconds():
+    assert diagnose_times(REF) is None
+    assert diagnose_times(np.array([])) is None
+    assert diagnose_times(np.arange(0.0, 600.0, 2.0)) is None  # 30 BPM, 10 minutes
+    assert diagnose_times(np.array([1.0, 9.0])) is None
+
+
+def test_evaluate_is_the_old_name():
+    assert evaluate_beats is evaluate
+
+
+def test_tempo_octave_from_beats():
+    out = tempo_octave(REF, np.arange(0.5, 20.0, 0.25))
+    assert out["tempo_ref"] == pytest.approx(120.0)
+    assert out["tempo_est"] == pytest.approx(240.0)
+    assert out["octave"] == "double"
+    assert np.isnan(tempo_octave(REF, np.array([1.0]))["tempo_est"])
+    assert tempo_octave(REF, np.array([1.0]))["octave"] == "other"
+
+
+def test_octave_counts():
+    octaves = ["correct", "double", "half", "other", "third", "correct"]
+    assert count_octave_errors(octaves) == 3
+    assert count_other_tempo(octaves) == 1
+    assert count_octave_errors([]) == 0
+
+
+def test_study_helpers_still_importable_from_the_old_path():
+    from beatsync.study import beat_evaluation
+
+    for name in ev.MOVED_TO_STUDY:
+        assert getattr(ev, name) is getattr(beat_evaluation, name)
+    with pytest.raises(AttributeError, match="no attribute"):
+        ev.no_such_name  # noqa: B018
+
+
+def test_evaluate_never_runs_a_tracker():
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(ev.__file__).read_text())
+    imported = {
+        (node.module or "") for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
+    } | {a.name for node in ast.walk(tree) if isinstance(node, ast.Import) for a in node.names}
+    assert not {m for m in imported if m.lstrip(".").split(".")[0] in ("beats", "peers", "study")}
 
 
 @pytest.mark.parametrize(

@@ -170,7 +170,7 @@ def test_beats_files(tmp_path):
     with pytest.raises(ParameterError, match="increasing"):
         io.read_beats(tmp_path / "bad.beats")
     (tmp_path / "ms.beats").write_text("abc\n")
-    with pytest.raises(ParameterError, match="not a time"):
+    with pytest.raises(ParameterError, match=r"line 1: time='abc' is not a number \[s\]"):
         io.read_beats(tmp_path / "ms.beats")
     with pytest.raises(ParameterError, match="increasing"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
@@ -195,3 +195,315 @@ def test_atomic_write_respects_umask_and_existing_mode(tmp_path):
     p.chmod(0o640)
     io.write_beats(p, [0.5, 1.5])
     assert p.stat().st_mode & 0o777 == 0o640
+
+
+# ------------------------------------------------------------ hardened readers
+
+
+def _wav_with_header_rate(tmp_path: Path, rate: int) -> Path:
+    import struct
+
+    p = io.write_audio(tmp_path / "a.wav", np.full(4410, 0.1, dtype=np.float32), 44100)
+    data = bytearray(p.read_bytes())
+    assert data[:4] == b"RIFF" and data[12:16] == b"fmt "
+    data[24:28] = struct.pack("<I", rate)  # sample rate field of the fmt chunk
+    p.write_bytes(bytes(data))
+    return p
+
+
+def test_wav_with_sample_rate_zero_refused(tmp_path):
+    p = _wav_with_header_rate(tmp_path, 0)
+    with pytest.raises(ParameterError, match=r"broken header: sample rate=0 must be a finite"):
+        io.read_audio(p)
+
+
+def test_wav_with_valid_header_rate_read(tmp_path):
+    y, sr = io.read_audio(_wav_with_header_rate(tmp_path, 8000))
+    assert sr == 8000 and y.dtype == np.float32 and y.size == 4410
+
+
+@pytest.mark.parametrize(
+    "sr, match", [(0, r"sr=0 must be a finite sample rate"), (22050.5, "whole number of Hz")]
+)
+def test_read_and_write_audio_bad_sr(tmp_path, sr, match):
+    p = io.write_audio(tmp_path / "a.wav", np.full(4410, 0.1, dtype=np.float32), 44100)
+    with pytest.raises(ParameterError, match=match):
+        io.read_audio(p, sr=sr)
+    with pytest.raises(ParameterError, match=match):
+        io.write_audio(tmp_path / "b.wav", np.zeros(10), sr)
+    assert not (tmp_path / "b.wav").exists()
+
+
+def test_npz_renamed_npy_refused(tmp_path):
+    np.savez(tmp_path / "m.npz", values=np.zeros((5, 2)))
+    p = (tmp_path / "m.npz").rename(tmp_path / "m.npy")
+    with pytest.raises(ParameterError, match=r"is an \.npz archive .*not a \.npy array"):
+        io.read_motion(p, fps=25)
+
+
+@pytest.mark.parametrize(
+    "array, match",
+    [
+        (np.array([["a", "b"]] * 4), "holds strings"),
+        (np.array([[b"a", b"b"]] * 4), "holds bytes"),
+        (np.zeros((4, 2), dtype=[("x", "f8"), ("y", "f8")]), "structured array"),
+        (np.zeros(4, dtype=[("x", "f8"), ("y", "f8")]), "structured array"),
+        (np.ones((4, 2)) * (1 + 1j), "complex"),
+        (np.zeros((4, 2), dtype="datetime64[s]"), "dates"),
+        (np.zeros((4, 2), dtype="timedelta64[s]"), "time deltas"),
+        (np.ones((4, 2), dtype=bool), "booleans"),
+        (np.array([[1.0, None]] * 4, dtype=object), "Python objects"),
+        (np.zeros((4, 2, 3, 1)), r"shape \(4, 2, 3, 1\); need 2-D"),
+    ],
+)
+def test_npy_dtype_and_shape_checks(tmp_path, array, match):
+    p = tmp_path / "t.npy"
+    np.save(p, array, allow_pickle=True)
+    with pytest.raises(ParameterError, match=match):
+        io.read_motion(p, fps=25)
+
+
+def test_npy_numeric_kinds_read(tmp_path):
+    for dtype in (np.int16, np.float32, np.float16):
+        np.save(tmp_path / "t.npy", np.arange(8).reshape(4, 2).astype(dtype))
+        m = io.read_motion(tmp_path / "t.npy", fps=25)
+        assert m.values.dtype == np.float64 and m.values[3, 1] == 7.0
+
+
+def test_mat_struct_without_freq_refused(tmp_path):
+    import scipy.io
+
+    rec = {"data": np.zeros((10, 3)), "markerName": np.array(["Head"], dtype=object)}
+    scipy.io.savemat(tmp_path / "m.mat", {"rec": rec})
+    with pytest.raises(ParameterError, match=r"recording 'rec' has no 'freq' field"):
+        io.read_mocap_mat(tmp_path / "m.mat")
+    scipy.io.savemat(tmp_path / "m0.mat", {"rec": {**rec, "freq": 0.0}})
+    with pytest.raises(ParameterError, match=r"freq=0.0 must be a finite frame rate"):
+        io.read_mocap_mat(tmp_path / "m0.mat")
+    scipy.io.savemat(tmp_path / "ok.mat", {"rec": {**rec, "freq": 100.0}})
+    assert io.read_mocap_mat(tmp_path / "ok.mat").fps == 100.0
+
+
+# ------------------------------------------------------------ BVH reader hardening
+
+_FRAME1 = "0 1 0 0 0 0 0 10 0"
+_FRAME2 = "0 1 0 0 0 0 0 20 0"
+
+
+@pytest.mark.parametrize(
+    "old, new, match",
+    [
+        # values sliding between frames: 10 + 8 values, the total (18) matches 2 x 9
+        (
+            f"{_FRAME1}\n{_FRAME2}",
+            f"{_FRAME1} 5\n0 1 0 0 0 0 0 20",
+            r"line 19: frame line 1 has 10",
+        ),
+        (
+            " OFFSET 0 -1 0\n  CHANNELS",
+            " OFFSET nan -1 0\n  CHANNELS",
+            r"line 8: OFFSET of joint 'knee' is not finite",
+        ),
+        (
+            "   OFFSET 0 -1 0\n  }",
+            "   OFFSET 0 inf 0\n  }",
+            r"line 12: OFFSET of End Site of 'knee' is not finite",
+        ),
+        (
+            "CHANNELS 3 Zrotation Xrotation",
+            "CHANNELS 3 Zrotation Zrotation",
+            r"line 9: channel Zrotation listed twice in joint 'knee'",
+        ),
+        ("  OFFSET 0 -1 0\n  CHANNELS", "  CHANNELS", r"line 6: joint 'knee' has no OFFSET line"),
+        ("   OFFSET 0 -1 0\n  }", "  }", r"line 10: End Site of 'knee' has no OFFSET line"),
+        (
+            " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n",
+            "",
+            r"line 2: joint 'hip' has no CHANNELS line",
+        ),
+        ("JOINT knee", "JOINT hip", r"line 6: duplicate joint name 'hip' \(first on line 2\)"),
+        (
+            "OFFSET 0 -1 0\n  CHANNELS",
+            "OFFSET 0 -1 0 7\n  CHANNELS",
+            r"line 8: OFFSET is followed by '7'",
+        ),
+        (
+            "OFFSET 0 -1 0\n  CHANNELS",
+            "OFFSET 0 -1\n  CHANNELS",
+            r"line 8: OFFSET needs 3 values on its line, got 2",
+        ),
+        (
+            "CHANNELS 3 Zrotation Xrotation Yrotation",
+            "CHANNELS 2 Zrotation Xrotation Yrotation",
+            r"line 9: CHANNELS 2 is followed by 'Yrotation'",
+        ),
+        (
+            "OFFSET 0 -1 0\n  CHANNELS",
+            "OFFSET 0 -1 0\n  OFFSET 0 -1 0\n  CHANNELS",
+            r"line 9: a second OFFSET in joint 'knee'",
+        ),
+        (_FRAME2, "0 1 0 0 0 0 0 2_0 0", r"line 20: non-numeric value '2_0'"),
+        (_FRAME2, "0 1 0 0 0 0 0 \u0662 0", r"line 20: non-numeric value"),
+        ("Frames: 2", "Frames: 2.5", r"line 17: Frames=.2.5. must be a whole number"),
+        ("Frames: 2", "Frames: -1", r"line 17: Frames=.-1. must be an integer >= 0"),
+        ("Frame Time: 0.04", "Frame Time 0.04", r"line 18: expected 'Frame Time: <value>'"),
+        ("Frames: 2", "Frames: 1000000000000", r"declares 1000000000000 frames but has 2"),
+        ("MOTION", "MOTION extra", r"line 16: unexpected 'extra' after MOTION"),
+        ("  End Site", "  End Sight", r"line 10: expected 'End Site', got 'End Sight'"),
+    ],
+)
+def test_bvh_malformed_with_line_numbers(tmp_path, old, new, match):
+    assert old in GOOD
+    with pytest.raises(ParameterError, match=match):
+        io.read_bvh(_write(tmp_path, GOOD.replace(old, new, 1)))
+
+
+def test_bvh_non_utf8_refused(tmp_path):
+    p = tmp_path / "latin.bvh"
+    p.write_bytes(GOOD.replace("knee", "kn\xe9e").encode("latin-1"))
+    with pytest.raises(ParameterError, match=r"line 6 is not UTF-8 text"):
+        io.read_bvh(p)
+
+
+@pytest.mark.parametrize(
+    "variant",
+    [
+        "\ufeff" + GOOD,  # UTF-8 byte-order mark
+        GOOD.replace("knee", "MOTIONx"),
+        GOOD.replace("knee", "MOTION"),  # a joint may even be called MOTION
+        GOOD.replace("Frame Time:", "Frame  Time:"),
+        GOOD.replace("Frame Time:", "Frame\tTime:"),
+        GOOD.replace("Frames: 2", "Frames:2").replace("Frame Time: ", "FRAME TIME :"),
+        GOOD.replace("\n", "\r\n"),
+        GOOD.replace(" ", "\t"),
+        GOOD.replace("ROOT hip\n{", "ROOT hip {"),
+        GOOD + "\n\n",
+    ],
+)
+def test_bvh_valid_variants_read(tmp_path, variant):
+    p = tmp_path / "v.bvh"
+    p.write_bytes(variant.encode("utf-8"))
+    m = io.read_bvh(p)
+    ref = io.read_bvh(_write(tmp_path, GOOD))
+    np.testing.assert_array_equal(m.values, ref.values)
+    assert m.fps == 25.0 and m.n_channels == 9
+    assert [j.parent for j in m.skeleton.joints] == [-1, 0, 1]
+
+
+def _sibling_bvh(n: int, *, same_name: bool = False) -> str:
+    body = "{\nOFFSET 0 1 0\nCHANNELS 1 Xrotation\nEnd Site\n{\nOFFSET 0 1 0\n}\n}\n"
+    joints = "".join(f"JOINT j{'' if same_name else i}\n{body}" for i in range(n))
+    frame = " ".join(["0"] * (n + 3))
+    return (
+        "HIERARCHY\nROOT hip\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n"
+        f"{joints}}}\nMOTION\nFrames: 2\nFrame Time: 0.04\n{frame}\n{frame}\n"
+    )
+
+
+def _best_time(fn, repeats=3):
+    import time
+
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def test_bvh_parse_is_linear_in_joint_count(tmp_path):
+    small, large = tmp_path / "s.bvh", tmp_path / "l.bvh"
+    small.write_text(_sibling_bvh(1000))
+    large.write_text(_sibling_bvh(4000))
+    assert io.read_bvh(large).skeleton.joints[-1].name == "j3999_end"
+    ratio = _best_time(lambda: io.read_bvh(large)) / _best_time(lambda: io.read_bvh(small))
+    # linear: ~4; quadratic: ~16
+    assert ratio < 10, ratio
+
+
+def test_bvh_duplicate_joint_names_refused_in_linear_time(tmp_path):
+    valid, dup = tmp_path / "v.bvh", tmp_path / "d.bvh"
+    valid.write_text(_sibling_bvh(5000))
+    dup.write_text(_sibling_bvh(5000, same_name=True))
+
+    def read_dup():
+        with pytest.raises(
+            ParameterError, match=r"line 15: duplicate joint name 'j' \(first on line 6\)"
+        ):
+            io.read_bvh(dup)
+
+    # refusing 5,000 same-named siblings costs no more than reading 5,000 distinct ones
+    # (a pairwise name count took seconds)
+    ratio = _best_time(read_dup, repeats=2) / _best_time(lambda: io.read_bvh(valid), repeats=2)
+    assert ratio < 3, ratio
+
+
+def _chain_bvh(depth: int) -> str:
+    lines = [
+        "HIERARCHY",
+        "ROOT j0",
+        "{",
+        "OFFSET 0 0 0",
+        "CHANNELS 3 Xposition Yposition Zposition",
+    ]
+    for i in range(1, depth):
+        lines += [f"JOINT j{i}", "{", "OFFSET 0 1 0", "CHANNELS 1 Zrotation"]
+    lines += ["End Site", "{", "OFFSET 0 1 0", "}"] + ["}"] * depth
+    frame = " ".join(str(k % 7) for k in range(depth + 2))
+    return "\n".join(lines + ["MOTION", "Frames: 1", "Frame Time: 0.01", frame]) + "\n"
+
+
+def test_write_bvh_deep_skeleton_round_trip(tmp_path):
+    p = tmp_path / "deep.bvh"
+    p.write_text(_chain_bvh(2000))
+    m = io.read_bvh(p)
+    assert len(m.skeleton.joints) == 2001
+    back = io.read_bvh(io.write_bvh(tmp_path / "w.bvh", m))
+    np.testing.assert_array_equal(back.values, m.values)
+    assert back.skeleton.joints == m.skeleton.joints
+
+
+def test_write_bvh_refuses_nan_offset(tmp_path, chain_motion):
+    from dataclasses import replace
+
+    from beatsync.motion import Skeleton
+
+    joints = list(chain_motion.skeleton.joints)
+    joints[1] = replace(joints[1], offset=np.array([0.0, np.nan, 0.0]))
+    m = Motion(
+        chain_motion.values, chain_motion.fps, chain_motion.channels, Skeleton(tuple(joints))
+    )
+    with pytest.raises(ParameterError, match=r"OFFSET of joint .* NaN"):
+        io.write_bvh(tmp_path / "x.bvh", m)
+    assert not (tmp_path / "x.bvh").exists()
+
+
+# ------------------------------------------------------------ bit-stable JSON
+
+
+def test_write_json_float_digits_hides_last_digit_noise(tmp_path):
+    a = {"score": 0.1 + 0.2, "arr": np.array([1 / 3, 2.0]), "f32": np.float32(0.25), "n": 3}
+    b = {"score": 0.3, "arr": np.array([1 / 3 + 1e-16, 2.0]), "f32": 0.25, "n": 3}
+    pa = io.write_json(tmp_path / "a.json", a, float_digits=10)
+    pb = io.write_json(tmp_path / "b.json", b, float_digits=10)
+    assert pa.read_bytes() == pb.read_bytes()
+    import json
+
+    assert json.loads(pa.read_text()) == {
+        "score": 0.3,
+        "arr": [0.3333333333, 2.0],
+        "f32": 0.25,
+        "n": 3,
+    }
+    # default: exact floats
+    exact = io.write_json(tmp_path / "e.json", {"score": 0.1 + 0.2})
+    assert "0.30000000000000004" in exact.read_text()
+
+
+@pytest.mark.parametrize(
+    "digits, match", [(0, "1-17"), (18, "1-17"), (2.5, "whole"), (True, "whole")]
+)
+def test_write_json_bad_float_digits(tmp_path, digits, match):
+    with pytest.raises(ParameterError, match=rf"float_digits={digits!r} must be"):
+        io.write_json(tmp_path / "x.json", {"a": 1.0}, float_digits=digits)
+    assert not (tmp_path / "x.json").exists()

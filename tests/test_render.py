@@ -102,6 +102,7 @@ def test_write_video_fallback_gif_and_wav(tmp_path):
         ({"audio": (np.zeros((2, 10)), 8000)}, "mono"),
         ({"audio": (np.zeros(10), 0)}, "sample rate"),
         ({"beats": [1.0, 0.5]}, "increasing"),
+        ({"duration": -1.0}, "duration"),
     ],
 )
 def test_write_video_bad_inputs(tmp_path, kwargs, match):
@@ -120,3 +121,33 @@ def test_beat_strip_times():
     assert np.allclose(t, [0.5, 0.75, 1.0, 1.25, 1.5])
     with pytest.raises(ParameterError, match="fewer than 2 beats"):
         render.beat_strip_times([0.0, 0.5], start=1.0)
+
+
+def _duration_s(path) -> float:
+    import re
+
+    m = re.search(r"Duration: (\d+):(\d+):([\d.]+)", _streams(path))
+    return int(m.group(1)) * 3600 + int(m.group(2)) * 60 + float(m.group(3))
+
+
+@pytest.mark.skipif(render.find_ffmpeg() is None, reason="no ffmpeg")
+def test_write_video_lasts_as_long_as_asked_holding_the_last_pose(tmp_path):
+    sr = 8000
+    y = 0.1 * np.sin(2 * np.pi * 440 * np.arange(4 * sr) / sr).astype(np.float32)
+    m = _motion(30)  # 1.5 s of motion, 4 s of song
+    short = render.write_video(m, tmp_path / "a.mp4", audio=(y, sr), fps=10, size=(64, 64))
+    full = render.write_video(m, tmp_path / "b.mp4", audio=(y, sr), fps=10, size=(64, 64),
+                              duration=4.0)
+    assert _duration_s(short) < 2.0
+    assert abs(_duration_s(full) - 4.0) < 0.15
+
+
+
+def test_position_only_motion_is_drawn_with_bones():
+    pos = np.zeros((4, 3, 3))
+    pos[:, 1, 2] = 0.5
+    pos[:, 2, 2] = 1.0
+    names = tuple(f"{j}_{a}" for j in ("a", "b", "c") for a in "xyz")
+    m = Motion(pos.reshape(4, -1), FPS, names, None, "positions")
+    _, bones = render.pose_positions(m)
+    assert len(bones) == 2  # a-b and b-c: drawn as bones, not dots

@@ -69,7 +69,7 @@ def test_cli_check_reports_unknown_parameter(nbdir, tmp_path, capsys):
     p = tmp_path / "p.yaml"
     p.write_text("tiny:\n  typo: 1\n")
     code = main(["reproduce", "--params", str(p), "--notebooks", str(nbdir), "--check"])
-    assert code == 2
+    assert code == 3
     assert "typo" in capsys.readouterr().err
 
 

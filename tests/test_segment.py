@@ -8,15 +8,39 @@ import numpy as np
 import pytest
 
 from beatsync import datasets
-from beatsync import segment as S
 from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.evaluate.segmentation import boundary_errors
 from beatsync.motion import Motion, marker_angles
 from beatsync.segment import (
+    DANCE_PERIOD_RANGE,
+    SEARCH_MEMORY_BUDGET,
     Segmentation,
     estimate_period_count,
+    period_range_from_beat,
     segment,
     segment_values,
+    segmentation_energy,
     select_channels,
+)
+from beatsync.segment import core as segment_core
+from beatsync.segment.channels import standardise
+from beatsync.segment.costs import edge_costs, pair_costs, resample_weights
+from beatsync.segment.period import estimate_period, estimation_band, period_tiers
+from beatsync.segment.reference import segment_literal
+from beatsync.segment.search import (
+    count_fits,
+    min_mean_energy,
+    optimum,
+    period_band,
+    search_bytes,
+    search_decimation,
+    shortest_path,
+    shortest_path_count,
+)
+from beatsync.study.paper_a_segmentation import (
+    minima_baseline,
+    synthetic_error_table,
+    uniform_baseline,
 )
 from beatsync.synth.motion import periodic_motion
 
@@ -68,7 +92,7 @@ def _brute_force(x, lo, hi):
     def rec(fr):
         nonlocal best
         if len(fr) >= 3 and fr[-1] >= n - lo:
-            e = S.segmentation_energy(x, np.array(fr)) / (len(fr) - 2)  # mean per pair
+            e = segmentation_energy(x, np.array(fr)) / (len(fr) - 2)  # mean per pair
             if e < best[0] - 1e-12:
                 best = (e, list(fr))
         for d in range(lo, hi + 1):
@@ -80,6 +104,12 @@ def _brute_force(x, lo, hi):
     return best
 
 
+def _same_boundaries(a, b):
+    """Same count and every boundary within one frame (near-ties may round either way)."""
+    assert a.size == b.size, (a, b)
+    assert np.abs(a - b).max() <= 1, (a, b)
+
+
 @pytest.mark.parametrize("seed", range(12))
 def test_dp_equals_literal_and_brute_force(seed):
     rng = np.random.default_rng(seed)
@@ -89,35 +119,36 @@ def test_dp_equals_literal_and_brute_force(seed):
     hi = lo + int(rng.integers(0, 3))
     t = np.arange(n)
     raw = np.sin(2 * np.pi * t / rng.uniform(4, 8))[:, None] + 0.5 * rng.standard_normal((n, n_ch))
-    x = S._standardise(raw)
-    cost = S._edge_costs(x, lo, hi)
+    x = standardise(raw)
+    cost = edge_costs(x, lo, hi)
     # plain argmin E (one DP pass) against the literal loops
-    f0, e0 = S._shortest_path(cost, n, lo, hi)
-    f0_lit, e0_lit = S._segment_literal(x, lo, hi, 0.0)
+    f0, e0 = shortest_path(cost, n, lo, hi)
+    f0_lit, e0_lit = segment_literal(x, lo, hi, 0.0)
     assert e0 == pytest.approx(e0_lit, abs=1e-9)
-    assert np.array_equal(f0, f0_lit)
+    assert segmentation_energy(x, f0) == pytest.approx(e0_lit, abs=1e-9)
+    _same_boundaries(f0, f0_lit)
     # the objective of segment(): min E / (p - 1), vs literal and brute force
-    f_fast, e_fast = S._min_mean_energy(lambda r: S._shortest_path(cost, n, lo, hi, r))
-    f_lit, e_lit = S._segment_literal(x, lo, hi)
+    f_fast, e_fast = min_mean_energy(lambda r: shortest_path(cost, n, lo, hi, r))
+    f_lit, e_lit = segment_literal(x, lo, hi)
     m_bf, f_bf = _brute_force(x, lo, hi)
-    assert e_fast == pytest.approx(e_lit, abs=1e-9)
-    assert np.array_equal(f_fast, f_lit)
+    assert e_fast / (f_fast.size - 2) == pytest.approx(e_lit / (f_lit.size - 2), abs=1e-9)
+    _same_boundaries(f_fast, f_lit)
     assert e_fast / (f_fast.size - 2) == pytest.approx(m_bf, abs=1e-9)
-    assert S.segmentation_energy(x, f_fast) == pytest.approx(e_fast, abs=1e-9)
+    assert segmentation_energy(x, f_fast) == pytest.approx(e_fast, abs=1e-9)
 
 
 def test_vectorised_edge_costs_match_direct_pearson(rng):
     s = periodic_motion(n_frames=300, n_channels=5, n_periods=10, seed=1)
-    x = S._standardise(s.motion.values)
+    x = standardise(s.motion.values)
     lo, hi = 26, 33
-    cost = S._edge_costs(x, lo, hi)
+    cost = edge_costs(x, lo, hi)
     n = x.shape[1]
     b = rng.integers(lo, n - lo, 500)
     i0 = rng.integers(0, hi - lo + 1, 500)
     i1 = rng.integers(0, hi - lo + 1, 500)
     ok = (b - lo - i0 >= 0) & (b + lo + i1 <= n - 1)
     b, i0, i1 = b[ok], i0[ok], i1[ok]
-    ref = S._pair_costs(x, b - lo - i0, b, b + lo + i1)
+    ref = pair_costs(x, b - lo - i0, b, b + lo + i1)
     np.testing.assert_allclose(cost[b, i0, i1], ref, atol=1e-10)
     # one edge by hand: np.interp + np.corrcoef
     a0, b0, c0 = 40, 70, 101
@@ -243,8 +274,12 @@ def _with_inf():
         (_vals(), {"alpha": -0.1}, "alpha"),
         (_vals(), {"period_range": (1.25, 0.25)}, "reversed"),
         (_vals(), {"period_range": (0.0, 1.0)}, "> 0"),
-        (_vals()[:12], {}, "shorter than two periods"),
-        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "shorter than two periods"),
+        (_vals()[:12], {}, "shorter than 3 periods of the shortest"),
+        (_vals()[:19], {}, "shorter than 3 periods of the shortest"),
+        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "shorter than 3 periods"),
+        (_vals(), {"period_range": (0.25, 1.25, 2.0)}, "two numbers"),
+        (_vals(), {"period_range": (0.25, 0.06)}, "reversed"),
+        (_vals(), {"n_periods": 10, "period_method": "wavelet"}, "period_method"),
         (_vals(), {"n_periods": 1}, "n_periods"),
         (_vals(), {"n_periods": 2.5}, "n_periods"),
         (_vals(), {"n_periods": 200}, "too short"),
@@ -262,6 +297,30 @@ def test_bad_input_raises(values, kwargs, match):
         segment_values(values, **kw)
 
 
+def test_clip_shorter_than_three_own_periods_is_refused():
+    """A 1 s excerpt of salsa (period ~1 s) from 10 s used to come back as 2 periods of 0.45 s."""
+    m = datasets.load_salsa("60_01")
+    start = int(10.0 * m.fps)
+    clip = m.slice_frames(start, start + int(m.fps))  # 1 s
+    with pytest.raises(ParameterError, match=r"holds only 2\.\d periods of its estimated"):
+        segment(clip)
+    # the same dance, long enough, is segmented at its period
+    longer = m.slice_frames(start, start + int(16 * m.fps))
+    assert 0.8 <= segment(longer).mean_period <= 1.2
+
+
+def test_short_clip_of_clearly_alike_periods_is_kept():
+    """2-2.5 periods of a clean 1 s cycle: one pair, clearly alike, so segmented."""
+    s = periodic_motion(n_frames=251, n_periods=10, fps=25.0, snr_db=30, seed=0)
+    for seconds in (2.0, 2.5):
+        seg = segment_values(s.motion.values[: int(seconds * 25) + 1], fps=25.0)
+        assert seg.n_periods == 2
+        assert seg.normalised_energy < 0.5
+        assert seg.mean_period == pytest.approx(1.0, abs=0.06)
+    # a given count is the caller's word: two periods are allowed
+    assert segment_values(s.motion.values[:51], fps=25.0, n_periods=2).n_periods == 2
+
+
 def test_channel_name_count_mismatch():
     with pytest.raises(ParameterError, match="transposed"):
         segment_values(_vals(), fps=25.0, channel_names=["a", "b"])
@@ -276,35 +335,37 @@ def test_no_warning_on_normal_input():
 
 def test_float32_edge_costs_close_to_float64():
     s = periodic_motion(n_frames=750, n_channels=29, n_periods=25, seed=6)
-    x = S._standardise(s.motion.values)
-    c64 = S._edge_costs(x, 26, 33)
-    c32 = S._edge_costs(x, 26, 33, dtype=np.float32)
+    x = standardise(s.motion.values)
+    c64 = edge_costs(x, 26, 33)
+    c32 = edge_costs(x, 26, 33, dtype=np.float32)
     ok = np.isfinite(c64)
     assert np.array_equal(ok, np.isfinite(c32))
     assert np.abs(c64[ok] - c32[ok]).max() < 1e-4
-    f64, _ = S._shortest_path(c64, 750, 26, 33)
-    f32, _ = S._shortest_path(c32, 750, 26, 33)
-    assert np.array_equal(f64, f32)
+    f64, e64 = shortest_path(c64, 750, 26, 33)
+    f32, e32 = shortest_path(c32, 750, 26, 33)
+    assert e32 == pytest.approx(e64, rel=1e-5)
+    assert segmentation_energy(x, f32) == pytest.approx(e64, rel=1e-5)
+    _same_boundaries(f32, f64)
 
 
 # ------------------------------------------------------ evaluation helpers (fig02)
 def test_boundary_errors_and_baselines():
     ref = np.array([0, 30, 61, 90, 120])
-    assert S.boundary_errors(ref, ref)["max"] == 0.0
-    e = S.boundary_errors(ref + 3, ref, remove_offset=True)
+    assert boundary_errors(ref, ref)["max"] == 0.0
+    e = boundary_errors(ref + 3, ref, remove_offset=True)
     assert e["max"] == 0.0 and e["offset"] == 3.0
-    e = S.boundary_errors(np.array([0, 32, 61, 88]), ref)
+    e = boundary_errors(np.array([0, 32, 61, 88]), ref)
     assert e["max"] == 2.0 and e["count_error"] == -1
     t = np.arange(500)
     sine = np.cos(2 * np.pi * t / 25.0)
-    mins = S.minima_baseline(sine, fps=25.0, period=1.0)
+    mins = minima_baseline(sine, fps=25.0, period=1.0)
     assert np.allclose(np.diff(mins), 25, atol=1)
-    uni = S.uniform_baseline(np.stack([sine, np.sin(2 * np.pi * t / 25.0)], 1), fps=25.0)
+    uni = uniform_baseline(np.stack([sine, np.sin(2 * np.pi * t / 25.0)], 1), fps=25.0)
     assert abs(np.diff(uni).mean() - 25) < 0.5
 
 
 def test_synthetic_error_table_small():
-    table = S.synthetic_error_table(snr_dbs=[20.0], alphas=[0.1], seeds=[0], n_frames=300,
+    table = synthetic_error_table(snr_dbs=[20.0], alphas=[0.1], seeds=[0], n_frames=300,
                                     n_channels=6, n_periods=10)  # fmt: skip
     assert set(table["method"]) == {
         "optimal, count estimated",
@@ -326,7 +387,7 @@ def _brute_force_count(x, lo, hi, count):
         nonlocal best
         if len(fr) == count + 1:
             if fr[-1] >= n - lo:
-                e = S.segmentation_energy(x, np.array(fr))
+                e = segmentation_energy(x, np.array(fr))
                 if e < best[0] - 1e-12:
                     best = (e, list(fr))
             return
@@ -347,19 +408,20 @@ def test_fixed_count_dp_equals_brute_force(seed):
     hi = lo + int(rng.integers(0, 3))
     t = np.arange(n)
     raw = np.sin(2 * np.pi * t / rng.uniform(4, 8))[:, None] + 0.5 * rng.standard_normal((n, 2))
-    x = S._standardise(raw)
-    cost = S._edge_costs(x, lo, hi)
+    x = standardise(raw)
+    cost = edge_costs(x, lo, hi)
     checked = 0
     for count in range(2, n // lo + 1):
         e_bf, f_bf = _brute_force_count(x, lo, hi, count)
+        assert count_fits(n, lo, hi, count) == (f_bf is not None)
         if f_bf is None:
-            with pytest.raises(ParameterError, match="do not fit"):
-                S._shortest_path_count(cost, n, lo, hi, count)
+            with pytest.raises(RuntimeError, match="do not fit"):
+                shortest_path_count(cost, n, lo, hi, count)
             continue
-        frames, energy = S._shortest_path_count(cost, n, lo, hi, count)
+        frames, energy = shortest_path_count(cost, n, lo, hi, count)
         assert frames.size == count + 1
         assert energy == pytest.approx(e_bf, abs=1e-9)
-        assert S.segmentation_energy(x, frames) == pytest.approx(e_bf, abs=1e-9)
+        assert segmentation_energy(x, frames) == pytest.approx(e_bf, abs=1e-9)
         checked += 1
     assert checked >= 1
 
@@ -374,13 +436,14 @@ def test_given_count_is_honoured_or_refused():
     assert seg.n_periods == 9
 
 
-def test_given_count_that_cannot_fit_is_refused():
+def test_count_that_cannot_fit_is_detected():
+    assert count_fits(300, 40, 42, 7)  # 7 * 40..42 frames fit in 300
+    assert not count_fits(300, 40, 42, 8)  # 8 * 40 > 299
     s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
-    x = S._standardise(s.motion.values)
-    cost = S._edge_costs(x, 40, 42)
-    S._shortest_path_count(cost, 300, 40, 42, 7)  # 7 * 40..42 frames fit in 300
-    with pytest.raises(ParameterError, match="8 periods of 40-42 frames"):
-        S._shortest_path_count(cost, 300, 40, 42, 8)  # 8 * 40 > 299
+    cost = edge_costs(standardise(s.motion.values), 40, 42)
+    assert shortest_path_count(cost, 300, 40, 42, 7)[0].size == 8
+    with pytest.raises(RuntimeError, match="8 periods of 40-42 frames"):
+        shortest_path_count(cost, 300, 40, 42, 8)
 
 
 # ------------------------------------------------------- memory of long periods
@@ -390,49 +453,109 @@ def test_long_period_runs_within_memory():
 
     s = periodic_motion(n_frames=2401, n_channels=3, fps=400.0, n_periods=6, snr_db=30,
                         seed=3)  # fmt: skip
-    x = S._standardise(s.motion.values)
+    x = standardise(s.motion.values)
     tracemalloc.start()
     try:
         seg = segment_values(s.motion.values, fps=400.0, n_periods=6)
         _, peak = tracemalloc.get_traced_memory()
     finally:
         tracemalloc.stop()
-    assert peak < S.SEARCH_MEMORY_BUDGET
-    lo, hi = S._band(2400 / 6, 0.1)
-    assert S._search_bytes(2401, lo, hi, 3, 6) > 2 * S.SEARCH_MEMORY_BUDGET
+    assert peak < SEARCH_MEMORY_BUDGET
+    lo, hi = period_band(2400 / 6, 0.1)
+    assert search_bytes(2401, lo, hi, 3, 6) > 2 * SEARCH_MEMORY_BUDGET
     assert seg.search_decimation > 1
     assert seg.n_periods == 6
     assert np.abs(seg.boundary_frames - s.boundary_frames).max() <= 3
-    assert seg.energy == pytest.approx(S.segmentation_energy(x, seg.boundary_frames), abs=1e-9)
+    assert seg.energy == pytest.approx(segmentation_energy(x, seg.boundary_frames), abs=1e-9)
 
 
 @pytest.mark.parametrize("n_periods", [10, None])
-def test_decimated_search_finds_the_exact_optimum(monkeypatch, n_periods):
+def test_decimated_search_finds_the_exact_optimum(n_periods):
+    """A search decimated to fit a smaller memory budget finds the full-rate optimum."""
     s = periodic_motion(n_frames=1200, n_channels=4, fps=100.0, n_periods=10, snr_db=20, seed=1)
-    kw = dict(fps=100.0, n_periods=n_periods, period_range=(0.5, 2.0))
-    exact = segment_values(s.motion.values, **kw)
-    assert exact.search_decimation == 1
-    monkeypatch.setattr(S, "SEARCH_MEMORY_BUDGET", 24 * 2**20)
-    coarse = segment_values(s.motion.values, **kw)
-    assert coarse.search_decimation >= 2
-    np.testing.assert_array_equal(coarse.boundary_frames, exact.boundary_frames)
-    assert coarse.energy == pytest.approx(exact.energy, abs=1e-4)  # float32 vs float64 sums
+    x = standardise(s.motion.values)
+    if n_periods is None:
+        nominal = estimate_period(x, *estimation_band(1200, 50.0, 200.0), "energy")
+    else:
+        nominal = 1199 / n_periods
+    lo, hi = period_band(nominal, 0.1)
+    assert search_decimation(1200, lo, hi, 4, n_periods) == 1
+    factor = search_decimation(1200, lo, hi, 4, n_periods, budget=24 * 2**20)
+    assert factor is not None and factor >= 2
+    f_exact, e_exact = optimum(x, lo, hi, n_periods, 1)
+    f_coarse, e_coarse = optimum(x, lo, hi, n_periods, factor)
+    # float32 sums (exact search) vs float64 refinement: energies, and +-1 frame
+    assert e_coarse == pytest.approx(e_exact, rel=1e-4)
+    assert segmentation_energy(x, f_coarse) == pytest.approx(e_coarse, abs=1e-9)
+    _same_boundaries(f_coarse, f_exact)
 
 
 def test_undecimatable_period_is_refused(monkeypatch):
+    lo, hi = period_band(299 / 10, 0.1)
+    assert search_decimation(300, lo, hi, 29, 10, budget=1) is None
     s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
-    monkeypatch.setattr(S, "SEARCH_MEMORY_BUDGET", 1)
+    monkeypatch.setattr(segment_core, "SEARCH_MEMORY_BUDGET", 1)
     with pytest.raises(ParameterError, match="lower --fps"):
         segment_values(s.motion.values, fps=25.0, n_periods=10)
 
 
 def test_resample_weights_vectorised_equals_scalar():
     d1 = np.array([7, 9, 10, 12])
-    j, w = S._resample_weights(10, d1)
+    j, w = resample_weights(10, d1)
     assert j.shape == w.shape == (4, 11)
     for row, d in enumerate(d1):
-        js, ws = S._resample_weights(10, int(d))
+        js, ws = resample_weights(10, int(d))
         np.testing.assert_array_equal(j[row], js)
         np.testing.assert_array_equal(w[row], ws)
         # resampling a ramp is exact: k * d1 / d0
         np.testing.assert_allclose(js + ws, np.arange(11) * d / 10)
+
+
+# ------------------------------------------------------- period range (dance cycles)
+def test_period_range_from_beat():
+    assert period_range_from_beat(0.5) == (0.5, 4.0)
+    assert period_range_from_beat(0.7, beats=(3, 6)) == pytest.approx((2.1, 4.2))
+
+
+@pytest.mark.parametrize(
+    "beat,kw,match",
+    [
+        (120.0, {}, "BPM"),  # a tempo, not a beat period
+        (0.0, {}, "> 0"),
+        (float("nan"), {}, "finite"),
+        ("fast", {}, "not a number"),
+        (0.5, {"beats": (8, 1)}, "reversed"),
+        (0.5, {"beats": (0, 8)}, "> 0"),
+        (0.5, {"beats": 8}, "two numbers"),
+    ],
+)
+def test_period_range_from_beat_bad_input(beat, kw, match):
+    with pytest.raises(ParameterError, match=match):
+        period_range_from_beat(beat, **kw)
+
+
+def test_period_tiers():
+    assert period_tiers(0.25, 1.25) == [(0.25, 1.25)]
+    assert period_tiers(*DANCE_PERIOD_RANGE) == [(0.25, 1.25), (1.25, 6.25)]
+    assert period_tiers(0.5, 4.0) == [(0.5, 2.5), (2.5, 4.0)]
+
+
+def test_long_cycle_found_in_the_dance_range():
+    """A 4 s figure (like a waltz box) with no shorter repetition."""
+    s = periodic_motion(n_frames=1001, n_channels=12, fps=25.0, n_periods=10, snr_db=20, seed=2)
+    with pytest.raises(ParameterError, match="not periodic"):
+        segment(s.motion)  # the paper's 0.25-1.25 s
+    seg = segment(s.motion, period_range=DANCE_PERIOD_RANGE)
+    assert seg.mean_period == pytest.approx(4.0, rel=0.03)
+    assert np.abs(seg.boundary_frames - s.boundary_frames[: seg.n_periods + 1]).max() <= 2
+    seg_b = segment(s.motion, period_range=period_range_from_beat(0.5))  # 1-8 beats
+    assert seg_b.mean_period == pytest.approx(4.0, rel=0.03)
+
+
+@pytest.mark.slow
+def test_dance_range_keeps_the_step_period_of_salsa():
+    """Searched at once over 0.25-6 s, salsa 61_04 came out as 9 periods of 2.9 s."""
+    m = datasets.load_salsa("61_04")
+    seg = segment(m, period_range=DANCE_PERIOD_RANGE)
+    assert seg.mean_period == pytest.approx(segment(m).mean_period, abs=1e-9)
+    assert 0.95 <= seg.mean_period <= 1.1

@@ -226,12 +226,34 @@ def test_no_warning_in_normal_case():
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": 99}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": -1}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": 0}, "beats"),
-        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": "2"}, "beats"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": "two"}, "beats"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": 1.5}, "beats"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": "x"}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"phase_offset": "x"}, "phase"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"delta": -1.0}, "delta"),
         (np.arange(0.0, 5.5, 1.0), np.array([0.0, np.nan, 1.0]), {}, "NaN"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"mode": "bars"}, "mode="),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"land": "feet"}, "land="),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"fill": "repeat"}, "fill="),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_bar": 0}, "beats_per_bar"),
+        (
+            np.arange(0.0, 5.5, 1.0),
+            np.arange(0, 10, 0.5),
+            {"dance_beats_per_period": 2.5},
+            "dance_beats_per_period",
+        ),
+        (
+            np.arange(0.0, 5.5, 1.0),
+            np.arange(0, 10, 0.5),
+            {"land": "accents", "phase_offset": 0.1},
+            "accents.*phase_offset",
+        ),
+        (
+            np.arange(0.0, 5.5, 1.0),
+            np.arange(0, 10, 0.5),
+            {"period_range": (1.0, 0.5)},
+            "period_range",
+        ),
     ],
 )
 def test_bad_inputs_raise(bounds, beats, kwargs, match):
@@ -245,3 +267,267 @@ def test_time_warp_bad_inputs():
         time_warp([0.0, 1.0, 2.0], [0.0, 1.0])
     with pytest.raises(ParameterError, match="at least 2"):
         time_warp([0.0], [0.0])
+
+
+# ---------------------------------------------------------------- accents
+
+
+def test_accent_lag():
+    from beatsync.sync import accent_lag
+
+    music = np.arange(0.5, 20.0, 0.5)
+    assert np.isclose(accent_lag(music + 0.1, music), 0.1)
+    assert np.isclose(accent_lag(music[1:] - 0.1, music), -0.1)
+    with pytest.raises(ParameterError, match="no motion beat"):
+        accent_lag([30.0], music)
+    with pytest.raises(ParameterError, match="at least 2 music beats"):
+        accent_lag([1.0], [0.5])
+
+
+def _bounce(fps: float = 60.0, seconds: float = 12.0, period: float = 1.1) -> Motion:
+    skel = Skeleton(
+        (
+            Joint("hip", -1, np.zeros(3), ("Xposition", "Yposition", "Zposition")),
+            Joint("end", 0, np.array([0.0, 0.5, 0.0]), (), True),
+        )
+    )
+    t = np.arange(int(seconds * fps)) / fps
+    v = np.zeros((t.size, 3))
+    v[:, 1] = np.cos(2 * np.pi * (t / period - 0.3))  # speed minima at phase 0.3 and 0.8
+    return Motion(v, fps, skel.channel_names(), skel, "bounce")
+
+
+def test_land_accents_puts_motion_beats_on_the_beats():
+    from beatsync.motion_beats import kinematic_beats
+
+    m = _bounce()
+    bounds = np.arange(0.0, 11.9, 1.1)
+    beats = 0.5 + np.arange(40) * 0.5
+    plain = synchronize(m, bounds, beats)
+    acc = synchronize(m, bounds, beats, land="accents")
+    assert acc.report["land"] == "accents" and plain.report["land"] == "boundaries"
+    # boundaries on beats: the accents sit at phase 0.3 of a 2-beat period, off the beat
+    d_plain = np.abs(np.subtract.outer(kinematic_beats(plain.motion), beats)).min(axis=1)
+    d_acc = np.abs(np.subtract.outer(kinematic_beats(acc.motion), beats)).min(axis=1)
+    assert np.median(d_plain) > 0.08
+    assert np.median(d_acc) < 1.5 / 60
+    assert acc.report["phase_offset_s"] == pytest.approx(-acc.report["accent_lag_s"])
+
+
+def test_land_accents_needs_positions():
+    m = _periodic_motion().select(["hip_Zrotation", "knee_Xrotation"])
+    with pytest.raises(ParameterError, match="accents.*positions"):
+        synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), land="accents")
+
+
+# ---------------------------------------------------------------- position-only motion
+
+
+def _arm_positions(fps: float = 25.0, seconds: float = 12.0, beat_times=None) -> Motion:
+    """A 3-joint arm (shoulder, elbow, wrist; bones 0.3 m) swinging, positions only.
+
+    The elbow swings by +-60 deg and the forearm by a further +-60 deg; the speed has
+    a minimum at every turn. ``beat_times``: the turns, else every 0.6 s.
+    """
+    t = np.arange(int(round(seconds * fps))) / fps
+    turns = np.arange(0.3, seconds, 0.6) if beat_times is None else np.asarray(beat_times)
+    # phase goes 0 -> 1 between successive turns: angles reverse at each turn
+    k = np.clip(np.searchsorted(turns, t, side="right") - 1, 0, turns.size - 2)
+    u = np.clip((t - turns[k]) / (turns[k + 1] - turns[k]), 0.0, 1.0)
+    sign = np.where(k % 2 == 0, 1.0, -1.0)
+    a1 = np.deg2rad(60.0) * sign * np.cos(np.pi * u)
+    a2 = a1 * 2.0
+    sh = np.stack([np.zeros_like(t), np.zeros_like(t), 1.4 + 0.02 * np.cos(np.pi * u)], axis=1)
+    el = sh + 0.3 * np.stack([np.sin(a1), np.zeros_like(t), -np.cos(a1)], axis=1)
+    wr = el + 0.3 * np.stack([np.sin(a2), np.zeros_like(t), -np.cos(a2)], axis=1)
+    pos = np.stack([sh, el, wr], axis=1)
+    names = tuple(f"{j}_{a}" for j in ("shoulder", "elbow", "wrist") for a in "xyz")
+    return Motion(pos.reshape(t.size, -1), fps, names, None, "arm")
+
+
+def test_restore_bone_lengths_after_linear_resampling():
+    from beatsync.sync.positions import restore_bone_lengths
+
+    m = _arm_positions(fps=10.0)  # fast turns per frame: linear blends cut the arc
+    pos = m.values.reshape(m.n_frames, 3, 3)
+    bones = np.array([[0, 1], [1, 2]])
+    t = (np.arange(m.n_frames - 1) + 0.5) / m.fps  # half-way between source frames
+    lin = 0.5 * (pos[:-1] + pos[1:])
+
+    def worst(p):
+        return np.abs(
+            np.linalg.norm(p[:, bones[:, 1]] - p[:, bones[:, 0]], axis=-1) / 0.3 - 1
+        ).max()
+
+    assert worst(lin) > 0.01  # the naive resampling shortens the forearm by over 1 %
+    fixed = restore_bone_lengths(lin, pos, bones, m.fps, t)
+    assert worst(fixed) < 1e-9
+    # directions are kept
+    d_lin = lin[:, 2] - lin[:, 1]
+    d_fix = fixed[:, 2] - fixed[:, 1]
+    cos = (
+        np.sum(d_lin * d_fix, axis=1)
+        / np.linalg.norm(d_lin, axis=1)
+        / np.linalg.norm(d_fix, axis=1)
+    )
+    assert np.all(cos > 1 - 1e-12)
+
+
+# ---------------------------------------------------------------- meter
+
+
+@pytest.mark.parametrize(
+    "period, dance, bar, expected",
+    [
+        (2.1, 3, 3, 3),  # a 3-beat waltz step on a 3/4 song at 120 BPM: 4.2 beats -> 3, not 4
+        (2.4, 3, None, 6),  # a 3-beat step, 4.8 beats -> 6 (a multiple of 3), never 5
+        (2.4, None, 3, 6),  # a 3/4 song alone: divisors or multiples of the bar
+        (2.4, None, None, 5),  # paper A's plain rule (no meter known)
+        (1.0, 1, 4, 2),  # one motion beat per period constrains nothing
+    ],
+)
+def test_beats_per_period_respects_meter(period, dance, bar, expected):
+    beats = np.arange(0.0, 30.0, 0.5)
+    got = beats_per_period(period, beats, dance_beats_per_period=dance, beats_per_bar=bar)
+    assert got == expected
+
+
+def _waltz_motion(step: float = 2.4, seconds: float = 14.4) -> Motion:
+    """A position-only dance with 3 motion beats (turns) per step of ``step`` s."""
+    turns = np.arange(0.0, seconds + step, step / 3)
+    m = _arm_positions(fps=25.0, seconds=seconds, beat_times=turns)
+    return m
+
+
+def test_sync_waltz_step_on_3_4_keeps_the_step_whole():
+    m = _waltz_motion()
+    bounds = np.arange(0.0, 14.3, 2.4)
+    beats = np.arange(0.2, 60.0, 0.5)  # 120 BPM: a step is 4.8 beats
+    res = synchronize(m, bounds, beats, beats_per_bar=3, dance_beats_per_period=3)
+    assert res.report["motion_beats_per_period_counted"] == 3  # the speed minima agree
+    assert res.report["beats_per_period"] == 6 and res.report["meter_fit"] is True
+    # the song's 3/4 alone: 4.8 beats -> 6, never 5
+    assert synchronize(m, bounds, beats, beats_per_bar=3).report["beats_per_period"] == 6
+
+
+def test_sync_waltz_step_on_4_4_says_the_meters_do_not_fit():
+    m = _waltz_motion()
+    bounds = np.arange(0.0, 14.3, 2.4)
+    beats = np.arange(0.2, 60.0, 0.5)
+    with pytest.warns(BeatsyncWarning, match="do not fit"):
+        res = synchronize(m, bounds, beats, beats_per_bar=4, dance_beats_per_period=3)
+    assert res.report["beats_per_period"] in (3, 6)  # the step stays whole, never 5 or 4
+    assert res.report["meter_fit"] is False and "do not fit" in res.report["meter_note"]
+
+
+# ---------------------------------------------------------------- fill
+
+
+def test_fill_loop_covers_a_song_longer_than_the_clip():
+    m = _periodic_motion(period=1.0, duration=6.0)
+    bounds = np.arange(0.0, 5.5, 1.0)  # 5 periods
+    beats = np.arange(0.3, 40.0, 0.55)  # 40 s song: 2 beats per period, 36 periods
+    stop = synchronize(m, bounds, beats, fill="stop")
+    loop = synchronize(m, bounds, beats, fill="loop")
+    r = loop.report
+    assert stop.report["repetitions"] == 1 and stop.report["output_duration_s"] < 8.0
+    assert r["repetitions"] >= 7 and r["periods_used"] >= 35
+    assert r["output_duration_s"] >= beats[-1] - 1.0 / FPS  # to the last beat
+    assert r["max_abs_residual_frames"] <= 0.5 + 1e-6
+    # blended joins: no jump bigger than the source's own largest frame-to-frame step
+    src_step = np.abs(np.diff(m.values[:, 3:], axis=0)).max()
+    out_step = np.abs(np.diff(loop.motion.values[:, 3:], axis=0)).max()
+    assert out_step <= 1.5 * src_step
+
+
+def test_fill_loop_of_a_clip_longer_than_the_song_is_stop_to_the_last_beat():
+    m = _periodic_motion(period=1.0, duration=6.0)
+    bounds = np.arange(0.0, 5.5, 1.0)
+    beats = np.arange(0.3, 3.0, 0.55)  # 5 beats: 2 periods and a half
+    res = synchronize(m, bounds, beats, fill="loop")
+    assert res.report["repetitions"] == 1 and res.report["periods_used"] == 2
+    assert res.report["output_duration_s"] >= beats[-1] - 1.0 / FPS
+
+
+# ---------------------------------------------------------------- modes
+
+
+def test_mode_beats_lands_the_dancers_own_beats():
+    from beatsync.motion_beats import kinematic_beats
+
+    rng = np.random.default_rng(3)
+    turns = np.cumsum(rng.uniform(0.45, 0.8, 30))  # an irregular dance: no period
+    m = _arm_positions(fps=25.0, seconds=15.0, beat_times=np.r_[0.0, turns])
+    beats = np.arange(0.5, 30.0, 0.5)
+    res = synchronize(m, None, beats, mode="beats")
+    r = res.report
+    assert r["mode"] == "beats" and r["beats_per_period"] >= 1
+    assert r["max_abs_residual_frames"] <= 0.5 + 1e-6
+    mb = kinematic_beats(res.motion)
+    inside = mb[(mb > beats[0]) & (mb < r["covered_s"][1] - 0.5)]
+    d = np.abs(np.subtract.outer(inside, beats)).min(axis=1)
+    assert np.median(d) <= 1.0 / 25 + 1e-9  # the dancer's beats now sit on the music's
+
+
+@pytest.fixture(scope="module")
+def waltz_dancer() -> Motion:
+    """12 s of a real waltz dancer (Dance-with-Melody, joint positions, 25 fps)."""
+    from beatsync import datasets
+
+    return datasets.load_dance_pair("DANCE_W_5").motion.slice_frames(0, 300)
+
+
+def test_mode_auto_falls_back_to_beats_and_says_so(waltz_dancer):
+    # paper A's period range (0.25-1.25 s) holds no cycle of this waltz: not periodic
+    beats = np.arange(0.5, 30.0, 0.5)
+    with pytest.warns(BeatsyncWarning, match="fell back"):
+        res = synchronize(
+            waltz_dancer, None, beats, mode="auto", fill="loop", period_range=(0.25, 1.25)
+        )
+    r = res.report
+    assert r["mode"] == "beats" and "refused" in r["mode_note"]
+    assert r["output_duration_s"] >= beats[-1] - 1.0 / 25 and r["repetitions"] >= 2
+    assert r["max_abs_residual_frames"] <= 0.5 + 1e-6
+
+
+def test_mode_periods_refuses_a_motion_that_is_not_periodic(waltz_dancer):
+    with pytest.raises(ParameterError, match="not look periodic.*mode='beats'"):
+        synchronize(
+            waltz_dancer, None, np.arange(0.5, 30.0, 0.5), mode="periods", period_range=(0.25, 1.25)
+        )
+
+
+@pytest.mark.parametrize("mode", ["periods", "beats"])
+def test_real_dancer_positions_both_modes_keep_bones(waltz_dancer, mode):
+    # the period range from the song (one to eight beats) holds the waltz's cycle
+    beats = np.arange(0.3, 40.0, 60 / 84)  # 84 BPM, 40 s: longer than the clip
+    res = synchronize(waltz_dancer, None, beats, mode=mode, fill="loop", beats_per_bar=3)
+    r = res.report
+    assert r["mode"] == mode and r["max_abs_residual_frames"] <= 0.5 + 1e-6
+    assert r["output_duration_s"] >= beats[-1] - 1.0 / 25
+    assert res.motion.is_positional
+    if mode == "periods":  # a waltz bar (about 2 s) on the 3/4 song: 3 beats
+        assert r["meter_fit"] is True and r["beats_per_period"] == 3
+    bones = waltz_dancer.bones
+
+    def lengths(m):
+        p = m.positions()
+        return np.linalg.norm(p[:, bones[:, 0]] - p[:, bones[:, 1]], axis=-1)
+
+    src, out = lengths(waltz_dancer), lengths(res.motion)
+    # each output frame's bones: within 1 % of the source's lengths near the frames shown
+    assert np.all(out >= 0.99 * src.min(axis=0)) and np.all(out <= 1.01 * src.max(axis=0))
+    # frame by frame (no loop): each bone as long as in the source at the time shown
+    stop = synchronize(waltz_dancer, None, beats, mode=mode, fill="stop", beats_per_bar=3)
+    f = np.clip(stop.warp_src_times * waltz_dancer.fps, 0, waltz_dancer.n_frames - 1)
+    i0 = np.floor(f).astype(int)
+    i1 = np.minimum(i0 + 1, waltz_dancer.n_frames - 1)
+    u = (f - i0)[:, None]
+    expected = src[i0] * (1 - u) + src[i1] * u
+    assert np.abs(lengths(stop.motion) / expected - 1).max() <= 0.01
+
+
+def test_mode_beats_needs_positions():
+    m = _periodic_motion().select(["hip_Zrotation", "knee_Xrotation"])
+    with pytest.raises(ParameterError, match="mode='beats' needs joint positions"):
+        synchronize(m, None, np.arange(0, 10, 0.5), mode="beats")

@@ -118,8 +118,31 @@ def test_drum_song_bad_input(kwargs):
         drum_song(10.0, **kwargs)
 
 
-def test_music_drum_song_is_a_reexport():
-    from beatsync import music
-    from beatsync.synth import audio
+def test_music_stage_does_not_import_synth():
+    import ast
+    import inspect
 
-    assert music.drum_song is audio.drum_song and music.DrumSong is audio.DrumSong
+    from beatsync import music
+
+    tree = ast.parse(inspect.getsource(music))
+    names = [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    assert not any("synth" in name for name in names)
+    assert not hasattr(music, "drum_song")
+
+
+def test_meter_pattern_accents_the_downbeats():
+    from beatsync.synth.audio import meter_pattern
+
+    ref = beat_times(90, duration=8.0, start=0.5)
+    y = meter_pattern(ref, meter="3/4", sr=8000, duration=8.0).astype(np.float64)
+    assert y.size == 64000
+    # the kick (on every third beat) carries the most energy in the 20 ms after its onset
+    energy = [np.sum(y[int(t * 8000) : int(t * 8000) + 160] ** 2) for t in ref[:9]]
+    assert np.argmax(energy[:3]) == 0 and energy[3] > energy[4]
+
+
+def test_meter_pattern_unknown_meter():
+    from beatsync.synth.audio import meter_pattern
+
+    with pytest.raises(ParameterError, match="meter='5/4' is unknown"):
+        meter_pattern([0.5, 1.0], meter="5/4", duration=2.0)

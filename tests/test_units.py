@@ -2,7 +2,24 @@ import numpy as np
 import pytest
 
 from beatsync.errors import ParameterError
-from beatsync.units import check_fps, check_range, check_times, frames_to_time, time_to_frames
+from beatsync.units import (
+    MAX_BPM,
+    MIN_BPM,
+    as_float,
+    as_float_array,
+    as_int,
+    check_audio,
+    check_between,
+    check_bpm,
+    check_finite,
+    check_fps,
+    check_positive,
+    check_range,
+    check_sample_rate,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 
 
 def test_frames_seconds_round_trip():
@@ -52,3 +69,200 @@ def test_range():
     assert check_range(0.25, 1.25, name="period_range", unit="s") == (0.25, 1.25)
     with pytest.raises(ParameterError, match="reversed"):
         check_range(1.25, 0.25, name="period_range", unit="s")
+
+
+# --------------------------------------------------------------- one validation layer
+
+
+@pytest.mark.parametrize(
+    "value, match",
+    [
+        ("abc", r"delta='abc' is text, not a number \[s\]"),
+        ("0.5", r"delta='0.5' is text, not a number \[s\]; pass a number"),
+        (None, r"delta=None is not a number"),
+        (True, r"delta=True is a bool"),
+        (np.array([0.5, 0.6]), r"single number \[s\], got an array of shape \(2,\)"),
+        ([0.5], r"single number \[s\], not a list"),
+        (np.nan, r"delta=nan must be a finite number \[s\]"),
+        (np.inf, r"finite"),
+        (1e999, r"finite"),
+    ],
+)
+def test_as_float_refuses(value, match):
+    with pytest.raises(ParameterError, match=match):
+        as_float(value, name="delta", unit="s")
+
+
+def test_as_float_accepts_numbers_and_numpy_scalars():
+    assert as_float("0.5", name="d", unit="s", text=True) == 0.5
+    with pytest.raises(ParameterError, match="not a number"):
+        as_float("abc", name="d", unit="s", text=True)
+    assert as_float(np.float32(2), name="d", unit="s") == 2.0
+    assert as_float(np.array(3.0), name="d", unit="s") == 3.0
+    assert np.isnan(as_float(np.nan, name="d", unit="s", allow_nonfinite=True))
+
+
+@pytest.mark.parametrize(
+    "value, match", [(2.5, "whole number"), (1, "integer >= 2"), ("x", "not a number")]
+)
+def test_as_int_refuses(value, match):
+    with pytest.raises(ParameterError, match=match):
+        as_int(value, name="n_periods", minimum=2)
+
+
+def test_as_int_accepts_integral_floats():
+    assert as_int(3.0, name="n", minimum=2) == 3
+
+
+@pytest.mark.parametrize(
+    "value, match",
+    [
+        (0, r"> 0 \[s\]"),
+        (-1, r"> 0 \[s\]"),
+        (np.nan, r"> 0 \[s\]"),
+        ("x", r"not a number \[s\]"),
+        (False, "bool"),
+    ],
+)
+def test_check_positive_refuses(value, match):
+    with pytest.raises(ParameterError, match=match):
+        check_positive(value, name="win_s", unit="s")
+
+
+@pytest.mark.parametrize(
+    "value, closed, match",
+    [
+        (0.5, "neither", r"alpha=0.5 must be in \(0, 0.5\) \(a fraction"),
+        (0.0, "high", r"alpha=0.0 must be in \(0, 0.5\]"),
+        (10, "both", r"must be in \[0, 0.5\]"),
+        (np.nan, "both", "finite"),
+    ],
+)
+def test_check_between_refuses(value, closed, match):
+    with pytest.raises(ParameterError, match=match):
+        check_between(
+            value,
+            name="alpha",
+            unit="",
+            low=0,
+            high=0.5,
+            closed=closed,
+            hint="a fraction of the period, not a percentage",
+        )
+
+
+def test_check_between_accepts_closed_bounds():
+    assert check_between(0.5, name="a", unit="s", low=0, high=0.5, closed="high") == 0.5
+    assert check_between(0, name="a", unit="s", low=0, high=0.5, closed="low") == 0.0
+
+
+@pytest.mark.parametrize(
+    "sr, match",
+    [
+        (0, r"sr=0 must be a finite sample rate > 0 \[Hz\]"),
+        (-22050, "> 0"),
+        (np.nan, "> 0"),
+        ("fast", r"sr='fast' is not a number \[Hz\]"),
+        (44.1, r"not kHz; did you mean sr=44100\?"),
+        (None, "not a number"),
+    ],
+)
+def test_check_sample_rate_refuses(sr, match):
+    with pytest.raises(ParameterError, match=match):
+        check_sample_rate(sr)
+
+
+def test_check_sample_rate_accepts():
+    assert check_sample_rate(22050) == 22050.0
+    assert check_sample_rate(np.int64(8000)) == 8000.0
+
+
+@pytest.mark.parametrize(
+    "bpm, match",
+    [
+        (0.5, r"bpm=0.5 is outside the plausible range 20-400 BPM \(did you give a beat period"),
+        (2.0, "beats per second"),
+        (1000, "sub-beats"),
+        (np.nan, "outside"),
+        ("x", r"not a number \[bpm\]"),
+    ],
+)
+def test_check_bpm_refuses(bpm, match):
+    with pytest.raises(ParameterError, match=match):
+        check_bpm(bpm)
+
+
+def test_check_bpm_one_range():
+    assert (MIN_BPM, MAX_BPM) == (20.0, 400.0)
+    assert check_bpm(20) == 20.0 and check_bpm(400) == 400.0
+
+
+def test_check_audio_keeps_float32_without_copy():
+    y = np.linspace(-0.5, 0.5, 2205, dtype=np.float32)
+    out, sr = check_audio(y, 22050)
+    assert out is y and out.dtype == np.float32 and sr == 22050.0
+    out64, _ = check_audio(y.astype(np.float64), 22050)
+    assert out64.dtype == np.float64
+    outi, _ = check_audio(np.arange(2205, dtype=np.int16), 22050)
+    assert outi.dtype == np.float64
+
+
+_Y = np.full(2205, 0.1, dtype=np.float32)
+
+
+@pytest.mark.parametrize(
+    "y, sr, kwargs, match",
+    [
+        (np.stack([_Y, _Y]), 22050, {}, r"mono \(1-D\), got shape \(2, 2205\); mix down"),
+        (_Y[:0], 22050, {}, "zero samples"),
+        (
+            np.where(np.arange(2205) == 7, np.nan, _Y),
+            22050,
+            {},
+            "1 NaN or infinite sample.*sample 7",
+        ),
+        (_Y, 0, {}, r"sr=0 must be a finite sample rate"),
+        (_Y + 1j, 22050, {}, "complex"),
+        (["a"] * 5, 22050, {}, "strings"),
+        (_Y, 22050, {"min_duration": 1.0}, r"only 0.100 s long \(2205 samples at sr=22050"),
+        (_Y * 0, 22050, {"silence_peak": 1e-7}, "all silent"),
+    ],
+)
+def test_check_audio_refuses(y, sr, kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        check_audio(y, sr, **kwargs)
+
+
+@pytest.mark.parametrize(
+    "values, match",
+    [
+        ([[1.0, 2.0], [3.0]], "ragged"),
+        (np.array([1 + 2j]), "complex"),
+        (np.array(["1.0"]), "strings"),
+        (np.array([b"1"]), "bytes"),
+        (np.array([True, False]), "booleans"),
+        (np.array(["2020-01-01"], dtype="datetime64[D]"), "dates"),
+        (np.zeros(2, dtype=[("a", "f8"), ("b", "f8")]), "structured"),
+        ([1.0, None], "None"),
+    ],
+)
+def test_as_float_array_refuses_non_numeric(values, match):
+    with pytest.raises(ParameterError, match=match):
+        as_float_array(values, name="values")
+
+
+def test_check_finite_dtype_none_keeps_float32():
+    x = np.zeros(3, dtype=np.float32)
+    assert check_finite(x, name="x", dtype=None) is x
+    assert check_finite(x, name="x").dtype == np.float64
+
+
+def test_check_times_refuses_strings_as_parameter_error():
+    with pytest.raises(ParameterError, match="strings"):
+        check_times(["a", "b"])
+
+
+def test_check_helpers_accept_numbers_written_as_text():
+    assert check_positive("2.5", name="th", unit="rd") == 2.5
+    assert check_fps("60", name="fps") == 60.0
+    assert check_bpm("120") == 120.0

@@ -16,7 +16,7 @@ skeleton); inputs are never written.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -131,6 +131,7 @@ def sync_grid(
     bpm: float | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
+    progress: Callable[..., None] | None = None,
 ) -> Any:
     """Synchronise every clip with every song on Dask; return a table of reports.
 
@@ -143,8 +144,9 @@ def sync_grid(
     scheduler : str, optional
         Address of an existing Dask scheduler; default: a local cluster. The workers
         read the inputs and write the outputs themselves, so every path must be valid
-        on every worker (a shared file system).
-    n_workers : int, optional
+        on every worker (a shared file system). See :func:`beatsync.cluster.dask_client`
+        (an unreachable scheduler is refused after a few seconds).
+    n_workers : int >= 1, optional
         Workers of the local cluster (default: one per core).
     processes : bool
         Local cluster with worker processes (default) or threads.
@@ -152,16 +154,27 @@ def sync_grid(
         Frame-rate override for every clip (e.g. 60 for the CMU salsa files).
     bpm : float, optional [BPM]
         Known tempo of every song.
+    progress : callable ``progress(done, total=None)``, optional
+        Called as pairs finish (e.g. a command's progress bar).
 
     Returns
     -------
     pandas.DataFrame
         One row per (clip, song): status, output path, tempo, frames, beats per
         period, maximum boundary residual [ms], or the error message.
+
+    Raises
+    ------
+    ParameterError
+        No clip or song, a missing input, a missing output folder, two inputs of the
+        same name, an output that would overwrite an input, a worker count below 1,
+        ``n_workers`` with ``scheduler``, an unreachable scheduler.
     """
     import pandas as pd
-    from dask.distributed import Client, LocalCluster
 
+    from .cluster import check_cluster_options, dask_client
+
+    check_cluster_options(scheduler, n_workers)
     clips = [str(c) for c in clips]
     songs = [str(s) for s in songs]
     if not clips or not songs:
@@ -191,18 +204,7 @@ def sync_grid(
                         "choose another --out-dir"
                     )
 
-    cluster = None
-    if scheduler is None:
-        cluster = LocalCluster(
-            n_workers=n_workers or os.cpu_count() or 1,
-            threads_per_worker=1,
-            processes=processes,
-            dashboard_address=None,
-        )
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
-    try:
+    with dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes) as client:
         song_f = {s: client.submit(_guard(prepare_song), s, bpm=bpm, pure=False) for s in songs}
         clip_f = {
             c: client.submit(
@@ -228,9 +230,11 @@ def sync_grid(
             for c in clips
             for s in songs
         ]
+        if progress is not None:
+            from dask.distributed import as_completed
+
+            progress(0, total=len(pairs))
+            for done, _ in enumerate(as_completed(pairs), 1):
+                progress(done)
         rows = client.gather(pairs)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
     return pd.DataFrame(rows)

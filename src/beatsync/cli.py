@@ -1,53 +1,155 @@
 """The ``beatsync`` command-line program.
 
-``beatsync SUBCOMMAND --help`` describes each subcommand. Every subcommand accepts
-``--json`` for machine-readable output. Bad input exits with status 2 and a one-line
-message naming the value and the likely mistake.
+``beatsync SUBCOMMAND --help`` describes each subcommand. Only the chosen
+subcommand's module is imported, so the program starts fast.
+
+Every subcommand accepts ``--json`` (the result as a JSON object on stdout) and
+``--quiet`` (no progress bars or progress lines on stderr; warnings and errors are
+still printed). Progress bars appear only when stderr is a terminal.
+
+Outputs are all-or-nothing: every output file of a command is checked before any
+work (an existing folder, a read-only file, an input file, a missing folder are
+refused), written to a hidden staging folder (``.beatsync-tmp-*``) next to it and
+renamed into place only when the whole command succeeded. An error, Ctrl-C or
+SIGTERM leaves every output path as it was.
+
+Exit status
+-----------
+===  ===============================================================================
+0    success
+1    the command ran but some of its items failed (``batch``: no pair synchronised;
+     ``data``: a checksum mismatch); the output says which
+2    usage error: unknown subcommand or option, missing or malformed argument
+     (argparse)
+3    bad input: a value, file or combination of options that cannot be used; the
+     message names it and the likely mistake (no traceback)
+4    the operating system refused (disk full, permission denied while writing)
+70   internal error: a bug in beatsync; the traceback is printed
+130  interrupted by Ctrl-C (SIGINT); 143 by SIGTERM; 129 by SIGHUP
+===  ===============================================================================
+
+Errors go to stderr as ``beatsync COMMAND: error: MESSAGE``; with ``--json`` as one
+line holding a JSON object ``{"error": MESSAGE, "kind": KIND, "command": COMMAND,
+"exit_code": N}``, where ``KIND`` is ``usage``, ``bad-input``, ``os-error``,
+``interrupted`` or ``internal`` (which adds ``"traceback"``).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
+from typing import NoReturn
 
 from . import __version__
-from .commands import COMMAND_MODULES
-from .errors import ParameterError
+from .commands import COMMAND_HELP, COMMAND_MODULES
+
+EXIT_USAGE = 2  # as beatsync.commands._common.EXIT_USAGE (not imported: --help stays light)
+
+__all__ = ["build_parser", "main", "UsageError"]
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+class UsageError(Exception):
+    """An argparse error, raised instead of exiting so that ``main`` can report it."""
+
+    def __init__(self, parser: argparse.ArgumentParser, message: str):
+        super().__init__(message)
+        self.parser = parser
+        self.message = message
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(self, message)
+
+
+def _load(name: str) -> object | None:
+    try:
+        return importlib.import_module(f".commands.{name}", __package__)
+    except ModuleNotFoundError as exc:
+        if exc.name == f"{__package__}.commands.{name}":
+            return None  # subcommand not part of this build
+        raise
+
+
+def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
+    """The program's parser.
+
+    Parameters
+    ----------
+    commands : iterable of str, optional
+        Subcommands to register fully (their modules are imported); the others are
+        listed with their one-line help only. Default: all of them.
+    """
+    full = set(COMMAND_MODULES if commands is None else commands)
+    parser = _Parser(
         prog="beatsync",
         description="Beat-synchronous dance animation: segment periodic motion, track "
         "music beats, make a dance follow a song, compose dances from a motion library.",
+        epilog="Exit status: 0 success, 1 some items failed, 2 usage error, 3 bad input, "
+        "4 system error (disk full, permission), 70 internal error, 130/143 interrupted.",
     )
     parser.add_argument("--version", action="version", version=f"beatsync {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(f".commands.{name}", __package__)
-        except ModuleNotFoundError as exc:
-            if exc.name == f"{__package__}.commands.{name}":
-                continue  # subcommand not part of this build
-            raise
-        module.register(sub)
+        if name in full or name not in COMMAND_HELP:
+            module = _load(name)
+            if module is not None:
+                module.register(sub)  # type: ignore[attr-defined]
+        else:
+            sub.add_parser(name, help=COMMAND_HELP[name], add_help=False)
     return parser
 
 
+def _chosen_command(argv: Sequence[str]) -> str | None:
+    """The subcommand named on the command line (the first non-option word), if any."""
+    for word in argv:
+        if word == "--":
+            return None
+        if not word.startswith("-"):
+            return word if word in COMMAND_MODULES else None
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Run the program; return its exit status (see the module docstring)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    as_json = "--json" in argv
+    chosen = _chosen_command(argv)
+    parser = build_parser([chosen] if chosen else [])
     try:
-        return int(args.func(args) or 0)
-    except ParameterError as exc:
-        print(f"beatsync {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+        args = parser.parse_args(argv)
+    except UsageError as exc:
+        return _usage_error(exc, chosen, as_json)
+    command = args.command
+    from .commands._common import error_report, signals_as_exceptions
+
+    with signals_as_exceptions():
+        try:
+            return int(args.func(args) or 0)
+        except BrokenPipeError:
+            # stdout closed early (e.g. `beatsync beats song.wav | head -1`): not an error
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 0
+        except SystemExit:
+            raise
+        except BaseException as exc:  # noqa: BLE001 - every failure becomes a report
+            return error_report(exc, command, as_json=as_json)
+
+
+def _usage_error(exc: UsageError, command: str | None, as_json: bool) -> int:
+    if as_json:
+        import json
+
+        obj = {"error": exc.message, "kind": "usage", "command": command, "exit_code": EXIT_USAGE}
+        print(json.dumps(obj), file=sys.stderr)
+    else:
+        exc.parser.print_usage(sys.stderr)
+        print(f"{exc.parser.prog}: error: {exc.message}", file=sys.stderr)
+    return EXIT_USAGE
 
 
 if __name__ == "__main__":  # pragma: no cover

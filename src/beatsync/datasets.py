@@ -12,6 +12,7 @@ environment variable ``BEATSYNC_DATA``.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -29,8 +30,13 @@ __all__ = [
     "load_mocap_toolbox",
     "load_madmom_sample",
     "load_click_808",
+    "load_real_dev",
+    "REAL_DEV_ITEMS",
     "SALSA_CLIPS",
     "WALK_CLIPS",
+    "DANCE_PAIRS",
+    "DancePair",
+    "load_dance_pair",
 ]
 
 CHECKSUMS: dict[str, str] = {
@@ -48,12 +54,36 @@ CHECKSUMS: dict[str, str] = {
     "audio/madmom/sample.tempo": "d90c1edbcdbb18b621142fd560c071a4db6b04ffd66631ea5e1e80ad964753f8",
     "audio/madmom/sample.wav": "d06b3c39384c4a0cf59f0bd326eda2443edf668fbb90647e37c801e59602866c",
     "audio/click_808_120bpm/808kick120bpm.mp3": "3158f626d69f15cf8fb60da6775a1a2fd7a10a48694b79175111734e04232245",
+    "motion/dance_with_melody/DANCE_C_4/skeletons.json": "2a46e279b4f24e3a43b5e00241f252076d42d2aa5b7af87cb07733ec4b79ed45",
+    "motion/dance_with_melody/DANCE_C_4/audio.ogg": "920bc5b516e7552528614546c38698753cd19518c8ba883d09013f07239b1b78",
+    "motion/dance_with_melody/DANCE_C_4/excerpt.json": "6e41bb20eb79ed2d0c25aa1c6e39611af6753e72095a56c03730bdfcb9c87ab9",
+    "motion/dance_with_melody/DANCE_R_3/skeletons.json": "c9f5c00d6c593c91ba2bb92511572301410d6ba73c8ee462348cb95e480aacf7",
+    "motion/dance_with_melody/DANCE_R_3/audio.ogg": "4813bc7a12b34ef8967b5d566c5354b7d47e7ab520c84070406bc88a674d8365",
+    "motion/dance_with_melody/DANCE_R_3/excerpt.json": "db642a80c667c57f7ef2f3b4559e2ac29fb3aa7e3035a1f27f12c6b3fa9aa7f4",
+    "motion/dance_with_melody/DANCE_W_5/skeletons.json": "e4195da19587285ee7a6f54fdbfb143a41aeae7a0e4efbc07a127945068f0148",
+    "motion/dance_with_melody/DANCE_W_5/audio.ogg": "87a84361437911c9a38844dbed31645c3366491510ca765a66a5381c4f43e641",
+    "motion/dance_with_melody/DANCE_W_5/excerpt.json": "1474a79aaec2380cc2d104f6b6f6b5e2976e1ea0459481d2daf134709000cabd",
+    "motion/dance_with_melody/DANCE_W_10/skeletons.json": "41177133f31c9532778ffa35e9ff8cd8426ef14147babc0ac57ff3bc26651cc6",
+    "motion/dance_with_melody/DANCE_W_10/audio.ogg": "71aec927fb9b118dc06a316a9a038b61dba04be30f9d136fc47479e108362944",
+    "motion/dance_with_melody/DANCE_W_10/excerpt.json": "f6ba540ecc63a839323e79916b7b6f3a4ed753863da64ab3817e03bf534586bc",
+    "audio/real_dev/ballroom_Media-105901.beats": "cf6bcda78741daf5e372cfe451a7665882ceeee60ca51052188efd371b12b91b",
+    "audio/real_dev/ballroom_Media-105901.wav": "284c02994f065b0323d68752dbbe5491a3102dba13c5495ddeaed84b7b489780",
+    "audio/real_dev/beat_this_annotations_LICENSE.txt": "5476ec1e3de92a2ff96356452c324dc2a566e48d8c98a22503aab88763798aaa",
+    "audio/real_dev/hainsworth_001.beats": "114fd1a3c8eb3bfec5ede3975a3fc70e2a91e272878be74984f7026959393437",
+    "audio/real_dev/hainsworth_001.flac": "1e8a5d9b959e02d2a85ab3ad8f29c5103794bb77c3b03eaa0458ae26d5a5e1d4",
+    "audio/real_dev/mirdata_LICENSE.txt": "acde8606934649e3b903e725f99788a8e2efb2a51437d12f228f31a584b954f6",
 }
 
 #: CMU salsa takes (subject_take); BVH header says 120 fps, the data is 60 fps.
 SALSA_CLIPS = ("60_01", "61_01", "60_04", "61_04")
 #: CMU subject 7 walking (periodic) and subject 5 pirouette (not periodic).
 WALK_CLIPS = ("007_01", "007_02", "007_12", "005_02")
+#: Real recordings with human beat annotations (the beat tracker's development set):
+#: name -> (audio file, beat file) under ``audio/real_dev/``.
+REAL_DEV_ITEMS = {
+    "hainsworth_001": ("hainsworth_001.flac", "hainsworth_001.beats"),
+    "ballroom_waltz": ("ballroom_Media-105901.wav", "ballroom_Media-105901.beats"),
+}
 #: Frame rate of every bundled CMU clip [Hz].
 CMU_FPS = 60.0
 
@@ -159,3 +189,83 @@ def load_click_808() -> tuple[np.ndarray, int]:
     from . import io
 
     return io.read_audio(path("audio/click_808_120bpm/808kick120bpm.mp3"))
+
+
+#: Dance-with-Melody excerpts (dancer + song): cha-cha, rumba, two waltzes.
+DANCE_PAIRS = ("DANCE_C_4", "DANCE_R_3", "DANCE_W_5", "DANCE_W_10")
+_DANCE_STYLE = {"C": "cha-cha", "R": "rumba", "W": "waltz"}
+
+
+@dataclass(frozen=True)
+class DancePair:
+    """A real dancer with the song they danced to (a bundled 24 s excerpt).
+
+    Attributes
+    ----------
+    name : str
+        ``"DANCE_C_4"``, ...
+    style : str
+        ``"cha-cha"``, ``"rumba"`` or ``"waltz"``.
+    motion : Motion
+        Joint positions, 23 joints, 25 fps, metres, z up (file: cm, y up).
+    y : np.ndarray [shape=(n,)]
+        The matching part of the song, mono.
+    sr : int [Hz]
+    audio_offset : float [s]
+        Time in ``y`` of motion frame 0 (the excerpt's audio starts this much earlier;
+        the dataset's own alignment of dance and song is approximate).
+    excerpt : dict
+        What was cut: original ``config``, first frame, song time of frame 0.
+    """
+
+    name: str
+    style: str
+    motion: Motion
+    y: np.ndarray
+    sr: int
+    audio_offset: float
+    excerpt: dict
+
+
+def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
+    """A Dance-with-Melody dancer and song (excerpt), checksum-verified.
+
+    Frame ``i`` of the motion plays at time ``audio_offset + i / fps`` of ``y``.
+    """
+    import json
+
+    from . import io
+
+    if name not in DANCE_PAIRS:
+        raise ParameterError(f"unknown Dance-with-Melody pair {name!r}; choose from {DANCE_PAIRS}")
+    folder = f"motion/dance_with_melody/{name}"
+    excerpt = json.loads(path(f"{folder}/excerpt.json").read_text(encoding="utf-8"))
+    motion = io.read_motion(
+        path(f"{folder}/skeletons.json"), fps=excerpt["fps"], up="y", units="cm"
+    )
+    y, sr = io.read_audio(path(f"{folder}/audio.ogg"))
+    return DancePair(
+        name=name,
+        style=_DANCE_STYLE[name.split("_")[1]],
+        motion=motion.rename(name),
+        y=y,
+        sr=sr,
+        audio_offset=float(excerpt["audio_offset_s"]),
+        excerpt=excerpt,
+    )
+def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
+    """A real development recording and its human beat annotations [s].
+
+    ``"hainsworth_001"`` (Hainsworth dataset excerpt 001, 56.5 s, about 100 BPM, 4/4) or
+    ``"ballroom_waltz"`` (Ballroom dataset, Waltz, Media-105901, 31.8 s, about 84 BPM,
+    3/4); both 44.1 kHz. Returns ``(y, sr, beats)``.
+    """
+    from . import io
+
+    if name not in REAL_DEV_ITEMS:
+        raise ParameterError(
+            f"unknown development recording {name!r}; choose from {sorted(REAL_DEV_ITEMS)}"
+        )
+    audio, beats = REAL_DEV_ITEMS[name]
+    y, sr = io.read_audio(path(f"audio/real_dev/{audio}"))
+    return y, sr, io.read_beats(path(f"audio/real_dev/{beats}"))

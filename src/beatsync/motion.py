@@ -11,6 +11,16 @@ Data contract
   converted to metres on reading).
 - A :class:`Skeleton` (from BVH) gives forward kinematics; marker data and plain
   tables have ``skeleton=None``.
+- A *position-only* motion (``skeleton=None``, channels ``"<joint>_x/_y/_z"`` in
+  joint order; :attr:`Motion.is_positional`) holds world joint positions directly:
+  :meth:`Motion.positions` reshapes them (no forward kinematics) and
+  :attr:`Motion.bones` gives joint-index pairs, given or inferred from constant joint
+  distances (:func:`infer_bones`). Canonical frame of joint positions read by
+  :mod:`beatsync.io.positions`: **metres, z up** (right-handed), the frame of the
+  MoCap Toolbox and most C3D files, and the one ``render`` assumes for skeleton-less
+  motion; files in centimetres or y up are converted on reading and back on writing.
+  :attr:`Motion.position_info` (a :class:`PositionInfo`) keeps what is needed to
+  write the motion back in its input's layout.
 """
 
 from __future__ import annotations
@@ -22,19 +32,35 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .errors import ParameterError
+from .joints import bone_lengths, check_bones, fill_joint_gaps, infer_bones
 from .units import check_finite, check_fps
 
 __all__ = [
     "Joint",
     "Skeleton",
     "Motion",
+    "PositionInfo",
+    "CANONICAL_UNITS",
+    "CANONICAL_UP",
+    "infer_bones",
+    "bone_lengths",
+    "bone_angles",
+    "fill_joint_gaps",
     "marker_angles",
     "fill_gaps",
+    "check_bones",
+    "has_marker_set",
     "is_marker_motion",
     "segmentation_view",
 ]
 
 _ROT_DOFS = ("Xrotation", "Yrotation", "Zrotation")
+#: Length unit of joint positions of a position-only motion read from a file.
+CANONICAL_UNITS = "m"
+#: Vertical axis of joint positions of a position-only motion read from a file.
+CANONICAL_UP = "z"
+#: Supported length units and their size in metres.
+UNIT_METRES = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 _POS_DOFS = ("Xposition", "Yposition", "Zposition")
 
 
@@ -105,6 +131,49 @@ class Skeleton:
 
 
 @dataclass(frozen=True, eq=False)
+class PositionInfo:
+    """What a position-only motion needs beyond its values: bones and its file's layout.
+
+    Parameters
+    ----------
+    bones : np.ndarray [shape=(n_bones, 2)], int, optional
+        Joint-index pairs; ``None``: inferred from the data (:func:`infer_bones`).
+    layout : str
+        Layout of the file it came from: ``"json"`` (Dance-with-Melody ``skeletons`` +
+        ``center``), ``"npy"``, ``"npz"``, ``"c3d"``, or ``"array"`` (made in memory).
+    units : {"m", "cm", "mm"}
+        Length unit of that file (the motion itself is in metres).
+    up : {"y", "z"}
+        Vertical axis of that file (the motion itself is z up).
+    units_source, up_source : {"given", "detected", "file"}
+        Whether the unit / axis was given by the caller, detected from the body's
+        size and shape, or read from the file's own parameters.
+    center : np.ndarray [shape=(n_frames, 3)] [m], optional
+        The JSON layout's per-frame root track, in the canonical frame; joint
+        positions of the motion are absolute (file ``skeletons`` + ``center``).
+    key : str, optional
+        Array name in an ``.npz`` file.
+    """
+
+    bones: np.ndarray | None = None
+    layout: str = "array"
+    units: str = CANONICAL_UNITS
+    up: str = CANONICAL_UP
+    units_source: str = "given"
+    up_source: str = "given"
+    center: np.ndarray | None = None
+    key: str | None = None
+
+    def describe(self) -> str:
+        """One line stating units and vertical axis and whether they were detected."""
+        return (
+            f"{self.layout} file in {self.units} ({self.units_source}), {self.up} up "
+            f"({self.up_source}); "
+            f"read as {CANONICAL_UNITS}, {CANONICAL_UP} up"
+        )
+
+
+@dataclass(frozen=True, eq=False)
 class Motion:
     """Multi-channel motion sampled at a constant frame rate.
 
@@ -116,6 +185,8 @@ class Motion:
     channels : tuple of str [len = n_channels]
     skeleton : Skeleton or None
     name : str
+    position_info : PositionInfo or None
+        Bones and file layout of a position-only motion (see :attr:`is_positional`).
     """
 
     values: np.ndarray
@@ -123,6 +194,7 @@ class Motion:
     channels: tuple[str, ...]
     skeleton: Skeleton | None = None
     name: str = ""
+    position_info: PositionInfo | None = None
     _cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -141,6 +213,64 @@ class Motion:
             )
         if self.skeleton is not None and self.skeleton.channel_names() != self.channels:
             raise ParameterError("channel names do not match the skeleton's channels")
+        info = self.position_info
+        if info is not None:
+            if not self.is_positional:
+                raise ParameterError(
+                    "position_info is only for position-only motion (no skeleton, channels "
+                    "<joint>_x/_y/_z); this motion has other channels"
+                )
+            if info.bones is not None:
+                object.__setattr__(
+                    self,
+                    "position_info",
+                    replace(info, bones=check_bones(info.bones, self.values.shape[1] // 3)),
+                )
+
+    # -- position-only motion ---------------------------------------------
+    @property
+    def is_positional(self) -> bool:
+        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples.
+
+        MoCap Toolbox markers and joint positions read by :mod:`beatsync.io.positions`
+        are position-only; BVH motion and angle tables are not.
+        """
+        if "positional" not in self._cache:
+            ch = self.channels
+            ok = self.skeleton is None and len(ch) >= 3 and len(ch) % 3 == 0
+            if ok:
+                for i in range(0, len(ch), 3):
+                    stems = {c.rpartition("_")[0] for c in ch[i : i + 3]}
+                    axes = tuple(c.rpartition("_")[2] for c in ch[i : i + 3])
+                    if len(stems) != 1 or axes != ("x", "y", "z") or "" in stems:
+                        ok = False
+                        break
+            self._cache["positional"] = ok
+        return self._cache["positional"]
+
+    @property
+    def bones(self) -> np.ndarray:
+        """Joint-index pairs ``(n_bones, 2)`` into axis 1 of :meth:`positions`.
+
+        BVH: ``(joint, parent)`` from the skeleton. Position-only motion: the given
+        bones, else inferred from constant joint distances (:func:`infer_bones`).
+        """
+        if self.skeleton is not None:
+            return np.array(
+                [(i, j.parent) for i, j in enumerate(self.skeleton.joints) if j.parent >= 0],
+                dtype=np.int64,
+            ).reshape(-1, 2)
+        if not self.is_positional:
+            raise ParameterError(
+                f"motion {self.name!r} has neither a skeleton nor joint positions "
+                "(channels <joint>_x/_y/_z): it has no bones"
+            )
+        info = self.position_info
+        if info is not None and info.bones is not None:
+            return info.bones
+        if "bones" not in self._cache:
+            self._cache["bones"] = infer_bones(self.positions())
+        return self._cache["bones"]
 
     # -- basic properties -------------------------------------------------
     @property
@@ -163,6 +293,9 @@ class Motion:
 
     @property
     def joint_names(self) -> list[str]:
+        """Joint names along axis 1 of :meth:`positions` (BVH joints or position triples)."""
+        if self.skeleton is None and self.is_positional:
+            return [c.rpartition("_")[0] for c in self.channels[::3]]
         if self.skeleton is None:
             raise ParameterError(
                 f"motion {self.name!r} has no skeleton (marker data or a plain table); "
@@ -187,6 +320,7 @@ class Motion:
             channels=self.channels,
             skeleton=self.skeleton,
             name=self.name,
+            position_info=self.position_info,
         )
 
     def select(self, names: list[str] | tuple[str, ...]) -> Motion:
@@ -201,7 +335,12 @@ class Motion:
                 f"frame slice {start}:{stop} is outside 0:{self.n_frames} "
                 "(frame indices, not seconds)"
             )
-        return self.with_values(self.values[start:stop])
+        out = self.with_values(self.values[start:stop])
+        info = self.position_info
+        if info is not None and info.center is not None and len(info.center) == self.n_frames:
+            info = replace(info, center=info.center[start:stop])
+            out = replace(out, position_info=info, _cache={})
+        return out
 
     def rename(self, name: str) -> Motion:
         return replace(self, name=name, _cache={})
@@ -246,13 +385,20 @@ class Motion:
     def positions(self) -> np.ndarray:
         """World positions of every joint and end site by forward kinematics.
 
+        Position-only motion: the values reshaped (a view), no kinematics.
+
         Returns
         -------
         positions : np.ndarray [shape=(n_frames, n_joints, 3)]
-            In the file's length units; axis 1 follows :attr:`joint_names`.
+            In the file's length units (position-only motion: metres, z up); axis 1
+            follows :attr:`joint_names`.
         """
         if "positions" in self._cache:
             return self._cache["positions"]
+        if self.skeleton is None and self.is_positional:
+            pos = self.values.reshape(self.n_frames, -1, 3)
+            self._cache["positions"] = pos
+            return pos
         if self.skeleton is None:
             raise ParameterError(
                 f"motion {self.name!r} has no skeleton (marker data or a plain table); "
@@ -400,6 +546,52 @@ def marker_angles(motion: Motion) -> Motion:
     return Motion(values, motion.fps, names, None, motion.name)
 
 
+def bone_angles(motion: Motion) -> Motion:
+    """Angles [deg] between every two bones that meet at a joint, as a motion.
+
+    For a position-only motion without a known marker set: each joint with two or
+    more bones (:attr:`Motion.bones`) gives the interior angle between each pair of
+    them (180 deg = straight), e.g. hip-knee-ankle. Such angles do not change when
+    the dancer travels or turns, nor with body size or units, so they suit paper A's
+    segmentation (which works on joint angles) where root-relative positions would
+    follow every turn of a ballroom dance. NaN gaps are filled linearly first.
+
+    Returns
+    -------
+    Motion
+        Channels ``"<a>-<joint>-<b>_angle"`` at the same frame rate, no skeleton.
+    """
+    motion = fill_gaps(motion)
+    pos = motion.positions()
+    names = motion.joint_names
+    neighbours: dict[int, list[int]] = {}
+    for a, b in motion.bones:
+        neighbours.setdefault(int(a), []).append(int(b))
+        neighbours.setdefault(int(b), []).append(int(a))
+    triples = [
+        (nb[i], v, nb[k])
+        for v, nb in sorted(neighbours.items())
+        for i in range(len(nb))
+        for k in range(i + 1, len(nb))
+    ]
+    if not triples:
+        raise ParameterError(
+            f"motion {motion.name!r} has {len(names)} joint(s) and no two bones meet at a "
+            "joint: joint angles need at least 3 joints in a chain"
+        )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        values = np.stack([_angle(pos[:, a], pos[:, v], pos[:, b]) for a, v, b in triples], 1)
+    values = np.where(np.isfinite(values), values, 180.0)  # coincident joints: straight
+    channels = tuple(f"{names[a]}-{names[v]}-{names[b]}_angle" for a, v, b in triples)
+    return Motion(values, motion.fps, channels, None, motion.name)
+
+
+def has_marker_set(motion: Motion) -> bool:
+    """True if the motion has the MoCap Toolbox 28-marker names :func:`marker_angles` needs."""
+    have = set(motion.channels)
+    return all(f"{m}_x" in have for ms in _MCT_POINTS.values() for m in ms)
+
+
 def is_marker_motion(motion: Motion) -> bool:
     """True for marker positions (channels ``"<marker>_x/_y/_z"``, no skeleton)."""
     return motion.skeleton is None and all(
@@ -410,7 +602,13 @@ def is_marker_motion(motion: Motion) -> bool:
 def segmentation_view(motion: Motion) -> Motion:
     """The joint-angle motion that segmentation works on (paper A works on joint angles).
 
-    BVH motion and angle tables are returned as they are; marker positions are
-    turned into joint angles with :func:`marker_angles`.
+    BVH motion and angle tables are returned as they are; MoCap Toolbox markers are
+    turned into joint angles with :func:`marker_angles`; other position-only motion
+    (e.g. keypoints without marker names) into the angles between its bones with
+    :func:`bone_angles` (travel- and turn-invariant, see there).
     """
-    return marker_angles(motion) if is_marker_motion(motion) else motion
+    if not is_marker_motion(motion):
+        return motion
+    if motion.is_positional and not has_marker_set(motion):
+        return bone_angles(motion)
+    return marker_angles(motion)

@@ -4,12 +4,11 @@ Paper B matches the *intensity* of the dance with that of the music beat by beat
 Music intensity of a beat interval ``[b_i, b_{i+1})`` is its sound pressure level,
 the RMS of the samples in dB (re full scale 1.0, floored at ``amin``); for the
 search it is z-scored over the song (:func:`music_intensity`). Beats come from
-:func:`beatsync.beats.track_beats` (:func:`track_music_beats`), which validates the
-audio with :func:`beatsync.beats.check_audio` (the same check is used here).
+:func:`beatsync.beats.track_beats` (:func:`track_music_beats`); audio is validated
+with :func:`beatsync.beats.check_audio`, the tracker's own check.
 
-:func:`drum_song` (and :class:`DrumSong`) is re-exported from
-:func:`beatsync.synth.audio.drum_song`: a documented synthetic song with exact beats
-and loudness sections, for the speed and quality studies.
+A synthetic song with exact beats and loudness sections for the speed and quality
+studies is :func:`beatsync.synth.audio.drum_song` (stages never import ``synth``).
 
 Data contract: audio is mono float ``y`` with ``sr`` [Hz]; beats are 1-D float64
 seconds, strictly increasing; intensities are one value per beat interval.
@@ -24,18 +23,15 @@ from typing import Any
 
 import numpy as np
 
-from .beats import check_audio, check_bpm, track_beats
+from .beats import check_audio, track_beats
 from .errors import ParameterError
 from .motion_beats import zscore
-from .synth.audio import DrumSong, drum_song
-from .units import check_times, time_to_frames
+from .units import check_bpm, check_times, time_to_frames
 
 __all__ = [
     "beat_rms_db",
     "music_intensity",
     "track_music_beats",
-    "DrumSong",
-    "drum_song",
 ]
 
 
@@ -87,7 +83,7 @@ def track_music_beats(
         Mono audio.
     sr : float > 0 [Hz]
     bpm : float, optional [bpm]
-        Known tempo (20-400 BPM, :func:`beatsync.beats.check_bpm`).
+        Known tempo (20-400 BPM, :func:`beatsync.units.check_bpm`).
     method : {"psf", "librosa"}
 
     Returns

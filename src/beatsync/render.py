@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from .errors import BeatsyncWarning, ParameterError
-from .units import check_fps, check_times, frames_to_time, time_to_frames
+from .units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "beat_strip_times",
@@ -60,13 +60,18 @@ def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
     -------
     positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
     bones : np.ndarray [shape=(n_bones, 2)], int
-        Pairs of joint indices (child, parent); empty for marker data.
+        Pairs of joint indices: (child, parent) for a skeleton; the motion's bones
+        (given, or inferred from steady joint distances) for position-only motion;
+        empty for a table whose bones are unknown (drawn as dots).
     """
     from .motion_beats import motion_positions
 
     pos = motion_positions(motion)
     skel = getattr(motion, "skeleton", None)
     if skel is None:
+        if getattr(motion, "is_positional", False):
+            bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
+            return pos, bones
         return pos, np.zeros((0, 2), dtype=np.int64)
     bones = np.array(
         [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0], dtype=np.int64
@@ -385,9 +390,15 @@ class _FrameRenderer:
 
 
 def _video_frames(
-    motion: Any, fps: float, beats: np.ndarray | None, up: str | None, azimuth: float
+    motion: Any,
+    fps: float,
+    beats: np.ndarray | None,
+    up: str | None,
+    azimuth: float,
+    duration: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    n_out = int(np.floor((motion.n_frames - 1) / motion.fps * fps + 1e-9)) + 1
+    last = (motion.n_frames - 1) / motion.fps if duration is None else duration - 1.0 / fps
+    n_out = int(np.floor(max(last, 0.0) * fps + 1e-9)) + 1
     t = frames_to_time(np.arange(n_out), fps=fps)
     src = np.clip(time_to_frames(t, fps=motion.fps), 0, motion.n_frames - 1)
     pos, bones = pose_positions(motion)
@@ -415,6 +426,7 @@ def write_video(
     title: str | None = None,
     ffmpeg: str | bool | None = None,
     progress: bool = False,
+    duration: float | None = None,
 ) -> Path:
     """Write a stick-figure video of ``motion``, with the music as soundtrack.
 
@@ -443,6 +455,9 @@ def write_video(
         forces the GIF + WAV fallback.
     progress : bool
         Show a tqdm progress bar on stderr.
+    duration : float > 0, optional [s]
+        Length of the video; default the motion's. Longer: the last pose is held
+        (e.g. to the end of the song, whose last beat the dance reaches).
 
     Returns
     -------
@@ -464,6 +479,8 @@ def write_video(
     if w < 32 or h < 32:
         raise ParameterError(f"size={size!r} is too small; give (width, height) in pixels >= 32")
     beats_arr = None if beats is None else check_times(beats, name="beats")
+    if duration is not None:
+        duration = check_positive(duration, name="duration", unit="s")
     y_sr = None
     if audio is not None:
         try:
@@ -477,7 +494,7 @@ def write_video(
             raise ParameterError(f"audio sample rate {sr!r} must be > 0 [Hz]")
         y_sr = (y, int(sr))
 
-    t, xy, bones, on = _video_frames(motion, fps, beats_arr, up, azimuth)
+    t, xy, bones, on = _video_frames(motion, fps, beats_arr, up, azimuth, duration)
     renderer = _FrameRenderer(xy, bones, (w, h), motion.name if title is None else title)
     exe = find_ffmpeg() if ffmpeg is None else (ffmpeg or None)
     frames_iter: Any = range(len(t))
@@ -485,10 +502,10 @@ def write_video(
         from tqdm import tqdm
 
         frames_iter = tqdm(frames_iter, desc="video", unit="frame", leave=False)
-    duration = len(t) / fps
+    length = len(t) / fps
 
     if exe is None:
-        return _write_gif_fallback(dest, renderer, xy, t, on, fps, y_sr, duration, frames_iter)
+        return _write_gif_fallback(dest, renderer, xy, t, on, fps, y_sr, length, frames_iter)
 
     with tempfile.TemporaryDirectory(dir=parent, prefix=".beatsync-video-") as tmp:
         tmp_video = Path(tmp) / ("out" + (dest.suffix or ".mp4"))
@@ -501,7 +518,7 @@ def write_video(
             from .io import write_audio
 
             y, sr = y_sr
-            n = min(y.size, int(np.ceil(duration * sr)))
+            n = min(y.size, int(np.ceil(length * sr)))
             wav = write_audio(Path(tmp) / "audio.wav", y[:n], sr)
             cmd += ["-i", str(wav)]
         cmd += ["-c:v", "libx264", "-preset", "veryfast", "-crf", "23", "-pix_fmt", "yuv420p"]

@@ -26,7 +26,9 @@ from typing import Any
 
 from .errors import ParameterError
 
-__all__ = ["load_params", "check_params", "run_notebooks", "NotebookRun"]
+__all__ = ["load_params", "check_params", "planned_outputs", "run_notebooks", "NotebookRun"]
+
+MANIFEST = "run_manifest.json"
 
 
 @dataclass(frozen=True)
@@ -106,6 +108,22 @@ def check_params(
     return {n: present[n] for n in names}
 
 
+def planned_outputs(
+    todo: dict[str, Path], *, output_dir: str | Path | None = "results/notebooks", in_place: bool
+) -> dict[str, Path]:
+    """Where :func:`run_notebooks` writes each notebook of ``todo``, and its manifest.
+
+    Returns ``{name: path}`` with the key ``MANIFEST`` for the manifest (not written
+    ``in_place``).
+    """
+    if in_place:
+        return dict(todo)
+    out_dir = Path(output_dir or "results/notebooks")
+    planned = {name: out_dir / path.name for name, path in todo.items()}
+    planned[MANIFEST] = out_dir / MANIFEST
+    return planned
+
+
 def run_notebooks(
     params_file: str | Path,
     *,
@@ -114,6 +132,7 @@ def run_notebooks(
     only: list[str] | None = None,
     in_place: bool = False,
     progress: Callable[[str], None] | None = None,
+    write_to: Callable[[Path], Path] | None = None,
 ) -> list[NotebookRun]:
     """Execute notebooks with papermill.
 
@@ -122,7 +141,7 @@ def run_notebooks(
     params_file : path
     notebooks_dir : path
     output_dir : path
-        Where executed copies go (ignored with ``in_place``).
+        Where executed copies go (ignored with ``in_place``); created if missing.
     only : list of str, optional
         Run only these notebooks.
     in_place : bool
@@ -130,6 +149,11 @@ def run_notebooks(
         refresh the committed, CI-parameter notebooks).
     progress : callable, optional
         Called with a line of text before and after each notebook.
+    write_to : callable, optional
+        Maps each destination of :func:`planned_outputs` to the file actually written
+        (a command writing all-or-nothing passes its staging paths); default: the
+        destination itself. A notebook that fails is kept, with its traceback cells,
+        as ``<name>.failed.ipynb`` next to its destination.
     """
     import nbformat
     import papermill as pm
@@ -140,13 +164,13 @@ def run_notebooks(
     params = load_params(params_file)
     todo = check_params(params, notebooks_dir, only=only)
     nb_dir = Path(notebooks_dir).resolve()
-    out_dir = None
+    planned = planned_outputs(todo, output_dir=output_dir, in_place=in_place)
     if not in_place:
-        out_dir = Path(output_dir or "results/notebooks").resolve()
-        out_dir.mkdir(parents=True, exist_ok=True)
+        Path(output_dir or "results/notebooks").mkdir(parents=True, exist_ok=True)
+    target = write_to or (lambda p: p)
     runs: list[NotebookRun] = []
     for name, path in todo.items():
-        dest = path if in_place else out_dir / path.name  # type: ignore[operator]
+        dest = planned[name].resolve()
         if progress:
             progress(f"running {name} ...")
         start = time.perf_counter()
@@ -168,18 +192,21 @@ def run_notebooks(
                 if progress:
                     progress(f"  {name} FAILED; executed notebook kept in {failed}")
             raise
+        except BaseException:  # Ctrl-C, SIGTERM: leave nothing behind
+            tmp.unlink(missing_ok=True)
+            raise
         executed = nbformat.read(tmp, as_version=4)
         executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
-        with atomic_write(dest) as fh:
+        with atomic_write(target(planned[name])) as fh:
             nbformat.write(executed, fh)
         tmp.unlink(missing_ok=True)
         seconds = time.perf_counter() - start
-        runs.append(NotebookRun(name, dest, params[name], seconds))
+        runs.append(NotebookRun(name, planned[name], params[name], seconds))
         if progress:
-            progress(f"  {name} done in {seconds:.1f} s -> {dest}")
-    if out_dir is not None:
+            progress(f"  {name} done in {seconds:.1f} s -> {planned[name]}")
+    if MANIFEST in planned:
         write_json(
-            out_dir / "run_manifest.json",
+            target(planned[MANIFEST]),
             {
                 "beatsync_version": __version__,
                 "params_file": str(params_file),

@@ -1,4 +1,20 @@
-"""Time bases and validation shared by every stage.
+"""Time bases and every validation helper of beatsync (the lowest layer but ``errors``).
+
+Every public entry of the package checks its inputs here, once; private functions
+trust them. The ``check_*`` helpers accept a number written as text (``"2.5"``, as
+the checks they replaced did); :func:`as_float` and :func:`as_int` refuse text unless
+``text=True`` (a count passed as ``"2"`` is a likely mistake in a call). Each helper
+raises :class:`~beatsync.errors.ParameterError` naming the value and the likely
+mistake (a period given for a rate, frames for seconds, kHz for Hz, a percentage for a
+fraction) and returns the value converted to its working type.
+
+Helpers
+-------
+- numbers: :func:`as_float`, :func:`as_int`, :func:`check_positive`,
+  :func:`check_between`, :func:`check_range`;
+- rates: :func:`check_fps` [Hz], :func:`check_sample_rate` [Hz], :func:`check_bpm`
+  [bpm] (one range, :data:`MIN_BPM`-:data:`MAX_BPM`);
+- arrays: :func:`check_finite`, :func:`check_times` [s], :func:`check_audio`.
 
 Data contract
 -------------
@@ -20,16 +36,110 @@ from .errors import ParameterError
 __all__ = [
     "frames_to_time",
     "time_to_frames",
+    "as_float",
+    "as_int",
     "check_fps",
     "check_times",
     "check_finite",
     "check_range",
     "check_positive",
+    "check_between",
+    "check_sample_rate",
+    "check_bpm",
+    "check_audio",
+    "as_float_array",
     "MIN_PLAUSIBLE_FPS",
+    "MIN_PLAUSIBLE_SR",
+    "MIN_BPM",
+    "MAX_BPM",
+    "check_whole",
+    "beat_phase",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
 MIN_PLAUSIBLE_FPS = 1.0
+#: Sample rates below this [Hz] are refused as a likely rate in kHz (``sr=44.1``).
+MIN_PLAUSIBLE_SR = 1000.0
+#: The one range of plausible tempi [bpm]: below it a beat period in seconds or beats
+#: per second was likely given, above it a rate in beats per minute of a sub-beat.
+MIN_BPM = 20.0
+MAX_BPM = 400.0
+
+
+def _unit(unit: str) -> str:
+    return f" [{unit}]" if unit else ""
+
+
+def as_float(
+    value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False, text: bool = False
+) -> float:
+    """Return ``value`` as a Python float, refusing what is not one finite number.
+
+    Parameters
+    ----------
+    value : number
+        A bool, a string or an array (even of one element) is refused: all are likely
+        mistakes in a call.
+    name : str
+        The parameter's name, used in messages.
+    unit : str
+        Its unit (``"s"``, ``"Hz"``, ``"bpm"``), used in messages.
+    allow_nonfinite : bool
+        Accept NaN and +-inf (default: refused).
+    text : bool
+        Accept a number written as text (``"0.5"``), as when reading a file.
+
+    Raises
+    ------
+    ParameterError
+        Not a number, or not finite.
+
+    Examples
+    --------
+    >>> as_float(0.5, name="delta", unit="s")
+    0.5
+    >>> as_float("0.5", name="delta", unit="s", text=True)
+    0.5
+    """
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name}={value!r} is a bool, not a number{_unit(unit)}")
+    if not text and isinstance(value, (str, bytes, np.str_, np.bytes_)):
+        raise ParameterError(
+            f"{name}={value!r} is text, not a number{_unit(unit)}; pass a number (convert "
+            "values read from text first)"
+        )
+    if isinstance(value, np.ndarray) and value.ndim > 0:
+        raise ParameterError(
+            f"{name} must be a single number{_unit(unit)}, got an array of shape {value.shape}"
+        )
+    if isinstance(value, (list, tuple, dict, set)):
+        raise ParameterError(
+            f"{name}={value!r} must be a single number{_unit(unit)}, not a {type(value).__name__}"
+        )
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"{name}={value!r} is not a number{_unit(unit)}") from None
+    if not allow_nonfinite and not np.isfinite(v):
+        raise ParameterError(f"{name}={value!r} must be a finite number{_unit(unit)}")
+    return v
+
+
+def as_int(
+    value: Any, *, name: str, unit: str = "", minimum: int | None = None, text: bool = False
+) -> int:
+    """Return ``value`` as an int, refusing fractions (``2.5``) and values below ``minimum``.
+
+    Integral floats (``3.0``) are accepted; text only with ``text=True`` (see
+    :func:`as_float`). Raises :class:`ParameterError`.
+    """
+    v = as_float(value, name=name, unit=unit, text=text)
+    if v != np.floor(v):
+        raise ParameterError(f"{name}={value!r} must be a whole number{_unit(unit)}")
+    i = int(v)
+    if minimum is not None and i < minimum:
+        raise ParameterError(f"{name}={value!r} must be an integer >= {minimum}{_unit(unit)}")
+    return i
 
 
 def check_fps(fps: Any, *, name: str = "fps") -> float:
@@ -40,10 +150,7 @@ def check_fps(fps: Any, *, name: str = "fps") -> float:
     ParameterError
         If ``fps`` is not a finite positive number.
     """
-    try:
-        value = float(fps)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}={fps!r} is not a number; give a frame rate in Hz") from None
+    value = as_float(fps, name=name, unit="Hz", allow_nonfinite=True, text=True)
     if not np.isfinite(value) or value <= 0:
         raise ParameterError(
             f"{name}={fps!r} must be a finite frame rate > 0 [Hz] "
@@ -60,13 +167,10 @@ def check_fps(fps: Any, *, name: str = "fps") -> float:
 def check_positive(value: Any, *, name: str, unit: str, allow_zero: bool = False) -> float:
     """Return ``value`` as a float after checking it is finite and > 0 (or >= 0) [unit].
 
-    Use for durations, tempi, window lengths: anything positive that is not a frame
-    rate (see :func:`check_fps`).
+    Use for durations, widths, window lengths: anything positive that is not a rate
+    (see :func:`check_fps`, :func:`check_sample_rate`, :func:`check_bpm`).
     """
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}={value!r} is not a number [{unit}]") from None
+    v = as_float(value, name=name, unit=unit, allow_nonfinite=True, text=True)
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         bound = ">= 0" if allow_zero else "> 0"
         raise ParameterError(f"{name}={value!r} must be a finite number {bound} [{unit}]")
@@ -128,9 +232,70 @@ def time_to_frames(
     raise ParameterError(f"mode={mode!r} must be 'round', 'floor' or 'ceil'")
 
 
-def check_finite(values: Any, *, name: str) -> np.ndarray:
-    """Return ``values`` as a float64 array, refusing NaN or infinite entries."""
-    arr = np.asarray(values, dtype=np.float64)
+_KIND_NAMES = {
+    "b": "booleans",
+    "c": "complex numbers (take .real or abs() first)",
+    "U": "strings",
+    "S": "bytes",
+    "O": "Python objects",
+    "M": "dates (datetime64)",
+    "m": "time deltas (timedelta64); convert them to seconds first",
+    "V": "records (a structured array); select one numeric field",
+}
+
+
+def as_float_array(values: Any, *, name: str, dtype: Any = np.float64) -> np.ndarray:
+    """Return ``values`` as a floating-point array, refusing non-numeric data.
+
+    Parameters
+    ----------
+    values : array_like
+        Integers or floats. Booleans, complex numbers, strings, bytes, dates and
+        structured records are refused (numeric strings are not parsed: a text column
+        usually means a header row or a wrong delimiter).
+    name : str
+        Used in messages.
+    dtype : numpy dtype or None
+        The result's dtype; ``None`` keeps a floating array's dtype (no copy) and
+        converts integers to float64.
+
+    Raises
+    ------
+    ParameterError
+        Ragged nested lists, or an array of a non-numeric kind.
+    """
+    try:
+        arr = np.asarray(values)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"{name} must be a numeric array; nested lists of unequal length (ragged) "
+            "cannot be one"
+        ) from None
+    if arr.dtype.kind == "O":
+        try:
+            if any(v is None or isinstance(v, (str, bytes)) for v in arr.flat):
+                raise TypeError
+            arr = arr.astype(np.float64)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"{name} must be a numeric array, but it holds {_KIND_NAMES['O']} "
+                "(None, strings or nested sequences?)"
+            ) from None
+    if arr.dtype.kind not in "iuf":
+        what = _KIND_NAMES.get(arr.dtype.kind, f"values of dtype {arr.dtype}")
+        raise ParameterError(f"{name} must be a numeric array, but it holds {what}")
+    if dtype is None:
+        return arr if arr.dtype.kind == "f" else arr.astype(np.float64)
+    return arr.astype(dtype, copy=False)
+
+
+def check_finite(values: Any, *, name: str, dtype: Any = np.float64) -> np.ndarray:
+    """Return ``values`` as a float array, refusing NaN or infinite entries.
+
+    ``dtype=None`` keeps a floating array's dtype (no conversion), see
+    :func:`as_float_array`, which also refuses non-numeric arrays.
+    """
+    arr = as_float_array(values, name=name, dtype=dtype)
     bad = ~np.isfinite(arr)
     if bad.any():
         idx = np.argwhere(bad)[0]
@@ -165,7 +330,7 @@ def check_times(
     ParameterError
         With the likely mistake: frames instead of seconds, milliseconds, unsorted.
     """
-    arr = np.asarray(times, dtype=np.float64)
+    arr = as_float_array(times, name=name)
     if arr.ndim != 1:
         raise ParameterError(
             f"{name} must be a 1-D array of times in seconds, got shape {arr.shape}"
@@ -199,8 +364,9 @@ def check_times(
 def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float]:
     """Validate an interval ``lo < hi``, both finite and > 0, in ``unit``."""
     try:
-        lo_f, hi_f = float(lo), float(hi)
-    except (TypeError, ValueError):
+        lo_f = as_float(lo, name=name, unit=unit, allow_nonfinite=True, text=True)
+        hi_f = as_float(hi, name=name, unit=unit, allow_nonfinite=True, text=True)
+    except ParameterError:
         raise ParameterError(f"{name}=({lo!r}, {hi!r}) must be two numbers [{unit}]") from None
     if not (np.isfinite(lo_f) and np.isfinite(hi_f)) or lo_f <= 0 or hi_f <= 0:
         raise ParameterError(f"{name}=({lo!r}, {hi!r}) must be finite and > 0 [{unit}]")
@@ -210,3 +376,186 @@ def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float
             f"smaller than the upper bound [{unit}]"
         )
     return lo_f, hi_f
+
+
+def check_between(
+    value: Any,
+    *,
+    name: str,
+    unit: str,
+    low: float,
+    high: float,
+    closed: str = "neither",
+    hint: str = "",
+) -> float:
+    """Return ``value`` as a float after checking it is finite and between two bounds.
+
+    Parameters
+    ----------
+    low, high : float
+        The bounds, in ``unit``.
+    closed : {"neither", "low", "high", "both"}
+        Which bounds are allowed: ``"high"`` is ``(low, high]``.
+    hint : str
+        The likely mistake, appended to the message (e.g. ``"a fraction, not a
+        percentage"``).
+
+    Examples
+    --------
+    >>> check_between(0.1, name="alpha", unit="", low=0, high=0.5)
+    0.1
+    """
+    if closed not in ("neither", "low", "high", "both"):
+        raise ValueError(f"closed={closed!r} must be 'neither', 'low', 'high' or 'both'")
+    v = as_float(value, name=name, unit=unit, text=True)
+    low_ok = v >= low if closed in ("low", "both") else v > low
+    high_ok = v <= high if closed in ("high", "both") else v < high
+    if not (low_ok and high_ok):
+        left = "[" if closed in ("low", "both") else "("
+        right = "]" if closed in ("high", "both") else ")"
+        more = f" ({hint})" if hint else ""
+        raise ParameterError(
+            f"{name}={value!r} must be in {left}{low:g}, {high:g}{right}{_unit(unit)}{more}"
+        )
+    return v
+
+
+def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
+    """Return an audio sample rate as a float after checking it is plausible [Hz].
+
+    A sample rate must be finite, > 0 and at least :data:`MIN_PLAUSIBLE_SR` (1000 Hz):
+    a smaller value is most likely a rate in kHz (``sr=44.1``) or a sample period.
+
+    Raises
+    ------
+    ParameterError
+        Not a number, not finite, <= 0, or implausibly small.
+
+    Examples
+    --------
+    >>> check_sample_rate(22050)
+    22050.0
+    """
+    v = as_float(sr, name=name, unit="Hz", allow_nonfinite=True, text=True)
+    if not np.isfinite(v) or v <= 0:
+        raise ParameterError(
+            f"{name}={sr!r} must be a finite sample rate > 0 [Hz] (a file header saying 0 "
+            "is broken: re-export the file)"
+        )
+    if v < MIN_PLAUSIBLE_SR:
+        guess = f"; did you mean {name}={v * 1000:g}?" if v >= 1 else ""
+        raise ParameterError(
+            f"{name}={sr!r} Hz is implausibly low for audio: a sample rate is given in Hz, "
+            f"not kHz{guess}"
+        )
+    return v
+
+
+def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
+    """Return a tempo as a float after checking it is in [:data:`MIN_BPM`, :data:`MAX_BPM`].
+
+    Raises
+    ------
+    ParameterError
+        Not a number, or outside the one plausible range (20-400 BPM); the message
+        names the likely mistake (a beat period in seconds, beats per second).
+
+    Examples
+    --------
+    >>> check_bpm(120)
+    120.0
+    """
+    v = as_float(bpm, name=name, unit="bpm", allow_nonfinite=True, text=True)
+    if not np.isfinite(v) or not MIN_BPM <= v <= MAX_BPM:
+        hint = "did you give a beat period in seconds, or beats per second?"
+        if np.isfinite(v) and v > MAX_BPM:
+            hint = "did you give a rate of sub-beats, or a tempo in another unit?"
+        raise ParameterError(
+            f"{name}={bpm!r} is outside the plausible range {MIN_BPM:g}-{MAX_BPM:g} BPM "
+            f"({hint})"
+        )
+    return v
+
+
+def check_audio(
+    y: Any,
+    sr: Any,
+    *,
+    name: str = "y",
+    min_duration: float | None = None,
+    silence_peak: float | None = None,
+) -> tuple[np.ndarray, float]:
+    """Validate mono audio; return ``(y, sr)`` with ``y`` as a float array, unconverted.
+
+    A float32 (or float64) ``y`` is returned as is, without a copy; integers become
+    float64. Call it once at a public entry; private functions trust its result.
+
+    Parameters
+    ----------
+    y : array_like [shape=(n,)]
+        Mono samples, finite.
+    sr : float > 0 [Hz]
+        See :func:`check_sample_rate`.
+    name : str
+        Used in messages.
+    min_duration : float, optional [s]
+        Refuse audio shorter than this (the message gives the length).
+    silence_peak : float, optional
+        Refuse audio whose peak magnitude is below this (all silent).
+
+    Raises
+    ------
+    ParameterError
+        Not 1-D (the message says how to mix down), empty, NaN/inf samples, a bad
+        sample rate, too short, or silent.
+    """
+    sr_f = check_sample_rate(sr)
+    arr = as_float_array(y, name=f"{name} (audio samples)", dtype=None)
+    if arr.ndim != 1:
+        raise ParameterError(
+            f"{name} must be mono (1-D), got shape {arr.shape}; mix down with y.mean(axis=0) "
+            "(librosa layout) or y.mean(axis=1) (soundfile layout)"
+        )
+    if arr.size == 0:
+        raise ParameterError(f"{name} is empty: the audio has zero samples")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise ParameterError(
+            f"{name} contains {int(bad.sum())} NaN or infinite sample(s) "
+            f"(first at sample {int(np.argmax(bad))}); repair or trim the audio"
+        )
+    if min_duration is not None:
+        duration = arr.size / sr_f
+        if duration < min_duration:
+            raise ParameterError(
+                f"the audio is only {duration:.3f} s long ({arr.size} samples at sr={sr_f:g} "
+                f"Hz); at least {min_duration:.3g} s is needed (give a longer excerpt, or "
+                "check the sample rate)"
+            )
+    if silence_peak is not None and not float(np.max(np.abs(arr))) >= silence_peak:
+        raise ParameterError(
+            f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
+        )
+    return arr, sr_f
+
+
+def check_whole(value: Any, *, name: str, minimum: int = 0) -> int:
+    """Return ``value`` as an int >= ``minimum`` (``2.5`` beats is a mistake, not 2).
+
+    The same check as :func:`as_int`, with a lower bound that defaults to 0.
+    """
+    return as_int(value, name=name, minimum=minimum)
+
+
+def beat_phase(events: Any, beats: Any) -> np.ndarray:
+    """Phase of each event inside the beat interval that holds it, in ``[0, 1)``.
+
+    0 is on a beat, 0.5 half-way to the next. Events before the first beat or at/after
+    the last one have no interval and are dropped. Inputs are event times [s], 1-D
+    and increasing (checked by the caller: this is a unit conversion, seconds to beats).
+    """
+    e = np.asarray(events, dtype=np.float64)
+    b = np.asarray(beats, dtype=np.float64)
+    e = e[(e >= b[0]) & (e < b[-1])]
+    i = np.searchsorted(b, e, side="right") - 1
+    return (e - b[i]) / (b[i + 1] - b[i])

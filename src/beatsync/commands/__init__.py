@@ -1,9 +1,35 @@
 """Subcommands of the ``beatsync`` program, one module each.
 
 Each module defines ``register(subparsers)``, which adds its parser and sets
-``func=run``; ``run(args)`` returns a JSON-serialisable ``dict`` and a human-readable
-text via :func:`beatsync.commands._common.emit`.
+``func=run``; ``run(args)`` checks the options and files (cheapest first, through
+:mod:`beatsync.commands._common`), calls the library, and prints a JSON-serialisable
+``dict`` or a human-readable text via :func:`beatsync.commands._common.emit`.
+
+The program imports only the module of the subcommand it runs: ``beatsync --help``
+lists the subcommands from :data:`COMMAND_HELP` without importing any of them.
 """
 
 # Order shown in ``beatsync --help``.
-COMMAND_MODULES = ("segment", "beats", "sync", "compose", "batch", "reproduce", "data")
+COMMAND_MODULES = (
+    "segment",
+    "beats",
+    "sync",
+    "compose",
+    "batch",
+    "evaluate",
+    "reproduce",
+    "data",
+)
+
+# One-line help of each subcommand, shown by ``beatsync --help`` (a module's own
+# ``register`` uses the same text; a subcommand missing here is imported to list it).
+COMMAND_HELP = {
+    "segment": "find the period boundaries of a periodic motion (paper A, section 3)",
+    "beats": "track the beats of a song and print their times in seconds",
+    "sync": "resample a periodic dance so that its periods land on the beats of a song",
+    "compose": "compose a dance for a song from a library of motion clips (motion graph + DP)",
+    "batch": "sync every motion clip with every song, in parallel on Dask",
+    "evaluate": "score beat trackers against annotations over a dataset (on Dask)",
+    "reproduce": "run the study's notebooks with papermill from a parameter file",
+    "data": "list the bundled data files and verify their SHA-256 checksums",
+}

@@ -4,16 +4,17 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, emit
+from . import COMMAND_HELP
+from ._common import EXIT_FAILED_ITEMS, EXIT_OK, add_output_flags, emit
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "data",
-        help="list the bundled data files and verify their SHA-256 checksums",
+        help=COMMAND_HELP["data"],
         description="Verify every file of the bundled data against data/README.md's checksums.",
     )
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
@@ -25,4 +26,4 @@ def run(args: argparse.Namespace) -> int:
     bad = [rel for rel, ok in status.items() if not ok]
     lines.append(f"data folder: {datasets.data_dir()}")
     emit({"data_dir": str(datasets.data_dir()), "files": status}, "\n".join(lines), args)
-    return 1 if bad else 0
+    return EXIT_FAILED_ITEMS if bad else EXIT_OK

@@ -1,24 +1,35 @@
-"""``beatsync reproduce``: run the study's notebooks with papermill."""
+"""``beatsync reproduce``: run the study's notebooks with papermill.
+
+The executed notebooks (and ``run_manifest.json``) are written all-or-nothing: they
+replace the previous ones only when every notebook ran. A notebook that fails is
+kept as ``<name>.failed.ipynb`` next to its destination, for its traceback cells.
+The artefacts the notebooks write themselves (``results/<notebook>/``) are theirs.
+"""
 
 from __future__ import annotations
 
 import argparse
-import sys
+import contextlib
+from pathlib import Path
 
-from ._common import add_json_flag, emit
+from . import COMMAND_HELP
+from ._common import Outputs, add_output_flags, check_input_file, emit, feedback
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "reproduce",
-        help="run the study's notebooks with papermill from a parameter file",
+        help=COMMAND_HELP["reproduce"],
         description="Execute every notebook (or --only some) with the parameters of a "
-        "parameter file; refuse parameters a notebook does not declare.",
+        "parameter file; refuse parameters a notebook does not declare. The executed "
+        "notebooks replace the previous ones only when all of them ran.",
     )
     p.add_argument("--params", default="params/paper.yaml", help="parameter file (YAML)")
     p.add_argument("--notebooks", default="notebooks", help="folder of the notebooks")
     p.add_argument(
-        "--output", default="results/notebooks", help="folder for the executed notebooks"
+        "--output",
+        default="results/notebooks",
+        help="folder for the executed notebooks (created if missing)",
     )
     p.add_argument("--only", nargs="+", metavar="NAME", help="run only these notebooks")
     p.add_argument(
@@ -29,28 +40,59 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--check", action="store_true", help="only check the parameter file, run nothing"
     )
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..runner import check_params, load_params, run_notebooks
+    from ..errors import ParameterError
+    from ..runner import check_params, load_params, planned_outputs, run_notebooks
 
+    check_input_file(args.params, "parameter file")
+    if not Path(args.notebooks).is_dir():
+        raise ParameterError(f"--notebooks {args.notebooks!r} is not a folder of notebooks")
+    if args.check and args.in_place:
+        raise ParameterError("--check runs nothing, so --in-place has nothing to overwrite")
+    todo = check_params(load_params(args.params), args.notebooks, only=args.only)
     if args.check:
-        todo = check_params(load_params(args.params), args.notebooks, only=args.only)
         return emit(
             {"params": args.params, "notebooks": sorted(todo)},
             f"{args.params}: OK for {len(todo)} notebook(s): {', '.join(sorted(todo))}",
             args,
         )
-    runs = run_notebooks(
-        args.params,
-        notebooks_dir=args.notebooks,
-        output_dir=args.output,
-        only=args.only,
-        in_place=args.in_place,
-        progress=lambda line: print(line, file=sys.stderr),
-    )
+    fb = feedback(args)
+    out_dir = Path(args.output)
+    made = None
+    if not args.in_place:
+        if out_dir.exists() and not out_dir.is_dir():
+            raise ParameterError(f"--output {args.output!r} is a file, not a folder")
+        if not out_dir.exists():
+            made = next((p for p in [out_dir, *out_dir.parents] if p.exists()), None)
+            out_dir.mkdir(parents=True)
+    try:
+        with Outputs(inputs=[args.params]) as outs:
+            for name, dest in planned_outputs(
+                todo, output_dir=out_dir, in_place=args.in_place
+            ).items():
+                # in place, a notebook is both input and output: declared as output only
+                outs.add(dest, option=f"notebook {name}" if name in todo else "manifest")
+            runs = run_notebooks(
+                args.params,
+                notebooks_dir=args.notebooks,
+                output_dir=out_dir,
+                only=args.only,
+                in_place=args.in_place,
+                progress=fb.info,
+                write_to=outs.path,
+            )
+    except BaseException:
+        if made is not None:  # remove the folders this command created, if still empty
+            for folder in [out_dir, *out_dir.parents]:
+                if folder == made:
+                    break
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
+        raise
     result = {
         "params": args.params,
         "notebooks": [

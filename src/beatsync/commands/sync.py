@@ -20,11 +20,20 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ._common import add_json_flag, add_period_range, check_output_path, check_side_outputs, emit
+from ._common import (
+    add_json_flag,
+    add_position_options,
+    check_output_path,
+    check_side_outputs,
+    emit,
+    position_options,
+)
 
 __all__ = ["register", "run"]
 
-_MOTION_OUT = (".bvh", ".csv")
+_MOTION_OUT = (".bvh", ".csv", ".json", ".npy", ".npz", ".c3d")
+#: shortest song the beat tracker is asked about [s]
+MIN_MUSIC_S = 1.0
 
 
 def register(subparsers: Any) -> None:
@@ -55,6 +64,7 @@ def register(subparsers: Any) -> None:
         "--out-fps", type=float, default=None, help="output frame rate [Hz] (default: the input's)"
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    add_position_options(p)
     p.add_argument(
         "--beats",
         default=None,
@@ -72,7 +82,8 @@ def register(subparsers: Any) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="music beats per motion period (default: round(motion period / beat))",
+        help="music beats per motion period, or per motion beat with --mode beats "
+        "(default: round(motion period / beat), respecting the meters)",
     )
     p.add_argument(
         "--first-beat",
@@ -94,7 +105,47 @@ def register(subparsers: Any) -> None:
         help="put the dancer's accents (kinematic beats: minima of joint speed) "
         "on the beats instead of the period boundaries",
     )
-    add_period_range(p)
+    p.add_argument(
+        "--mode",
+        choices=("auto", "periods", "beats"),
+        default="auto",
+        help="what lands on the beats: 'periods' (paper A: the motion's periods), 'beats' "
+        "(the dancer's own motion beats, for dances that are not strictly periodic), or "
+        "'auto' (periods if the motion is periodic, else beats, with a warning; default)",
+    )
+    p.add_argument(
+        "--fill",
+        choices=("loop", "stop"),
+        default="loop",
+        help="'loop' (default): repeat whole periods, with blended joins, until the dance "
+        "covers the song to its last beat; 'stop': end with the clip's last period",
+    )
+    p.add_argument(
+        "--beats-per-bar",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the music's meter (3 for a waltz; default: estimated by the beat tracker); "
+        "beats per period then respect it",
+    )
+    p.add_argument(
+        "--dance-beats",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
+        "a waltz box); beats per period are then a multiple of it, and a warning says so "
+        "when the song's meter does not fit",
+    )
+    p.add_argument(
+        "--period-range",
+        nargs=2,
+        type=float,
+        default=None,
+        metavar=("LO", "HI"),
+        help="shortest and longest motion period searched [s] (default: one to eight beats "
+        "of the song, so real dance cycles such as a 4 s waltz box are found)",
+    )
     p.add_argument(
         "--video",
         default=None,
@@ -140,6 +191,21 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | N
         raise ParameterError(
             "--align-accents measures the phase offset itself; do not also give --phase-offset"
         )
+    if args.beats_per_bar is not None and args.beats_per_bar < 1:
+        raise ParameterError(
+            f"--beats-per-bar {args.beats_per_bar} must be a whole number of beats >= 1 "
+            "(3 for a waltz, 4 for most pop)"
+        )
+    if args.dance_beats is not None and args.dance_beats < 1:
+        raise ParameterError(
+            f"--dance-beats {args.dance_beats} must be a whole number of beats >= 1 "
+            "(3 for a waltz step)"
+        )
+    if args.period_range is not None and not 0 < args.period_range[0] < args.period_range[1]:
+        raise ParameterError(
+            f"--period-range {args.period_range[0]:g} {args.period_range[1]:g} must be "
+            "LO HI with 0 < LO < HI [s]"
+        )
     if args.beats is not None and args.bpm is not None:
         raise ParameterError(
             "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
@@ -148,7 +214,8 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | N
     out = Path(args.output)
     if out.suffix.lower() not in _MOTION_OUT:
         raise ParameterError(
-            f"output {args.output!r} must end in .bvh or .csv (the motion is written there)"
+            f"output {args.output!r} must end in .bvh or .csv, or for joint positions .json, "
+            ".npy, .npz or .c3d (the motion is written there)"
         )
     for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
         if inp is not None and not Path(inp).is_file():
@@ -181,43 +248,35 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     from ..sync import synchronize
 
     t_start = time.perf_counter()
-    steps = _Steps(5 + (video is not None))
+    steps = _Steps(4 + (video is not None))
     timings: dict[str, float] = {}
     try:
         steps.step("reading motion")
         t0 = time.perf_counter()
-        motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+        motion = io.read_motion(
+            args.motion, fps=args.fps, variable=args.variable, **position_options(args)
+        )
         if out.suffix.lower() == ".bvh" and motion.skeleton is None:
+            alt = (
+                ".json, .npy or .c3d (joint positions, in the input's layout) or .csv"
+                if motion.is_positional
+                else ".csv"
+            )
             raise ParameterError(
-                f"{args.motion!r} has no skeleton (marker data or a joint-angle table), so it "
-                "cannot be written as BVH; give an output ending in .csv instead"
+                f"{args.motion!r} has no skeleton (joint positions, markers or a joint-angle "
+                f"table), so it cannot be written as BVH; give an output ending in {alt}"
+            )
+        if out.suffix.lower() in (".json", ".npz", ".c3d") and not motion.is_positional:
+            raise ParameterError(
+                f"{args.motion!r} is not joint positions, so it cannot be written as "
+                f"{out.suffix}; give an output ending in .bvh (with a skeleton) or .csv"
             )
         y, sr = io.read_audio(args.audio)
         timings["read_s"] = time.perf_counter() - t0
         steps.done()
 
-        steps.step("segmenting periods")
-        t0 = time.perf_counter()
-        from ..motion import segmentation_view
-        from ..segment import segment
-
-        lo, hi = args.period_range
-        seg = segment(segmentation_view(motion), period_range=(lo, hi))
-        if seg.n_periods < 1 or len(seg.boundaries) < 2:
-            raise ParameterError(
-                f"{args.motion!r} does not look periodic: no full motion period found "
-                f"in {lo}-{hi} s (try --period-range, or a periodic dance clip)"
-            )
-        timings["segment_s"] = time.perf_counter() - t0
-        steps.done()
-
         music_s = y.size / sr
-        if music_s < seg.mean_period:
-            raise ParameterError(
-                f"the music ({music_s:.2f} s) is shorter than one motion period "
-                f"({seg.mean_period:.2f} s): use a longer song"
-            )
-
+        meter = (args.beats_per_bar, "--beats-per-bar" if args.beats_per_bar else "unknown")
         steps.step("finding beats")
         t0 = time.perf_counter()
         if args.beats is not None:
@@ -226,8 +285,15 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         else:
             from ..beats import track_beats
 
+            if music_s < MIN_MUSIC_S:
+                raise ParameterError(
+                    f"the music ({music_s:.2f} s) is shorter than {MIN_MUSIC_S:g} s: too short "
+                    "to find beats in; use a longer song"
+                )
             track = track_beats(y, sr, bpm=args.bpm)
             beats = np.asarray(track.beats, dtype=np.float64)
+            if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
+                meter = (int(track.beats_per_bar), "estimated by track_beats")
             beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
         if beats.size < 2:
             raise ParameterError(
@@ -237,19 +303,23 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         timings["beats_s"] = time.perf_counter() - t0
         steps.done()
 
-        steps.step("resampling motion")
+        steps.step("synchronising motion")
         t0 = time.perf_counter()
         res = synchronize(
             motion,
-            seg.boundaries,
+            None,
             beats,
+            mode=args.mode,
+            land="accents" if args.align_accents else "boundaries",
+            fill=args.fill,
             beats_per_period=args.beats_per_period,
+            beats_per_bar=meter[0],
+            dance_beats_per_period=args.dance_beats,
             first_beat=args.first_beat,
             out_fps=args.out_fps,
             phase_offset=args.phase_offset,
+            period_range=None if args.period_range is None else tuple(args.period_range),
         )
-        if args.align_accents:
-            res = _align_accents(res, motion, seg.boundaries, beats, args)
         timings["sync_s"] = time.perf_counter() - t0
         steps.done()
 
@@ -258,17 +328,15 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
             steps.step("writing video")
             t0 = time.perf_counter()
             vid = _render_video(
-                res.motion, video, (y, sr), beats, args.video_fps, steps.interactive
+                res.motion, video, (y, sr), beats, args.video_fps, steps.interactive,
+                music_s if args.fill == "loop" else None,
             )
             written["video"] = str(vid)
             timings["video_s"] = time.perf_counter() - t0
             steps.done()
 
         steps.step("writing motion")
-        if out.suffix.lower() == ".bvh":
-            io.write_bvh(out, res.motion)
-        else:
-            io.write_table(out, res.motion)
+        io.write_motion(out, res.motion)
         written["motion"] = str(out)
         steps.done()
     finally:
@@ -281,11 +349,13 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
         "audio": str(args.audio),
         "beats_source": beat_source,
         "n_music_beats": int(beats.size),
+        "beats_per_bar": meter[0],
+        "beats_per_bar_source": meter[1],
         "music_duration_s": music_s,
         "segmentation": {
-            "n_periods": int(seg.n_periods),
-            "mean_period_s": float(seg.mean_period),
-            "boundaries_s": np.asarray(seg.boundaries),
+            "mode": rep["mode"],
+            "n_periods": int(rep["periods_available"]),
+            "mean_period_s": float(rep["mean_motion_period_s"]),
         },
         "report": rep,
         "outputs": written,
@@ -294,57 +364,48 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     return result
 
 
-def _align_accents(
-    res: Any, motion: Any, boundaries: Any, beats: np.ndarray, args: argparse.Namespace
-) -> Any:
-    """Synchronise again so that the kinematic beats, not the boundaries, hit the beats."""
-    from ..evaluate.alignment import kinematic_phase_offset
-    from ..motion_beats import kinematic_beats
-    from ..sync import synchronize
-
-    try:
-        mb = kinematic_beats(res.motion)
-    except ParameterError as exc:
-        raise ParameterError(
-            f"--align-accents needs joint positions (a BVH skeleton or markers): {exc}"
-        ) from None
-    lag = kinematic_phase_offset(mb, beats)
-    first = args.first_beat
-    if beats[first] - lag < 0:
-        first += 1
-    return synchronize(
-        motion,
-        boundaries,
-        beats,
-        beats_per_period=args.beats_per_period,
-        first_beat=first,
-        out_fps=args.out_fps,
-        phase_offset=-lag,
-    )
-
-
 def _render_video(
-    motion: Any, path: Path, audio: Any, beats: np.ndarray, fps: float, progress: bool
+    motion: Any,
+    path: Path,
+    audio: Any,
+    beats: np.ndarray,
+    fps: float,
+    progress: bool,
+    duration: float | None,
 ) -> Path:
     from .. import render
 
-    return render.write_video(motion, path, audio=audio, fps=fps, beats=beats, progress=progress)
+    return render.write_video(
+        motion, path, audio=audio, fps=fps, beats=beats, progress=progress, duration=duration
+    )
 
 
 def _text(result: dict[str, Any]) -> str:
     r = result["report"]
     res = np.abs(np.asarray(r["residual_ms"]))
     near = np.abs(np.asarray(r["residual_nearest_frame_ms"]))
+    unit = "periods" if r["mode"] == "periods" else "motion beats"
+    meter = ""
+    if r.get("meter_fit") is False:
+        meter = " (meters do not fit)"
     lines = [
         f"motion   {result['motion']}: {r['input_frames']} frames at {r['input_fps']:g} fps, "
-        f"{result['segmentation']['n_periods']} periods of "
-        f"{result['segmentation']['mean_period_s']:.3f} s (mean)",
+        f"{result['segmentation']['n_periods']} {unit} of "
+        f"{result['segmentation']['mean_period_s']:.3f} s "
+        f"({'mean' if r['mode'] == 'periods' else 'median'})",
         f"music    {result['audio']}: {result['music_duration_s']:.2f} s, "
         f"{result['n_music_beats']} beats ({result['beats_source']}), "
         f"beat period {r['beat_period_s']:.3f} s",
-        f"mapping  {r['periods_used']} of {r['periods_available']} periods, "
-        f"{r['beats_per_period']} beat(s) per period ({r['beats_per_period_rule']}), "
-        f"first period on beat {r['first_beat']}"
+        f"mode     {r['mode']}"
+        + (
+            (" (auto: not periodic, fell back to motion beats)" if r["mode"] == "beats"
+             else " (auto: periodic)")
+            if r["mode_requested"] == "auto" else ""
+        )
+        + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
+        f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "
+        f"{r['beats_per_period']} beat(s) per {unit[:-1]} ({r['beats_per_period_rule']})"
+        f"{meter}, first on beat {r['first_beat']}"
         + (f", {r['phase_offset_s'] * 1000:+.0f} ms after it" if r["phase_offset_s"] else ""),
         f"tempo    playback speed x{r['tempo_ratio_range'][0]:.3f} .. "
         f"x{r['tempo_ratio_range'][1]:.3f}",

@@ -1,9 +1,13 @@
-"""Scores.
+"""Scores: metrics on arrays, mir_eval style (``validate``, the metrics, ``evaluate``).
+
+No module here runs a pipeline stage; :mod:`beatsync.study` runs them and calls these.
 
 - :mod:`beatsync.evaluate.beats`: beat tracking against annotations, every
-  ``mir_eval.beat`` metric with an explicit ``min_beat_time``.
+  ``mir_eval.beat`` metric with an explicit ``min_beat_time``; the tempo octave.
 - :mod:`beatsync.evaluate.alignment`: dance-music beat alignment, both published
   scores (averaged over motion beats, or over music beats; Gaussian sigma in seconds).
+- :mod:`beatsync.evaluate.segmentation`: period boundaries against ground truth
+  (boundary error in frames, count error).
 """
 
 from .alignment import (
@@ -11,21 +15,22 @@ from .alignment import (
     beat_alignment_motion,
     beat_alignment_music,
     beat_phase_consistency,
-    evaluate_sync,
-    kinematic_phase_offset,
     offset_control,
+    sync_residuals,
 )
-from .beats import METRICS, evaluate_beats, octave_relation
+from .beats import METRICS, evaluate_beats, octave_relation, tempo_octave
+from .segmentation import boundary_errors
 
 __all__ = [
     "evaluate_beats",
     "octave_relation",
+    "tempo_octave",
     "METRICS",
     "alignment_scores",
     "beat_alignment_motion",
     "beat_alignment_music",
     "beat_phase_consistency",
-    "kinematic_phase_offset",
     "offset_control",
-    "evaluate_sync",
+    "sync_residuals",
+    "boundary_errors",
 ]

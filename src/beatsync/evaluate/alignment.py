@@ -19,8 +19,13 @@ Both use ``exp(-d^2 / (2 sigma^2))`` with ``d`` the distance to the nearest beat
 Every table of this project says which of the two it reports; :func:`alignment_scores`
 returns both.
 
-Kinematic beats come from :func:`beatsync.motion_beats.kinematic_beats` (local minima
-of smoothed joint speed).
+Motion beats are given as times (e.g. from :func:`beatsync.motion_beats.kinematic_beats`,
+local minima of smoothed joint speed); this module never runs a stage (mir_eval style:
+:func:`validate`, the metrics, and :func:`evaluate` returning all of them). Also here:
+:func:`beat_phase_consistency` (is the dance phase-locked to the music?),
+:func:`offset_control` (chance level by random offsets of the motion beats) and
+:func:`sync_residuals` (how far synchronised boundaries land from their beats).
+What runs the pipeline for the paper's tables is in :mod:`beatsync.study.paper_a_sync`.
 
 Data contract
 -------------
@@ -29,7 +34,8 @@ Beat times are 1-D float64 arrays in seconds, strictly increasing (as in
 sits exactly on a beat of the other set. Empty input is degenerate but legal: a
 :class:`~beatsync.errors.BeatsyncWarning` is issued and the score is 0.
 
-Notebook: ``notebooks/paper_a_tab01_frame_counts.ipynb`` (alignment before/after sync).
+Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb`` (alignment before/after sync),
+``notebooks/paper_a_fig03_animation_frames.ipynb`` (residuals).
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ..units import check_times
+from ..units import beat_phase, check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "validate",
@@ -48,12 +54,10 @@ __all__ = [
     "beat_alignment_motion",
     "beat_alignment_music",
     "alignment_scores",
-    "motion_alignment",
     "offset_control",
     "beat_phase_consistency",
-    "kinematic_phase_offset",
-    "evaluate_sync",
-    "sync_table",
+    "sync_residuals",
+    "evaluate",
 ]
 
 #: Gaussian width of both published scores: 3 frames at 60 fps [s]
@@ -217,46 +221,6 @@ def alignment_scores(
     }
 
 
-def _kinematic_beats(motion: Any, **kwargs: Any) -> np.ndarray:
-    from ..motion_beats import kinematic_beats
-
-    return kinematic_beats(motion, **kwargs)
-
-
-def motion_alignment(
-    motion: Any,
-    music_beats: Any,
-    *,
-    sigma: float = DEFAULT_SIGMA,
-    offset: float = 0.0,
-    **beat_kwargs: Any,
-) -> dict[str, float]:
-    """Both alignment scores of a motion's kinematic beats against music beats.
-
-    Parameters
-    ----------
-    motion : beatsync.motion.Motion
-        With a skeleton or marker positions; frame ``k`` plays at music time
-        ``offset + k / fps``.
-    music_beats : np.ndarray [s]
-    sigma : float > 0 [s]
-    offset : float [s]
-        Music time of the motion's first frame.
-    **beat_kwargs
-        Passed to :func:`beatsync.motion_beats.kinematic_beats` (``method``, ``smooth``...).
-
-    Returns
-    -------
-    dict
-        As :func:`alignment_scores`, computed over the time both play.
-    """
-    mb = _kinematic_beats(motion, **beat_kwargs) + float(offset)
-    mb = mb[mb >= 0]
-    start = max(0.0, float(offset))
-    end = float(offset) + float(motion.duration)
-    return alignment_scores(mb, music_beats, sigma=sigma, span=(start, end))
-
-
 def offset_control(
     motion_beats: Any,
     music_beats: Any,
@@ -322,7 +286,7 @@ def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
     mb, yb = validate(motion_beats, music_beats)
     if yb.size < 2:
         raise ParameterError("beat_phase_consistency needs at least 2 music beats")
-    phase, _ = _phases(mb, yb)
+    phase = beat_phase(mb, yb)
     if phase.size == 0:
         warnings.warn("no motion beats inside the music's beats; returning 0", BeatsyncWarning,
                       stacklevel=2)
@@ -330,245 +294,76 @@ def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
     return float(np.abs(np.mean(np.exp(2j * np.pi * phase))))
 
 
-def _phases(mb: np.ndarray, yb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    mb = mb[(mb >= yb[0]) & (mb < yb[-1])]
-    i = np.searchsorted(yb, mb, side="right") - 1
-    return (mb - yb[i]) / (yb[i + 1] - yb[i]), np.diff(yb)[i]
-
-
-def kinematic_phase_offset(motion_beats: Any, music_beats: Any) -> float:
-    """Mean lag of the motion beats behind the music beats [s], in ``(-T/2, T/2]``.
-
-    The circular mean of the motion beats' phases inside their beat intervals, times
-    the median beat period ``T``. Synchronising with ``phase_offset=-lag``
-    (:func:`beatsync.sync.synchronize`) moves the dancer's accents onto the beats.
-
-    Raises
-    ------
-    ParameterError
-        Fewer than 2 music beats, or no motion beat inside the music's beats.
-    """
-    mb, yb = validate(motion_beats, music_beats)
-    if yb.size < 2:
-        raise ParameterError("kinematic_phase_offset needs at least 2 music beats")
-    phase, _ = _phases(mb, yb)
-    if phase.size == 0:
-        raise ParameterError("no motion beat falls inside the music's beats: no phase to measure")
-    mean = np.angle(np.mean(np.exp(2j * np.pi * phase))) / (2 * np.pi)  # (-0.5, 0.5]
-    return float(mean * np.median(np.diff(yb)))
-
-
-def evaluate_sync(
-    motion: Any,
-    beats: Any,
-    *,
-    boundaries: Any = None,
-    segment_input: Any = None,
-    period_range: tuple[float, float] = (0.25, 1.25),
-    sigma: float = DEFAULT_SIGMA,
-    n_control: int = 100,
-    seed: int = 0,
-    **sync_kwargs: Any,
-) -> dict[str, Any]:
-    """Synchronise a motion to music beats and score it: one row of a results table.
-
-    Runs :func:`beatsync.segment.segment` (unless ``boundaries`` are given),
-    :func:`beatsync.sync.synchronize`, then both alignment scores and the phase
-    consistency of the kinematic beats against the music beats *before* (the
-    original motion played from music time 0) and *after* synchronisation, and the
-    random-offset control of the synchronised motion (:func:`offset_control`), and
-    ``aligned_*``: synchronised again with ``phase_offset = -kinematic_phase_offset``
-    so that the dancer's accents, not the segmentation's boundaries, land on the beats.
-    Motions without positions (plain joint-angle tables) get NaN alignment scores.
+def sync_residuals(landed: Any, targets: Any, *, fps: float | None = None) -> dict[str, Any]:
+    """How far synchronised events land from the beats they were meant for.
 
     Parameters
     ----------
-    motion : Motion
-    beats : np.ndarray [s]
-        Music beats.
-    boundaries : np.ndarray [s], optional
-        Period boundaries; default from ``segment(segment_input or motion)``.
-    segment_input : Motion, optional
-        What to segment if different from ``motion`` (e.g. ``marker_angles(markers)``).
-    period_range : (float, float) [s]
-        Passed to ``segment``.
-    sigma : float [s]
-    n_control, seed
-        Random-offset control trials and seed.
-    **sync_kwargs
-        Passed to :func:`~beatsync.sync.synchronize` (``beats_per_period``, ``out_fps``...).
+    landed : np.ndarray [shape=(n,)] [s]
+        Music time at which each event (period boundary, motion beat) is shown, e.g.
+        ``np.asarray(report["target_beats_s"]) + np.asarray(report["residual_ms"]) / 1e3``.
+    targets : np.ndarray [shape=(n,)] [s]
+        The beat (or beat plus phase offset) each event was meant for.
+    fps : float > 0, optional [Hz]
+        Frame rate of the synchronised motion: also the residual of the frame
+        nearest to each landing (what a viewer sees).
 
     Returns
     -------
     dict
-        ``input_frames``, ``output_frames``, ``periods_available``, ``periods_used``,
-        ``beats_per_period``, ``mean_period_s``, ``speed_min``, ``speed_max``,
-        ``max_residual_ms``, ``max_residual_frames``, and ``before_/after_/control_``
-        ``motion`` / ``music`` alignment and ``before_/after_phase``; plus
-        ``result`` (the :class:`~beatsync.sync.SyncResult`).
+        ``residual_ms`` (landed - target), ``max_abs_residual_ms``, and with ``fps``:
+        ``residual_nearest_frame_ms``, ``max_abs_residual_frames``.
+
+    Raises
+    ------
+    ParameterError
+        Different lengths, not times, a bad ``fps``.
+
+    Examples
+    --------
+    >>> sync_residuals([1.0, 2.001], [1.0, 2.0])["max_abs_residual_ms"]
+    1.0
     """
-    from ..sync import synchronize
-
-    yb = check_times(beats, name="beats")
-    n_periods = None
-    if boundaries is None:
-        from ..segment import segment
-
-        seg = segment(motion if segment_input is None else segment_input,
-                      period_range=period_range)
-        boundaries = seg.boundaries
-        n_periods = int(seg.n_periods)
-    res = synchronize(motion, boundaries, yb, **sync_kwargs)
-    rep = res.report
-    row: dict[str, Any] = {
-        "input_frames": rep["input_frames"],
-        "input_fps": rep["input_fps"],
-        "output_frames": rep["output_frames"],
-        "periods_available": rep["periods_available"] if n_periods is None else n_periods,
-        "periods_used": rep["periods_used"],
-        "beats_per_period": rep["beats_per_period"],
-        "mean_period_s": rep["mean_motion_period_s"],
-        "beat_period_s": rep["beat_period_s"],
-        "speed_min": rep["tempo_ratio_range"][0],
-        "speed_max": rep["tempo_ratio_range"][1],
-        "max_residual_ms": rep["max_abs_residual_ms"],
-        "max_residual_frames": rep["max_abs_residual_frames"],
+    x = check_times(landed, name="landed")
+    t = check_times(targets, name="targets")
+    if x.shape != t.shape:
+        raise ParameterError(
+            f"landed has {x.size} times but targets {t.size}: one target per landed event"
+        )
+    res = (x - t) * 1e3
+    out: dict[str, Any] = {
+        "residual_ms": res,
+        "max_abs_residual_ms": float(np.abs(res).max()) if res.size else 0.0,
     }
-    keys = ("before_motion", "before_music", "before_phase", "after_motion", "after_music",
-            "after_phase", "control_motion", "control_music", "phase_offset_s",
-            "aligned_motion", "aligned_music")
-    try:
-        mb_before = _kinematic_beats(motion)
-        mb_after = _kinematic_beats(res.motion)
-    except ParameterError:  # no positions: a plain joint-angle table
-        row.update({k: float("nan") for k in keys})
-        row["result"] = res
-        return row
-    end_before = float(motion.duration)
-    end_after = float(res.motion.duration)
-    before = alignment_scores(mb_before, yb, sigma=sigma, span=(0.0, min(end_before, yb[-1])))
-    after = alignment_scores(mb_after, yb, sigma=sigma, span=(0.0, min(end_after, yb[-1])))
-    in_after = yb[yb <= end_after]
-    ctrl = offset_control(mb_after, in_after, sigma=sigma, n_trials=n_control, seed=seed)
-    # accents on the beat: shift the landing by the measured kinematic lag
-    lag = kinematic_phase_offset(mb_after, yb)
-    kw = dict(sync_kwargs)
-    first = int(kw.pop("first_beat", 0))
-    if yb[first] - lag < 0:
-        first += 1
-    res_al = synchronize(motion, boundaries, yb, phase_offset=-lag, first_beat=first, **kw)
-    mb_al = _kinematic_beats(res_al.motion)
-    aligned = alignment_scores(
-        mb_al, yb, sigma=sigma, span=(0.0, min(float(res_al.motion.duration), yb[-1]))
-    )
-    row.update(
-        {
-            "before_motion": before["alignment_motion"],
-            "before_music": before["alignment_music"],
-            "before_phase": beat_phase_consistency(mb_before, yb),
-            "after_motion": after["alignment_motion"],
-            "after_music": after["alignment_music"],
-            "after_phase": beat_phase_consistency(mb_after, yb),
-            "control_motion": ctrl["alignment_motion_mean"],
-            "control_music": ctrl["alignment_music_mean"],
-            "phase_offset_s": -lag,
-            "aligned_motion": aligned["alignment_motion"],
-            "aligned_music": aligned["alignment_music"],
-        }
-    )
-    row["result"] = res
-    return row
+    if fps is not None:
+        fps = check_fps(fps)
+        near = (frames_to_time(time_to_frames(x, fps=fps), fps=fps) - t) * 1e3
+        out["residual_nearest_frame_ms"] = near
+        out["max_abs_residual_frames"] = float(np.abs(near).max() * fps / 1e3) if near.size else 0.0
+    return out
 
 
-def sync_table(
-    clips: dict[str, dict[str, Any]],
-    songs: dict[str, dict[str, Any]],
-    *,
-    period_range: tuple[float, float] = (0.25, 1.25),
-    sigma: float = DEFAULT_SIGMA,
-    n_control: int = 100,
-    seed: int = 0,
-    paper_frames: dict[tuple[str, str], Any] | None = None,
-) -> Any:
-    """Synchronise every clip to every song; one table row per pair (paper A, Table 1).
+def evaluate(
+    motion_beats: Any, music_beats: Any, *, sigma: float = DEFAULT_SIGMA, **kwargs: Any
+) -> dict[str, float]:
+    """Every alignment metric of motion beats against music beats.
 
     Parameters
     ----------
-    clips : dict
-        ``name -> {"motion": Motion, "segment_input": Motion or None, "data": str}``;
-        each clip is segmented once (``segment(segment_input or motion)``).
-    songs : dict
-        ``name -> {"beats": np.ndarray [s], "bpm": float, "data": str}``.
-    period_range : (float, float) [s]
-    sigma : float [s]
-    n_control, seed
-        Random-offset control (see :func:`offset_control`).
-    paper_frames : dict, optional
-        ``(clip, song) -> the paper's number of output frames``; missing pairs are
-        reported as ``"n/a"`` (not available), never invented.
+    motion_beats, music_beats : np.ndarray [s]
+    sigma : float > 0 [s]
+    **kwargs
+        ``span`` for :func:`alignment_scores`.
 
     Returns
     -------
-    pandas.DataFrame
-        Columns: clip, clip data, fps, input frames, song, song data, BPM, periods,
-        periods used, beats/period, output frames, paper output frames, max residual
-        [frames], alignment before/after/control (``_motion``: averaged over motion
-        beats, Siyao et al. 2022; ``_music``: averaged over music beats, Li et al.
-        2021), phase consistency before/after, and ``note`` (why a clip has no
-        result, e.g. segmentation refused it as not periodic).
+    dict
+        :func:`alignment_scores` plus ``phase_consistency`` (NaN with fewer than two
+        music beats).
     """
-    import pandas as pd
-
-    from ..segment import segment
-
-    paper_frames = paper_frames or {}
-    rows = []
-    for cname, clip in clips.items():
-        motion = clip["motion"]
-        seg_in = clip.get("segment_input") or motion
-        try:
-            seg = segment(seg_in, period_range=period_range)
-        except ParameterError as exc:  # e.g. refused as not periodic: say so in the table
-            for sname, song in songs.items():
-                rows.append({"clip": cname, "clip data": clip.get("data", ""),
-                             "fps": float(motion.fps), "input frames": int(motion.n_frames),
-                             "song": sname, "song data": song.get("data", ""),
-                             "BPM": song.get("bpm", float("nan")),
-                             "paper output frames": paper_frames.get((cname, sname), "n/a"),
-                             "note": f"segmentation refused: {str(exc)[:60]}..."})
-            continue
-        for sname, song in songs.items():
-            r = evaluate_sync(
-                motion, song["beats"], boundaries=seg.boundaries, sigma=sigma,
-                n_control=n_control, seed=seed,
-            )
-            rows.append(
-                {
-                    "clip": cname,
-                    "clip data": clip.get("data", ""),
-                    "fps": r["input_fps"],
-                    "input frames": r["input_frames"],
-                    "song": sname,
-                    "song data": song.get("data", ""),
-                    "BPM": song.get("bpm", float("nan")),
-                    "periods": int(seg.n_periods),
-                    "periods used": r["periods_used"],
-                    "beats/period": r["beats_per_period"],
-                    "output frames": r["output_frames"],
-                    "paper output frames": paper_frames.get((cname, sname), "n/a"),
-                    "max residual [frames]": r["max_residual_frames"],
-                    "before_motion": r["before_motion"],
-                    "after_motion": r["after_motion"],
-                    "control_motion": r["control_motion"],
-                    "before_music": r["before_music"],
-                    "after_music": r["after_music"],
-                    "control_music": r["control_music"],
-                    "before_phase": r["before_phase"],
-                    "after_phase": r["after_phase"],
-                    "phase offset [s]": r["phase_offset_s"],
-                    "aligned_motion": r["aligned_motion"],
-                    "aligned_music": r["aligned_music"],
-                    "note": "",
-                }
-            )
-    return pd.DataFrame(rows)
+    out: dict[str, float] = dict(alignment_scores(motion_beats, music_beats, sigma=sigma, **kwargs))
+    yb = validate(motion_beats, music_beats)[1]
+    out["phase_consistency"] = (
+        beat_phase_consistency(motion_beats, music_beats) if yb.size >= 2 else float("nan")
+    )
+    return out

@@ -1,13 +1,20 @@
-"""Beat-tracking scores: a validated wrapper around :mod:`mir_eval.beat`.
+"""Beat-tracking scores on arrays, in the style of :mod:`mir_eval.beat`.
 
 Data contract
 -------------
-Reference and estimated beats are 1-D ``float64`` arrays of times in seconds,
-strictly increasing and >= 0. ``min_beat_time`` [s] is always explicit: mir_eval's
-default (5 s) silently drops the first 5 s, which is most of a short clip.
+Reference and estimated beats are 1-D arrays of times in seconds, strictly
+increasing and >= 0. :func:`validate` checks both and diagnoses the usual mistake
+(frame indices or milliseconds instead of seconds). ``min_beat_time`` [s] is always
+explicit: mir_eval's default (5 s) silently drops the first 5 s, which is most of a
+short clip.
 
-All mir_eval.beat metrics are returned: F-measure, Cemgil (and its max-over-variants
-form), Goto, P-score, CMLc, CMLt, AMLc, AMLt and information gain.
+Every metric takes ``(reference, estimated)`` already trimmed; :func:`evaluate`
+validates, trims and returns all of them (:data:`METRICS`): F-measure, Cemgil (and
+its max-over-variants form), Goto, P-score, CMLc, CMLt, AMLc, AMLt and information
+gain. :func:`tempo_octave` names the metrical relation of the estimated tempo to the
+reference (correct, double, half, triple, third, other).
+
+This module never runs a tracker: :mod:`beatsync.study.beat_evaluation` does that.
 
 Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
 """
@@ -15,33 +22,40 @@ Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
 from typing import Any
 
 import mir_eval
 import numpy as np
-import pandas as pd
 
 from ..errors import BeatsyncWarning, ParameterError
-from ..units import check_times
+from ..units import check_positive, check_times
 
 __all__ = [
+    "validate",
+    "diagnose_times",
+    "f_measure",
+    "cemgil",
+    "goto",
+    "p_score",
+    "continuity",
+    "information_gain",
+    "evaluate",
     "evaluate_beats",
+    "median_tempo",
+    "octave_relation",
+    "tempo_octave",
+    "count_octave_errors",
+    "count_other_tempo",
     "METRICS",
     "TABLE_METRICS",
-    "MAX_BEAT_INTERVAL",
-    "octave_relation",
-    "score_items",
-    "summarize_scores",
     "OCTAVE_ERRORS",
-    "beat_targets",
-    "sweep_frontend",
+    "MAX_BEAT_INTERVAL",
 ]
 
 #: Beat sequences whose median interval exceeds this [s] are refused (not seconds).
 MAX_BEAT_INTERVAL = 10.0
 
-#: Keys of the dict returned by :func:`evaluate_beats`.
+#: Keys of the dict returned by :func:`evaluate`.
 METRICS = (
     "F-measure",
     "Cemgil",
@@ -55,27 +69,109 @@ METRICS = (
     "Information gain",
 )
 
+#: Metrics shown in the study tables (``notebooks/paper_a_sec4_beat_tracking.ipynb``).
+TABLE_METRICS = (
+    "F-measure",
+    "Cemgil",
+    "P-score",
+    "Correct Metric Level Total",
+    "Any Metric Level Total",
+    "Information gain",
+)
+
+#: Values of :func:`octave_relation` that are octave errors.
+OCTAVE_ERRORS = ("double", "half", "triple", "third")
+
+
+def diagnose_times(times: np.ndarray) -> str | None:
+    """Say what a sequence of increasing event times looks like if not seconds.
+
+    Parameters
+    ----------
+    times : np.ndarray [shape=(n,)]
+        Finite, increasing values (already checked by :func:`beatsync.units.check_times`).
+
+    Returns
+    -------
+    str or None
+        ``None`` if the values are plausible beat times in seconds; otherwise a
+        phrase naming what they look like: ``"frame indices"`` (integers at most 150
+        apart: 40 BPM and faster at 100 frames/s), ``"milliseconds"`` (150-3000 apart:
+        20-400 BPM in ms), or ``"not beat times"``.
+    """
+    if times.size == 0:
+        return None
+    if times.size < 3:
+        return "milliseconds or frame indices" if times[-1] > mir_eval.beat.MAX_TIME else None
+    step = float(np.median(np.diff(times)))
+    if step <= MAX_BEAT_INTERVAL and times[-1] <= mir_eval.beat.MAX_TIME:
+        return None
+    integers = bool(np.all(times == np.round(times)))
+    if integers and step < 150.0:
+        return "frame indices"
+    if 150.0 <= step <= 3000.0:
+        return "milliseconds"
+    return "not beat times"
+
+
+def validate(reference: Any, estimated: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Check reference and estimated beats; return them as ``float64`` arrays.
+
+    Raises
+    ------
+    ParameterError
+        Not 1-D, negative, non-finite, not strictly increasing; or values that look
+        like frame indices or milliseconds (the message says which).
+    """
+    return _check(reference, "reference beats"), _check(estimated, "estimated beats")
+
 
 def _check(beats: Any, name: str) -> np.ndarray:
-    arr = np.asarray(beats, dtype=np.float64) if not isinstance(beats, np.ndarray) else beats
-    arr = check_times(arr, name=name)
-    if arr.size and arr[-1] > mir_eval.beat.MAX_TIME:
+    arr = check_times(beats, name=name)
+    looks = diagnose_times(arr)
+    if looks is not None:
+        step = float(np.median(np.diff(arr))) if arr.size > 1 else float("nan")
         raise ParameterError(
-            f"{name} ends at {arr[-1]!r} s, more than {mir_eval.beat.MAX_TIME:g} s: "
-            "these look like milliseconds or sample indices, not seconds"
+            f"{name} are not times in seconds: they end at {arr[-1]:g} with a median "
+            f"spacing of {step:g}, which looks like {looks}; convert them to seconds"
         )
-    if arr.size > 2 and np.median(np.diff(arr)) > MAX_BEAT_INTERVAL:
-        raise ParameterError(
-            f"{name} are {np.median(np.diff(arr)):g} s apart (median): slower than "
-            f"{60 / MAX_BEAT_INTERVAL:g} BPM; these look like milliseconds or frame "
-            "indices, not seconds"
-        )
-    return arr.astype(np.float64)
+    return arr
 
 
-def evaluate_beats(
-    reference: np.ndarray,
-    estimated: np.ndarray,
+def f_measure(reference: np.ndarray, estimated: np.ndarray) -> float:
+    """F-measure with a +-70 ms window (:func:`mir_eval.beat.f_measure`)."""
+    return float(mir_eval.beat.f_measure(reference, estimated))
+
+
+def cemgil(reference: np.ndarray, estimated: np.ndarray) -> tuple[float, float]:
+    """Cemgil accuracy and its best over metrical variants (:func:`mir_eval.beat.cemgil`)."""
+    a, b = mir_eval.beat.cemgil(reference, estimated)
+    return float(a), float(b)
+
+
+def goto(reference: np.ndarray, estimated: np.ndarray) -> float:
+    """Goto's binary accuracy (:func:`mir_eval.beat.goto`)."""
+    return float(mir_eval.beat.goto(reference, estimated))
+
+
+def p_score(reference: np.ndarray, estimated: np.ndarray) -> float:
+    """McKinney's P-score (:func:`mir_eval.beat.p_score`)."""
+    return float(mir_eval.beat.p_score(reference, estimated))
+
+
+def continuity(reference: np.ndarray, estimated: np.ndarray) -> tuple[float, ...]:
+    """CMLc, CMLt, AMLc, AMLt (:func:`mir_eval.beat.continuity`)."""
+    return tuple(float(v) for v in mir_eval.beat.continuity(reference, estimated))
+
+
+def information_gain(reference: np.ndarray, estimated: np.ndarray) -> float:
+    """Normalised information gain (:func:`mir_eval.beat.information_gain`)."""
+    return float(mir_eval.beat.information_gain(reference, estimated))
+
+
+def evaluate(
+    reference: Any,
+    estimated: Any,
     *,
     min_beat_time: float,
 ) -> dict[str, float]:
@@ -100,7 +196,7 @@ def evaluate_beats(
     ------
     ParameterError
         Times not 1-D, negative, non-finite, not strictly increasing, or in
-        milliseconds; ``min_beat_time`` negative or not finite.
+        milliseconds or frames; ``min_beat_time`` negative or not finite.
 
     Warns
     -----
@@ -110,17 +206,11 @@ def evaluate_beats(
     Examples
     --------
     >>> ref = np.arange(0.5, 10, 0.5)
-    >>> evaluate_beats(ref, ref, min_beat_time=0.0)["F-measure"]
+    >>> evaluate(ref, ref, min_beat_time=0.0)["F-measure"]
     1.0
     """
-    try:
-        mbt = float(min_beat_time)
-    except (TypeError, ValueError):
-        raise ParameterError(f"min_beat_time={min_beat_time!r} is not a number [s]") from None
-    if not np.isfinite(mbt) or mbt < 0:
-        raise ParameterError(f"min_beat_time={min_beat_time!r} must be a time >= 0 [s]")
-    ref = _check(reference, "reference beats")
-    est = _check(estimated, "estimated beats")
+    mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
+    ref, est = validate(reference, estimated)
     ref = mir_eval.beat.trim_beats(ref, min_beat_time=mbt)
     est = mir_eval.beat.trim_beats(est, min_beat_time=mbt)
     if ref.size == 0 or est.size == 0:
@@ -133,14 +223,27 @@ def evaluate_beats(
         return {k: 0.0 for k in METRICS}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # mir_eval warns about what we have checked
-        f = mir_eval.beat.f_measure(ref, est)
-        cem, cem_best = mir_eval.beat.cemgil(ref, est)
-        goto = mir_eval.beat.goto(ref, est)
-        p = mir_eval.beat.p_score(ref, est)
-        cmlc, cmlt, amlc, amlt = mir_eval.beat.continuity(ref, est)
-        ig = mir_eval.beat.information_gain(ref, est)
-    values = (f, cem, cem_best, goto, p, cmlc, cmlt, amlc, amlt, ig)
-    return {k: float(v) for k, v in zip(METRICS, values, strict=True)}
+        values = (
+            f_measure(ref, est),
+            *cemgil(ref, est),
+            goto(ref, est),
+            p_score(ref, est),
+            *continuity(ref, est),
+            information_gain(ref, est),
+        )
+    return dict(zip(METRICS, values, strict=True))
+
+
+#: The name used before the mir_eval-style :func:`evaluate` (same function).
+evaluate_beats = evaluate
+
+
+def median_tempo(beats: Any) -> float:
+    """Tempo [BPM] of the median inter-beat interval; NaN with fewer than two beats."""
+    b = np.asarray(beats, dtype=np.float64)
+    if b.size < 2:
+        return float("nan")
+    return 60.0 / float(np.median(np.diff(b)))
 
 
 def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 0.08) -> str:
@@ -173,198 +276,39 @@ def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 
     return "other"
 
 
-# --------------------------------------------------------------------------- study helpers
-
-#: Metrics shown in the study table (``notebooks/paper_a_sec4_beat_tracking.ipynb``).
-TABLE_METRICS = (
-    "F-measure",
-    "Cemgil",
-    "P-score",
-    "Correct Metric Level Total",
-    "Any Metric Level Total",
-    "Information gain",
-)
+def count_octave_errors(octaves: Any) -> int:
+    """How many relations of :func:`octave_relation` are octave errors (:data:`OCTAVE_ERRORS`)."""
+    return int(np.isin(np.asarray(octaves, dtype=object), OCTAVE_ERRORS).sum())
 
 
-def score_items(
-    items: Sequence[Any],
-    *,
-    methods: Sequence[str] = ("psf", "librosa"),
-    min_beat_time: float,
-    track_kwargs: dict[str, Any] | None = None,
-    progress: bool = False,
-) -> pd.DataFrame:
-    """Track and score every test item with every method.
+def count_other_tempo(octaves: Any) -> int:
+    """How many relations of :func:`octave_relation` are ``"other"`` (not a metrical level)."""
+    return int((np.asarray(octaves, dtype=object) == "other").sum())
 
-    Parameters
-    ----------
-    items : sequence of objects with ``name, group, kind, y, sr, beats, bpm``
-        E.g. :func:`beatsync.synth.audio.make_beat_test_set`.
-    methods : sequence of {"psf", "librosa"}
-    min_beat_time : float >= 0 [s]
-        Passed to :func:`evaluate_beats`.
-    track_kwargs : dict, optional
-        Extra keyword arguments of :func:`beatsync.beats.track_beats` (``psf`` only).
-    progress : bool
-        Show a tqdm bar on stderr.
+
+def tempo_octave(reference: Any, estimated: Any) -> dict[str, Any]:
+    """Median tempi of both beat sequences and their relation (:func:`octave_relation`).
 
     Returns
     -------
-    pandas.DataFrame
-        One row per (item, method): ``item, group, kind, bpm, method, tempo_ref,
-        tempo_est, octave`` (see :func:`octave_relation`, from median beat intervals),
-        all :data:`METRICS`, and ``seconds`` (tracking time, not for display).
+    dict
+        ``tempo_ref`` and ``tempo_est`` [BPM] (NaN with fewer than two beats) and
+        ``octave``.
     """
-    import time
-
-    from ..beats import track_beats
-
-    rows = []
-    jobs = [(it, m) for it in items for m in methods]
-    if progress:
-        from tqdm import tqdm
-
-        jobs = tqdm(jobs, desc="beat tracking", leave=False)
-    for it, method in jobs:
-        kw = dict(track_kwargs or {}) if method == "psf" else {}
-        t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)
-            track = track_beats(it.y, it.sr, method=method, **kw)
-        seconds = time.perf_counter() - t0
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)
-            scores = evaluate_beats(it.beats, track.beats, min_beat_time=min_beat_time)
-        ref_tempo = 60.0 / float(np.median(np.diff(it.beats)))
-        est_tempo = (
-            60.0 / float(np.median(np.diff(track.beats))) if track.beats.size > 1 else np.nan
-        )
-        rows.append(
-            {
-                "item": it.name,
-                "group": it.group,
-                "kind": it.kind,
-                "bpm": float(it.bpm),
-                "method": method,
-                "tempo_ref": ref_tempo,
-                "tempo_est": est_tempo,
-                "octave": octave_relation(est_tempo, ref_tempo),
-                **scores,
-                "seconds": seconds,
-                "audio_seconds": len(it.y) / it.sr,
-            }
-        )
-    return pd.DataFrame(rows)
+    ref, est = validate(reference, estimated)
+    t_ref, t_est = median_tempo(ref), median_tempo(est)
+    return {"tempo_ref": t_ref, "tempo_est": t_est, "octave": octave_relation(t_est, t_ref)}
 
 
-#: Values of the ``octave`` column (:func:`octave_relation`) that are octave errors.
-OCTAVE_ERRORS = ("double", "half", "triple", "third")
+#: Study helpers that run trackers; they live in :mod:`beatsync.study.beat_evaluation`.
+#: Importable from here (lazily, nothing is imported at load time) only until the
+#: beat-tracking notebook and benchmark import them from the study layer.
+MOVED_TO_STUDY = ("score_items", "summarize_scores", "beat_targets", "sweep_frontend")
 
 
-def _count_octave_errors(octave: pd.Series) -> int:
-    return int(octave.isin(OCTAVE_ERRORS).sum())
+def __getattr__(name: str) -> Any:
+    if name in MOVED_TO_STUDY:
+        import importlib
 
-
-def _count_other_tempo(octave: pd.Series) -> int:
-    return int((octave == "other").sum())
-
-
-def summarize_scores(
-    scores: pd.DataFrame, *, by: str | None = "group", metrics: Sequence[str] = TABLE_METRICS
-) -> pd.DataFrame:
-    """Mean of ``metrics`` per ``by`` and method, with octave-error counts.
-
-    Parameters
-    ----------
-    scores : pandas.DataFrame
-        Output of :func:`score_items`.
-    by : str or None
-        Column to group by besides ``method`` (e.g. ``"group"``, ``"kind"``); ``None``:
-        one row per method over all items.
-    metrics : sequence of str
-
-    Returns
-    -------
-    pandas.DataFrame
-        Index ``(by, method)`` (or ``method`` if ``by`` is None); columns the metrics
-        (means), ``n`` (items), ``octave errors`` (tempo double/half/triple/third,
-        :data:`OCTAVE_ERRORS`) and ``other tempo``.
-    """
-    keys = ["method"] if by is None else [by, "method"]
-    missing = [k for k in [*keys, "octave", *metrics] if k not in scores.columns]
-    if missing:
-        raise ParameterError(
-            f"scores has no column(s) {missing}; pass the table from score_items "
-            f"(columns: {list(scores.columns)})"
-        )
-    g = scores.groupby(keys, sort=False)
-    out = g[list(metrics)].mean()
-    out["n"] = g.size()
-    out["octave errors"] = g["octave"].agg(_count_octave_errors)
-    out["other tempo"] = g["octave"].agg(_count_other_tempo)
-    return out
-
-
-def beat_targets(scores: pd.DataFrame, *, method: str = "psf") -> pd.DataFrame:
-    """The issue's accuracy targets on the synthetic set, with PASS/FAIL.
-
-    Targets: mean F-measure >= 0.95 on ``clean`` items, mean AMLt >= 0.98 over all
-    items, mean F-measure >= 0.95 on ``change`` (abrupt tempo change) items.
-    """
-    s = scores[scores["method"] == method]
-    rows = []
-    for name, sel, metric, thr in (
-        ("mean F, clean items", s["group"] == "clean", "F-measure", 0.95),
-        ("mean AMLt, all items", slice(None), "Any Metric Level Total", 0.98),
-        ("mean F, tempo-change items", s["group"] == "change", "F-measure", 0.95),
-    ):
-        sub = s.loc[sel]
-        value = float(sub[metric].mean()) if len(sub) else float("nan")
-        rows.append(
-            {
-                "target": name,
-                "method": method,
-                "n": len(sub),
-                "value": value,
-                "threshold": thr,
-                "result": "PASS" if value >= thr else "FAIL",
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def sweep_frontend(
-    items: Sequence[Any],
-    grid: dict[str, Sequence[Any]],
-    *,
-    min_beat_time: float,
-    metrics: Sequence[str] = ("F-measure", "Any Metric Level Total", "Cemgil"),
-) -> pd.DataFrame:
-    """Score the ``psf`` tracker for every combination of front-end parameters.
-
-    Parameters
-    ----------
-    items : sequence of test items
-    grid : dict
-        Parameter name (``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
-        ``flux_norm_s``) -> values. Combinations with ``hop_s > win_s / 2`` are skipped.
-    min_beat_time : float >= 0 [s]
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per combination: the parameters and the mean of ``metrics``.
-    """
-    import itertools
-
-    keys = list(grid)
-    rows = []
-    for combo in itertools.product(*(grid[k] for k in keys)):
-        params = dict(zip(keys, combo, strict=True))
-        if "hop_s" in params and params["hop_s"] > params.get("win_s", 0.023) / 2:
-            continue
-        sc = score_items(items, methods=("psf",), min_beat_time=min_beat_time, track_kwargs=params)
-        row = {k: (str(tuple(v)) if isinstance(v, (list, tuple)) else v) for k, v in params.items()}
-        row.update({m: float(sc[m].mean()) for m in metrics})
-        rows.append(row)
-    return pd.DataFrame(rows)
+        return getattr(importlib.import_module("beatsync.study.beat_evaluation"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,7 +1,9 @@
 """Reading and writing files: the only package of beatsync that touches the disk.
 
 Modules: ``_files`` (atomic writes, JSON/CSV, checksums), ``bvh``, ``tables``
-(``.mat`` markers, CSV/NPY angle tables, ``.npz``), ``audio`` (audio and beat files).
+(``.mat`` markers, CSV/NPY angle tables, ``.npz``), ``positions`` (joint positions:
+Dance-with-Melody JSON, ``(n_frames, n_joints, 3)`` arrays, C3D), ``audio`` (audio
+and beat files). :func:`read_motion` and :func:`write_motion` choose by suffix.
 
 Data contract
 -------------
@@ -20,10 +22,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import ParameterError
 from ..motion import Motion
 from ._files import (
     atomic_write,
+    check_input_file,
     check_output_folder,
     sha256_file,
     to_jsonable,
@@ -32,12 +37,37 @@ from ._files import (
 )
 from .audio import read_audio, read_beats, write_audio, write_beats
 from .bvh import read_bvh, write_bvh
-from .tables import read_mocap_mat, read_npz, read_table, write_npz, write_table
+from .positions import (
+    is_position_array,
+    read_c3d,
+    read_positions_array,
+    read_positions_json,
+    write_c3d,
+    write_positions_array,
+    write_positions_json,
+)
+from .tables import (
+    check_npy_header,
+    read_mocap_mat,
+    read_npz,
+    read_table,
+    write_npz,
+    write_table,
+)
 
 __all__ = [
     "atomic_write",
+    "check_input_file",
+    "check_npy_header",
     "check_output_folder",
     "read_motion",
+    "write_motion",
+    "read_positions_json",
+    "write_positions_json",
+    "read_positions_array",
+    "write_positions_array",
+    "read_c3d",
+    "write_c3d",
     "read_bvh",
     "write_bvh",
     "read_mocap_mat",
@@ -55,22 +85,49 @@ __all__ = [
     "write_npz",
     "AUDIO_SUFFIXES",
     "MOTION_SUFFIXES",
+    "MOTION_OUTPUT_SUFFIXES",
 ]
 
-MOTION_SUFFIXES = (".bvh", ".mat", ".csv", ".npy")
+MOTION_SUFFIXES = (".bvh", ".mat", ".csv", ".npy", ".npz", ".json", ".c3d")
 AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aiff", ".aif", ".m4a")
+#: Suffixes :func:`write_motion` writes.
+MOTION_OUTPUT_SUFFIXES = (".bvh", ".csv", ".npy", ".npz", ".json", ".c3d")
 
 
 def read_motion(
-    path: str | os.PathLike[str], *, fps: float | None = None, variable: str | None = None
+    path: str | os.PathLike[str],
+    *,
+    fps: float | None = None,
+    variable: str | None = None,
+    up: str | None = None,
+    units: str | None = None,
+    max_gap: float = 0.25,
 ) -> Motion:
     """Read any supported motion file, chosen by its suffix.
 
     ``.bvh`` (``fps`` overrides the header), ``.mat`` (MoCap Toolbox markers;
-    ``variable`` names the recording), ``.csv``/``.npy`` (``fps`` required).
+    ``variable`` names the recording), ``.csv`` and 2-D ``.npy`` angle tables (``fps``
+    required); joint positions (:mod:`beatsync.io.positions`): ``.json``
+    (Dance-with-Melody layout, ``fps`` required), 3-D ``.npy`` ``(n_frames, n_joints,
+    3)`` (``fps`` required), ``.npz`` (``variable`` names the array; ``fps`` unless
+    stored), ``.c3d`` (its own rate; a contradicting ``fps`` is refused). For joint
+    positions, ``up`` (``"y"``/``"z"``) and ``units`` (``"m"``/``"cm"``/``"mm"``) of the
+    file are detected unless given, and gaps up to ``max_gap`` seconds are filled.
     """
     p = Path(path)
     suffix = p.suffix.lower()
+    if suffix == ".npy":
+        check_npy_header(p)  # an .npz renamed, strings, records...: refused before any load
+    positional = suffix in (".json", ".npz", ".c3d") or (
+        suffix == ".npy" and p.is_file() and is_position_array(p)
+    )
+    if not positional and (up is not None or units is not None):
+        given = ", ".join(f"{k}={v!r}" for k, v in (("up", up), ("units", units)) if v)
+        raise ParameterError(
+            f"{given} apply to joint-position files (.json, .c3d, .npz or .npy arrays of "
+            f"shape (frames, joints, 3)); {str(p)!r} is not one: leave them out"
+        )
+    opts = {"up": up, "units": units, "max_gap": max_gap}
     if suffix == ".bvh":
         return read_bvh(p, fps=fps)
     if suffix == ".mat":
@@ -78,8 +135,66 @@ def read_motion(
         if fps is not None:
             m = m.with_values(m.values, fps=fps)
         return m
+    if suffix == ".json":
+        return read_positions_json(p, fps=fps, **opts)
+    if suffix == ".c3d":
+        return read_c3d(p, fps=fps, **opts)
+    if positional:
+        return read_positions_array(p, fps=fps, key=variable, **opts)
     if suffix in (".csv", ".npy"):
         return read_table(p, fps=fps)
     raise ParameterError(
         f"unsupported motion file {str(p)!r}: expected one of {', '.join(MOTION_SUFFIXES)}"
+    )
+
+
+def write_motion(path: str | os.PathLike[str], motion: Motion) -> Path:
+    """Write a motion in the format its suffix names, matching :func:`read_motion` (atomic).
+
+    ``.bvh``: rotation data with a skeleton. Joint positions (a position-only motion)
+    go back in their input's layout, units and vertical axis: ``.json``
+    (Dance-with-Melody), ``.npy`` ``(n_frames, n_joints, 3)``, ``.npz``, ``.c3d``.
+    ``.csv`` (and ``.npy`` for motion that is not joint positions): the values as a
+    table, one column per channel.
+
+    Raises
+    ------
+    ParameterError
+        BVH for motion without a skeleton (joint positions: the alternatives named),
+        joint-position formats for other motion, an unknown suffix.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix == ".bvh":
+        if motion.skeleton is None:
+            what = (
+                "joint positions without joint rotations"
+                if motion.is_positional
+                else "a table without a skeleton"
+            )
+            alt = (
+                "write .json, .npy or .c3d (positions, in the input's layout) or .csv"
+                if motion.is_positional
+                else "write .csv"
+            )
+            raise ParameterError(
+                f"cannot write {str(p)!r} as BVH: motion {motion.name!r} is {what}, and "
+                f"BVH stores rotations of a skeleton; {alt}"
+            )
+        return write_bvh(p, motion)
+    if suffix == ".csv":
+        return write_table(p, motion)
+    if suffix == ".json":
+        return write_positions_json(p, motion)
+    if suffix == ".c3d":
+        return write_c3d(p, motion)
+    if suffix in (".npy", ".npz") and motion.is_positional:
+        return write_positions_array(p, motion)
+    if suffix == ".npy":
+        with atomic_write(p, mode="wb") as fh:
+            np.save(fh, motion.values)
+        return p
+    raise ParameterError(
+        f"cannot write motion as {str(p)!r}: choose a suffix from "
+        f"{', '.join(MOTION_OUTPUT_SUFFIXES)} (.npz only for joint positions)"
     )

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_finite, check_times
-from ._files import _existing_file, atomic_write
+from ..units import as_float, check_audio, check_finite, check_sample_rate, check_times
+from ._files import atomic_write, check_input_file
 
 
 def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[np.ndarray, int]:
@@ -35,9 +35,9 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     """
     import soundfile as sf
 
-    p = _existing_file(path, "audio")
-    if sr is not None and (not np.isfinite(sr) or sr <= 0):
-        raise ParameterError(f"sr={sr!r} must be a sample rate > 0 [Hz]")
+    p = check_input_file(path, "audio")
+    if sr is not None:
+        sr = _integral_rate(sr, name="sr")
     try:
         data, file_sr = sf.read(p, dtype="float32", always_2d=True)
         y = data.mean(axis=1)
@@ -54,17 +54,27 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
                 "is it a WAV/FLAC/OGG/MP3 file?"
             ) from None
     y = np.asarray(y, dtype=np.float32)
+    try:
+        file_sr = _integral_rate(file_sr, name="sample rate")
+    except ParameterError as exc:
+        raise ParameterError(f"audio file {str(p)!r} has a broken header: {exc}") from None
     if y.size == 0:
         raise ParameterError(f"audio file {str(p)!r} has no samples")
-    if not np.all(np.isfinite(y)):
-        raise ParameterError(f"audio file {str(p)!r} contains NaN or infinite samples")
-    file_sr = int(file_sr)
-    if sr is not None and int(sr) != file_sr:
+    y, _ = check_audio(y, file_sr, name=f"audio file {str(p)!r}")
+    if sr is not None and sr != file_sr:
         import librosa
 
-        y = librosa.resample(y, orig_sr=file_sr, target_sr=int(sr)).astype(np.float32)
-        file_sr = int(sr)
+        y = librosa.resample(y, orig_sr=file_sr, target_sr=sr).astype(np.float32)
+        file_sr = sr
     return y, file_sr
+
+
+def _integral_rate(sr: object, *, name: str) -> int:
+    """A sample rate that files can hold: a plausible whole number of Hz."""
+    v = check_sample_rate(sr, name=name)
+    if v != round(v):
+        raise ParameterError(f"{name}={sr!r} must be a whole number of Hz for an audio file")
+    return int(round(v))
 
 
 def write_audio(path: str | os.PathLike[str], y: np.ndarray, sr: int) -> Path:
@@ -72,14 +82,17 @@ def write_audio(path: str | os.PathLike[str], y: np.ndarray, sr: int) -> Path:
     import soundfile as sf
 
     dest = Path(path)
+    sr = _integral_rate(sr, name="sr")
     y = check_finite(y, name="audio samples").astype(np.float32)
-    if sr is None or sr <= 0:
-        raise ParameterError(f"sr={sr!r} must be a sample rate > 0 [Hz]")
+    if y.ndim not in (1, 2) or y.shape[0] == 0:
+        raise ParameterError(
+            f"audio samples must be (n,) or (n, channels) with n > 0, got shape {y.shape}"
+        )
     fmt = dest.suffix.lstrip(".").upper() or "WAV"
     if fmt not in sf.available_formats():
         raise ParameterError(f"cannot write audio as {dest.suffix!r}; use .wav or .flac")
     with atomic_write(dest, "wb") as fh:
-        sf.write(fh, y, int(sr), format=fmt)
+        sf.write(fh, y, sr, format=fmt)
     return dest
 
 
@@ -96,10 +109,10 @@ def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
     ParameterError
         Unreadable file, non-numeric values, or times that are not increasing seconds.
     """
-    p = _existing_file(path, "beat annotation")
+    p = check_input_file(path, "beat annotation")
     times = []
     try:
-        text = p.read_text()
+        text = p.read_text(encoding="utf-8-sig")
     except (UnicodeDecodeError, OSError) as exc:
         raise ParameterError(f"cannot read {str(p)!r} as a text file of times: {exc}") from None
     for n, line in enumerate(text.splitlines(), 1):
@@ -107,12 +120,7 @@ def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
         if not s or s.startswith("#"):
             continue
         first = s.replace(",", " ").split()[0]
-        try:
-            times.append(float(first))
-        except ValueError:
-            raise ParameterError(
-                f"{str(p)!r} line {n}: {first!r} is not a time in seconds"
-            ) from None
+        times.append(as_float(first, name=f"{str(p)!r} line {n}: time", unit="s", text=True))
     return check_times(np.array(times), name=f"beat times in {p.name}", allow_empty=False)
 
 

@@ -1,101 +1,272 @@
-"""BVH motion files: read (with a frame-rate override) and write (exact round trip)."""
+"""BVH motion files: read (with a frame-rate override) and write (exact round trip).
+
+The reader is one pass over the file's lines in linear time: the hierarchy is parsed
+token by token (so a joint may be named ``MOTION``), and the MOTION block is streamed
+into a preallocated float64 array in chunks, so memory stays near the size of the
+values (an 86 MB file no longer needs a gigabyte). Every malformed header, hierarchy
+line or frame line is refused with its line number. The writer is iterative, so any
+hierarchy the reader accepts (however deep) can be written back.
+"""
 
 from __future__ import annotations
 
+import math
 import os
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..units import check_finite, check_fps
-from ._files import _existing_file, atomic_write
+from ..units import as_float, as_int, check_finite, check_fps
+from ._files import atomic_write, check_input_file
+
+__all__ = ["read_bvh", "write_bvh", "BVH_CHANNELS"]
+
+#: The six channel names a BVH ``CHANNELS`` line may hold (each at most once per joint).
+BVH_CHANNELS = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
+
+_FRAMES_RE = re.compile(r"frames\s*:\s*(\S+)", re.IGNORECASE)
+_FRAME_TIME_RE = re.compile(r"frame\s+time\s*:\s*(\S+)", re.IGNORECASE)
+_CHUNK_ROWS = 4096  # frame lines converted to floats at once
 
 
-def _parse_hierarchy(tokens: list[str], path: Path) -> tuple[Skeleton, int]:
-    joints: list[Joint] = []
-    i = 0
-    stack: list[int] = []
-    pending_parent = -1
+class _Lines:
+    """Numbered text lines of a binary file: UTF-8 (an optional byte-order mark
+    skipped), ``\\n``, ``\\r\\n`` or ``\\r`` line ends, decoded one line at a time so a
+    decoding error is reported with its line number."""
 
-    def err(msg: str) -> ParameterError:
-        return ParameterError(f"malformed BVH {str(path)!r}: {msg}")
+    def __init__(self, fh, path: Path) -> None:
+        self._it = self._numbered(fh)
+        self.path = path
+        self.lineno = 0
 
-    if not tokens or tokens[0].upper() != "HIERARCHY":
-        raise err("it does not start with HIERARCHY (is it a BVH file?)")
-    i = 1
-    n = len(tokens)
-    while i < n:
-        tok = tokens[i]
-        up = tok.upper()
-        if up in ("ROOT", "JOINT"):
-            if i + 2 >= n:
-                raise err("file ends inside a joint definition (truncated?)")
-            name = tokens[i + 1]
-            if tokens[i + 2] != "{":
-                raise err(f"expected '{{' after {tok} {name}")
-            parent = stack[-1] if stack else -1
-            if up == "ROOT" and stack:
-                raise err("ROOT inside another joint")
-            joints.append(Joint(name, parent, np.zeros(3)))
-            stack.append(len(joints) - 1)
-            i += 3
-        elif up == "END":
-            if i + 2 >= n or tokens[i + 1].upper() != "SITE" or tokens[i + 2] != "{":
-                raise err("malformed End Site")
-            parent = stack[-1] if stack else -1
-            pname = joints[parent].name if parent >= 0 else "root"
-            joints.append(Joint(f"{pname}_end", parent, np.zeros(3), (), True))
-            stack.append(len(joints) - 1)
-            i += 3
-        elif up == "OFFSET":
-            if not stack:
-                raise err("OFFSET outside a joint")
+    def _numbered(self, fh) -> Iterator[tuple[int, str]]:
+        lineno = 0
+        for raw in fh:
+            if lineno == 0 and raw.startswith(b"\xef\xbb\xbf"):
+                raw = raw[3:]
+            parts = raw.rstrip(b"\r\n").split(b"\r") if b"\r" in raw else (raw,)
+            for part in parts:
+                lineno += 1
+                try:
+                    yield lineno, part.decode("utf-8")
+                except UnicodeDecodeError as exc:
+                    raise ParameterError(
+                        f"malformed BVH {str(self.path)!r}: line {lineno} is not UTF-8 text "
+                        f"({exc.reason}); is it a BVH file?"
+                    ) from None
+
+    def __iter__(self) -> Iterator[tuple[int, str]]:
+        return self
+
+    def __next__(self) -> tuple[int, str]:
+        self.lineno, line = next(self._it)
+        return self.lineno, line
+
+
+@dataclass
+class _Node:
+    name: str
+    parent: int
+    line: int
+    is_end_site: bool
+    offset: list[float] | None = None
+    channels: tuple[str, ...] | None = None
+
+
+class _HierarchyParser:
+    """Token-by-token parser of the HIERARCHY section; stops at the MOTION keyword."""
+
+    def __init__(self, lines: _Lines, path: Path) -> None:
+        self.lines = lines
+        self.path = path
+        self.pending: list[str] = []
+        self.lineno = 0
+
+    def err(self, msg: str, line: int | None = None) -> ParameterError:
+        where = self.lineno if line is None else line
+        return ParameterError(f"malformed BVH {str(self.path)!r}, line {where}: {msg}")
+
+    def next_token(self, what: str) -> str:
+        while not self.pending:
             try:
-                off = np.array([float(t) for t in tokens[i + 1 : i + 4]])
-            except ValueError:
-                raise err(f"bad OFFSET values {tokens[i + 1 : i + 4]}") from None
-            if off.shape != (3,):
-                raise err("OFFSET needs three numbers (truncated?)")
-            j = joints[stack[-1]]
-            joints[stack[-1]] = Joint(j.name, j.parent, off, j.channels, j.is_end_site)
-            i += 4
-        elif up == "CHANNELS":
+                self.lineno, line = next(self.lines)
+            except StopIteration:
+                raise self.err(
+                    f"file ends where {what} was expected: no MOTION section (truncated?)"
+                ) from None
+            self.pending = line.split()[::-1]
+        return self.pending.pop()
+
+    def numbers(self, count: int, what: str) -> list[str]:
+        """The next ``count`` tokens, which must be on the current line."""
+        if len(self.pending) < count:
+            raise self.err(
+                f"{what} needs {count} values on its line, got {len(self.pending)} (truncated?)"
+            )
+        return [self.pending.pop() for _ in range(count)]
+
+    def parse(self) -> Skeleton:
+        first = self.next_token("HIERARCHY")
+        if first.upper() != "HIERARCHY":
+            raise self.err(f"it starts with {first[:40]!r}, not HIERARCHY (is it a BVH file?)")
+        nodes: list[_Node] = []
+        stack: list[int] = []
+        seen: dict[str, int] = {}  # joint name -> its line: duplicates found in linear time
+
+        def add(node: _Node) -> None:
+            if node.name in seen:
+                raise self.err(
+                    f"duplicate joint name {node.name!r} (first on line {seen[node.name]})",
+                    node.line,
+                )
+            seen[node.name] = node.line
+            nodes.append(node)
+            stack.append(len(nodes) - 1)
+
+        while True:
+            tok = self.next_token("'ROOT', a joint statement or 'MOTION'")
+            up = tok.upper()
             if not stack:
-                raise err("CHANNELS outside a joint")
-            try:
-                k = int(tokens[i + 1])
-            except (ValueError, IndexError):
-                raise err("CHANNELS needs a count") from None
-            chans = tuple(tokens[i + 2 : i + 2 + k])
-            valid = {"Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation"}
-            if len(chans) != k or not set(chans) <= valid:
-                raise err(f"bad CHANNELS list {chans}")
-            j = joints[stack[-1]]
-            joints[stack[-1]] = Joint(j.name, j.parent, j.offset, chans, j.is_end_site)
-            i += 2 + k
-        elif tok == "}":
-            if not stack:
-                raise err("unbalanced '}'")
-            stack.pop()
-            i += 1
-        elif up == "MOTION":
-            if stack:
-                raise err("MOTION section starts before the hierarchy is closed (truncated?)")
-            pending_parent = i + 1
-            break
-        else:
-            raise err(f"unexpected token {tok!r}")
-    if pending_parent < 0:
-        raise err("no MOTION section (file truncated?)")
-    if not joints:
-        raise err("no joints in the hierarchy")
-    names = [j.name for j in joints]
-    if len(set(names)) != len(names):
-        dup = sorted({x for x in names if names.count(x) > 1})
-        raise err(f"duplicate joint names {dup}")
-    return Skeleton(tuple(joints)), pending_parent
+                if up == "MOTION":
+                    if self.pending:
+                        raise self.err(f"unexpected {self.pending[-1]!r} after MOTION")
+                    break
+                if up != "ROOT":
+                    raise self.err(f"expected ROOT or MOTION, got {tok[:40]!r}")
+            top = nodes[stack[-1]] if stack else None
+            if up in ("ROOT", "JOINT"):
+                if up == "ROOT" and stack:
+                    raise self.err("ROOT inside another joint (a '}' is missing?)")
+                if top is not None and top.is_end_site:
+                    raise self.err(f"an End Site cannot hold a {tok}")
+                line = self.lineno
+                name = self.next_token(f"the name after {tok}")
+                if name in ("{", "}"):
+                    raise self.err(f"{tok} has no name")
+                self.expect_brace(f"{tok} {name}")
+                add(_Node(name, stack[-1] if stack else -1, line, False))
+            elif up == "END":
+                if top is None or top.is_end_site:
+                    raise self.err("End Site outside a joint")
+                line = self.lineno
+                site = self.next_token("'Site' after End")
+                if site.upper() != "SITE":
+                    raise self.err(f"expected 'End Site', got 'End {site[:40]}'")
+                self.expect_brace("End Site")
+                add(_Node(f"{top.name}_end", stack[-1], line, True))
+            elif up == "OFFSET":
+                assert top is not None
+                if top.offset is not None:
+                    raise self.err(f"a second OFFSET in {self.label(top)}")
+                toks = self.numbers(3, "OFFSET")
+                for t in toks:
+                    if not _is_plain_number(t):
+                        raise self.err(f"OFFSET value {t[:40]!r} is not a number")
+                off = [float(t) for t in toks]
+                if not all(math.isfinite(v) for v in off):
+                    raise self.err(
+                        f"OFFSET of {self.label(top)} is not finite ({' '.join(toks)}); a bone "
+                        "length must be a number"
+                    )
+                if self.pending:
+                    raise self.err(
+                        f"OFFSET is followed by {self.pending[-1][:40]!r} on its line (an "
+                        "OFFSET has three values)"
+                    )
+                top.offset = off
+            elif up == "CHANNELS":
+                assert top is not None
+                if top.is_end_site:
+                    raise self.err("an End Site has no CHANNELS")
+                if top.channels is not None:
+                    raise self.err(f"a second CHANNELS line in {self.label(top)}")
+                k = self.numbers(1, "CHANNELS")[0]
+                try:
+                    count = as_int(k, name="CHANNELS count", minimum=0, text=True)
+                except ParameterError as exc:
+                    raise self.err(str(exc)) from None
+                chans = tuple(self.numbers(count, f"CHANNELS {count}"))
+                unknown = [c for c in chans if c not in BVH_CHANNELS]
+                if unknown:
+                    raise self.err(
+                        f"unknown channel {unknown[0][:40]!r} in CHANNELS; channels are "
+                        f"{', '.join(BVH_CHANNELS)}"
+                    )
+                if len(set(chans)) != len(chans):
+                    dup = next(c for c in chans if chans.count(c) > 1)
+                    raise self.err(f"channel {dup} listed twice in {self.label(top)}")
+                if self.pending:
+                    raise self.err(
+                        f"CHANNELS {count} is followed by {self.pending[-1][:40]!r} on its line "
+                        "(wrong channel count?)"
+                    )
+                top.channels = chans
+            elif tok == "}":
+                assert top is not None
+                if top.offset is None:
+                    raise self.err(f"{self.label(top)} has no OFFSET line", top.line)
+                if top.channels is None and not top.is_end_site:
+                    raise self.err(f"{self.label(top)} has no CHANNELS line", top.line)
+                stack.pop()
+            elif up == "MOTION":
+                raise self.err(
+                    f"MOTION section starts before {self.label(top)} is closed "
+                    "(a '}' is missing, or the file is truncated?)"
+                )
+            else:
+                raise self.err(f"unexpected token {tok[:40]!r}")
+        if not nodes:
+            raise self.err("no joints in the hierarchy")
+        return Skeleton(
+            tuple(
+                Joint(n.name, n.parent, np.array(n.offset), n.channels or (), n.is_end_site)
+                for n in nodes
+            )
+        )
+
+    def expect_brace(self, what: str) -> None:
+        brace = self.next_token(f"'{{' after {what}")
+        if brace != "{":
+            raise self.err(f"expected '{{' after {what}, got {brace[:40]!r}")
+
+    @staticmethod
+    def label(node: _Node | None) -> str:
+        if node is None:
+            return "the hierarchy"
+        return f"End Site of {node.name[:-4]!r}" if node.is_end_site else f"joint {node.name!r}"
+
+
+_NUMBER_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+
+
+def _is_plain_number(tok: str) -> bool:
+    """A decimal number in ASCII (no underscores, no Unicode digits); also nan/inf,
+    refused later by the finite check with a clearer message."""
+    return _NUMBER_RE.fullmatch(tok) is not None or tok.lower().lstrip("+-") in (
+        "nan",
+        "inf",
+        "infinity",
+    )
+
+
+def _header_value(lines: _Lines, pattern: re.Pattern[str], what: str, path: Path) -> str:
+    for lineno, line in lines:
+        s = line.strip()
+        if not s:
+            continue
+        match = pattern.fullmatch(s)
+        if match is None:
+            raise ParameterError(
+                f"malformed BVH {str(path)!r}, line {lineno}: expected '{what} <value>', got "
+                f"{s[:60]!r}"
+            )
+        return match.group(1)
+    raise ParameterError(f"malformed BVH {str(path)!r}: no '{what}' line (file truncated?)")
 
 
 def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motion:
@@ -104,6 +275,7 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
     Parameters
     ----------
     path : path-like
+        A UTF-8 text file (a byte-order mark is allowed).
     fps : float > 0 [Hz], optional
         Override the frame rate declared by ``Frame Time`` (the CMU salsa BVH files
         declare 120 fps but are 60 fps).
@@ -116,58 +288,45 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
     Raises
     ------
     ParameterError
-        Missing, truncated or malformed file; frame lines with the wrong number of
-        values; a frame count that does not match; NaN/inf values; a bad frame time.
+        With the line number: a missing, truncated or malformed file; a joint without
+        OFFSET or CHANNELS, a non-finite offset, duplicate joint or channel names;
+        frame lines with the wrong number of values or non-numeric values; a frame
+        count that does not match; NaN/inf values; a bad frame time.
     """
-    p = _existing_file(path, "BVH")
+    p = check_input_file(path, "BVH")
     try:
-        text = p.read_text()
-    except (UnicodeDecodeError, OSError) as exc:
-        raise ParameterError(f"cannot read BVH {str(p)!r} as text: {exc}") from None
-    head, sep, motion_part = text.partition("MOTION")
-    if not sep:
-        raise ParameterError(f"malformed BVH {str(p)!r}: no MOTION section (file truncated?)")
-    skeleton, _ = _parse_hierarchy(head.split() + ["MOTION"], p)
-    lines = motion_part.strip("\n").splitlines()
-    header: dict[str, str] = {}
-    k = 0
-    while k < len(lines) and len(header) < 2:
-        line = lines[k].strip()
-        k += 1
-        if not line:
-            continue
-        key, colon, val = line.partition(":")
-        if not colon:
-            raise ParameterError(f"malformed BVH {str(p)!r}: expected 'Frames:' and 'Frame Time:'")
-        header[key.strip().lower()] = val.strip()
-    try:
-        n_declared = int(header["frames"])
-        frame_time = float(header["frame time"])
-    except (KeyError, ValueError):
-        raise ParameterError(
-            f"malformed BVH {str(p)!r}: missing or bad 'Frames:'/'Frame Time:' header"
-        ) from None
-    n_ch = len(skeleton.channel_names())
-    rows = [ln for ln in lines[k:] if ln.strip()]
-    if len(rows) != n_declared:
-        raise ParameterError(
-            f"BVH {str(p)!r} declares {n_declared} frames but has {len(rows)} frame lines "
-            "(file truncated or edited?)"
-        )
-    if n_declared == 0:
-        raise ParameterError(f"BVH {str(p)!r} has no frames")
-    try:
-        flat = np.array(" ".join(rows).split(), dtype=np.float64)
-    except ValueError:
-        raise ParameterError(f"BVH {str(p)!r} has non-numeric values in its frame lines") from None
-    if flat.size != n_declared * n_ch:
-        counts = [len(r.split()) for r in rows]
-        bad = next(i for i, c in enumerate(counts) if c != n_ch)
-        raise ParameterError(
-            f"BVH {str(p)!r}: frame line {bad + 1} has {counts[bad]} values but the hierarchy "
-            f"defines {n_ch} channels"
-        )
-    values = flat.reshape(n_declared, n_ch)
+        with open(p, "rb") as fh:
+            lines = _Lines(fh, p)
+            skeleton = _HierarchyParser(lines, p).parse()
+            n_text = _header_value(lines, _FRAMES_RE, "Frames:", p)
+            frames_line = lines.lineno
+            t_text = _header_value(lines, _FRAME_TIME_RE, "Frame Time:", p)
+            t_line = lines.lineno
+            names = skeleton.channel_names()
+            try:
+                if not _is_plain_number(n_text):
+                    raise ParameterError(f"line {frames_line}: Frames={n_text!r} is not a number")
+                n_declared = as_int(
+                    n_text, name=f"line {frames_line}: Frames", minimum=0, text=True
+                )
+                if not _is_plain_number(t_text):
+                    raise ParameterError(f"line {t_line}: Frame Time={t_text!r} is not a number")
+                frame_time = as_float(
+                    t_text,
+                    name=f"line {t_line}: Frame Time",
+                    unit="s",
+                    allow_nonfinite=True,
+                    text=True,
+                )
+            except ParameterError as exc:
+                raise ParameterError(f"malformed BVH {str(p)!r}: {exc}") from None
+            if n_declared == 0:
+                raise ParameterError(f"BVH {str(p)!r} has no frames (Frames: 0)")
+            if not names:
+                raise ParameterError(f"BVH {str(p)!r}: the hierarchy defines no channels")
+            values = _read_frames(lines, n_declared, len(names), p)
+    except OSError as exc:
+        raise ParameterError(f"cannot read BVH {str(p)!r}: {exc}") from None
     check_finite(values, name=f"BVH {p.name} values")
     if fps is None:
         if not np.isfinite(frame_time) or frame_time <= 0:
@@ -177,7 +336,92 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
         rate = 1.0 / frame_time
     else:
         rate = check_fps(fps)
-    return Motion(values, rate, skeleton.channel_names(), skeleton, p.stem)
+    return Motion(values, rate, names, skeleton, p.stem)
+
+
+def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.ndarray:
+    """Stream the frame lines into a preallocated ``(n_declared, n_ch)`` array.
+
+    Lines are gathered in chunks; each chunk is parsed by numpy's C text reader, and
+    only a chunk it refuses (or reads to another shape) is split line by line in
+    Python to name the first bad line.
+    """
+    # A frame line holds n_ch numbers: at least 2 * n_ch - 1 characters and a newline,
+    # so the file's size bounds the number of frames it can hold: a huge declared count
+    # in a small file allocates no more than the file could fill.
+    capacity = min(n_declared, path.stat().st_size // (2 * n_ch) + 1)
+    values = np.empty((capacity, n_ch), dtype=np.float64)
+    chunk: list[str] = []
+    chunk_lines: list[int] = []
+    stored = 0  # frame lines converted into values
+    row = 0  # frame lines seen
+
+    def flush() -> None:
+        nonlocal stored
+        block = _parse_chunk(chunk, chunk_lines, stored, n_ch, path)
+        values[stored : stored + len(chunk)] = block
+        stored += len(chunk)
+        chunk.clear()
+        chunk_lines.clear()
+
+    for lineno, line in lines:
+        if not line.strip():
+            continue
+        if row >= capacity:  # more frame lines than declared: count them, store nothing
+            if chunk:
+                flush()
+            row += 1
+            continue
+        if not line.isascii() or "_" in line:  # Python and numpy read "1_0" and Unicode digits
+            bad = next((t for t in line.split() if not _is_plain_number(t)), None)
+            if bad is not None:
+                raise ParameterError(
+                    f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
+                    "frame line"
+                )
+        chunk.append(line)
+        chunk_lines.append(lineno)
+        row += 1
+        if len(chunk) == _CHUNK_ROWS:
+            flush()
+    if chunk:
+        flush()
+    if row == n_declared and stored != n_declared:
+        raise RuntimeError(f"BVH frames stored {stored} of the {row} frames read")
+    if row != n_declared:
+        raise ParameterError(
+            f"BVH {str(path)!r} declares {n_declared} frames but has {row} frame lines "
+            "(file truncated or edited?)"
+        )
+    return values
+
+
+def _parse_chunk(
+    chunk: list[str], linenos: list[int], first_row: int, n_ch: int, path: Path
+) -> np.ndarray:
+    """Frame lines as a ``(len(chunk), n_ch)`` array, or the first bad line named."""
+    try:
+        block = np.loadtxt(chunk, dtype=np.float64, comments=None, ndmin=2)
+        if block.shape == (len(chunk), n_ch):
+            return block
+    except ValueError:
+        pass
+    rows = []
+    for k, (lineno, line) in enumerate(zip(linenos, chunk, strict=True)):
+        toks = line.split()
+        if len(toks) != n_ch:
+            raise ParameterError(
+                f"BVH {str(path)!r}, line {lineno}: frame line {first_row + k + 1} has "
+                f"{len(toks)} values but the hierarchy defines {n_ch} channels"
+            )
+        bad = next((t for t in toks if not _is_plain_number(t)), None)
+        if bad is not None:
+            raise ParameterError(
+                f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
+                "frame line"
+            )
+        rows.append(toks)
+    return np.array(rows, dtype=np.float64)
 
 
 def _fmt(x: float) -> str:
@@ -188,7 +432,13 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write ``motion`` as BVH with its skeleton; atomic.
 
     Values are written with the shortest decimal that round-trips exactly, so
-    ``read_bvh(write_bvh(p, m))`` gives identical values and frame rate.
+    ``read_bvh(write_bvh(p, m))`` gives identical values and frame rate. The
+    hierarchy is written without recursion, so any depth the reader accepts works.
+
+    Raises
+    ------
+    ParameterError
+        No skeleton (marker data or a plain table), or NaN/inf values or offsets.
     """
     if motion.skeleton is None:
         raise ParameterError(
@@ -197,14 +447,21 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
         )
     check_finite(motion.values, name="motion values")
     joints = motion.skeleton.joints
+    for j in joints:
+        check_finite(j.offset, name=f"OFFSET of joint {j.name!r}")
     children: dict[int, list[int]] = {i: [] for i in range(-1, len(joints))}
     for i, j in enumerate(joints):
         children[j.parent].append(i)
     out: list[str] = ["HIERARCHY"]
-
-    def emit(i: int, depth: int) -> None:
+    # (joint, depth, opening?) in reverse order: an explicit stack instead of recursion
+    todo: list[tuple[int, int, bool]] = [(r, 0, True) for r in reversed(children[-1])]
+    while todo:
+        i, depth, opening = todo.pop()
         j = joints[i]
         ind = "\t" * depth
+        if not opening:
+            out.append(f"{ind}}}")
+            continue
         if j.is_end_site:
             out.append(f"{ind}End Site")
         else:
@@ -213,16 +470,14 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
         out.append(f"{ind}\tOFFSET {' '.join(_fmt(v) for v in j.offset)}")
         if not j.is_end_site:
             out.append(f"{ind}\tCHANNELS {len(j.channels)} {' '.join(j.channels)}")
-        for c in children[i]:
-            emit(c, depth + 1)
-        out.append(f"{ind}}}")
-
-    for r in children[-1]:
-        emit(r, 0)
+        todo.append((i, depth, False))
+        todo.extend((c, depth + 1, True) for c in reversed(children[i]))
     out.append("MOTION")
     out.append(f"Frames: {motion.n_frames}")
     out.append(f"Frame Time: {_fmt(1.0 / motion.fps)}")
-    body = "\n".join(" ".join(map(repr, row)) for row in motion.values.tolist())
     with atomic_write(path) as fh:
-        fh.write("\n".join(out) + "\n" + body + "\n")
+        fh.write("\n".join(out) + "\n")
+        for start in range(0, motion.n_frames, _CHUNK_ROWS):
+            rows = motion.values[start : start + _CHUNK_ROWS].tolist()
+            fh.write("".join(" ".join(map(repr, row)) + "\n" for row in rows))
     return Path(path)

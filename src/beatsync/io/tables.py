@@ -9,8 +9,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from ..units import check_finite, check_fps
-from ._files import _existing_file, atomic_write, write_csv
+from ..units import as_float, as_float_array, check_finite, check_fps
+from ._files import atomic_write, check_input_file, write_csv
 
 
 def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) -> Motion:
@@ -31,7 +31,7 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
     """
     import scipy.io
 
-    p = _existing_file(path, "MAT")
+    p = check_input_file(path, "MAT")
     try:
         mat = scipy.io.loadmat(p, squeeze_me=True, struct_as_record=False)
     except Exception as exc:  # scipy raises several types for bad files
@@ -53,14 +53,29 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
             f"{str(p)!r} has no marker recording {variable!r}; choose from {cands}"
         )
     s = mat[variable]
-    data = np.asarray(s.data, dtype=np.float64)
+    where = f"{str(p)!r} recording {variable!r}"
+    if not hasattr(s, "freq"):
+        raise ParameterError(
+            f"{where} has no 'freq' field (the frame rate); is it a MoCap Toolbox struct? "
+            "Give the frame rate with fps= (--fps)"
+        )
+    rate = check_fps(_scalar(s.freq), name=f"{where} freq")
+    data = as_float_array(s.data, name=f"{where} data")
     names = [str(n) for n in np.atleast_1d(s.markerName)]
     if data.ndim != 2 or data.shape[1] != 3 * len(names):
         raise ParameterError(
-            f"{variable!r} data has shape {data.shape}, expected (frames, 3 x {len(names)} markers)"
+            f"{where} data has shape {data.shape}, expected (frames, 3 x {len(names)} markers)"
         )
+    if data.shape[0] < 2:
+        raise ParameterError(f"{where} has {data.shape[0]} frame(s); need at least 2")
     channels = tuple(f"{m}_{a}" for m in names for a in "xyz")
-    return Motion(data / 1000.0, float(s.freq), channels, None, variable)
+    return Motion(data / 1000.0, rate, channels, None, variable)
+
+
+def _scalar(value: object) -> object:
+    """A MATLAB scalar as loaded by scipy (a 0-d or 1-element array) as a plain value."""
+    arr = np.asarray(value)
+    return arr.reshape(()).item() if arr.size == 1 and arr.dtype.kind in "iuf" else value
 
 
 def read_table(
@@ -75,20 +90,20 @@ def read_table(
     channels : list of str, optional
         Names for ``.npy`` columns (default ``"ch0"``, ``"ch1"``, ...).
     """
-    p = _existing_file(path, "table")
+    p = check_input_file(path, "table")
     if fps is None:
         raise ParameterError(
             f"{str(p)!r} is a plain table without a frame rate: give it with fps= (--fps)"
         )
     rate = check_fps(fps)
     if p.suffix.lower() == ".npy":
-        try:
-            values = np.load(p, allow_pickle=False)
-        except Exception as exc:
-            raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
-        if values.ndim != 2:
-            raise ParameterError(f"{str(p)!r} holds shape {values.shape}; need (frames, channels)")
+        values = _read_npy(p)
         names = tuple(channels) if channels else tuple(f"ch{i}" for i in range(values.shape[1]))
+        if len(names) != values.shape[1]:
+            raise ParameterError(
+                f"{len(names)} channel names given for the {values.shape[1]} columns of "
+                f"{str(p)!r}"
+            )
     else:
         import pandas as pd
 
@@ -117,10 +132,67 @@ def read_table(
     return Motion(values, rate, names, None, p.stem)
 
 
+def check_npy_header(path: str | os.PathLike[str]) -> tuple[tuple[int, ...], np.dtype]:
+    """Return the shape and dtype of a ``.npy`` file from its header, nothing else read.
+
+    Raises
+    ------
+    ParameterError
+        Not a ``.npy`` file (an ``.npz`` archive renamed is named as such), a broken
+        header, or a dtype that is not integers or floats (strings, bytes, records,
+        complex numbers, dates, Python objects).
+    """
+    p = check_input_file(path, ".npy")
+    with open(p, "rb") as fh:
+        magic = fh.read(6)
+        if magic[:2] == b"PK":
+            raise ParameterError(
+                f"{str(p)!r} is an .npz archive (a zip of arrays), not a .npy array: rename "
+                "it .npz, or save one array with numpy.save"
+            )
+        if magic != b"\x93NUMPY":
+            raise ParameterError(f"{str(p)!r} is not a .npy file (no NumPy header)")
+        fh.seek(0)
+        try:
+            version = np.lib.format.read_magic(fh)
+            read_header = (
+                np.lib.format.read_array_header_1_0
+                if version == (1, 0)
+                else np.lib.format.read_array_header_2_0
+            )
+            shape, _, dtype = read_header(fh)
+        except Exception as exc:  # numpy raises several types for broken headers
+            raise ParameterError(f"{str(p)!r} has a broken .npy header: {exc}") from None
+    if dtype.hasobject:
+        raise ParameterError(
+            f"{str(p)!r} holds Python objects (a pickled array), which are never loaded; "
+            "save a numeric array"
+        )
+    if dtype.names is not None or dtype.kind not in "iuf":
+        # describe the dtype in the words of as_float_array; nothing of the file is read
+        as_float_array(np.empty(0, dtype=dtype), name=f"{str(p)!r}")
+    return tuple(shape), dtype
+
+
+def _read_npy(p: Path) -> np.ndarray:
+    """A ``.npy`` file holding one numeric ``(frames, channels)`` array, else a clear error."""
+    check_npy_header(p)
+    try:
+        values = np.load(p, allow_pickle=False)
+    except Exception as exc:  # truncated data, unsupported versions
+        raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
+    if values.ndim != 2:
+        raise ParameterError(
+            f"{str(p)!r} holds an array of shape {values.shape}; need 2-D (frames, channels) "
+            "angles, or 3-D (frames, joints, 3) joint positions"
+        )
+    return values.astype(np.float64, copy=False)
+
+
 def _is_number(text: str) -> bool:
     try:
-        float(text)
-    except ValueError:
+        as_float(text, name="header", allow_nonfinite=True, text=True)
+    except ParameterError:
         return False
     return True
 
@@ -134,7 +206,7 @@ def write_table(path: str | os.PathLike[str], motion: Motion) -> Path:
 
 def read_npz(path: str | os.PathLike[str]) -> dict[str, np.ndarray]:
     """Read every array of an ``.npz`` file (no pickles)."""
-    p = _existing_file(path, "npz")
+    p = check_input_file(path, "npz")
     try:
         with np.load(p, allow_pickle=False) as data:
             return {k: data[k] for k in data.files}

@@ -17,8 +17,7 @@ It stands in for the paper's test music, which is not available.
 :func:`drum_song` renders a song for the motion-graph studies (paper B): the drum
 pattern of :func:`drum_pattern` at a constant tempo, with a gain that changes every
 ``section_beats`` beats to a random level in ``level_range_db`` (seeded), so its
-intensity varies like verses and choruses. Its beats are exact. It is re-exported as
-:func:`beatsync.music.drum_song`.
+intensity varies like verses and choruses. Its beats are exact.
 
 Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
 """
@@ -31,7 +30,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_positive, check_range, check_times, frames_to_time, time_to_frames
+from ..units import (
+    check_bpm,
+    check_positive,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 
 __all__ = [
     "BeatTestItem",
@@ -44,9 +49,14 @@ __all__ = [
     "drum_song",
     "GROUPS",
     "KINDS",
+    "METERS",
+    "meter_pattern",
 ]
 
 GROUPS = ("clean", "drift", "swing", "noise", "change")
+#: Meters of :func:`meter_pattern`: beats per bar and eighth notes per beat (2/4 and
+#: 3/4 simple, beat = quarter note; 6/8 compound, beat = dotted quarter).
+METERS = {"2/4": (2, 2), "3/4": (3, 2), "6/8": (2, 3)}
 KINDS = ("click", "drums")
 
 
@@ -87,18 +97,6 @@ class BeatTestItem:
         return len(self.y) / self.sr
 
 
-def _check_bpm(bpm: float, name: str = "bpm") -> float:
-    try:
-        value = float(bpm)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}={bpm!r} is not a number [bpm]") from None
-    if not np.isfinite(value) or not 10.0 <= value <= 400.0:
-        raise ParameterError(
-            f"{name}={bpm!r} is outside 10-400 BPM (did you pass a beat period in seconds?)"
-        )
-    return value
-
-
 def beat_times(
     bpm: float,
     *,
@@ -129,7 +127,7 @@ def beat_times(
     -------
     beats : np.ndarray [s]
     """
-    bpm = _check_bpm(bpm)
+    bpm = check_bpm(bpm)
     duration = check_positive(duration, name="duration", unit="s")
     if not 0.0 <= drift < 0.5:
         raise ParameterError(f"drift={drift!r} must be a relative amplitude in [0, 0.5)")
@@ -139,7 +137,7 @@ def beat_times(
     t = np.arange(int(np.ceil(duration * fs)) + 1) / fs
     tempo = bpm * (1.0 + drift * np.sin(2 * np.pi * t / duration))
     if bpm_end is not None:
-        bpm_end = _check_bpm(bpm_end, "bpm_end")
+        bpm_end = check_bpm(bpm_end, name="bpm_end")
         tc = duration / 2 if change_time is None else float(change_time)
         tempo = np.where(t < tc, tempo, bpm_end * tempo / bpm)
     # beats elapsed since `start`, by trapezoidal integration of beats per second
@@ -273,6 +271,50 @@ def drum_pattern(
     return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
 
 
+def meter_pattern(
+    beats: np.ndarray,
+    *,
+    meter: str,
+    sr: int = 22050,
+    duration: float,
+    seed: int = 0,
+) -> np.ndarray:
+    """Render a drum pattern in a meter, with eighth-note subdivisions and exact beats.
+
+    The first beat of every bar gets a kick (gain 1), the other beats a snare (0.6);
+    a hi-hat plays every eighth note: on the beats at gain 0.5, between them at 0.3
+    (``METERS[meter][1]`` eighths per beat: 2 in 2/4 and 3/4, 3 in 6/8). ``beats`` are
+    the beat (tactus) times: quarter notes in 2/4 and 3/4, dotted quarters in 6/8.
+
+    Parameters
+    ----------
+    beats : np.ndarray [s]
+    meter : {"2/4", "3/4", "6/8"}
+    sr : int > 0 [Hz]
+    duration : float > 0 [s]
+    seed : int
+        Seed of the noise in the snare and hi-hat sounds.
+
+    Returns
+    -------
+    y : np.ndarray [shape=(round(duration * sr),)], float32
+    """
+    if meter not in METERS:
+        raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")
+    beats, sr, duration = _check_common(beats, sr, duration)
+    per_bar, eighths = METERS[meter]
+    rng = np.random.default_rng(seed)
+    n = int(round(duration * sr))
+    down = np.arange(beats.size) % per_bar == 0
+    y = _render(beats[down], _kick(sr), n, sr, 1.0)
+    y += _render(beats[~down], _snare(sr, rng), n, sr, 0.6)
+    hat = _hihat(sr, rng)
+    y += _render(beats, hat, n, sr, 0.5)
+    for k in range(1, eighths):
+        y += _render(_offbeats(beats, k / eighths), hat, n, sr, 0.3)
+    return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
+
+
 def add_noise(y: np.ndarray, *, snr_db: float, seed: int = 0) -> np.ndarray:
     """Add white Gaussian noise at ``snr_db`` [dB] relative to the mean power of ``y``."""
     y = np.asarray(y, dtype=np.float64)
@@ -342,13 +384,12 @@ def make_beat_test_set(
     for g in groups:
         if g not in GROUPS:
             raise ParameterError(f"unknown group {g!r}; choose from {GROUPS}")
-    check_range(min(bpms), 400.0, name="bpms", unit="bpm") if len(bpms) else None
     rng = np.random.default_rng(seed)
     items = []
     for kind in kinds:
         for group in groups:
             for bpm in bpms:
-                bpm = _check_bpm(bpm)
+                bpm = check_bpm(bpm)
                 start = 0.2 + float(rng.uniform(0.0, 0.3))
                 item_seed = int(rng.integers(2**31))
                 bpm_end = _second_tempo(bpm) if group == "change" else bpm
@@ -429,7 +470,7 @@ def drum_song(
         The gain is constant between beats, with 5 ms ramps at changes (no clicks).
     """
     duration = check_positive(duration, name="duration", unit="s")
-    bpm = check_positive(bpm, name="bpm", unit="BPM")
+    bpm = check_bpm(bpm)
     if int(section_beats) < 1:
         raise ParameterError(f"section_beats={section_beats!r} must be >= 1")
     lo, hi = (float(v) for v in level_range_db)

@@ -1,0 +1,401 @@
+"""Phase-slope (group-delay) onsets: the tracker's front end (paper A, eqs. 6-8).
+
+1. **Phase-slope function** (:func:`phase_slope`). For short frames, the average
+   group delay is computed without phase unwrapping as
+   ``sum_k Re(X_k conj(Y_k)) / sum_k |X_k|^2`` per frequency band, where ``X`` is the
+   STFT with window ``w`` and ``Y`` the STFT with the time-ramped window ``n w(n)``
+   (energy-weighted averaging over the band's bins). Relative to the frame centre it
+   is the phase slope: it crosses zero upwards when an impulse-like onset passes the
+   frame centre, and ``t_frame - psf`` locates the onset to sub-frame precision.
+2. **Onsets** (:func:`onset_strength_psf`): positive zero crossings of the phase
+   slope in each band, weighted by the band's (locally normalised) spectral flux
+   (eq. 6-7); bands combined with weights ``6 - c`` (c = 1..4, low bands count most).
+
+The front-end settings (window, hop, FFT size, band edges) are not published in the
+paper; :data:`FRONTEND_DEFAULTS` are swept in
+``notebooks/paper_a_sec4_beat_tracking.ipynb``. numpy and scipy only (no
+JIT compilation on the first call).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..units import check_audio, check_positive, frames_to_time, time_to_frames
+from .filters import moving_max, moving_mean
+
+__all__ = [
+    "SILENCE_PEAK",
+    "FRONTEND_DEFAULTS",
+    "FrontEnd",
+    "OnsetSignal",
+    "frontend_settings",
+    "phase_slope",
+    "onset_strength_psf",
+    "compute_onsets",
+]
+
+#: Audio whose peak magnitude is below this (re full scale 1.0, -140 dBFS) is silent.
+SILENCE_PEAK = 1e-7
+
+#: Defaults of the phase-slope front end (all swept in the notebook).
+FRONTEND_DEFAULTS: dict[str, Any] = {
+    "win_s": 0.023,  # analysis window [s]
+    "hop_s": 0.0058,  # hop [s]
+    "n_fft": None,  # FFT size [samples]; None: next power of two >= window
+    "band_edges_hz": (0.0, 250.0, 1000.0, 4000.0, 22050.0),  # 4 bands [Hz]
+    "flux_norm_s": 0.5,  # local-mean window removed from the flux [s]
+    "analysis_sr": 22050,  # audio above this rate is resampled to it first [Hz]; None: never
+}
+
+
+@dataclass(frozen=True)
+class FrontEnd:
+    """Validated front-end settings in samples at the analysis rate.
+
+    Attributes
+    ----------
+    analysis_sr : float [Hz]
+        Rate the audio is analysed at (the input rate, or lower after resampling).
+    win_length : int [samples]
+        Analysis window.
+    hop_length : int [samples]
+        Hop between frames (at most half the window).
+    n_fft : int [samples]
+        FFT size (>= ``win_length``).
+    band_edges_hz : tuple of float [Hz]
+        Increasing band edges (``len - 1`` bands).
+    flux_norm_s : float >= 0 [s]
+        Window of the local mean removed from the flux (0: none).
+    """
+
+    analysis_sr: float
+    win_length: int
+    hop_length: int
+    n_fft: int
+    band_edges_hz: tuple[float, ...]
+    flux_norm_s: float
+
+    @property
+    def fps(self) -> float:
+        """Frame rate of the onset signal [Hz]."""
+        return self.analysis_sr / self.hop_length
+
+
+def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
+    """Validate front-end parameters (keys of :data:`FRONTEND_DEFAULTS`) for input rate ``sr``.
+
+    Raises
+    ------
+    ParameterError
+        Unknown key, non-positive window or hop, a hop over half the window, an FFT
+        shorter than the window, or band edges that do not increase.
+    """
+    unknown = set(params) - set(FRONTEND_DEFAULTS)
+    if unknown:
+        raise ParameterError(
+            f"unknown front-end parameter(s) {sorted(unknown)}; known: {sorted(FRONTEND_DEFAULTS)}"
+        )
+    p = {**FRONTEND_DEFAULTS, **params}
+    if p["analysis_sr"] is not None:
+        target = check_positive(p["analysis_sr"], name="analysis_sr", unit="Hz")
+        sr = min(sr, float(int(round(target))))
+    win = int(time_to_frames(check_positive(p["win_s"], name="win_s", unit="s"), fps=sr))
+    hop = int(time_to_frames(check_positive(p["hop_s"], name="hop_s", unit="s"), fps=sr))
+    if win < 16:
+        raise ParameterError(f"win_s={p['win_s']!r} s is only {win} samples at sr={sr:g}")
+    if hop < 1 or hop > win // 2:
+        raise ParameterError(
+            f"hop_s={p['hop_s']!r} s must be at most half the window win_s={p['win_s']!r} s "
+            "(the phase-slope zero crossings would be missed)"
+        )
+    n_fft = p["n_fft"]
+    n_fft = int(2 ** np.ceil(np.log2(win))) if n_fft is None else int(n_fft)
+    if n_fft < win:
+        raise ParameterError(f"n_fft={n_fft} must be >= the window length {win} samples")
+    edges = np.asarray(p["band_edges_hz"], dtype=np.float64)
+    if edges.ndim != 1 or edges.size < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
+        raise ParameterError(
+            f"band_edges_hz={p['band_edges_hz']!r} must be increasing frequencies [Hz]"
+        )
+    flux_norm_s = check_positive(p["flux_norm_s"], name="flux_norm_s", unit="s", allow_zero=True)
+    return FrontEnd(sr, win, hop, n_fft, tuple(float(e) for e in edges), flux_norm_s)
+
+
+@dataclass(frozen=True)
+class OnsetSignal:
+    """Output of :func:`onset_strength_psf`.
+
+    Attributes
+    ----------
+    envelope : np.ndarray [shape=(n_frames,)]
+        Band-weighted onset signal at the frame rate (impulses at the onsets).
+    bands : np.ndarray [shape=(n_bands, n_frames)]
+        Per-band onset signals (unweighted).
+    fps : float [Hz]
+        Frame rate.
+    onset_times : np.ndarray [s]
+        Sub-frame onset times (phase-slope zero crossings) of all bands.
+    onset_strengths : np.ndarray
+        Band-weighted strength of each onset.
+    band_weights : np.ndarray
+        Weight ``6 - c`` of each band (normalised to sum 1).
+    psf : np.ndarray [shape=(n_bands, n_frames)] [s]
+        Phase-slope function per band (NaN where the band is silent).
+    """
+
+    envelope: np.ndarray
+    bands: np.ndarray
+    fps: float
+    onset_times: np.ndarray
+    onset_strengths: np.ndarray
+    band_weights: np.ndarray
+    psf: np.ndarray = field(repr=False)
+
+
+# --------------------------------------------------------------------------- STFT
+
+
+def _hann(n: int) -> np.ndarray:
+    """Periodic Hann window of ``n`` samples (the DFT-even form used for STFTs)."""
+    return 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
+
+
+def _stft(y32: np.ndarray, window: np.ndarray, n_fft: int, hop: int) -> np.ndarray:
+    """Centred STFT, shape (n_frames, n_bins), complex64.
+
+    Frame ``m`` is centred on sample ``m * hop`` (zero padding of ``n_fft // 2`` at
+    both ends); the window is centred inside the ``n_fft`` frame.
+    """
+    win = window.size
+    w = np.zeros(n_fft, dtype=np.float32)
+    left = (n_fft - win) // 2
+    w[left : left + win] = window
+    pad = n_fft // 2
+    yp = np.pad(y32, (pad, pad))
+    frames = np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]
+    import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
+
+    return scipy.fft.rfft(frames * w, axis=1)
+
+
+def _bin_bands(freqs: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Band index of each FFT bin (-1 outside the edges; the top edge is inclusive)."""
+    band = np.searchsorted(edges, freqs, side="right") - 1
+    band[freqs == edges[-1]] = edges.size - 2
+    band[(freqs < edges[0]) | (freqs > edges[-1])] = -1
+    return band
+
+
+def _band_matrix(sr: float, fe: FrontEnd) -> np.ndarray:
+    """Membership of each FFT bin in each band, shape (n_bins, n_bands), float32."""
+    freqs = np.fft.rfftfreq(fe.n_fft, d=1.0 / sr)
+    edges = np.asarray(fe.band_edges_hz)
+    band = _bin_bands(freqs, edges)
+    return (band[:, None] == np.arange(edges.size - 1)[None, :]).astype(np.float32)
+
+
+def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd):
+    """Phase slope, band energy, frame rate and STFT magnitude (frames x bins)."""
+    win, hop, n_fft = fe.win_length, fe.hop_length, fe.n_fft
+    w = _hann(win)
+    ramp = np.arange(win) - (win - 1) / 2.0  # time ramp centred on the frame centre
+    y32 = y.astype(np.float32)
+    X = _stft(y32, w, n_fft, hop)
+    Y = _stft(y32, w * ramp, n_fft, hop)
+    member = _band_matrix(sr, fe)  # (n_bins, n_bands)
+    power = X.real**2 + X.imag**2
+    cross = X.real * Y.real + X.imag * Y.imag  # Re(X conj(Y))
+    del Y
+    # energy-weighted average over the band's bins: sums as one matrix product each
+    energy = (power @ member).T.astype(np.float64)
+    num = (cross @ member).T.astype(np.float64)
+    floor = 1e-10 * max(float(energy.max()), 1e-30)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        centroid = num / energy  # samples relative to the frame centre
+    centroid[energy <= floor] = np.nan
+    psf = -centroid / sr  # frame centre minus energy centroid [s]
+    return psf, energy, sr / hop, np.sqrt(power), member
+
+
+def phase_slope(
+    y: np.ndarray,
+    sr: float,
+    *,
+    win_s: float = FRONTEND_DEFAULTS["win_s"],
+    hop_s: float = FRONTEND_DEFAULTS["hop_s"],
+    n_fft: int | None = None,
+    band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
+) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+    """Phase-slope function per band (energy-weighted average group delay).
+
+    Parameters
+    ----------
+    y : np.ndarray [shape=(n,)]
+    sr : float > 0 [Hz]
+    win_s, hop_s : float > 0 [s]
+    n_fft : int, optional [samples]
+    band_edges_hz : sequence of float [Hz]
+
+    Returns
+    -------
+    psf : np.ndarray [shape=(n_bands, n_frames)] [s]
+        Frame centre time minus the band's energy centroid in time: negative before an
+        impulse reaches the frame centre, positive after. NaN where the band is silent.
+    energy : np.ndarray [shape=(n_bands, n_frames)]
+        Band energy ``sum |X|^2``.
+    fps : float [Hz]
+    mag : np.ndarray [shape=(n_bins, n_frames)]
+        STFT magnitude (for the spectral flux).
+    """
+    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
+    y = np.asarray(y, dtype=np.float64)
+    fe = frontend_settings(
+        {
+            "win_s": win_s,
+            "hop_s": hop_s,
+            "n_fft": n_fft,
+            "band_edges_hz": band_edges_hz,
+            "analysis_sr": None,
+        },
+        sr,
+    )
+    psf, energy, fps, mag, _ = _phase_slope(y, sr, fe)
+    return psf, energy, fps, mag.T
+
+
+def onset_strength_psf(
+    y: np.ndarray,
+    sr: float,
+    *,
+    win_s: float = FRONTEND_DEFAULTS["win_s"],
+    hop_s: float = FRONTEND_DEFAULTS["hop_s"],
+    n_fft: int | None = FRONTEND_DEFAULTS["n_fft"],
+    band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
+    flux_norm_s: float = FRONTEND_DEFAULTS["flux_norm_s"],
+    analysis_sr: float | None = FRONTEND_DEFAULTS["analysis_sr"],
+) -> OnsetSignal:
+    """Onset signal from positive zero crossings of the band phase-slope function.
+
+    Every positive zero crossing of band ``c``'s phase slope is an onset candidate;
+    its strength is the band's spectral flux (half-wave rectified log-magnitude
+    difference, minus its local mean over ``flux_norm_s``) around the crossing
+    (eq. 6-7). Bands are combined with weights ``6 - c``.
+
+    Parameters
+    ----------
+    y : np.ndarray [shape=(n,)]
+        Mono audio.
+    sr : float > 0 [Hz]
+    win_s : float > 0 [s]
+        Analysis window (default 23 ms).
+    hop_s : float > 0 [s]
+        Hop, at most ``win_s / 2`` (default 5.8 ms).
+    n_fft : int, optional [samples]
+    band_edges_hz : sequence of float [Hz]
+        Band edges (default 0, 250, 1000, 4000, 22050: four bands).
+    flux_norm_s : float >= 0 [s]
+        Window of the local mean removed from the flux (0: none).
+    analysis_sr : float > 0 [Hz] or None
+        Audio at a higher rate is first resampled to this rate (polyphase), so that
+        the front end behaves the same for 22.05, 44.1 and 48 kHz input and costs
+        the same per second; None analyses at the input rate.
+
+    Returns
+    -------
+    OnsetSignal
+
+    Examples
+    --------
+    >>> from beatsync.synth.audio import click_track
+    >>> y = click_track([0.5, 1.0, 1.5], sr=22050, duration=2.0)
+    >>> ons = onset_strength_psf(y, 22050)
+    >>> bool(abs(ons.onset_times[np.argmax(ons.onset_strengths)] - 0.5) < 0.01)
+    True
+    """
+    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
+    y = np.asarray(y, dtype=np.float64)
+    fe = frontend_settings(
+        {
+            "win_s": win_s,
+            "hop_s": hop_s,
+            "n_fft": n_fft,
+            "band_edges_hz": band_edges_hz,
+            "flux_norm_s": flux_norm_s,
+            "analysis_sr": analysis_sr,
+        },
+        sr,
+    )
+    return compute_onsets(y, sr, fe)
+
+
+def _resample(y: np.ndarray, sr: float, target: float) -> np.ndarray:
+    """Band-limited resampling from ``sr`` to ``target`` [Hz] (``target < sr``) by FFT.
+
+    The spectrum is truncated at the new Nyquist frequency (ideal low-pass) after
+    zero-padding to a fast FFT length; scipy.fft only (scipy.signal's import alone
+    costs more than tracking a song).
+    """
+    import scipy.fft  # noqa: PLC0415
+
+    n_out = int(round(y.size * target / sr))
+    m = scipy.fft.next_fast_len(y.size, real=True)
+    m_out = int(round(m * target / sr))
+    spec = scipy.fft.rfft(y, n=m)[: m_out // 2 + 1]
+    return scipy.fft.irfft(spec, n=m_out)[:n_out] * (m_out / m)
+
+
+def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
+    """:func:`onset_strength_psf` on validated input (``y`` finite mono, not silent)."""
+    if fe.analysis_sr != sr:
+        y, sr = _resample(y, sr, fe.analysis_sr), fe.analysis_sr
+    y = y / np.max(np.abs(y))
+    psf, _, fps, mag, member = _phase_slope(y, sr, fe)
+    n_bands, n_frames = psf.shape
+    logmag = np.log1p(np.float32(100.0) * mag)
+    diff = np.diff(logmag, axis=0, prepend=logmag[:1])
+    np.maximum(diff, 0.0, out=diff)
+    counts = np.maximum(member.sum(axis=0)[:, None], 1.0)
+    flux = (diff @ member).T.astype(np.float64) / counts  # mean over the band's bins
+    del diff, logmag
+    if fe.flux_norm_s > 0:  # remove the fluctuation floor of sustained sounds
+        size = max(int(time_to_frames(fe.flux_norm_s, fps=fps)), 3)
+        flux = np.maximum(flux - moving_mean(flux, size), 0.0)
+    # the flux peaks when the onset enters the window, up to half a window before the
+    # phase-slope zero crossing: take its maximum over a window-long neighbourhood
+    reach = int(np.ceil(fe.win_length / fe.hop_length / 2)) + 1
+    flux = moving_max(flux, 2 * reach + 1, origin=reach // 2)
+    weights = np.maximum(6.0 - np.arange(1, n_bands + 1, dtype=np.float64), 1.0)
+    weights = weights / weights.sum()
+    bands = np.zeros((n_bands, n_frames))
+    times_all, strength_all = [], []
+    frame_t = frames_to_time(np.arange(n_frames), fps=fps)
+    for c in range(n_bands):
+        p = psf[c]
+        a, b = p[:-1], p[1:]
+        idx = np.flatnonzero((a < 0) & (b >= 0))  # NaN compares False: silent frames skipped
+        if idx.size == 0:
+            continue
+        # sub-frame onset time by linear interpolation of the zero crossing
+        frac = a[idx] / (a[idx] - b[idx])
+        t_on = frame_t[idx] + frac / fps
+        s = flux[c, idx]
+        keep = s > 0
+        idx, frac, t_on, s = idx[keep], frac[keep], t_on[keep], s[keep]
+        np.add.at(bands[c], idx, s * (1 - frac))
+        np.add.at(bands[c], np.minimum(idx + 1, n_frames - 1), s * frac)
+        times_all.append(t_on)
+        strength_all.append(weights[c] * s)
+    envelope = weights @ bands
+    if times_all:
+        t = np.concatenate(times_all)
+        s = np.concatenate(strength_all)
+        order = np.argsort(t, kind="stable")
+        t, s = t[order], s[order]
+    else:
+        t = s = np.empty(0)
+    return OnsetSignal(envelope, bands, fps, t, s, weights, psf)

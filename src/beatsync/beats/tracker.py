@@ -1,0 +1,379 @@
+"""The public beat tracker: :func:`track_beats` and its result :class:`BeatTrack`.
+
+Validation happens here, once (:mod:`beatsync.units` helpers); the stage modules
+(:mod:`.onset`, :mod:`.tempo`, :mod:`.phase`, :mod:`.metrical`) trust their inputs.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import BeatsyncWarning, ParameterError
+from ..units import (
+    MAX_BPM,
+    MIN_BPM,
+    check_bpm,
+    check_positive,
+    check_range,
+    check_times,
+    frames_to_time,
+)
+from ..units import check_audio as _units_check_audio
+from .filters import gaussian_smooth
+from .metrical import METER_MODEL, estimate_meter, tactus_observation
+from .onset import SILENCE_PEAK, OnsetSignal, compute_onsets, frontend_settings
+from .phase import place_beats
+from .tempo import analysis_windows, period_grid, tempo_hmm
+
+__all__ = [
+    "check_audio",
+    "SILENCE_PEAK",
+    "MIN_SANE_BPM",
+    "MAX_SANE_BPM",
+    "BeatTrack",
+    "track_beats",
+    "beat_tempo",
+    "mix_clicks",
+    "check_duration",
+    "MIN_DURATION_S",
+    "MIN_PULSE_CLARITY",
+]
+
+#: The plausible tempo range [bpm] (:data:`beatsync.units.MIN_BPM`, ``MAX_BPM``).
+MIN_SANE_BPM = MIN_BPM
+MAX_SANE_BPM = MAX_BPM
+#: Audio shorter than this is refused [s] (:func:`check_duration`): two beat periods
+#: at 80 BPM, three at 120 BPM. A shorter clip cannot show a pulse (two beat periods)
+#: at any but the fastest tempi, and the tracker would return a tempo made up by its
+#: prior. The madmom sample (2.8 s) passes.
+MIN_DURATION_S = 1.5
+#: Below this pulse clarity (median over the tempo windows of the highest resonator
+#: salience of a tactus period, :func:`beatsync.beats.metrical.resonator_salience`) a
+#: warning says the beats may be meaningless. Calibrated on real music and noise: six
+#: 30 s noises (white, brown) reach 0.11-0.13, the annotated real recordings 0.35
+#: (Hainsworth 001, the Ballroom waltz) to 1.4 (madmom sample, 808 loop), the synthetic
+#: set 1.2-1.5; 0.2 is about the geometric mean of 0.13 and 0.35.
+MIN_PULSE_CLARITY = 0.2
+
+
+@dataclass(frozen=True)
+class BeatTrack:
+    """Result of :func:`track_beats`.
+
+    Attributes
+    ----------
+    beats : np.ndarray [s]
+        Beat times, strictly increasing.
+    tempo : float [bpm]
+        Median of the tempo curve (NaN if no beat was found).
+    tempo_times : np.ndarray [s]
+        Centre of each tempo window.
+    tempo_curve : np.ndarray [bpm]
+        Tempo per window.
+    method : str
+        ``"psf"`` or ``"librosa"``.
+    beats_per_bar : int
+        Meter estimate: beats per bar from the metrical model (2, 3, 4, ...; 0 if
+        not estimated, e.g. by ``method="librosa"`` or when no beat was found).
+    """
+
+    beats: np.ndarray
+    tempo: float
+    tempo_times: np.ndarray
+    tempo_curve: np.ndarray
+    method: str
+    beats_per_bar: int = 0
+
+
+def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndarray, float]:
+    """Validate mono audio for the tracker; return ``(y float64, sr float)``.
+
+    :func:`beatsync.units.check_audio` with the silence threshold :data:`SILENCE_PEAK`
+    (``allow_silent=True``: no silence check, e.g. to measure a level).
+
+    Raises
+    ------
+    ParameterError
+        Empty, multi-channel, non-finite or (unless ``allow_silent``) all-silent
+        audio, or an implausible ``sr``.
+    """
+    arr, sr_f = _units_check_audio(y, sr, silence_peak=None if allow_silent else SILENCE_PEAK)
+    return np.asarray(arr, dtype=np.float64), sr_f
+
+
+def mix_clicks(y: np.ndarray, sr: float, beats: np.ndarray) -> np.ndarray:
+    """The audio with a click on every beat, to listen to the beats (float32).
+
+    The audio is normalised to peak 0.8; each click is a 1 kHz tone decaying over
+    about 0.1 s at amplitude 0.5; the mix is scaled down only if it would clip.
+    Trusts its input (validated audio, beat times inside it).
+    """
+    y = np.asarray(y, dtype=np.float64)
+    t = np.arange(int(0.1 * sr)) / sr
+    click = np.sin(2 * np.pi * 1000.0 * t) * np.exp(-t / 0.02)
+    mix = 0.8 * y / max(float(np.max(np.abs(y))), 1e-9)
+    for i in np.rint(np.asarray(beats) * sr).astype(np.int64):
+        if 0 <= i < y.size:
+            seg = click[: y.size - i]
+            mix[i : i + seg.size] += 0.5 * seg
+    return (mix / max(float(np.max(np.abs(mix))), 1.0)).astype(np.float32)
+
+
+def check_duration(n_samples: int, sr: float, *, bpm: float | None = None) -> float:
+    """Refuse audio too short to hold a pulse; return its duration [s].
+
+    Rule: the audio must last at least :data:`MIN_DURATION_S` (1.5 s, two beat
+    periods at 80 BPM) and, when the tempo is known (``bpm``), at least two beat
+    periods of it (``2 * 60 / bpm`` s).
+
+    Raises
+    ------
+    ParameterError
+        If the audio is shorter; the message gives its duration and the rule.
+    """
+    duration = float(frames_to_time(n_samples, fps=sr))
+    need, why = MIN_DURATION_S, "the fixed minimum: two beat periods at 80 BPM"
+    if bpm is not None and 2 * 60.0 / bpm > need:
+        need, why = 2 * 60.0 / bpm, f"two beat periods at the given bpm={bpm:g}"
+    if duration < need:
+        raise ParameterError(
+            f"the audio is only {duration:.3f} s long ({n_samples} samples at sr={sr:g} Hz): "
+            f"beat tracking needs at least {need:.3g} s ({why}); give a longer excerpt "
+            "(or check the sample rate)"
+        )
+    return duration
+
+
+def beat_tempo(beats: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Instantaneous tempo of each beat interval: ``60 / (b[i+1] - b[i])``.
+
+    Parameters
+    ----------
+    beats : np.ndarray [shape=(K,)] [s]
+        Strictly increasing beat times.
+
+    Returns
+    -------
+    starts : np.ndarray [shape=(K-1,)] [s]
+        Start ``b[i]`` of each interval (plot as steps with ``where="post"``).
+    bpm : np.ndarray [shape=(K-1,)] [bpm]
+        Tempo of each interval (empty for fewer than two beats).
+
+    Examples
+    --------
+    >>> beat_tempo([0.0, 0.5, 1.0, 1.75])[1]
+    array([120., 120.,  80.])
+    """
+    beats = check_times(beats, name="beats")
+    return beats[:-1].copy(), 60.0 / np.diff(beats)
+
+
+def track_beats(
+    y: np.ndarray,
+    sr: float,
+    *,
+    method: str = "psf",
+    bpm: float | None = None,
+    min_bpm: float = 40.0,
+    max_bpm: float = 240.0,
+    prior_period_s: float = METER_MODEL.tactus_median_s,
+    prior_sigma: float = METER_MODEL.tactus_sigma,
+    tempo_win_s: float = 8.0,
+    tempo_hop_s: float = 1.0,
+    time_varying: bool = True,
+    **frontend_params: Any,
+) -> BeatTrack:
+    """Track the beats of a piece of music.
+
+    Parameters
+    ----------
+    y : np.ndarray [shape=(n,)]
+        Mono audio, finite, not all silent.
+    sr : float > 0 [Hz]
+    method : {"psf", "librosa"}
+        ``"psf"``: phase-slope onsets, the metrical model of Klapuri et al. (2006)
+        decoded by the tempo HMM, and the phase HMM (paper A, section 4);
+        ``"librosa"``: :func:`librosa.beat.beat_track` (dynamic programming).
+    bpm : float, optional [bpm]
+        Known tempo: skips tempo estimation (the beat period is fixed).
+    min_bpm, max_bpm : float [bpm]
+        Tempo range searched (the metrical level is chosen inside it), within 20-400.
+    prior_period_s : float > 0 [s]
+        Median of the log-normal prior on the beat (tactus) period of the metrical
+        model (0.55 s = 109 BPM, Klapuri et al. 2006).
+    prior_sigma : float > 0
+        Standard deviation of that prior in natural-log units of the period.
+    tempo_win_s, tempo_hop_s : float > 0 [s]
+        Windows of the tempo HMM (8 s, 1 s hop).
+    time_varying : bool
+        Follow tempo changes (True) or force one tempo for the whole piece (False).
+    **frontend_params
+        Phase-slope front end: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
+        ``flux_norm_s``, ``analysis_sr`` (see :func:`beatsync.beats.onset_strength_psf`).
+
+    Returns
+    -------
+    BeatTrack
+
+    Raises
+    ------
+    ParameterError
+        Empty, silent or non-finite audio; audio too short for a pulse (shorter
+        than 1.5 s, or than two beat periods of a given ``bpm``, see
+        :func:`check_duration`); ``sr <= 0``; ``min_bpm >= max_bpm``; a ``bpm``,
+        ``min_bpm`` or ``max_bpm`` outside 20-400; unknown method or front-end
+        parameter.
+
+    Warns
+    -----
+    BeatsyncWarning
+        If no onsets are found (e.g. a steady tone): returns no beats. If the pulse
+        is unclear (e.g. noise, ``MIN_PULSE_CLARITY``): returns the beats found.
+
+    Examples
+    --------
+    >>> from beatsync.synth.audio import beat_times, click_track
+    >>> ref = beat_times(120, duration=10.0, start=0.3)
+    >>> y = click_track(ref, sr=22050, duration=10.0)
+    >>> bt = track_beats(y, 22050)
+    >>> round(bt.tempo)
+    120
+    """
+    y, sr = check_audio(y, sr)
+    min_bpm, max_bpm = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="bpm")
+    check_bpm(min_bpm, name="min_bpm")
+    check_bpm(max_bpm, name="max_bpm")
+    if bpm is not None:
+        bpm = check_bpm(bpm)
+    check_duration(y.size, sr, bpm=bpm)
+    if method == "librosa":
+        if frontend_params:
+            raise ParameterError(
+                f"front-end parameters {sorted(frontend_params)} only apply to method='psf'"
+            )
+        return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
+    if method != "psf":
+        raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
+    prior_period_s = check_positive(prior_period_s, name="prior_period_s", unit="s")
+    prior_sigma = check_positive(prior_sigma, name="prior_sigma", unit="log-period")
+    tempo_win_s = check_positive(tempo_win_s, name="tempo_win_s", unit="s")
+    tempo_hop_s = check_positive(tempo_hop_s, name="tempo_hop_s", unit="s")
+    fe = frontend_settings(frontend_params, sr)
+    if y.size / sr * fe.analysis_sr < 4 * fe.win_length:
+        raise ParameterError(
+            f"the audio is only {y.size / sr:.3f} s long ({y.size} samples at sr={sr:g}): "
+            f"shorter than 4 analysis windows of {fe.win_length} samples at "
+            f"{fe.analysis_sr:g} Hz"
+        )
+    ons = compute_onsets(y, sr, fe)
+    return _track_psf(
+        ons,
+        duration=y.size / sr,
+        bpm=bpm,
+        min_bpm=min_bpm,
+        max_bpm=max_bpm,
+        prior_period_s=prior_period_s,
+        prior_sigma=prior_sigma,
+        tempo_win_s=tempo_win_s,
+        tempo_hop_s=tempo_hop_s,
+        time_varying=time_varying,
+    )
+
+
+def _empty(method: str, msg: str) -> BeatTrack:
+    warnings.warn(msg, BeatsyncWarning, stacklevel=3)
+    e = np.empty(0)
+    return BeatTrack(e, float("nan"), e, e, method)
+
+
+def _track_psf(
+    ons: OnsetSignal,
+    *,
+    duration: float,
+    bpm,
+    min_bpm,
+    max_bpm,
+    prior_period_s,
+    prior_sigma,
+    tempo_win_s,
+    tempo_hop_s,
+    time_varying,
+) -> BeatTrack:
+    fps = ons.fps
+    n = ons.envelope.size
+    if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
+        return _empty("psf", "no onsets found in the audio (a steady sound?): no beats")
+    model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
+    sigma = max(0.01 * fps, 0.5)  # 10 ms: onsets a frame apart still resonate together
+    accents = np.stack([gaussian_smooth(band, sigma) for band in ons.bands])
+    starts, stops, centres = analysis_windows(n, fps, tempo_win_s, tempo_hop_s)
+    if bpm is not None:
+        periods = np.array([60.0 / bpm])
+    else:
+        periods = period_grid(min_bpm, max_bpm)
+    # above this the 10-ms smoothing leaves < 1 % of the accent power
+    max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * sigma / fps)
+    log_obs, salience, measure = tactus_observation(
+        accents, fps, starts, stops, periods, model, max_hz=max_hz
+    )
+    if bpm is None:
+        clarity = float(np.median(salience.max(axis=0)))
+        if clarity < MIN_PULSE_CLARITY:
+            warnings.warn(
+                f"no clear pulse in the audio (pulse clarity {clarity:.2f} < "
+                f"{MIN_PULSE_CLARITY}): noise or free rhythm? the beats may be meaningless",
+                BeatsyncWarning,
+                stacklevel=3,
+            )
+        if not time_varying:
+            log_obs = np.repeat(log_obs.sum(axis=1, keepdims=True), centres.size, axis=1)
+        path = tempo_hmm(log_obs, periods, trans_sigma=0.02, p_jump=1e-4)
+    else:
+        path = np.zeros(centres.size, dtype=np.int64)
+    period_w = periods[path]
+    beats_per_bar = estimate_meter(measure[path, np.arange(path.size)], period_w)
+    beats, _ = place_beats(ons, period_w, centres, tempo_win_s, duration)
+    tempo_curve = 60.0 / period_w
+    if bpm is None and beats.size > 3:
+        # refine the grid tempo (0.5 % steps) with the median beat interval per window
+        ibi = np.diff(beats)
+        mid = (beats[1:] + beats[:-1]) / 2
+        reach = tempo_win_s / 2 if time_varying else np.inf  # one tempo: whole piece
+        for i, c in enumerate(centres):
+            sel = ibi[np.abs(mid - c) <= reach]
+            if sel.size >= 3:
+                est = 60.0 / np.median(sel)
+                if abs(np.log(est / tempo_curve[i])) < 0.05:  # same metrical level
+                    tempo_curve[i] = est
+    return BeatTrack(
+        beats.astype(np.float64),
+        float(np.median(tempo_curve)),
+        centres.astype(np.float64),
+        tempo_curve,
+        "psf",
+        beats_per_bar,
+    )
+
+
+def _track_librosa(y, sr, *, bpm, min_bpm, max_bpm) -> BeatTrack:
+    import librosa  # noqa: PLC0415 (heavy; only for the comparison method)
+    import scipy.stats  # noqa: PLC0415
+
+    hop = 512
+    kwargs: dict[str, Any] = {}
+    if bpm is not None:
+        kwargs["bpm"] = bpm
+    elif (min_bpm, max_bpm) != (40.0, 240.0):
+        # a user-narrowed range: flat prior inside it (else librosa's log-normal prior)
+        kwargs["prior"] = scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
+    tempo, beats = librosa.beat.beat_track(
+        y=y.astype(np.float32), sr=sr, hop_length=hop, units="time", **kwargs
+    )
+    tempo = float(np.atleast_1d(tempo)[0])
+    beats = np.unique(np.asarray(beats, dtype=np.float64))
+    dur = y.size / sr
+    return BeatTrack(beats, tempo, np.array([dur / 2]), np.array([tempo]), "librosa")

@@ -1,0 +1,166 @@
+"""One Dask set-up for the parallel commands (``batch``, ``evaluate beats``).
+
+:func:`dask_client` yields a :class:`distributed.Client` on either a local cluster
+(``n_workers`` single-threaded worker processes, default one per core) or an existing
+scheduler given by address (``"tcp://10.0.0.5:8786"``). It checks its arguments
+before starting anything, gives up on an unreachable scheduler after
+``timeout`` seconds with a :class:`~beatsync.errors.ParameterError` (not a hang, not
+a traceback), and closes the client and the local cluster on the way out, also on
+Ctrl-C.
+
+Workers of an existing cluster must see the same file paths as the client (a shared
+file system) and have beatsync installed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections.abc import Iterator
+from typing import Any
+
+from .errors import ParameterError
+
+__all__ = [
+    "dask_client",
+    "check_workers",
+    "check_cluster_options",
+    "default_workers",
+    "CONNECT_TIMEOUT",
+]
+
+#: Seconds to wait for an existing scheduler before giving up.
+CONNECT_TIMEOUT = 5.0
+
+
+def default_workers() -> int:
+    """Workers of a local cluster when none are asked for: one per core."""
+    return os.cpu_count() or 1
+
+
+def check_workers(n_workers: Any, *, name: str = "--workers") -> int | None:
+    """Check a local cluster's worker count: ``None`` (default) or a whole number >= 1.
+
+    Raises
+    ------
+    ParameterError
+        Zero, negative, fractional or non-numeric counts.
+    """
+    if n_workers is None:
+        return None
+    if isinstance(n_workers, bool) or not isinstance(n_workers, (int, float, str)):
+        raise ParameterError(f"{name}={n_workers!r} must be a whole number of workers >= 1")
+    try:
+        value = float(n_workers)
+    except ValueError:
+        raise ParameterError(f"{name}={n_workers!r} is not a number of workers") from None
+    if value != int(value) or value < 1:
+        raise ParameterError(
+            f"{name}={n_workers!r} must be a whole number of workers >= 1 "
+            f"(this machine has {default_workers()} cores; omit it for one worker per core)"
+        )
+    return int(value)
+
+
+def check_cluster_options(scheduler: Any, n_workers: Any) -> int | None:
+    """Check ``--scheduler`` and ``--workers`` together; return the worker count.
+
+    Raises
+    ------
+    ParameterError
+        A bad worker count (:func:`check_workers`), an empty address, or both options
+        (``--workers`` sizes a local cluster; an existing one has its own workers).
+    """
+    n = check_workers(n_workers)
+    if scheduler is None:
+        return n
+    if not isinstance(scheduler, str) or not scheduler.strip():
+        raise ParameterError(
+            f"--scheduler={scheduler!r} is not an address; expected e.g. tcp://10.0.0.5:8786"
+        )
+    if n is not None:
+        raise ParameterError(
+            f"--workers {n} sets the size of a local cluster; with --scheduler "
+            f"{scheduler!r} the tasks run on that cluster's workers: give one or the other"
+        )
+    return n
+
+
+@contextlib.contextmanager
+def dask_client(
+    *,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    processes: bool = True,
+    timeout: float | None = None,
+) -> Iterator[Any]:
+    """A Dask client on a new local cluster or on an existing scheduler.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running scheduler (``tcp://host:port`` or ``host:port``).
+        Default: start a local cluster.
+    n_workers : int >= 1, optional
+        Workers of the local cluster (default: one per core). Refused together with
+        ``scheduler`` (that cluster has its own workers).
+    processes : bool
+        Local workers are processes (default) or threads of this process.
+    timeout : float > 0 [s], optional
+        How long to wait for ``scheduler`` (default :data:`CONNECT_TIMEOUT`).
+
+    Yields
+    ------
+    distributed.Client
+
+    Raises
+    ------
+    ParameterError
+        A bad worker count, both ``scheduler`` and ``n_workers``, a malformed
+        address, or a scheduler that does not answer within ``timeout`` seconds.
+    """
+    n = check_cluster_options(scheduler, n_workers)
+    from dask.distributed import Client, LocalCluster
+
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(
+            n_workers=n or default_workers(),
+            threads_per_worker=1,
+            processes=processes,
+            dashboard_address=None,
+            # no dashboard; the scheduler's small HTTP server on a free port, not 8787
+            scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
+            silence_logs=logging.ERROR,
+        )
+        client = Client(cluster)
+    else:
+        client = _connect(scheduler.strip(), CONNECT_TIMEOUT if timeout is None else timeout)
+    try:
+        yield client
+    finally:
+        with contextlib.suppress(Exception):
+            client.close()
+        if cluster is not None:
+            with contextlib.suppress(Exception):
+                cluster.close()
+
+
+def _connect(address: str, timeout: float) -> Any:
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout=timeout)
+    except ValueError as exc:  # malformed address: unknown scheme, no port
+        raise ParameterError(
+            f"--scheduler {address!r} is not a Dask scheduler address ({exc}); "
+            "expected e.g. tcp://10.0.0.5:8786"
+        ) from None
+    except Exception as exc:  # refused, timed out, or something else answering there
+        reason = "no answer" if isinstance(exc, (OSError, TimeoutError)) else type(exc).__name__
+        raise ParameterError(
+            f"could not connect to the Dask scheduler at {address!r} within {timeout:g} s "
+            f"({reason}); is `dask scheduler` running there and reachable? "
+            "Omit --scheduler to run on a local cluster"
+        ) from None

@@ -1,0 +1,155 @@
+"""``beatsync evaluate beats``: score a beat tracker against annotations over a dataset."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ._common import add_output_flags, emit
+
+#: Unmatched audio files named in the text output before "... and N more".
+SHOWN = 10
+
+EXIT_FAILED_ITEMS = 1  # as beatsync.commands._common (not imported: --help stays light)
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    from ..peers import PEERS
+
+    p = subparsers.add_parser(
+        "evaluate",
+        help="score beat trackers against annotations over a dataset (on Dask)",
+        description="Score a method over a dataset of files. WHAT is what is scored.",
+        epilog="`beatsync evaluate WHAT --help` lists the options of WHAT (each accepts "
+        "--json for machine-readable output).",
+    )
+    sub = p.add_subparsers(dest="what", metavar="WHAT")
+    sub.required = True
+    b = sub.add_parser(
+        "beats",
+        help="track every audio file and score it with mir_eval",
+        description="Track the beats of every audio file under --audio with --method, score "
+        "them with every mir_eval.beat metric against the annotation of the same name "
+        "(NAME.beats under --annotations: one time [s] per line, an optional second column "
+        "is ignored), on a Dask cluster (local by default). Each track's row is appended to "
+        "RESULTS_DIR/tracks.jsonl as soon as it finishes, so an interrupted run loses only "
+        "the tracks in flight and a rerun skips the tracks already scored (--force re-runs "
+        "them). At the end RESULTS_DIR/tracks.csv and RESULTS_DIR/summary.csv (means per "
+        "method and folder) are written. A track that fails (unreadable, silent) is recorded "
+        "with its error; audio without an annotation is listed and skipped.",
+    )
+    b.add_argument("--audio", required=True, metavar="DIR", help="folder of audio files")
+    b.add_argument(
+        "--annotations", required=True, metavar="DIR", help="folder of NAME.beats files [s]"
+    )
+    b.add_argument(
+        "--method",
+        default="psf",
+        choices=list(PEERS),
+        help="beat tracker (default psf, ours; essentia-* need pip install 'beatsync[peers]')",
+    )
+    b.add_argument("--out", required=True, metavar="RESULTS_DIR", help="results folder")
+    b.add_argument(
+        "--min-beat-time",
+        type=float,
+        default=0.0,
+        help="beats before this time are not scored [s] (default 0; MIREX uses 5)",
+    )
+    b.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    b.add_argument(
+        "--workers", type=int, default=None, help="local cluster workers (default: cores)"
+    )
+    b.add_argument("--force", action="store_true", help="re-run tracks already scored")
+    add_output_flags(b)
+    b.set_defaults(func=run_beats)
+
+
+def run_beats(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .. import peers
+    from ..cluster import check_cluster_options
+    from ..errors import ParameterError
+    from ..study.beat_dataset import RESULT_FILES, evaluate_dataset, find_tracks
+    from ..units import check_positive
+    from ._common import check_output, feedback
+
+    fb = feedback(args)
+    # cheapest first: options, then the output folder, then the inputs
+    workers = check_cluster_options(args.scheduler, args.workers)
+    mbt = check_positive(args.min_beat_time, name="--min-beat-time", unit="s", allow_zero=True)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out {args.out!r} is a file; give a folder for the results")
+    if out.is_dir():  # the files it will hold must be writable files
+        for name in RESULT_FILES:
+            check_output(out / name, option="--out")
+    peers.get(args.method)
+    found = find_tracks(args.audio, args.annotations)
+    if found.unmatched:
+        names = [str(p) for p in found.unmatched]
+        more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
+        fb.warn(
+            f"{len(names)} audio file(s) without an annotation (NAME.beats) are skipped: "
+            f"{', '.join(names[:SHOWN])}{more}"
+        )
+    try:
+        with fb.step(f"evaluate {args.method}") as progress:
+            run = evaluate_dataset(
+                found.tracks,
+                out,
+                method=args.method,
+                min_beat_time=mbt,
+                force=args.force,
+                scheduler=args.scheduler,
+                n_workers=workers,
+                progress=progress,
+            )
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc, out / "tracks.jsonl", args)
+    t = run.tracks
+    failed = t[t["status"] != "ok"]
+    result = {
+        "method": args.method,
+        "tracks": len(t),
+        "scored_now": run.scored,
+        "skipped": run.skipped,
+        "failed": failed[["key", "error"]].to_dict("records"),
+        "unmatched": [str(p) for p in found.unmatched],
+        "summary": run.summary.to_dict("records"),
+        "files": {k: str(v) for k, v in run.files.items()},
+    }
+    cols = ["method", "group", "tracks", "failed", "F-measure", "Correct Metric Level Total"]
+    cols += ["Any Metric Level Total", "octave errors"]
+    shown = run.summary[cols].rename(
+        columns={"Correct Metric Level Total": "CMLt", "Any Metric Level Total": "AMLt"}
+    )
+    lines = [shown.to_string(index=False, float_format=lambda x: f"{x:.3f}"), ""]
+    for _, row in failed.iterrows():
+        lines.append(f"failed: {row['key']}: {row['error']}")
+    skipped = f", {run.skipped} already scored (--force re-runs them)" if run.skipped else ""
+    lines.append(
+        f"{len(t) - len(failed)}/{len(t)} tracks scored with {args.method} "
+        f"({run.scored} run now{skipped}); results in {run.files['summary'].parent}"
+    )
+    emit(result, "\n".join(lines), args)
+    return 0 if len(failed) < len(t) else EXIT_FAILED_ITEMS
+
+
+def _interrupted(exc: KeyboardInterrupt, log: object, args: argparse.Namespace) -> int:
+    """Ctrl-C or SIGTERM: the finished tracks stay recorded; say so and how to go on."""
+    import json
+    import signal
+
+    signum = int(getattr(exc, "signum", signal.SIGINT))
+    msg = (
+        f"interrupted by {signal.Signals(signum).name}; the finished tracks are recorded in "
+        f"{str(log)!r}: run the same command again to score the others"
+    )
+    if args.json:
+        obj = {"error": msg, "kind": "interrupted", "command": "evaluate",
+               "exit_code": 128 + signum}  # fmt: skip
+        print(json.dumps(obj), file=sys.stderr, flush=True)
+    else:
+        print(f"beatsync evaluate: error: {msg}", file=sys.stderr, flush=True)
+    return 128 + signum

@@ -1,0 +1,59 @@
+"""Scores of a temporal segmentation against reference period boundaries.
+
+Data contract (mir_eval style): boundaries are 1-D arrays of frame indices (or any
+common time unit), increasing; ``reference`` is the ground truth, ``estimated`` what a
+segmentation found. No segmentation is run here (see
+:mod:`beatsync.study.paper_a_segmentation` for the pipelines of the notebook).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["boundary_errors"]
+
+
+def boundary_errors(estimated: Any, reference: Any, *, remove_offset: bool = False) -> dict:
+    """Boundary error [frames] of estimated against reference boundary frames.
+
+    Each reference boundary inside the estimated span is matched to the nearest
+    estimated boundary.
+
+    Parameters
+    ----------
+    estimated, reference : array_like [frames]
+    remove_offset : bool
+        Subtract the median signed error first (for baselines whose boundaries sit at
+        another phase of the cycle, e.g. minima of one angle).
+
+    Returns
+    -------
+    dict
+        ``mean``, ``max`` [frames], ``n_matched``, ``count_error`` (estimated minus
+        reference number of periods) and ``offset`` [frames].
+    """
+    est = np.asarray(estimated, dtype=np.float64)
+    ref = np.asarray(reference, dtype=np.float64)
+    if est.size == 0 or ref.size == 0:
+        return {"mean": np.nan, "max": np.nan, "n_matched": 0, "count_error": est.size - ref.size,
+                "offset": 0.0}  # fmt: skip
+    idx = np.clip(np.searchsorted(est, ref), 1, max(est.size - 1, 1))
+    left = est[idx - 1]
+    right = est[np.minimum(idx, est.size - 1)]
+    nearest = np.where(np.abs(ref - left) <= np.abs(ref - right), left, right)
+    signed = nearest - ref
+    offset = float(np.median(signed)) if remove_offset else 0.0
+    if remove_offset:
+        shifted = est - offset
+        return boundary_errors(shifted, ref) | {"offset": offset}
+    inside = (ref >= est[0] - 0.5) & (ref <= est[-1] + 0.5)
+    err = np.abs(signed[inside]) if inside.any() else np.abs(signed)
+    return {
+        "mean": float(err.mean()),
+        "max": float(err.max()),
+        "n_matched": int(err.size),
+        "count_error": int(est.size - ref.size),
+        "offset": offset,
+    }

@@ -1,0 +1,606 @@
+"""Joint-position motion files: Dance-with-Melody JSON, ``.npy``/``.npz`` arrays, C3D.
+
+Every reader returns a position-only :class:`~beatsync.motion.Motion` in the canonical
+frame (metres, z up; see :mod:`beatsync.motion`) with a
+:class:`~beatsync.motion.PositionInfo` that records the file's layout, units and
+vertical axis, so that the writers here put the motion back in that layout.
+
+Layouts
+-------
+- ``.json`` (Dance-with-Melody): ``{"length": N, "center": [N][3], "skeletons":
+  [N][J][3]}``; ``skeletons`` are joint positions relative to ``center``, the
+  per-frame root position (the four bundled dancers: 23 joints, centimetres, y up,
+  25 fps, which the file does not store). The motion holds absolute positions
+  (``skeletons + center``).
+- ``.npy``: one array ``(n_frames, n_joints, 3)`` (e.g. AIST++ ``keypoints3d``).
+- ``.npz``: such an array under a key (named, or found: ``keypoints3d`` or the only
+  3-D array with 3 columns); a scalar ``fps`` in the archive is used as the rate.
+- ``.c3d``: marker points through the ``c3d`` package; the file's own rate, labels
+  and unit (``POINT:UNITS``); points flagged invalid (negative residual) are gaps.
+
+Units (``"m"``, ``"cm"``, ``"mm"``) and vertical axis (``"y"``, ``"z"``) are given
+or detected: the vertical axis is the one of y and z along which the body extends
+most (median over frames), the unit the one that makes that extent a human size
+(0.25-3 m). Short NaN gaps are filled (:func:`beatsync.motion.fill_joint_gaps`),
+long ones refused with the joint named.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import warnings
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..motion import (
+    UNIT_METRES,
+    Motion,
+    PositionInfo,
+    fill_joint_gaps,
+)
+from ..units import check_fps, check_positive
+from ._files import atomic_write, check_input_file
+
+__all__ = [
+    "read_positions_json",
+    "read_positions_array",
+    "read_c3d",
+    "write_positions_json",
+    "write_positions_array",
+    "write_c3d",
+    "is_position_array",
+    "detect_up",
+    "detect_units",
+    "to_canonical",
+    "from_canonical",
+    "POSITION_SUFFIXES",
+]
+
+POSITION_SUFFIXES = (".json", ".npy", ".npz", ".c3d")
+#: Plausible body height range [m] for detecting units.
+_HEIGHT_M = (0.25, 3.0)
+#: Preferred key of an AIST++-style archive.
+_KEYPOINT_KEYS = ("keypoints3d", "keypoints3d_optim", "positions", "joints")
+
+
+# --------------------------------------------------------------------------- frames
+
+
+def _check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str | None:
+    if value is None:
+        return None
+    if value not in choices:
+        raise ParameterError(
+            f"{name}={value!r} must be one of {', '.join(repr(c) for c in choices)}"
+        )
+    return str(value)
+
+
+def _extents(pos: np.ndarray) -> np.ndarray:
+    """Median over frames of the body's extent along x, y and z (file units)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN frames
+        ext = np.nanmax(pos, axis=1) - np.nanmin(pos, axis=1)
+        return np.nanmedian(ext, axis=0)
+
+
+def detect_up(positions: Any) -> str:
+    """The vertical axis (``"y"`` or ``"z"``) of joint positions ``(n_frames, n_joints, 3)``.
+
+    The body of a standing or dancing person extends further along the vertical
+    than along the depth axis; an ambiguous case (extents within 15 %) is refused.
+    """
+    ext = _extents(np.asarray(positions, dtype=np.float64))
+    ey, ez = float(ext[1]), float(ext[2])
+    if ey > 1.15 * ez:
+        return "y"
+    if ez > 1.15 * ey:
+        return "z"
+    raise ParameterError(
+        f"cannot tell the vertical axis: the body extends {ey:.3g} along y and {ez:.3g} "
+        "along z (file units); give it with up='y' or up='z' (--up)"
+    )
+
+
+def detect_units(positions: Any, up: str) -> str:
+    """The length unit (``"m"``, ``"cm"``, ``"mm"``) that makes the body a human size.
+
+    The body's vertical extent (median over frames) must be 0.25-3 m in one unit.
+    """
+    h = float(_extents(np.asarray(positions, dtype=np.float64))["xyz".index(up)])
+    for unit, scale in UNIT_METRES.items():
+        if _HEIGHT_M[0] <= h * scale <= _HEIGHT_M[1]:
+            return unit
+    raise ParameterError(
+        f"cannot tell the length unit: the body is {h:.3g} file units tall, which is not "
+        "a human size (0.25-3 m) in metres, centimetres or millimetres; give it with "
+        "units='m', 'cm' or 'mm' (--units)"
+    )
+
+
+def to_canonical(positions: Any, *, units: str, up: str) -> np.ndarray:
+    """File positions -> metres, z up (right-handed: y up ``(x, y, z)`` -> ``(x, -z, y)``)."""
+    p = np.asarray(positions, dtype=np.float64) * UNIT_METRES[units]
+    if up == "y":
+        p = np.stack([p[..., 0], -p[..., 2], p[..., 1]], axis=-1)
+    return p
+
+
+def from_canonical(positions: Any, *, units: str, up: str) -> np.ndarray:
+    """Metres, z up -> the file's units and vertical axis (inverse of :func:`to_canonical`)."""
+    p = np.asarray(positions, dtype=np.float64)
+    if up == "y":
+        p = np.stack([p[..., 0], p[..., 2], -p[..., 1]], axis=-1)
+    return p / UNIT_METRES[units]
+
+
+def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, bool, str, bool]:
+    up_det = up is None
+    up = detect_up(pos) if up is None else up
+    units_det = units is None
+    units = detect_units(pos, up) if units is None else units
+    h = float(_extents(pos)["xyz".index(up)]) * UNIT_METRES[units]
+    if not 0.05 <= h <= 10.0:
+        raise ParameterError(
+            f"with units={units!r} the body is {h:.3g} m tall: the unit looks wrong "
+            f"(detected: {detect_units(pos, up) if h > 0 else '?'})"
+        )
+    return units, units_det, up, up_det
+
+
+# --------------------------------------------------------------------------- building
+
+
+def _names(n_joints: int, names: Any = None) -> tuple[str, ...]:
+    if names is None:
+        return tuple(f"j{i}" for i in range(n_joints))
+    out = []
+    seen: set[str] = set()
+    for i, n in enumerate(names):
+        clean = "_".join(str(n).split()) or f"j{i}"
+        if clean in seen:
+            clean = f"{clean}_{i}"
+        seen.add(clean)
+        out.append(clean)
+    return tuple(out)
+
+
+def _build(
+    pos: np.ndarray,
+    *,
+    fps: float,
+    name: str,
+    source: str,
+    layout: str,
+    units: str | None,
+    up: str | None,
+    bones: Any,
+    max_gap: float,
+    joint_names: Any = None,
+    center: np.ndarray | None = None,
+    key: str | None = None,
+) -> Motion:
+    """Validate file positions ``(n, J, 3)``, fill gaps, convert, and make the Motion."""
+    if pos.ndim != 3 or pos.shape[2] != 3:
+        raise ParameterError(
+            f"{source} holds an array of shape {pos.shape}; joint positions must be "
+            "(n_frames, n_joints, 3)"
+        )
+    n, n_j = pos.shape[0], pos.shape[1]
+    if n_j < 2:
+        raise ParameterError(
+            f"{source} has {n_j} joint(s); a position-only motion needs at least 2 joints "
+            "(is the array transposed? it must be frames x joints x 3)"
+        )
+    if n < 2:
+        raise ParameterError(f"{source} has {n} frame(s); need at least 2")
+    names = _names(n_j, joint_names)
+    max_gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
+    if center is not None:
+        center = fill_joint_gaps(center[:, None, :], fps, max_gap=max_gap, joint_names=["center"])[
+            :, 0
+        ]
+        pos = pos + center[:, None, :]
+    pos = fill_joint_gaps(pos, fps, max_gap=max_gap, joint_names=names)
+    units, units_det, up, up_det = _frame_of(pos, units, up)
+    info = PositionInfo(
+        bones=bones,
+        layout=layout,
+        units=units,
+        up=up,
+        units_source="detected" if units_det else "given",
+        up_source="detected" if up_det else "given",
+        center=None if center is None else to_canonical(center, units=units, up=up),
+        key=key,
+    )
+    values = to_canonical(pos, units=units, up=up).reshape(n, 3 * n_j)
+    channels = tuple(f"{j}_{a}" for j in names for a in "xyz")
+    return Motion(values, fps, channels, None, name, position_info=info)
+
+
+def _need_fps(fps: Any, source: str, hint: str = "") -> float:
+    if fps is None:
+        raise ParameterError(f"{source} stores no frame rate: give it with fps= (--fps){hint}")
+    return check_fps(fps)
+
+
+# --------------------------------------------------------------------------- JSON
+
+
+def read_positions_json(
+    path: str | os.PathLike[str],
+    *,
+    fps: float | None,
+    up: str | None = None,
+    units: str | None = None,
+    bones: Any = None,
+    max_gap: float = 0.25,
+) -> Motion:
+    """Read the Dance-with-Melody JSON layout (``skeletons`` [N][J][3] + ``center`` [N][3]).
+
+    Parameters
+    ----------
+    fps : float > 0 [Hz]
+        Required (the layout stores no rate; the Dance-with-Melody dataset is 25 fps).
+    up : {"y", "z"}, optional
+        Vertical axis of the file; default detected.
+    units : {"m", "cm", "mm"}, optional
+        Length unit of the file; default detected.
+    bones : array_like [shape=(n_bones, 2)], optional
+        Joint-index pairs; default inferred from the data.
+    max_gap : float >= 0 [s]
+        Longest run of missing (``null``/NaN) values filled per joint.
+
+    Returns
+    -------
+    Motion
+        Absolute joint positions (``skeletons + center``) in metres, z up, joints
+        ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
+    """
+    p = check_input_file(path, "JSON motion")
+    up = _check_choice(up, "up", ("y", "z"))
+    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    rate = _need_fps(
+        fps, f"{str(p)!r} (JSON joint positions)", "; the Dance-with-Melody dataset is 25 fps"
+    )
+    try:
+        with open(p, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ParameterError(f"cannot read {str(p)!r} as JSON: {exc}") from None
+    expected = (
+        "expected the Dance-with-Melody layout: an object with 'skeletons' "
+        "[frames][joints][3] (joint positions) and 'center' [frames][3] (root track), "
+        "optionally 'length'"
+    )
+    if not isinstance(doc, dict) or "skeletons" not in doc:
+        got = f"keys {sorted(doc)[:8]}" if isinstance(doc, dict) else type(doc).__name__
+        raise ParameterError(f"{str(p)!r} is a JSON of another layout ({got}); {expected}")
+    skel = _ragged_check(doc["skeletons"], "skeletons", p, 3)
+    center = None
+    if doc.get("center") is not None:
+        center = _ragged_check(doc["center"], "center", p, 2)
+        if center.shape[1:] != (3,) or center.shape[0] != skel.shape[0]:
+            raise ParameterError(
+                f"{str(p)!r}: 'center' has shape {center.shape} but 'skeletons' has "
+                f"{skel.shape[0]} frames; {expected}"
+            )
+    length = doc.get("length")
+    if length is not None and length != skel.shape[0]:
+        raise ParameterError(
+            f"{str(p)!r} says length={length!r} but 'skeletons' has {skel.shape[0]} frames "
+            "(truncated or edited file?)"
+        )
+    name = p.parent.name if p.stem == "skeletons" else p.stem
+    return _build(
+        skel,
+        fps=rate,
+        name=name,
+        source=repr(str(p)),
+        layout="json",
+        units=units,
+        up=up,
+        bones=bones,
+        max_gap=max_gap,
+        center=center,
+    )
+
+
+def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
+    """A nested list as a float array (``null`` -> NaN), refusing ragged nesting."""
+    if not isinstance(data, list) or not data:
+        raise ParameterError(f"{str(p)!r}: {what!r} must be a non-empty list of frames")
+    try:
+        arr = np.array(data, dtype=np.float64)  # null -> NaN
+    except (TypeError, ValueError):
+        arr = None
+    if arr is not None and arr.ndim == ndim and arr.shape[-1] == 3:
+        return arr
+    layout = "[frames][joints][3]" if ndim == 3 else "[frames][3]"
+    n0 = len(data[0]) if isinstance(data[0], list) else None
+    for i, frame in enumerate(data):
+        if not isinstance(frame, list):
+            break
+        if ndim == 3 and len(frame) != n0:
+            raise ParameterError(
+                f"{str(p)!r}: {what!r} is ragged: frame {i} has {len(frame)} joints, frame 0 "
+                f"has {n0}; every frame needs the same joints ({layout})"
+            )
+        points = frame if ndim == 3 else [frame]
+        for j, point in enumerate(points):
+            if not isinstance(point, list) or len(point) != 3:
+                size = len(point) if isinstance(point, list) else "not a list of"
+                where = f"frame {i} joint {j}" if ndim == 3 else f"frame {i}"
+                raise ParameterError(
+                    f"{str(p)!r}: {what!r} is ragged: {where} has {size} coordinates; "
+                    f"need 3 (x, y, z) per point ({layout})"
+                )
+    raise ParameterError(f"{str(p)!r}: {what!r} must be numbers nested as {layout}")
+
+
+def write_positions_json(path: str | os.PathLike[str], motion: Motion) -> Path:
+    """Write a position-only motion in the Dance-with-Melody JSON layout (atomic).
+
+    Positions go back to the units and vertical axis of ``motion.position_info``
+    (metres, z up without it). ``center`` is the motion's root track where it still
+    has one per frame (a motion read from such a file), else the per-frame mean of
+    the joints; ``skeletons`` are the positions relative to it.
+    """
+    info = _positional_info(motion, ".json")
+    pos = motion.positions()
+    center = info.center
+    if center is None or len(center) != motion.n_frames:
+        center = pos.mean(axis=1)
+    skel = from_canonical(pos - center[:, None, :], units=info.units, up=info.up)
+    c = from_canonical(center, units=info.units, up=info.up)
+    doc = {"length": motion.n_frames, "center": c.tolist(), "skeletons": skel.tolist()}
+    with atomic_write(path) as fh:
+        json.dump(doc, fh, allow_nan=False)
+    return Path(path)
+
+
+def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
+    if not motion.is_positional:
+        raise ParameterError(
+            f"motion {motion.name!r} is not joint positions (channels <joint>_x/_y/_z), so "
+            f"it cannot be written as {suffix} joint positions; write .bvh (rotation "
+            "data with a skeleton) or a .csv table"
+        )
+    info = motion.position_info
+    return info if info is not None else PositionInfo()
+
+
+# --------------------------------------------------------------------------- arrays
+
+
+def is_position_array(path: str | os.PathLike[str]) -> bool:
+    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only).
+
+    Other shapes are left to the table reader, which explains what it needs.
+    """
+    p = check_input_file(path, ".npy")
+    try:
+        arr = np.load(p, mmap_mode="r", allow_pickle=False)
+    except Exception:  # not a plain numeric .npy array: the table reader says why
+        return False
+    if not isinstance(arr, np.ndarray):  # an .npz archive renamed .npy
+        arr.close()
+        return False
+    return arr.ndim == 3 and arr.shape[-1] == 3 and arr.dtype.kind in "iuf"
+
+
+def read_positions_array(
+    path: str | os.PathLike[str],
+    *,
+    fps: float | None = None,
+    key: str | None = None,
+    up: str | None = None,
+    units: str | None = None,
+    bones: Any = None,
+    max_gap: float = 0.25,
+    joint_names: Any = None,
+) -> Motion:
+    """Read joint positions ``(n_frames, n_joints, 3)`` from ``.npy`` or ``.npz``.
+
+    Parameters
+    ----------
+    fps : float > 0 [Hz], optional
+        Required unless an ``.npz`` holds a scalar ``fps``; a given rate that
+        contradicts the archive's is refused.
+    key : str, optional
+        Array name in an ``.npz``; default ``keypoints3d`` (AIST++) or the only
+        ``(n, J, 3)`` array.
+    up, units, bones, max_gap
+        As for :func:`read_positions_json`.
+    joint_names : sequence of str, optional
+        Default ``j0``, ``j1``, ...
+    """
+    p = check_input_file(path, "array")
+    up = _check_choice(up, "up", ("y", "z"))
+    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    suffix = p.suffix.lower()
+    file_fps = None
+    if suffix == ".npz":
+        try:
+            with np.load(p, allow_pickle=False) as data:
+                arrays = {k: data[k] for k in data.files}
+        except Exception as exc:
+            raise ParameterError(f"cannot read {str(p)!r} as an .npz archive: {exc}") from None
+        cands = [k for k, v in arrays.items() if v.ndim == 3 and v.shape[-1] == 3]
+        if key is None:
+            pref = [k for k in _KEYPOINT_KEYS if k in cands]
+            if pref:
+                key = pref[0]
+            elif len(cands) == 1:
+                key = cands[0]
+            else:
+                raise ParameterError(
+                    f"{str(p)!r} holds {'no' if not cands else 'several'} (frames, joints, 3) "
+                    f"arrays {cands} among {sorted(arrays)}; name one with key= (--variable)"
+                )
+        if key not in arrays:
+            raise ParameterError(f"{str(p)!r} has no array {key!r}; it holds {sorted(arrays)}")
+        pos = np.asarray(arrays[key], dtype=np.float64)
+        for k in ("fps", "frame_rate", "framerate"):
+            if k in arrays and arrays[k].size == 1:
+                file_fps = check_fps(float(arrays[k]), name=f"{k} stored in {p.name}")
+    else:
+        try:
+            pos = np.asarray(np.load(p, allow_pickle=False), dtype=np.float64)
+        except Exception as exc:
+            raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
+    rate = _file_rate(fps, file_fps, p) if file_fps is not None else _need_fps(fps, repr(str(p)))
+    return _build(
+        pos,
+        fps=rate,
+        name=p.stem,
+        source=repr(str(p)) + (f" array {key!r}" if key else ""),
+        layout=suffix.lstrip("."),
+        units=units,
+        up=up,
+        bones=bones,
+        max_gap=max_gap,
+        joint_names=joint_names,
+        key=key,
+    )
+
+
+def _file_rate(fps: Any, file_fps: float, p: Path) -> float:
+    """The file's own rate; a given ``fps`` must agree with it."""
+    if fps is not None:
+        given = check_fps(fps)
+        if abs(given - file_fps) > 1e-6 * file_fps:
+            raise ParameterError(
+                f"fps={fps!r} contradicts the frame rate stored in {str(p)!r} ({file_fps:g} Hz); "
+                "leave fps out (the file's rate is used) or fix the file"
+            )
+    return file_fps
+
+
+def write_positions_array(path: str | os.PathLike[str], motion: Motion) -> Path:
+    """Write a position-only motion as ``(n_frames, n_joints, 3)`` (atomic).
+
+    ``.npy``: the array alone; ``.npz``: the array under the motion's key (default
+    ``keypoints3d``) and the scalar ``fps``. Units and vertical axis of
+    ``motion.position_info`` (metres, z up without it).
+    """
+    dest = Path(path)
+    info = _positional_info(motion, dest.suffix.lower())
+    arr = from_canonical(motion.positions(), units=info.units, up=info.up)
+    with atomic_write(dest, mode="wb") as fh:
+        if dest.suffix.lower() == ".npz":
+            np.savez(fh, **{info.key or "keypoints3d": arr, "fps": np.float64(motion.fps)})
+        else:
+            np.save(fh, arr)
+    return dest
+
+
+# --------------------------------------------------------------------------- C3D
+
+
+def read_c3d(
+    path: str | os.PathLike[str],
+    *,
+    fps: float | None = None,
+    up: str | None = None,
+    units: str | None = None,
+    bones: Any = None,
+    max_gap: float = 0.25,
+) -> Motion:
+    """Read the marker points of a C3D file (its own rate, labels and unit).
+
+    Points with a negative residual (the C3D flag for 'not seen') are gaps, filled
+    up to ``max_gap`` seconds. ``fps`` may be given only if it equals the file's
+    rate. ``units`` defaults to the file's ``POINT:UNITS``; ``up`` to the file's
+    ``POINT:Y_SCREEN`` (``+Y``/``+Z``) or is detected.
+    """
+    import c3d
+
+    p = check_input_file(path, "C3D")
+    up = _check_choice(up, "up", ("y", "z"))
+    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    try:
+        with open(p, "rb") as fh, warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "No analog data found" and the like
+            reader = c3d.Reader(fh)
+            n_points = int(reader.point_used)
+            rate = float(reader.point_rate)
+            labels = [str(s).strip() for s in reader.point_labels][:n_points] if n_points else []
+            file_units = _param_str(reader, "POINT:UNITS")
+            screen = _param_str(reader, "POINT:Y_SCREEN")
+            frames = []
+            if n_points > 0:
+                for _, points, _ in reader.read_frames():
+                    xyz = np.array(points[:, :3], dtype=np.float64)
+                    xyz[points[:, 3] < 0] = np.nan
+                    frames.append(xyz)
+    except ParameterError:
+        raise
+    except Exception as exc:  # the c3d package raises several types for bad files
+        raise ParameterError(f"cannot read {str(p)!r} as a C3D file: {exc}") from None
+    if n_points == 0 or not frames:
+        raise ParameterError(
+            f"{str(p)!r} is a C3D file without marker points (only analog data?); "
+            "beatsync needs 3-D points"
+        )
+    rate = _file_rate(fps, check_fps(rate, name=f"point rate of {p.name}"), p)
+    file_unit = {"m": "m", "cm": "cm", "mm": "mm"}.get(file_units.lower())
+    file_up = screen[1].lower() if screen.upper() in ("+Y", "+Z") else None
+    motion = _build(
+        np.stack(frames),
+        fps=rate,
+        name=p.stem,
+        source=repr(str(p)),
+        layout="c3d",
+        units=units or file_unit,
+        up=up or file_up,
+        bones=bones,
+        max_gap=max_gap,
+        joint_names=labels if len(labels) == n_points else None,
+    )
+    info = motion.position_info
+    if info is None:  # pragma: no cover - _build always sets it
+        raise RuntimeError("position reader lost its PositionInfo")
+    info = replace(
+        info,
+        units_source="file" if units is None and file_unit else info.units_source,
+        up_source="file" if up is None and file_up else info.up_source,
+    )
+    return replace(motion, position_info=info, _cache={})
+
+
+def _param_str(reader: Any, name: str) -> str:
+    param = reader.get(name)
+    if param is None:
+        return ""
+    try:
+        return str(param.string_value).strip()
+    except Exception:
+        return ""
+
+
+def write_c3d(path: str | os.PathLike[str], motion: Motion) -> Path:
+    """Write a position-only motion as C3D points (float, the motion's rate) (atomic).
+
+    Units and vertical axis of ``motion.position_info`` (millimetres, z up without
+    one: the usual C3D convention); joint names become point labels.
+    """
+    import c3d
+
+    info = _positional_info(motion, ".c3d")
+    units = info.units if motion.position_info is not None else "mm"
+    pos = from_canonical(motion.positions(), units=units, up=info.up).astype(np.float32)
+    writer = c3d.Writer(point_rate=float(motion.fps), point_units=f"{units:<4}")
+    writer.set_point_labels([n[:30] for n in motion.joint_names])
+    analog = np.zeros((0, 0), dtype=np.float32)
+    residual = np.zeros((pos.shape[1], 2), dtype=np.float32)
+    writer.add_frames([(np.hstack([frame, residual]), analog) for frame in pos])
+    with atomic_write(path, mode="wb") as fh, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        writer.write(fh)
+    return Path(path)

@@ -1,0 +1,85 @@
+"""Validation of the segmentation's arguments (called once, at the public entry).
+
+Data contract: each ``check_*`` takes what a user passed and returns it in the form
+the package uses (float, int, a ``(lo, hi)`` tuple of floats [s], a finite float64
+``(n_frames, n_channels)`` array), or raises :class:`~beatsync.errors.ParameterError`
+naming the value and the likely mistake.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..units import check_finite, check_range
+from .period import PERIOD_METHODS
+
+__all__ = [
+    "check_values",
+    "check_alpha",
+    "check_period_range",
+    "check_n_periods",
+    "check_period_method",
+]
+
+
+def check_values(values: Any) -> np.ndarray:
+    """Values as a finite float64 ``(n_frames, n_channels)`` array (1-D: one channel)."""
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError("values must be a numeric array (n_frames, n_channels)") from None
+    if arr.ndim == 1:
+        arr = arr[:, None]
+    if arr.ndim != 2:
+        raise ParameterError(f"values must be 2-D (n_frames, n_channels), got shape {arr.shape}")
+    if arr.shape[0] < 3:
+        raise ParameterError(f"values have {arr.shape[0]} frame(s); a segmentation needs more")
+    return check_finite(arr, name="motion values")
+
+
+def check_alpha(alpha: Any) -> float:
+    """The alpha of eq. 3: a fraction of the period in (0, 0.5)."""
+    try:
+        a = float(alpha)
+    except (TypeError, ValueError):
+        raise ParameterError(f"alpha={alpha!r} is not a number in (0, 0.5)") from None
+    if not (np.isfinite(a) and 0.0 < a < 0.5):
+        hint = " (a fraction of the period, e.g. 0.1, not a percentage)" if a >= 0.5 else ""
+        raise ParameterError(f"alpha={alpha!r} must be in (0, 0.5){hint}")
+    return a
+
+
+def check_period_range(period_range: Any) -> tuple[float, float]:
+    """Shortest and longest period [s]: two finite numbers, ``0 < lo < hi``."""
+    try:
+        lo, hi = period_range
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"period_range={period_range!r} must be two numbers (shortest, longest) [s]"
+        ) from None
+    return check_range(lo, hi, name="period_range", unit="s")
+
+
+def check_n_periods(n_periods: Any) -> int | None:
+    """A period count: None (estimate it) or an integer >= 2."""
+    if n_periods is None:
+        return None
+    try:
+        p = int(n_periods)
+    except (TypeError, ValueError):
+        raise ParameterError(f"n_periods={n_periods!r} must be an integer >= 2") from None
+    if p != n_periods or p < 2:
+        raise ParameterError(f"n_periods={n_periods!r} must be an integer >= 2")
+    return p
+
+
+def check_period_method(period_method: Any, n_periods: int | None) -> str:
+    """The method actually used: ``"given"`` when a count is given, else the one asked."""
+    if period_method not in PERIOD_METHODS:
+        raise ParameterError(f"period_method={period_method!r}: choose one of {PERIOD_METHODS}")
+    if period_method == "given" and n_periods is None:
+        raise ParameterError("period_method='given' needs n_periods (the period count)")
+    return "given" if n_periods is not None else str(period_method)

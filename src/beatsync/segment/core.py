@@ -1,0 +1,554 @@
+"""The public entry of the segmentation: :func:`segment`, :func:`segment_values`, the result.
+
+Data contract
+-------------
+- Input: a :class:`~beatsync.motion.Motion` (:func:`segment`) or values ``(n_frames,
+  n_channels)`` at ``fps > 0`` [Hz] (:func:`segment_values`), time first; rotation
+  channels in degrees. Periods and ranges in seconds.
+- Output: :class:`Segmentation`, whose ``boundaries`` are ``n_periods + 1`` strictly
+  increasing times [s] within ``[0, (n_frames - 1) / fps]``. Frames are used only
+  inside the package; conversion goes through :func:`beatsync.units.frames_to_time`.
+
+Every argument is validated here, once, cheapest first (numbers, then the values,
+then what the data allow: constant channels, clip length, whether the count fits);
+the modules below trust their inputs. User mistakes raise
+:class:`~beatsync.errors.ParameterError`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..units import (
+    check_finite,
+    check_fps,
+    check_positive,
+    check_range,
+    frames_to_time,
+    time_to_frames,
+)
+from .channels import nonconstant_channels, select_channels, standardise, unwrap_rotations
+from .checks import (
+    check_alpha,
+    check_n_periods,
+    check_period_method,
+    check_period_range,
+    check_values,
+)
+from .period import (
+    MAX_NORMALISED_ENERGY,
+    MIN_PERIODICITY_CONTRAST,
+    estimate_period,
+    estimation_band,
+    period_tiers,
+    periodicity_contrast,
+)
+from .search import SEARCH_MEMORY_BUDGET, optimum, period_band, search_decimation
+
+if TYPE_CHECKING:
+    from ..motion import Motion
+
+__all__ = [
+    "DEFAULT_PERIOD_RANGE",
+    "DANCE_PERIOD_RANGE",
+    "MIN_CLIP_PERIODS",
+    "SHORT_CLIP_MAX_ENERGY",
+    "Segmentation",
+    "period_range_from_beat",
+    "segment",
+    "segment_values",
+    "estimate_period_count",
+]
+
+DEFAULT_PERIOD_RANGE = (0.25, 1.25)
+"""Shortest and longest period [s] searched by default when the count is estimated.
+
+The paper's range: dance steps and gait cycles. Longer cycles (dance figures: a
+waltz box of 6 beats lasts about 4 s) need a wider range, :data:`DANCE_PERIOD_RANGE`
+or :func:`period_range_from_beat` when the music is known. It is not the default
+because the periodicity test cannot yet tell a long figure from a non-periodic motion:
+with :data:`DANCE_PERIOD_RANGE`, the CMU 005_02 pirouette is accepted as 4 periods
+of 1.66 s (periodicity contrast 0.20, in the range of real figures, 0.14-0.26)."""
+
+DANCE_PERIOD_RANGE = (0.25, 6.25)
+"""Steps (0.25-1.25 s) and figures (1.25-6.25 s), searched shortest first (see
+:func:`~beatsync.segment.period.period_tiers`): covers a slow waltz box (6 beats at
+60 BPM, 6 s)."""
+
+MIN_CLIP_PERIODS = 3
+"""A clip shorter than this many of its estimated periods needs :data:`SHORT_CLIP_MAX_ENERGY`.
+
+Below three periods the optimum has a single pair of consecutive periods to compare,
+which a short clip of one movement can fake (a 1 s salsa excerpt, period ~1 s, was
+cut into two "periods" of 0.45 s whose halves were barely alike); from three on
+there are two pairs and the periodicity test can compare with longer periods."""
+
+SHORT_CLIP_MAX_ENERGY = 0.5
+"""Largest mean Pearson distance of a clip shorter than :data:`MIN_CLIP_PERIODS` periods.
+
+A clip that short is accepted only if its periods are clearly alike (mean r >= 0.5,
+halfway between uncorrelated and identical); otherwise it is refused as too short."""
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """Result of :func:`segment`.
+
+    Attributes
+    ----------
+    boundaries : np.ndarray [s]
+        ``n_periods + 1`` strictly increasing times: start of the first period ... end
+        of the last, within ``[0, (n_frames - 1) / fps]``.
+    n_periods : int
+    mean_period : float [s]
+    energy : float
+        E of the optimum (sum over consecutive period pairs and channels of 1 - r).
+    channels : tuple of str
+        Channels used (after selection and constant-channel exclusion).
+    fps : float [Hz]
+    period_method : str
+        ``"energy"``, ``"fft"`` or ``"given"``.
+    search_decimation : int >= 1
+        Time decimation factor of the search (1: exact search at full rate; above
+        :data:`SEARCH_MEMORY_BUDGET` the search runs at ``fps / f`` and the boundaries
+        are refined at full rate, see :func:`segment_values`).
+    """
+
+    boundaries: np.ndarray
+    n_periods: int
+    mean_period: float
+    energy: float
+    channels: tuple[str, ...]
+    fps: float
+    period_method: str
+    search_decimation: int = 1
+
+    @property
+    def boundary_frames(self) -> np.ndarray:
+        """Boundaries as frame indices (int64)."""
+        return time_to_frames(self.boundaries, fps=self.fps)
+
+    @property
+    def periods(self) -> np.ndarray:
+        """Period durations [s]."""
+        return np.diff(self.boundaries)
+
+    @property
+    def normalised_energy(self) -> float:
+        """Mean Pearson distance between consecutive periods, E / (channels * (p-1))."""
+        return float(self.energy / (len(self.channels) * max(self.n_periods - 1, 1)))
+
+
+def _motion_channels(vals: np.ndarray, names: tuple[str, ...]) -> tuple[np.ndarray, tuple]:
+    """Standardised non-constant channels ``(C, n)`` and their names."""
+    keep = nonconstant_channels(vals)
+    if not keep.any():
+        raise ParameterError(
+            "every selected channel is constant: there is no motion to segment "
+            "(choose other channels, e.g. channels='all')"
+        )
+    used = tuple(nm for nm, k in zip(names, keep, strict=True) if k)
+    return standardise(vals[:, keep]), used
+
+
+def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[float, float]:
+    """Candidate periods [frames] for estimating the count, or a ParameterError."""
+    lo_p, hi_p = time_to_frames(period_range, fps=fps, round_to_int=False)
+    lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
+    span = float(frames_to_time(n - 1, fps=fps))
+    if span < MIN_CLIP_PERIODS * period_range[0]:
+        raise ParameterError(
+            f"clip of {n} frames lasts {span:.3f} s at fps={fps:g}, shorter than "
+            f"{MIN_CLIP_PERIODS} periods of the shortest requested period "
+            f"{period_range[0]:g} s; give a longer clip, a shorter --period-range, or check "
+            "fps (frames vs seconds)"
+        )
+    if hi_f < lo_f:
+        raise ParameterError(
+            f"no period of {period_range[0]:g}-{period_range[1]:g} s spans two frames and fits "
+            f"twice in {n} frames at fps={fps:g}; give a longer period range or clip, or "
+            "check fps"
+        )
+    return lo_f, hi_f
+
+
+# ---------------------------------------------------------------------- the entry
+
+
+class _NotPeriodic(ParameterError):
+    """The periodicity test refused the optimum (a longer tier may still be periodic)."""
+
+
+def _segment(
+    vals: np.ndarray,
+    names: tuple[str, ...],
+    *,
+    fps: float,
+    alpha: float,
+    n_periods: int | None,
+    period_range: tuple[float, float],
+    method: str,
+) -> Segmentation:
+    """Segmentation of validated values (finite, 2-D, named); data checks and the search.
+
+    With the count estimated, the period range is searched tier by tier
+    (:func:`period_tiers`), shortest first; the first tier whose optimum passes the
+    periodicity test gives the result, so the period is the shortest repeating cycle.
+    """
+    n = vals.shape[0]
+    if n_periods is not None:
+        x, used = _motion_channels(vals, names)
+        return _search(x, used, fps=fps, alpha=alpha, nominal=(n - 1) / n_periods,
+                       count=n_periods, period_range=period_range)  # fmt: skip
+    tiers = period_tiers(*period_range)
+    bands = [_frame_band(n, fps, tiers[0])]  # the clip's length first (cheap)
+    x, used = _motion_channels(vals, names)
+    refusal = None
+    for i, tier in enumerate(tiers):
+        if i:
+            lo_p, hi_p = time_to_frames(tier, fps=fps, round_to_int=False)
+            lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
+            if hi_f < lo_f:  # the clip cannot show two periods of this tier
+                break
+            bands.append((lo_f, hi_f))
+        nominal = estimate_period(x, *bands[i], method)
+        try:
+            return _search(x, used, fps=fps, alpha=alpha, nominal=nominal, count=None,
+                           period_range=tier, method=method)  # fmt: skip
+        except _NotPeriodic as exc:
+            refusal = exc
+    if refusal is None:
+        raise RuntimeError("no tier of the period range was searched")
+    if len(bands) > 1:
+        searched = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
+        raise ParameterError(f"{refusal} (period tiers searched, shortest first: {searched})")
+    raise ParameterError(str(refusal))
+
+
+def _search(
+    x: np.ndarray,
+    used: tuple[str, ...],
+    *,
+    fps: float,
+    alpha: float,
+    nominal: float,
+    count: int | None,
+    period_range: tuple[float, float],
+    method: str = "given",
+) -> Segmentation:
+    """The optimum around ``nominal`` [frames], the clip-length and periodicity tests."""
+    n = x.shape[1]
+    p = count if count is not None else max(2, int(np.floor((n - 1) / nominal + 1e-9)))
+    lo, hi = period_band(nominal, alpha)
+    if lo < 2:
+        raise ParameterError(
+            f"{p} periods in {n} frames is {nominal:.2f} frames per period: too short to "
+            "segment (need >= 2 frames per period); fewer periods or a higher frame rate"
+        )
+    if lo > hi:
+        raise ParameterError(
+            f"alpha={alpha:g} allows no whole-frame period length around {nominal:.2f} "
+            "frames; increase alpha"
+        )
+    factor = search_decimation(n, lo, hi, x.shape[0], count, SEARCH_MEMORY_BUDGET)
+    if factor is None:
+        raise ParameterError(
+            f"the period of ~{(lo + hi) / 2:.0f} frames (band {lo}-{hi}) needs more than "
+            f"{SEARCH_MEMORY_BUDGET / 2**20:.0f} MiB to search and cannot be decimated "
+            "further; give a lower --fps or a shorter --period-range / more periods"
+        )
+    frames, energy = optimum(x, lo, hi, count, factor)
+    n_found = frames.size - 1
+    e_norm = energy / (x.shape[0] * max(n_found - 1, 1))
+    if count is None and (n - 1) < MIN_CLIP_PERIODS * nominal and e_norm >= SHORT_CLIP_MAX_ENERGY:
+        per = float(frames_to_time(nominal, fps=fps))
+        span = float(frames_to_time(n - 1, fps=fps))
+        raise ParameterError(
+            f"clip of {span:.3f} s holds only {(n - 1) / nominal:.1f} periods of its "
+            f"estimated period {per:.3f} s, and they are not clearly alike (mean Pearson "
+            f"distance {e_norm:.3f} >= {SHORT_CLIP_MAX_ENERGY}): too short to tell a "
+            "repeating movement from a single one. Give a clip of at least "
+            f"{MIN_CLIP_PERIODS} periods ({MIN_CLIP_PERIODS * per:.1f} s), or the period count "
+            "(n_periods / --periods) if you know it"
+        )
+    contrast = periodicity_contrast(x, frames)
+    if e_norm >= MAX_NORMALISED_ENERGY or (
+        np.isfinite(contrast) and contrast < MIN_PERIODICITY_CONTRAST
+    ):
+        hint = ""
+        if method == "given":
+            lo_p, hi_p = time_to_frames(period_range, fps=fps, round_to_int=False)
+            lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
+            if lo_f <= hi_f:  # the count the data suggest, for the message
+                est = estimate_period(x, lo_f, hi_f, "energy")
+                hint = (
+                    f"; n_periods={p} was given: is it right? The energy estimate of the "
+                    f"count in {period_range[0]:g}-{period_range[1]:g} s periods is "
+                    f"{max(2, int(np.floor((n - 1) / est + 1e-9)))}"
+                )
+            else:
+                hint = f"; n_periods={p} was given: check the count"
+        raise _NotPeriodic(
+            f"the motion is not periodic: the best segmentation into {n_found} periods of "
+            f"~{float(frames_to_time((frames[-1] - frames[0]) / n_found, fps=fps)):.3f} s has "
+            f"mean Pearson distance "
+            f"{e_norm:.3f} between consecutive periods, and uniform segmentations at this "
+            f"period beat those at wrong periods by only {contrast:.3f} (periodic needs "
+            f"< {MAX_NORMALISED_ENERGY} and a "
+            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. Try other "
+            "channels, another period_range, or a clip with repeated movement" + hint
+        )
+    times = frames_to_time(frames, fps=fps)
+    return Segmentation(
+        boundaries=times,
+        n_periods=int(n_found),
+        mean_period=float((times[-1] - times[0]) / n_found),
+        energy=float(energy),
+        channels=used,
+        fps=fps,
+        period_method=method,
+        search_decimation=factor,
+    )
+
+
+def segment_values(
+    values: Any,
+    *,
+    fps: float,
+    alpha: float = 0.1,
+    n_periods: int | None = None,
+    period_range: tuple[float, float] = DEFAULT_PERIOD_RANGE,
+    period_method: str = "energy",
+    channel_names: Sequence[str] | None = None,
+) -> Segmentation:
+    """Globally optimal segmentation of a periodic multi-channel signal (paper A, sec. 3).
+
+    Parameters
+    ----------
+    values : np.ndarray [shape=(n_frames, n_channels)]
+        Joint angles (any unit; each channel is z-scored, which leaves r unchanged).
+        Angles must already be unwrapped (:func:`segment` does it for BVH rotations).
+    fps : float > 0 [Hz]
+    alpha : float in (0, 0.5)
+        Allowed relative deviation of every period from the nominal period (eq. 3).
+    n_periods : int >= 2, optional
+        Number of periods (e.g. from the music). Overrides ``period_method``; the result
+        then has exactly this many periods, each within the alpha band around
+        ``(n_frames - 1) / n_periods`` frames (or a ParameterError if they do not fit
+        or the forced segmentation is not periodic).
+    period_range : (float, float) [s]
+        Shortest and longest period for estimating the count (default
+        :data:`DEFAULT_PERIOD_RANGE`, the paper's 0.25-1.25 s). A range spanning more
+        than a factor 5 is searched in tiers, shortest first, and the first tier whose
+        optimum is periodic gives the result (the shortest repeating cycle):
+        :data:`DANCE_PERIOD_RANGE` (0.25-6.25 s) for dance figures, or
+        :func:`period_range_from_beat` when the music's beat is known.
+    period_method : {"energy", "fft", "given"}
+        How to get the count when ``n_periods`` is None (see
+        :func:`estimate_period_count`). ``"given"`` requires ``n_periods``.
+    channel_names : sequence of str, optional
+        Names of the columns (reported in :attr:`Segmentation.channels`).
+
+    Returns
+    -------
+    Segmentation
+
+    Raises
+    ------
+    ParameterError
+        NaN/inf values, ``fps <= 0``, alpha outside (0, 0.5), reversed period range, a
+        clip shorter than :data:`MIN_CLIP_PERIODS` (3) of the shortest period of the
+        range or of its own estimated period (with the count estimated), all channels
+        constant, ``n_periods`` too many for the frames, or a clip that is not
+        periodic (normalised energy above :data:`MAX_NORMALISED_ENERGY` or too little
+        periodicity contrast; with ``n_periods`` given, often a wrong count).
+
+    Examples
+    --------
+    >>> from beatsync.synth.motion import periodic_motion
+    >>> s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
+    >>> seg = segment_values(s.motion.values, fps=25, n_periods=10)
+    >>> int(abs(seg.boundary_frames - s.boundary_frames).max()) <= 1
+    True
+    """
+    fps = check_fps(fps)
+    alpha = check_alpha(alpha)
+    p = check_n_periods(n_periods)
+    lo_s, hi_s = check_period_range(period_range)
+    method = check_period_method(period_method, p)
+    vals = check_values(values)
+    names = (
+        tuple(str(c) for c in channel_names)
+        if channel_names is not None
+        else tuple(f"ch{i}" for i in range(vals.shape[1]))
+    )
+    if len(names) != vals.shape[1]:
+        raise ParameterError(
+            f"{len(names)} channel names for {vals.shape[1]} value columns; is the array "
+            "transposed (it must be frames x channels)?"
+        )
+    return _segment(vals, names, fps=fps, alpha=alpha, n_periods=p,
+                    period_range=(lo_s, hi_s), method=method)  # fmt: skip
+
+
+def segment(
+    motion: Motion,
+    *,
+    alpha: float = 0.1,
+    n_periods: int | None = None,
+    period_range: tuple[float, float] = DEFAULT_PERIOD_RANGE,
+    period_method: str = "energy",
+    channels: str | Sequence[str] = "default",
+) -> Segmentation:
+    """Split a periodic motion into its periods, globally optimally (paper A, sec. 3).
+
+    Parameters
+    ----------
+    motion : Motion
+        Joint angles (BVH rotations, degrees) or marker-derived ``*_angle`` channels
+        (:func:`beatsync.motion.marker_angles`).
+    alpha : float in (0, 0.5)
+        Allowed relative deviation of each period from the nominal period (eq. 3).
+    n_periods : int >= 2, optional
+        Period count if known (e.g. from the music); the result has exactly this many
+        periods (see :func:`segment_values`).
+    period_range : (float, float) [s]
+        Shortest and longest period when estimating the count (default
+        :data:`DEFAULT_PERIOD_RANGE`, 0.25-1.25 s; searched in tiers, shortest first, see
+        :func:`segment_values`).
+    period_method : {"energy", "fft", "given"}
+    channels : "default", "all" or list of str
+        See :func:`~beatsync.segment.select_channels`.
+
+    Returns
+    -------
+    Segmentation
+        ``boundaries`` [s] within ``[0, (n_frames-1)/fps]``; ``mean_period`` [s].
+
+    Raises
+    ------
+    ParameterError
+        See :func:`segment_values`.
+
+    Examples
+    --------
+    >>> from beatsync.synth.motion import periodic_motion
+    >>> s = periodic_motion(n_frames=300, n_periods=10, seed=1)
+    >>> seg = segment(s.motion, n_periods=10)
+    >>> seg.n_periods, round(seg.mean_period, 3)
+    (10, 1.196)
+    """
+    alpha = check_alpha(alpha)
+    p = check_n_periods(n_periods)
+    lo_s, hi_s = check_period_range(period_range)
+    method = check_period_method(period_method, p)
+    names = select_channels(motion.channels, channels)
+    idx = [motion.channel_index(nm) for nm in names]
+    values = check_finite(motion.values[:, idx], name=f"motion {motion.name!r} values")
+    if values.shape[0] < 3:
+        raise ParameterError(
+            f"motion {motion.name!r} has {values.shape[0]} frame(s); a segmentation needs more"
+        )
+    return _segment(unwrap_rotations(values, names), names, fps=motion.fps, alpha=alpha,
+                    n_periods=p, period_range=(lo_s, hi_s), method=method)  # fmt: skip
+
+
+def estimate_period_count(
+    values: Any,
+    *,
+    fps: float,
+    period_range: tuple[float, float] = DEFAULT_PERIOD_RANGE,
+    method: str = "energy",
+) -> int:
+    """Number of whole periods ``p`` in a clip, by FFT peak or uniform-segmentation energy.
+
+    Parameters
+    ----------
+    values : np.ndarray [shape=(n_frames, n_channels)]
+        Channels to analyse (near-constant channels are ignored).
+    fps : float > 0 [Hz]
+    period_range : (float, float) [s]
+        Shortest and longest period considered (default :data:`DEFAULT_PERIOD_RANGE`),
+        all at once (no tiers: the count of the best uniform segmentation in the range).
+    method : {"energy", "fft"}
+        ``"fft"``: the peak of the channel-summed power spectrum (z-scored channels,
+        Hann window, 8x zero padding) within ``1/period_range``. ``"energy"``: the
+        period ``T`` minimising the energy of the uniform segmentation ``0, T, 2T, ...``
+        per pair of consecutive periods (``E(U) / (s - 1)``; the paper writes ``E/s``,
+        which favours fewer, longer periods on short clips), over a 0.25-frame grid
+        (at most 400 log-spaced candidates). If the minimum lies at the short end of
+        the range (where short windows of a slow signal correlate trivially), the
+        lowest interior local minimum is taken instead (if any). See
+        :func:`beatsync.segment.period.estimate_period`.
+
+    Returns
+    -------
+    int >= 2
+        ``floor((n_frames - 1) / (T * fps))``.
+
+    Raises
+    ------
+    ParameterError
+        Bad ``fps``/range/values/method, or a clip shorter than
+        :data:`MIN_CLIP_PERIODS` of the shortest periods.
+    """
+    fps = check_fps(fps)
+    lo_s, hi_s = check_period_range(period_range)
+    if method not in ("energy", "fft"):
+        raise ParameterError(f"method={method!r}: choose 'energy' or 'fft'")
+    vals = check_values(values)
+    n = vals.shape[0]
+    lo_f, hi_f = _frame_band(n, fps, (lo_s, hi_s))
+    x, _ = _motion_channels(vals, tuple(f"ch{i}" for i in range(vals.shape[1])))
+    per = estimate_period(x, lo_f, hi_f, method)
+    return max(2, int(np.floor((n - 1) / per + 1e-9)))
+
+
+def period_range_from_beat(
+    beat_period: float, *, beats: tuple[float, float] = (1.0, 8.0)
+) -> tuple[float, float]:
+    """Period range [s] of a dance to music with this beat period: ``beats`` beats.
+
+    A dance cycle lasts a whole number of beats, from one step per beat to a figure
+    of a few bars (a waltz box: 6 beats; a salsa basic: 8). The range is searched
+    shortest first (:func:`~beatsync.segment.period.period_tiers`).
+
+    Parameters
+    ----------
+    beat_period : float > 0 [s]
+        The music's beat period (60 / BPM), e.g. the median inter-beat interval.
+    beats : (float, float)
+        Fewest and most beats per motion period (default 1 to 8).
+
+    Returns
+    -------
+    (float, float) [s]
+
+    Raises
+    ------
+    ParameterError
+        A beat period that is not a positive number of seconds (a BPM value, say), or
+        a reversed or non-positive ``beats`` range.
+
+    Examples
+    --------
+    >>> period_range_from_beat(0.5)
+    (0.5, 4.0)
+    """
+    bp = check_positive(beat_period, name="beat_period", unit="s")
+    if bp > 5.0:
+        raise ParameterError(
+            f"beat_period={beat_period!r} s is longer than 5 s (12 BPM): is it a tempo in "
+            f"BPM? The beat period is 60 / BPM ({60.0 / bp:.3f} s for {bp:g} BPM)"
+        )
+    try:
+        b_lo, b_hi = beats
+    except (TypeError, ValueError):
+        raise ParameterError(f"beats={beats!r} must be two numbers (fewest, most)") from None
+    b_lo, b_hi = check_range(b_lo, b_hi, name="beats", unit="beats")
+    return b_lo * bp, b_hi * bp

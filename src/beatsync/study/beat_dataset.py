@@ -1,0 +1,509 @@
+"""Beat trackers run and scored over a dataset of audio files, on Dask.
+
+``beatsync evaluate beats`` calls this module. :func:`find_tracks` pairs every audio
+file with the annotation of the same stem (``.beats``: one time [s] per line, an
+optional second column such as the beat in the bar is ignored);
+:func:`evaluate_dataset` tracks and scores every pair on Dask
+(:func:`beatsync.cluster.dask_client`) and records one row per track as soon as it
+finishes in ``OUT/tracks.jsonl`` (append-only: a crash or Ctrl-C loses at most the
+tracks in flight; a rerun skips the tracks already scored), then writes
+``OUT/tracks.csv`` and ``OUT/summary.csv`` (means per method and folder) atomically.
+A track that fails (unreadable, silent, too short) is recorded with its error.
+
+Methods are named as in :data:`beatsync.peers.PEERS` (``psf`` is ours); scores are
+:func:`beatsync.evaluate.beats.evaluate`. Every time is in seconds, every tempo in BPM.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import time
+import uuid
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import io, peers
+from ..errors import BeatsyncWarning, ParameterError
+from ..evaluate.beats import (
+    METRICS,
+    count_octave_errors,
+    count_other_tempo,
+    diagnose_times,
+    evaluate,
+    tempo_octave,
+)
+
+__all__ = [
+    "Track",
+    "TrackList",
+    "find_tracks",
+    "read_annotation",
+    "evaluate_track",
+    "TrackLog",
+    "DatasetRun",
+    "evaluate_dataset",
+    "summarize_dataset",
+    "ANNOTATION_SUFFIX",
+    "RESULT_FILES",
+]
+
+
+#: Files a run writes in its output folder.
+RESULT_FILES = ("tracks.jsonl", "tracks.csv", "summary.csv")
+
+#: Suffix of beat annotation files: one time [s] per line, optionally a second column.
+ANNOTATION_SUFFIX = ".beats"
+
+
+@dataclass(frozen=True)
+class Track:
+    """One audio file and its annotation.
+
+    Attributes
+    ----------
+    key : str
+        The audio file's path relative to the audio folder, without suffix (POSIX).
+    group : str
+        Its folder relative to the audio folder (``"."`` at the top).
+    audio, annotation : Path
+    """
+
+    key: str
+    group: str
+    audio: Path
+    annotation: Path
+
+
+@dataclass(frozen=True)
+class TrackList:
+    """Output of :func:`find_tracks`: the pairs, and the audio files left without one."""
+
+    tracks: list[Track]
+    unmatched: list[Path] = field(default_factory=list)
+
+
+def _folder(path: str | os.PathLike[str], what: str) -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"{what} folder {str(p)!r} does not exist")
+    if not p.is_dir():
+        raise ParameterError(f"{what} folder {str(p)!r} is a file, not a folder")
+    return p
+
+
+def find_tracks(
+    audio_dir: str | os.PathLike[str], annotation_dir: str | os.PathLike[str]
+) -> TrackList:
+    """Pair every audio file under ``audio_dir`` with the ``.beats`` file of its stem.
+
+    The annotation at the same relative path is preferred (``a/x.wav`` ->
+    ``a/x.beats``); otherwise the only ``x.beats`` anywhere under ``annotation_dir``
+    (flat annotation folders, as in most datasets). Audio files are those with a
+    suffix in :data:`beatsync.io.AUDIO_SUFFIXES`, searched recursively.
+
+    Raises
+    ------
+    ParameterError
+        A folder that is missing or a file; no audio file; no annotation file; no
+        audio file with an annotation.
+    """
+    a_dir = _folder(audio_dir, "audio")
+    b_dir = _folder(annotation_dir, "annotation")
+    audio = sorted(
+        p for p in a_dir.rglob("*") if p.suffix.lower() in io.AUDIO_SUFFIXES and p.is_file()
+    )
+    if not audio:
+        raise ParameterError(
+            f"audio folder {str(a_dir)!r} holds no audio file ({', '.join(io.AUDIO_SUFFIXES)})"
+        )
+    notes = sorted(p for p in b_dir.rglob(f"*{ANNOTATION_SUFFIX}") if p.is_file())
+    if not notes:
+        raise ParameterError(
+            f"annotation folder {str(b_dir)!r} holds no {ANNOTATION_SUFFIX} file "
+            "(one beat time [s] per line)"
+        )
+    by_rel = {p.relative_to(b_dir).with_suffix("").as_posix(): p for p in notes}
+    by_stem: dict[str, list[Path]] = {}
+    for p in notes:
+        by_stem.setdefault(p.stem, []).append(p)
+    tracks, unmatched = [], []
+    seen: set[str] = set()
+    for p in audio:
+        rel = p.relative_to(a_dir)
+        key = rel.with_suffix("").as_posix()
+        note = by_rel.get(key)
+        if note is None and len(by_stem.get(p.stem, [])) == 1:
+            note = by_stem[p.stem][0]
+        if note is None or key in seen:  # no annotation, or x.wav beside x.flac
+            unmatched.append(p)
+            continue
+        seen.add(key)
+        group = rel.parent.as_posix()
+        tracks.append(Track(key, group, p, note))
+    if not tracks:
+        raise ParameterError(
+            f"none of the {len(audio)} audio files under {str(a_dir)!r} has an annotation "
+            f"of the same name ({ANNOTATION_SUFFIX}) under {str(b_dir)!r}, e.g. "
+            f"{audio[0].stem}{ANNOTATION_SUFFIX}"
+        )
+    return TrackList(tracks, unmatched)
+
+
+def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
+    """Beat times [s] of an annotation file, refused if they are not seconds.
+
+    Raises
+    ------
+    ParameterError
+        Unreadable, empty, unsorted, non-numeric (:func:`beatsync.io.read_beats`), or
+        values that look like frame indices or milliseconds (the message says which).
+    """
+    times = io.read_beats(path)
+    looks = diagnose_times(times)
+    if looks is not None:
+        step = float(np.median(np.diff(times))) if times.size > 1 else float("nan")
+        raise ParameterError(
+            f"annotation {str(path)!r} is not beat times in seconds: it ends at "
+            f"{times[-1]:g} with a median spacing of {step:g}, which looks like {looks}"
+        )
+    return times
+
+
+def evaluate_track(
+    audio: str,
+    reference: np.ndarray,
+    *,
+    method: str,
+    min_beat_time: float,
+    name: str,
+    group: str = ".",
+) -> dict[str, Any]:
+    """Track one audio file and score it; a failure becomes the row's ``error``.
+
+    A task of :func:`evaluate_dataset` (runs on a Dask worker); never raises for a
+    bad track (unreadable, silent, too short), so one track cannot stop a run.
+
+    Parameters
+    ----------
+    audio : str
+        Audio file path (valid on the worker).
+    reference : np.ndarray [s]
+        Annotated beats (:func:`read_annotation`).
+    method : str
+        A name of :data:`beatsync.peers.PEERS`.
+    min_beat_time : float >= 0 [s]
+    name : str
+        The track's key (:attr:`Track.key`), recorded as ``key``.
+    group : str
+        The track's folder (:attr:`Track.group`).
+
+    Returns
+    -------
+    dict
+        ``key, group, audio, method, min_beat_time, status`` (``"ok"`` or
+        ``"error"``), ``error``, ``warning`` (the tracker's or scorer's warnings),
+        ``n_ref, n_est, tempo_ref, tempo_est, octave``, every metric of
+        :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking
+        time), ``audio_seconds`` and ``beats`` (the estimated times).
+    """
+    row: dict[str, Any] = {
+        "key": name,
+        "group": group,
+        "audio": str(audio),
+        "method": method,
+        "min_beat_time": float(min_beat_time),
+        "status": "error",
+        "error": "",
+        "warning": "",
+    }
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("ignore")
+            warnings.simplefilter("always", BeatsyncWarning)
+            y, sr = io.read_audio(audio)
+            est = peers.track(method, y, sr)
+            seconds = time.perf_counter() - t0
+            scores = evaluate(reference, est, min_beat_time=min_beat_time)
+    except ParameterError as exc:
+        row["error"] = str(exc)
+        return row
+    except Exception as exc:  # one broken track must not stop a run over thousands
+        row["error"] = f"{type(exc).__name__}: {exc}"
+        return row
+    row.update(
+        status="ok",
+        warning="; ".join(dict.fromkeys(str(w.message) for w in caught)),
+        n_ref=int(reference.size),
+        n_est=int(est.size),
+        **tempo_octave(reference, est),
+        **scores,
+        seconds=seconds,
+        audio_seconds=y.size / sr,
+        beats=[round(float(b), 6) for b in est],
+    )
+    return row
+
+
+class TrackLog:
+    """The append-only JSON-lines record of a dataset run (``OUT/tracks.jsonl``).
+
+    Each :meth:`append` writes one line and flushes it to disk, so a crash loses at
+    most the line being written; :meth:`rows` skips such a torn line.
+    """
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        self.path = Path(path)
+
+    def rows(self) -> list[dict[str, Any]]:
+        """Every complete row, in the order written."""
+        if not self.path.is_file():
+            return []
+        out = []
+        with open(self.path, encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                try:
+                    row = json.loads(line)
+                except ValueError:
+                    continue  # torn last line of an interrupted run
+                if isinstance(row, dict) and "key" in row and "method" in row:
+                    out.append(row)
+        return out
+
+    def latest(self) -> dict[tuple[str, str], dict[str, Any]]:
+        """The last row of each ``(method, key)``."""
+        return {(r["method"], r["key"]): r for r in self.rows()}
+
+    def rewrite(self, rows: Sequence[dict[str, Any]]) -> None:
+        """Replace the record with ``rows`` (atomic)."""
+        with io.atomic_write(self.path) as fh:
+            for r in rows:
+                fh.write(json.dumps(io.to_jsonable(r), allow_nan=False) + "\n")
+
+    def append(self, row: dict[str, Any]) -> None:
+        """Append one row and flush it to disk."""
+        line = json.dumps(io.to_jsonable(row), allow_nan=False) + "\n"
+        torn = self.path.is_file() and self.path.stat().st_size > 0 and not self._ends_in_newline()
+        with open(self.path, "a", encoding="utf-8") as fh:
+            fh.write(("\n" if torn else "") + line)
+            fh.flush()
+            os.fsync(fh.fileno())
+
+    def _ends_in_newline(self) -> bool:
+        with open(self.path, "rb") as fh:
+            fh.seek(-1, os.SEEK_END)
+            return fh.read(1) == b"\n"
+
+
+#: Columns of ``summary.csv`` after the keys (means of the metrics over ``ok`` tracks).
+SUMMARY_METRICS = METRICS
+
+
+def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
+    """Means per method and folder (and over all folders) of a dataset run's rows.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``method, group`` (``"all"`` for every folder together), ``tracks``,
+        ``failed``, the mean of every metric over the scored tracks, ``octave
+        errors`` and ``other tempo`` (counts).
+    """
+    table = pd.DataFrame(list(rows))
+    if table.empty:
+        return pd.DataFrame(columns=["method", "group", "tracks", "failed", *METRICS])
+    parts = []
+    for group_by_folder in (True, False):
+        t = table if group_by_folder else table.assign(group="all")
+        for (method, group), sub in t.groupby(["method", "group"], sort=True):
+            ok = sub[sub["status"] == "ok"]
+            rec: dict[str, Any] = {
+                "method": method,
+                "group": group,
+                "tracks": len(sub),
+                "failed": int((sub["status"] != "ok").sum()),
+            }
+            for m in METRICS:
+                rec[m] = float(ok[m].mean()) if len(ok) and m in ok else float("nan")
+            octave = ok["octave"] if "octave" in ok else pd.Series(dtype=object)
+            rec["octave errors"] = count_octave_errors(octave)
+            rec["other tempo"] = count_other_tempo(octave)
+            parts.append(rec)
+    out = pd.DataFrame(parts)
+    if out["group"].nunique() == 2 and set(out["group"]) == {".", "all"}:
+        out = out[out["group"] == "all"]  # one folder: the per-folder rows repeat "all"
+    return out.reset_index(drop=True)
+
+
+@dataclass(frozen=True)
+class DatasetRun:
+    """Output of :func:`evaluate_dataset`.
+
+    Attributes
+    ----------
+    tracks : pandas.DataFrame
+        The latest row of every track of this method (without the beat lists).
+    summary : pandas.DataFrame
+        :func:`summarize_dataset` of every method recorded in the output folder.
+    scored, skipped : int
+        Tracks run now, and tracks already recorded by an earlier run.
+    files : dict of str -> Path
+        ``log`` (``tracks.jsonl``), ``tracks`` (CSV) and ``summary`` (CSV).
+    """
+
+    tracks: pd.DataFrame
+    summary: pd.DataFrame
+    scored: int
+    skipped: int
+    files: dict[str, Path]
+
+
+def _table(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
+    table = pd.DataFrame([{k: v for k, v in r.items() if k != "beats"} for r in rows])
+    return table.sort_values(["method", "key"]).reset_index(drop=True) if len(table) else table
+
+
+def _output_folder(out_dir: str | os.PathLike[str]) -> Path:
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"output folder {str(out)!r} is a file; give a folder for the results")
+    if not out.exists():
+        io.check_output_folder(out)  # its parent must exist and be writable
+    elif not os.access(out, os.W_OK):
+        raise ParameterError(f"output folder {str(out)!r} is not writable")
+    return out
+
+
+def evaluate_dataset(
+    tracks: Sequence[Track],
+    out_dir: str | os.PathLike[str],
+    *,
+    method: str = "psf",
+    min_beat_time: float = 0.0,
+    force: bool = False,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    processes: bool = True,
+    progress: Callable[..., None] | None = None,
+) -> DatasetRun:
+    """Track and score every track on Dask; record each row as soon as it finishes.
+
+    Parameters
+    ----------
+    tracks : sequence of Track
+        From :func:`find_tracks`.
+    out_dir : path
+        Results folder (created if missing; its parent must exist): ``tracks.jsonl``
+        (one row per finished track, appended), ``tracks.csv``, ``summary.csv``.
+    method : str
+        A name of :data:`beatsync.peers.PEERS`.
+    min_beat_time : float >= 0 [s]
+        Beats before this time are not scored (mir_eval/MIREX use 5 s; 0 scores all).
+    force : bool
+        Re-run tracks already recorded for ``method`` (default: skip those scored).
+        Tracks recorded with an error are always re-run.
+    scheduler, n_workers, processes
+        See :func:`beatsync.cluster.dask_client`. Workers of an existing cluster must
+        see the audio files at the same paths.
+    progress : callable ``progress(done, total=None)``, optional
+        Called as tracks finish (e.g. a command's progress bar).
+
+    Raises
+    ------
+    ParameterError
+        An unknown or unavailable method; an annotation that is not beat times in
+        seconds; an output folder that is a file; results in ``out_dir`` recorded
+        with another ``min_beat_time`` (without ``force``); a bad worker count or an
+        unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
+    """
+    from ..cluster import check_cluster_options, dask_client
+    from ..units import check_positive
+
+    peers.get(method)
+    mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
+    check_cluster_options(scheduler, n_workers)
+    if not tracks:
+        raise ParameterError("no tracks to evaluate; see find_tracks")
+    keys = [t.key for t in tracks]
+    if len(set(keys)) != len(keys):
+        raise ParameterError("tracks must have distinct keys (relative audio paths)")
+    out = _output_folder(out_dir)
+    refs = {t.key: read_annotation(t.annotation) for t in tracks}
+    log = TrackLog(out / "tracks.jsonl")
+    previous = {k: r for (m, k), r in log.latest().items() if m == method}
+    if not force:
+        other = sorted({r["min_beat_time"] for r in previous.values()} - {mbt})
+        if other:
+            raise ParameterError(
+                f"{str(log.path)!r} holds {method} results scored with min_beat_time="
+                f"{other[0]:g} s, not {mbt:g} s; use --force to re-run them or another --out"
+            )
+    done = set() if force else {k for k, r in previous.items() if r.get("status") == "ok"}
+    todo = [t for t in tracks if t.key not in done]
+    with contextlib.ExitStack() as stack:
+        if todo:  # connect first: an unreachable scheduler changes nothing on disk
+            client = stack.enter_context(
+                dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes)
+            )
+        out.mkdir(exist_ok=True)
+        if force and previous:
+            log.rewrite([r for r in log.rows() if r["method"] != method])
+        if todo:
+            _run(client, todo, refs, log, method=method, mbt=mbt, progress=progress)
+    latest = log.latest()
+    mine = [latest[(method, k)] for k in keys if (method, k) in latest]
+    files = {"log": log.path, "tracks": out / "tracks.csv", "summary": out / "summary.csv"}
+    summary = summarize_dataset(list(latest.values()))
+    io.write_csv(files["tracks"], _table(list(latest.values())))
+    io.write_csv(files["summary"], summary)
+    return DatasetRun(_table(mine), summary, len(todo), len(tracks) - len(todo), files)
+
+
+def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
+    from dask.distributed import as_completed
+
+    futures = {
+        client.submit(
+            evaluate_track,
+            str(t.audio),
+            refs[t.key],
+            method=method,
+            min_beat_time=mbt,
+            name=t.key,
+            group=t.group,
+            key=f"evaluate-{method}-{t.key}-{uuid.uuid4().hex}",
+        ): t
+        for t in todo
+    }
+    if progress is not None:
+        progress(0, total=len(todo))
+    try:
+        for done, fut in enumerate(as_completed(futures), 1):
+            t = futures[fut]
+            try:
+                row = fut.result()
+            except Exception as exc:  # the worker died (e.g. out of memory)
+                row = {
+                    "key": t.key,
+                    "group": t.group,
+                    "audio": str(t.audio),
+                    "method": method,
+                    "min_beat_time": mbt,
+                    "status": "error",
+                    "error": f"{type(exc).__name__}: {exc}",
+                    "warning": "",
+                }
+            log.append(row)
+            if progress is not None:
+                progress(done)
+    finally:
+        for fut in futures:
+            fut.cancel()

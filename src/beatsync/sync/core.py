@@ -1,0 +1,515 @@
+"""The public entry :func:`synchronize` and its result (see :mod:`beatsync.sync`)."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import BeatsyncWarning, ParameterError
+from ..units import check_fps, check_range, check_times, check_whole, frames_to_time, time_to_frames
+from .fill import LoopedClip, loop_events
+from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
+from .positions import restore_bone_lengths
+from .warp import TimeWarp, integrate_warp
+
+__all__ = [
+    "MODES",
+    "LANDINGS",
+    "FILLS",
+    "SyncResult",
+    "motion_beat_count",
+    "position_bones",
+    "synchronize",
+]
+
+MODES = ("periods", "beats", "auto")
+LANDINGS = ("boundaries", "accents")
+FILLS = ("stop", "loop")
+#: width of the blended window at each loop join [s] (capped at half an interval)
+JOIN_S = 0.2
+#: default period range when segmenting, in music beats: one to eight beats
+PERIOD_BEATS = (0.9, 8.5)
+#: share of periods that must hold the same number of motion beats to call it a meter
+METER_AGREEMENT = 0.6
+
+
+@dataclass(frozen=True)
+class SyncResult:
+    """Output of :func:`synchronize`.
+
+    Attributes
+    ----------
+    motion : Motion
+        The beat-synchronous motion at ``out_fps``; frame ``k`` plays at music time
+        ``k / out_fps`` [s].
+    warp_src_times : np.ndarray [shape=(n_out,)] [s]
+        Source time shown by each output frame (non-decreasing), in the looped
+        timeline when ``fill="loop"`` repeated the clip (the clip's own time otherwise).
+    report : dict
+        ``mode`` (``"periods"`` or ``"beats"``, as used), ``mode_requested``,
+        ``mode_note`` (why ``auto`` fell back), ``land``, ``fill``, ``repetitions``,
+        ``input_frames``, ``output_frames``, ``input_fps``, ``output_fps``,
+        ``periods_available``, ``periods_used`` (intervals: periods, or motion-beat
+        segments in beats mode, counted over all repetitions),
+        ``beats_per_period`` (per motion beat in beats mode),
+        ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
+        ``dance_beats_per_period``, ``motion_beats_per_period_counted``,
+        ``beats_per_bar``, ``period_range_s``, ``first_beat``,
+        ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
+        ``beat_period_s``, ``delta_s``, ``rate_range`` (target/source),
+        ``tempo_ratio_range`` (playback speed, source/target), ``target_beats_s``,
+        ``boundaries_s``, ``residual_ms`` (one per boundary),
+        ``residual_nearest_frame_ms``, ``max_abs_residual_ms``,
+        ``max_abs_residual_frames``, ``lead_in_hold_frames``, ``n_scaled_periods``,
+        ``covered_s`` (music time span the dance covers).
+    warp : TimeWarp
+        The warp itself (for plots).
+    """
+
+    motion: Any
+    warp_src_times: np.ndarray
+    report: dict = field(default_factory=dict)
+    warp: TimeWarp | None = None
+
+
+def position_bones(motion: Any) -> np.ndarray | None:
+    """Bones of a position-only motion (joint-index pairs), None for other motions."""
+    if not getattr(motion, "is_positional", False):
+        return None
+    bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
+    return bones if bones.size else None
+
+
+def _choice(value: Any, options: tuple[str, ...], name: str) -> str:
+    if not isinstance(value, str) or value not in options:
+        raise ParameterError(f"{name}={value!r} must be one of {', '.join(options)}")
+    return value
+
+
+def _events(
+    motion: Any, boundaries: Any, mode: str, period_range: tuple[float, float], duration: float
+) -> tuple[np.ndarray, str, str]:
+    """The motion events to land on beats: ``(events, mode used, note)``."""
+    if boundaries is not None:
+        s = check_times(boundaries, name="boundaries", duration=duration)
+        if mode != "beats":
+            if s.size < 2:
+                raise ParameterError(
+                    f"got {s.size} period boundary(ies): the motion does not look periodic "
+                    "(segmentation found no full period); nothing to synchronise"
+                )
+            return s, "periods", ""
+    if mode == "beats":
+        return _motion_beats(motion, "mode='beats'"), "beats", ""
+    from ..motion import segmentation_view
+    from ..segment import segment
+
+    try:
+        seg = segment(segmentation_view(motion), period_range=period_range)
+        if len(seg.boundaries) < 2:
+            raise ParameterError("segmentation found no full period")
+    except ParameterError as exc:
+        if mode == "periods":
+            raise ParameterError(
+                f"the motion does not look periodic ({exc}); use mode='beats' (--mode beats) "
+                "to warp the dancer's own motion beats instead"
+            ) from None
+        note = (
+            f"the periodicity test refused the motion ({exc}); fell back to warping the "
+            "dancer's own motion beats onto the music's beats (mode='beats')"
+        )
+        warnings.warn(note, BeatsyncWarning, stacklevel=3)
+        return _motion_beats(motion, "the fallback to motion beats"), "beats", note
+    return np.asarray(seg.boundaries, dtype=np.float64), "periods", ""
+
+
+def _motion_beats(motion: Any, what: str) -> np.ndarray:
+    from ..motion_beats import kinematic_beats
+
+    try:
+        mb = kinematic_beats(motion)
+    except ParameterError as exc:
+        raise ParameterError(
+            f"{what} needs joint positions (a skeleton or markers): {exc}"
+        ) from None
+    if mb.size < 2:
+        raise ParameterError(
+            f"{what} found {mb.size} motion beat(s) in the dance; at least 2 are needed "
+            "(is the dancer standing still?)"
+        )
+    return mb
+
+
+def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
+    """Motion beats per period, counted from the kinematic beats (informative only).
+
+    The count that holds in at least :data:`METER_AGREEMENT` of the periods, else None
+    (also None without joint positions). Speed minima do not mark every step of a
+    real dance (a real waltz bar shows 2 of its 3 steps), so this count is reported,
+    never used to choose the beats per period: give the dance's meter instead.
+    """
+    from ..motion_beats import kinematic_beats
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BeatsyncWarning)  # no beats: no count, no news
+            mb = kinematic_beats(motion)
+    except ParameterError:  # no positions
+        return None
+    counts = np.histogram(mb, bins=events)[0]
+    values, freq = np.unique(counts, return_counts=True)
+    k = int(values[np.argmax(freq)])
+    return k if k >= 1 and freq.max() >= METER_AGREEMENT * counts.size else None
+
+
+def synchronize(
+    motion: Any,
+    boundaries: Any,
+    beats: Any,
+    *,
+    mode: str = "periods",
+    land: str = "boundaries",
+    fill: str = "stop",
+    beats_per_period: int | None = None,
+    beats_per_bar: int | None = None,
+    dance_beats_per_period: int | None = None,
+    first_beat: int = 0,
+    out_fps: float | None = None,
+    delta: float | None = None,
+    phase_offset: float = 0.0,
+    period_range: tuple[float, float] | None = None,
+) -> SyncResult:
+    """Resample a dance so that its periods (or its own motion beats) land on music beats.
+
+    Paper A, section 5: every motion period is mapped to a whole number of
+    consecutive music beats, its rate set so it lasts as long as those beats, the
+    rates blended smoothly (eq. 9) and integrated into a time warp on which the
+    motion is resampled (slerp for rotations, linear for positions). The output's
+    time 0 is the music's time 0.
+
+    Parameters
+    ----------
+    motion : beatsync.motion.Motion
+        Source dance: BVH joint angles, marker positions or joint positions, ``fps`` [Hz].
+    boundaries : np.ndarray [shape=(p+1,), p >= 1] [s] or None
+        Period boundaries in the source's time (``segment(motion).boundaries``).
+        None: segment here (``mode="periods"``/``"auto"``) with ``period_range``.
+    beats : np.ndarray [shape=(n,), n >= 2] [s]
+        Music beat times (e.g. ``track_beats(y, sr).beats``).
+    mode : {"periods", "beats", "auto"}
+        ``"periods"``: paper A (periods on groups of beats). ``"beats"``: warp the
+        dancer's own kinematic beats (:func:`beatsync.motion_beats.kinematic_beats`)
+        onto the music's beats, a whole number of beats per motion beat, with the
+        same smooth rate; for dances that are not strictly periodic (figures vary).
+        ``"auto"``: periods when the motion is periodic, else beats, with a
+        :class:`~beatsync.errors.BeatsyncWarning` and ``report["mode_note"]``.
+    land : {"boundaries", "accents"}
+        What lands on the beats: the period boundaries, or the dancer's accents
+        (the motion is synchronised, the mean lag of its kinematic beats behind the
+        music beats measured, and synchronised again with ``phase_offset=-lag``).
+    fill : {"stop", "loop"}
+        ``"stop"``: the output ends with the clip's last period that fits (paper A).
+        ``"loop"``: whole periods (or beat segments) are repeated, with blended joins,
+        so the dance covers the song up to its last beat; ``report["repetitions"]``.
+    beats_per_period : int >= 1, optional
+        Beats one period (or one motion beat) spans; default chosen by
+        :func:`beatsync.sync.beats_per_period` from the tempo ratio and the meters.
+    beats_per_bar : int >= 1, optional
+        The music's meter (e.g. ``track.beats_per_bar``); respected when choosing.
+    dance_beats_per_period : int >= 1, optional
+        The dance's meter: beats of one period of the dance (3 for a waltz step, 6
+        for a waltz box); the count then is a multiple of it (or it halved), and a
+        warning says so when it cannot also respect ``beats_per_bar``. The report's
+        ``motion_beats_per_period_counted`` (kinematic beats per period) is a hint.
+    first_beat : int >= 0
+        Index of the beat the first boundary lands on.
+    out_fps : float > 0, optional [Hz]
+        Output frame rate; default ``motion.fps``.
+    delta : float > 0, optional [s]
+        Gaussian width of eq. 9; default the mean motion period (or beat interval).
+    phase_offset : float [s]
+        Land the boundaries this long after their beats (negative: before).
+    period_range : (float, float) [s], optional
+        Shortest and longest period when segmenting here (``boundaries=None``);
+        default from the music: one to eight of its beats (``PERIOD_BEATS``), so real
+        dance cycles (a waltz box is 6 beats, about 4 s) are found.
+
+    Returns
+    -------
+    SyncResult
+
+    Raises
+    ------
+    ParameterError
+        Boundaries outside the motion (frames instead of seconds?), fewer than two
+        boundaries (not periodic) in ``mode="periods"``, no motion beats in
+        ``mode="beats"``, fewer than two music beats, music too short for one period
+        after ``first_beat``, an unknown mode/land/fill, ``land="accents"`` or
+        ``fill``/``mode`` together with ``phase_offset`` misuse, bad ``out_fps``.
+
+    Examples
+    --------
+    >>> res = synchronize(motion, seg.boundaries, track.beats)  # doctest: +SKIP
+    >>> res.report["max_abs_residual_ms"]  # doctest: +SKIP
+    0.0
+    >>> res = synchronize(dancer, None, track.beats, mode="auto", fill="loop")  # doctest: +SKIP
+    >>> res.report["mode"], res.report["repetitions"]  # doctest: +SKIP
+    ('beats', 3)
+    """
+    mode = _choice(mode, MODES, "mode")
+    land = _choice(land, LANDINGS, "land")
+    fill = _choice(fill, FILLS, "fill")
+    fps = check_fps(motion.fps, name="motion.fps")
+    out_fps = fps if out_fps is None else check_fps(out_fps, name="out_fps")
+    n_frames = int(motion.n_frames)
+    if n_frames < 2:
+        raise ParameterError(f"motion has {n_frames} frame(s); at least 2 are needed to resample")
+    beats = check_times(beats, name="beats")
+    if beats.size < 2:
+        raise ParameterError(
+            f"the music has {beats.size} detectable beat(s); at least 2 are needed "
+            "(is it silent or without rhythm? give the tempo with bpm / --bpm)"
+        )
+    first_beat = check_whole(first_beat, name="first_beat")
+    if first_beat >= beats.size:
+        raise ParameterError(
+            f"first_beat={first_beat} but the music has only {beats.size} beats (indices from 0)"
+        )
+    override = (
+        None
+        if beats_per_period is None
+        else check_whole(beats_per_period, name="beats_per_period", minimum=1)
+    )
+    bar = (
+        None
+        if beats_per_bar is None
+        else check_whole(beats_per_bar, name="beats_per_bar", minimum=1)
+    )
+    dance = (
+        None
+        if dance_beats_per_period is None
+        else check_whole(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
+    )
+    try:
+        phase_offset = float(phase_offset)
+    except (TypeError, ValueError):
+        raise ParameterError(f"phase_offset={phase_offset!r} must be a time in seconds") from None
+    if not np.isfinite(phase_offset):
+        raise ParameterError(f"phase_offset={phase_offset!r} must be finite [s]")
+    if land == "accents" and phase_offset != 0.0:
+        raise ParameterError(
+            "land='accents' measures the phase offset itself; do not also give phase_offset"
+        )
+    if delta is not None:
+        from ..units import check_positive
+
+        delta = check_positive(delta, name="delta", unit="s")
+    beat_period = float(np.median(np.diff(beats)))
+    if period_range is None:
+        period_range = (PERIOD_BEATS[0] * beat_period, PERIOD_BEATS[1] * beat_period)
+    else:
+        try:
+            lo, hi = period_range
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"period_range={period_range!r} must be (shortest, longest) [s]"
+            ) from None
+        period_range = check_range(lo, hi, name="period_range", unit="s")
+    duration = float(frames_to_time(n_frames - 1, fps=fps))  # sample_motion clips here
+
+    events, used_mode, note = _events(
+        motion, boundaries, mode, period_range, float(motion.duration)
+    )
+    intervals = np.diff(events)
+    unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
+    counted = motion_beat_count(motion, events) if used_mode == "periods" else None
+    if override is not None:
+        count = BeatCount(override, "override", unit / beat_period)
+    else:
+        count = choose_count(unit / beat_period, dance=dance, bar=bar)
+    if count.meter_fit is False:
+        warnings.warn(count.note, BeatsyncWarning, stacklevel=2)
+    counts = (
+        beats_per_unit(intervals, count.m)
+        if used_mode == "beats"
+        else np.full(intervals.size, count.m, dtype=np.int64)
+    )
+    plan = {
+        "motion": motion,
+        "events": events,
+        "counts": counts,
+        "beats": beats,
+        "fill": fill,
+        "first_beat": first_beat,
+        "fps": fps,
+        "out_fps": out_fps,
+        "delta": delta,
+        "duration": duration,
+    }
+    lag = 0.0
+    res = _resample(plan, phase_offset)
+    if land == "accents":
+        from ..motion_beats import kinematic_beats
+
+        try:
+            mb = kinematic_beats(res.motion)
+        except ParameterError as exc:
+            raise ParameterError(
+                f"land='accents' needs joint positions (a skeleton or markers): {exc}"
+            ) from None
+        lag = lag_of(mb, beats)
+        if beats[first_beat] - lag < 0:
+            plan["first_beat"] = first_beat = first_beat + 1
+        res = _resample(plan, -lag)
+    ratio = unit / beat_period / count.m
+    if ratio > 2.0 or ratio < 0.5:
+        warnings.warn(
+            f"motion {'beats' if used_mode == 'beats' else 'periods'} ({unit:.3f} s) become "
+            f"{count.m} beat(s) of {beat_period:.3f} s: the dance is played {ratio:.2f}x its "
+            "speed; check the beats or set beats_per_period",
+            BeatsyncWarning,
+            stacklevel=2,
+        )
+    res.report.update(
+        {
+            "mode": used_mode,
+            "mode_requested": mode,
+            "mode_note": note,
+            "land": land,
+            "accent_lag_s": lag,
+            "beats_per_period": int(count.m),
+            "beats_per_period_rule": count.rule,
+            "meter_fit": count.meter_fit,
+            "meter_note": count.note,
+            "dance_beats_per_period": dance,
+            "motion_beats_per_period_counted": counted,
+            "beats_per_bar": bar,
+            "period_range_s": None if boundaries is not None else list(period_range),
+            "mean_motion_period_s": unit,
+            "beat_period_s": beat_period,
+        }
+    )
+    return res
+
+
+def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
+    """Warp and resample (inputs checked by :func:`synchronize`)."""
+    motion, events, counts, beats = plan["motion"], plan["events"], plan["counts"], plan["beats"]
+    first_beat, fps, out_fps = plan["first_beat"], plan["fps"], plan["out_fps"]
+    duration = plan["duration"]
+    n_avail = events.size - 1
+    cum = np.concatenate([[0], np.cumsum(counts)])
+    last_beat = beats.size - 1
+    looped: LoopedClip | None = None
+    if plan["fill"] == "loop" and cum[-1] < last_beat - first_beat:
+        # enough repetitions that whole intervals reach the last beat, plus one for the tail
+        per_rep = int(cum[-1] - cum[0])
+        need = -(-(last_beat - first_beat) // max(per_rep, 1)) * n_avail + 1
+        looped = loop_events(events, need, join=JOIN_S)
+        events = looped.events
+        counts = np.resize(counts, events.size - 1)
+        cum = np.concatenate([[0], np.cumsum(counts)])
+    n_fit = int(np.searchsorted(cum, last_beat - first_beat, side="right")) - 1
+    if n_fit < 1:
+        raise ParameterError(
+            f"the music is too short: {beats.size - first_beat} beat(s) from beat {first_beat} "
+            f"(last at {beats[-1]:.2f} s) cannot hold one motion period of {int(counts[0])} "
+            f"beat(s) ({float(events[1] - events[0]):.2f} s of motion); use a longer song, an "
+            "earlier first_beat or fewer beats_per_period"
+        )
+    p = min(n_avail if looped is None else events.size - 1, n_fit)
+    targets = beats[first_beat + cum[: p + 1]] + phase_offset
+    if targets[0] < 0:
+        raise ParameterError(
+            f"phase_offset={phase_offset:.3f} s puts the first boundary at {targets[0]:.3f} s, "
+            "before the music starts; use first_beat >= 1 or a smaller offset"
+        )
+    used = events[: p + 1]
+    end = None
+    if p == events.size - 1 and duration > used[-1]:
+        end = duration  # the clip's tail after its last boundary
+    warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+    if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
+        # cover the beats after the last whole interval with part of the next one: the
+        # warp goes on at its end rate up to the last beat (within that interval)
+        need = beats[last_beat] + phase_offset - targets[-1]
+        end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
+        warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+    tau_end = float(warp.tgt[-1])
+    if tau_end <= 0:
+        raise ParameterError(
+            f"the warped motion ends at music time {tau_end:.3f} s <= 0: first_beat={first_beat} "
+            "is too early for the motion before the first boundary"
+        )
+    # the last frame is the first one at or after the last warped time, so the frame
+    # nearest to the last boundary exists (the source is clipped there)
+    n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
+    out_times = frames_to_time(np.arange(n_out), fps=out_fps)
+    src_times = warp.to_source(out_times)
+    if looped is None:
+        from ..rotations import sample_motion
+
+        values = sample_motion(motion, src_times)
+    else:
+        values = looped.sample(motion, src_times)
+    bones = position_bones(motion)
+    if bones is not None:  # position-only: linear resampling, then bone lengths restored
+        a, b, w = (src_times, None, None) if looped is None else looped.source_times(src_times)
+        pos = restore_bone_lengths(
+            values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
+        )
+        values = pos.reshape(n_out, -1)
+    out_motion = motion.with_values(values, fps=out_fps)
+
+    # residuals: realised warp (interpolated between output frames) and nearest frame
+    live = (out_times > warp.tgt[0]) & (out_times < warp.tgt[-1])
+    # the realised warp: output frames joined by straight lines, plus the warp's ends
+    # (a boundary may sit exactly where a held lead-in or the clipped tail starts)
+    xs = np.concatenate([warp.src[:1], src_times[live], warp.src[-1:]])
+    ys = np.concatenate([warp.tgt[:1], out_times[live], warp.tgt[-1:]])
+    realised = np.interp(used, xs, ys)
+    residual = (realised - targets) * 1e3
+    nearest = np.clip(time_to_frames(realised, fps=out_fps), 0, n_out - 1)
+    nearest_res = (frames_to_time(nearest, fps=out_fps) - targets) * 1e3
+    frame_ms = 1e3 / out_fps
+    lead_in = int(np.count_nonzero(out_times < warp.tgt[0]))
+    report: dict[str, Any] = {
+        "input_frames": int(motion.n_frames),
+        "output_frames": n_out,
+        "input_fps": fps,
+        "output_fps": out_fps,
+        "input_duration_s": duration,
+        "output_duration_s": float(frames_to_time(n_out - 1, fps=out_fps)),
+        "fill": plan["fill"],
+        "repetitions": 1 if looped is None else looped.repetitions,
+        "periods_available": int(n_avail),
+        "periods_used": int(p),
+        "first_beat": first_beat,
+        "phase_offset_s": phase_offset,
+        "delta_s": float(warp.delta),
+        "rate_range": [float(warp.period_rates.min()), float(warp.period_rates.max())],
+        "continuous_rate_range": [float(warp.rate.min()), float(warp.rate.max())],
+        "tempo_ratio_range": [
+            float(1.0 / warp.period_rates.max()),
+            float(1.0 / warp.period_rates.min()),
+        ],
+        "target_beats_s": targets,
+        "boundaries_s": used,
+        "residual_ms": residual,
+        "residual_nearest_frame_ms": nearest_res,
+        "max_abs_residual_ms": float(np.abs(residual).max()),
+        "max_abs_residual_frames": float(np.abs(nearest_res).max() / frame_ms),
+        "output_frame_ms": frame_ms,
+        "lead_in_hold_frames": lead_in,
+        "n_scaled_periods": int(warp.n_scaled),
+        "covered_s": [
+            float(targets[0]),
+            float(min(tau_end, frames_to_time(n_out - 1, fps=out_fps))),
+        ],
+    }
+    # the first boundary frame index in the output, for users who trim
+    report["first_boundary_frame"] = int(time_to_frames(targets[0], fps=out_fps))
+    return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)

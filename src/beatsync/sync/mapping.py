@@ -1,0 +1,238 @@
+"""How many music beats a motion period (or motion beat) spans, and where accents sit.
+
+- :func:`beats_per_period`: the whole number ``m`` of music beats one motion period
+  spans. Without meters it is ``round(P / b)`` (paper A's reading). With meters it
+  respects both: the dance's own beats per period (a waltz step has 3 motion beats,
+  so it spans 3 or 6 music beats, never 5) and the music's beats per bar (``m``
+  divides the bar or is a whole number of bars). When no count fits both meters
+  within a factor of 2 of ``P / b``, the dance's meter wins and the report says the
+  meters do not fit.
+- :func:`beats_per_unit`: the count of every interval of a sequence of motion events
+  (periods, or the dancer's own motion beats in ``mode="beats"``): ``m`` for the
+  median interval, and a proportional whole number for the others (a missed motion
+  beat leaves an interval twice as long, which spans twice the beats).
+- :func:`accent_lag`: the mean lag of motion beats behind music beats, used by
+  ``synchronize(..., land="accents")`` to put the dancer's accents on the beats.
+
+All times are seconds; counts are whole numbers of beats.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..units import beat_phase, check_positive, check_times, check_whole
+
+__all__ = [
+    "BeatCount",
+    "accent_lag",
+    "beats_per_period",
+    "beats_per_unit",
+    "choose_count",
+    "lag_of",
+]
+
+#: farthest a meter-respecting count may be from the plain rule, as a ratio
+METER_REACH = 2.0
+
+
+@dataclass(frozen=True)
+class BeatCount:
+    """A choice of beats per period (or per motion beat) and why.
+
+    Attributes
+    ----------
+    m : int >= 1
+        Music beats per period (or per motion beat).
+    rule : str
+        How ``m`` was chosen (``"override"``, ``"round(P / b)"``, ``"meter"``).
+    ideal : float
+        ``P / b``: motion period over music beat period.
+    meter_fit : bool or None
+        Whether ``m`` respects both meters; None when no meter was known.
+    note : str
+        Why the meters do not fit (empty otherwise).
+    """
+
+    m: int
+    rule: str
+    ideal: float
+    meter_fit: bool | None = None
+    note: str = ""
+
+
+def _candidates(dance: int | None, bar: int | None, limit: int) -> list[int]:
+    """Counts respecting the dance's meter (multiples of it, or it halved by 2s) and
+    the bar (dividing it, or whole bars), up to ``limit``."""
+    out = []
+    for m in range(1, limit + 1):
+        dance_ok = dance is None or m % dance == 0 or (dance % m == 0 and _power_of_two(dance // m))
+        bar_ok = bar is None or m % bar == 0 or bar % m == 0
+        if dance_ok and bar_ok:
+            out.append(m)
+    return out
+
+
+def _power_of_two(k: int) -> bool:
+    return k >= 1 and (k & (k - 1)) == 0
+
+
+def _nearest(cands: list[int], ideal: float) -> int:
+    # nearest on a log scale (3 vs 6 beats are equally far from 4.24); ties to the larger
+    return min(cands, key=lambda m: (abs(np.log(m / ideal)), -m))
+
+
+def choose_count(ideal: float, *, dance: int | None = None, bar: int | None = None) -> BeatCount:
+    """:func:`beats_per_period` on checked inputs (``ideal = P / b > 0``)."""
+    plain = max(1, int(np.rint(ideal)))
+    if dance is None and bar is None:
+        return BeatCount(plain, "round(P / b)", ideal)
+    limit = max(2 * plain + 2, 2 * (dance or 1), 2 * (bar or 1))
+    both = [
+        m for m in _candidates(dance, bar, limit) if abs(np.log(m / ideal)) <= np.log(METER_REACH)
+    ]
+    if plain in both:  # the plain rule already respects the meters
+        return BeatCount(plain, "round(P / b), fits the meter", ideal, True)
+    if both:
+        return BeatCount(_nearest(both, ideal), "meter", ideal, True)
+    # the meters do not fit: keep the dance's own meter (its steps stay whole)
+    own = _candidates(dance, None, limit) if dance is not None else _candidates(None, bar, limit)
+    m = _nearest(own, ideal)
+    note = (
+        f"the dance's meter ({dance} motion beats per period) and the music's "
+        f"({bar} beats per bar) do not fit within x{METER_REACH:g} of the tempo ratio "
+        f"{ideal:.2f}: {m} beats per period keeps the dance's steps whole but not its "
+        "bars on the music's bars"
+        if dance is not None and bar is not None
+        else f"no count fitting the meter is within x{METER_REACH:g} of {ideal:.2f}"
+    )
+    return BeatCount(m, "meter", ideal, False, note)
+
+
+def beats_per_period(
+    mean_period: float,
+    beats: Any,
+    *,
+    override: int | None = None,
+    dance_beats_per_period: int | None = None,
+    beats_per_bar: int | None = None,
+) -> int:
+    """Number of music beats one motion period spans.
+
+    Rule: the count ``m`` nearest (on a log scale) to ``P / b``, ``P`` the mean motion
+    period and ``b`` the median inter-beat interval, among the counts that respect
+    the meters given: a multiple of the dance's beats per period (or that count
+    halved by powers of 2), and a divisor or multiple of the music's beats per bar.
+    Without meters, ``m = max(1, round(P / b))``: a 1 s salsa step on 120 BPM music
+    spans 2 beats. A 2.1 s waltz step of 3 motion beats on 120 BPM music in 3/4 spans
+    3 beats, never 4 or 5.
+
+    Parameters
+    ----------
+    mean_period : float > 0 [s]
+        Mean duration of one motion period (e.g. ``Segmentation.mean_period``).
+    beats : np.ndarray [shape=(n,), n >= 2] [s]
+        Music beat times.
+    override : int >= 1, optional
+        Use this count instead of the rule.
+    dance_beats_per_period : int >= 1, optional
+        Motion beats in one period of the dance (3 for a waltz step).
+    beats_per_bar : int >= 1, optional
+        The music's meter (3 for a waltz, 4 for most pop).
+
+    Returns
+    -------
+    m : int >= 1 [beats]
+
+    Raises
+    ------
+    ParameterError
+        Fewer than two beats, a non-positive period, a bad override or meter.
+
+    Examples
+    --------
+    >>> beats_per_period(1.0, np.arange(0, 10, 0.5))
+    2
+    >>> beats_per_period(2.1, np.arange(0, 10, 0.5), dance_beats_per_period=3, beats_per_bar=3)
+    3
+    """
+    if override is not None:
+        return check_whole(override, name="beats_per_period", minimum=1)
+    beats = check_times(beats, name="beats")
+    if beats.size < 2:
+        raise ParameterError(
+            f"need at least 2 music beats to know the beat period, got {beats.size}; "
+            "the music may be silent or have no detectable beats (give --bpm or a beats file)"
+        )
+    mean_period = check_positive(mean_period, name="mean_period", unit="s")
+    dance = None
+    if dance_beats_per_period is not None:
+        dance = check_whole(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
+    bar = (
+        None
+        if beats_per_bar is None
+        else check_whole(beats_per_bar, name="beats_per_bar", minimum=1)
+    )
+    beat_period = float(np.median(np.diff(beats)))
+    return choose_count(mean_period / beat_period, dance=dance, bar=bar).m
+
+
+def beats_per_unit(intervals: np.ndarray, m: int) -> np.ndarray:
+    """Whole music beats for each interval between motion events (checked inputs).
+
+    The median interval spans ``m`` beats; every interval spans
+    ``max(1, round(m * interval / median))``, so an interval where a motion beat was
+    missed (twice as long) spans twice the beats and the dance keeps its tempo.
+    """
+    med = float(np.median(intervals))
+    return np.maximum(1, np.rint(m * intervals / med)).astype(np.int64)
+
+
+def accent_lag(motion_beats: Any, music_beats: Any) -> float:
+    """Mean lag of the motion beats behind the music beats [s], in ``(-T/2, T/2]``.
+
+    The circular mean of the motion beats' phases inside their beat intervals, times
+    the median beat period ``T``. Synchronising with ``phase_offset=-lag`` moves the
+    dancer's accents onto the beats (what ``synchronize(..., land="accents")`` does).
+
+    Parameters
+    ----------
+    motion_beats : np.ndarray [shape=(n,)] [s]
+        E.g. :func:`beatsync.motion_beats.kinematic_beats` of a synchronised motion.
+    music_beats : np.ndarray [shape=(m,), m >= 2] [s]
+
+    Returns
+    -------
+    lag : float [s]
+
+    Raises
+    ------
+    ParameterError
+        Fewer than 2 music beats, or no motion beat inside the music's beats.
+
+    Examples
+    --------
+    >>> round(accent_lag(np.arange(0.6, 5, 0.5), np.arange(0.5, 6, 0.5)), 3)
+    0.1
+    """
+    mb = check_times(motion_beats, name="motion_beats")
+    yb = check_times(music_beats, name="music_beats")
+    if yb.size < 2:
+        raise ParameterError("accent_lag needs at least 2 music beats to know the beat period")
+    return lag_of(mb, yb)
+
+
+def lag_of(mb: np.ndarray, yb: np.ndarray) -> float:
+    """:func:`accent_lag` on checked inputs."""
+    phase = beat_phase(mb, yb)
+    if phase.size == 0:
+        raise ParameterError(
+            "no motion beat falls inside the music's beats: no accent phase to measure "
+            "(is the motion still, or the music after it?)"
+        )
+    mean = np.angle(np.mean(np.exp(2j * np.pi * phase))) / (2 * np.pi)  # (-0.5, 0.5]
+    return float(mean * np.median(np.diff(yb)))

@@ -1,0 +1,289 @@
+"""End-to-end tests of ``beatsync evaluate beats`` (dataset scoring on Dask)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from beatsync import cluster, datasets, io
+from beatsync.cli import build_parser, main
+from beatsync.errors import ParameterError
+from beatsync.study import beat_dataset
+from beatsync.study.beat_dataset import TrackLog, find_tracks
+from beatsync.synth.audio import beat_times, click_track, drum_pattern
+
+SR = 22050
+GOOD = ["rock/drums_96", "rock/drums_132", "clicks/click_110", "sample"]
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    """Synthetic songs in two folders, the real madmom sample, a silent and a broken file.
+
+    Annotations are flat (as in most datasets); one audio file has none.
+    """
+    d = tmp_path_factory.mktemp("dataset")
+    audio, notes = d / "audio", d / "annotations"
+    for sub in ("rock", "clicks"):
+        (audio / sub).mkdir(parents=True)
+    notes.mkdir()
+    for bpm in (96, 132):
+        ref = beat_times(bpm, duration=8.0, start=0.3)
+        y = drum_pattern(ref, sr=SR, duration=8.0, seed=bpm)
+        io.write_audio(audio / "rock" / f"drums_{bpm}.wav", y, SR)
+        io.write_beats(notes / f"drums_{bpm}.beats", ref)
+    ref = beat_times(110, duration=8.0, start=0.45)
+    io.write_audio(audio / "clicks" / "click_110.flac", click_track(ref, sr=SR, duration=8.0), SR)
+    # two columns (time, beat in bar), as the real annotation is written
+    (notes / "click_110.beats").write_text(
+        "".join(f"{t:.4f}\t{i % 4 + 1}\n" for i, t in enumerate(ref))
+    )
+    shutil.copy(datasets.path("audio/madmom/sample.wav"), audio / "sample.wav")
+    shutil.copy(datasets.path("audio/madmom/sample.beats"), notes / "sample.beats")
+    io.write_audio(audio / "silent.wav", np.zeros(4 * SR, dtype=np.float32), SR)
+    io.write_beats(notes / "silent.beats", np.arange(0.5, 4.0, 0.5))
+    (audio / "broken.wav").write_bytes(b"RIFF....WAVEfmt not really audio")
+    io.write_beats(notes / "broken.beats", np.arange(0.5, 4.0, 0.5))
+    io.write_audio(audio / "rock" / "orphan.wav", np.zeros(SR, dtype=np.float32), SR)
+    return audio, notes
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """An existing cluster of 2 workers (threads here: no start-up or compilation per run)."""
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, processes=False, dashboard_address=":0") as lc:
+        yield lc.scheduler_address
+
+
+def _argv(dataset, out, *extra):
+    audio, notes = dataset
+    return [
+        "evaluate", "beats", "--audio", str(audio), "--annotations", str(notes),
+        "--out", str(out), *extra,
+    ]  # fmt: skip
+
+
+def _run(argv, capsys):
+    code = main(argv)
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+@pytest.mark.slow
+def test_end_to_end_two_local_workers(dataset, tmp_path, capsys):
+    out = tmp_path / "results"
+    code, stdout, err = _run(_argv(dataset, out, "--workers", "2", "--json"), capsys)
+    assert code == 0, err
+    res = json.loads(stdout)
+    assert res["tracks"] == 6 and res["scored_now"] == 6 and res["skipped"] == 0
+    assert res["unmatched"] == [str(dataset[0] / "rock" / "orphan.wav")]
+    assert "orphan.wav" in err and "without an annotation" in err
+    failed = {f["key"]: f["error"] for f in res["failed"]}
+    assert set(failed) == {"silent", "broken"}
+    assert "silent" in failed["silent"]
+    assert "cannot read" in failed["broken"]
+    tracks = pd.read_csv(out / "tracks.csv").set_index("key")
+    ok = tracks[tracks["status"] == "ok"]
+    assert sorted(ok.index) == sorted(GOOD)
+    for key in ("rock/drums_96", "rock/drums_132", "clicks/click_110"):
+        assert ok.loc[key, "F-measure"] >= 0.9, key
+        assert ok.loc[key, "octave"] == "correct", key
+    # the real recording: 4 annotated beats, scored whatever the tracker does
+    assert ok.loc["sample", "n_ref"] == 4
+    assert 0.0 <= ok.loc["sample", "F-measure"] <= 1.0
+    summary = pd.read_csv(out / "summary.csv", keep_default_na=False)
+    assert set(summary["group"]) == {".", "rock", "clicks", "all"}
+    every = summary[summary["group"] == "all"].iloc[0]
+    assert every["tracks"] == 6 and every["failed"] == 2
+    assert every["F-measure"] == pytest.approx(ok["F-measure"].mean())
+    rock = summary[summary["group"] == "rock"].iloc[0]
+    assert rock["tracks"] == 2 and rock["failed"] == 0
+    rows = TrackLog(out / "tracks.jsonl").rows()
+    assert len(rows) == 6
+    beats = {r["key"]: r["beats"] for r in rows if r["status"] == "ok"}
+    assert len(beats["rock/drums_96"]) == ok.loc["rock/drums_96", "n_est"]
+
+
+def test_rerun_skips_finished_tracks_and_force_reruns(dataset, scheduler, tmp_path, capsys):
+    out = tmp_path / "results"
+    code, stdout, err = _run(_argv(dataset, out, "--scheduler", scheduler, "--json"), capsys)
+    assert code == 0, err
+    first = TrackLog(out / "tracks.jsonl").rows()
+    assert len(first) == 6
+    # the rerun re-tries only the two failures, without touching the scored rows
+    code, stdout, _ = _run(_argv(dataset, out, "--scheduler", scheduler, "--json"), capsys)
+    res = json.loads(stdout)
+    assert (res["scored_now"], res["skipped"]) == (2, 4)
+    assert TrackLog(out / "tracks.jsonl").rows()[:6] == first
+    code, stdout, _ = _run(
+        _argv(dataset, out, "--scheduler", scheduler, "--force", "--json"), capsys
+    )
+    res = json.loads(stdout)
+    assert (res["scored_now"], res["skipped"]) == (6, 0)
+    assert len(TrackLog(out / "tracks.jsonl").rows()) == 6  # --force replaced the old rows
+
+
+def test_resume_after_interrupted_run(dataset, scheduler, tmp_path, capsys, monkeypatch):
+    out = tmp_path / "results"
+    real_append = TrackLog.append
+    calls = []
+
+    def append_then_interrupt(self, row):
+        real_append(self, row)
+        calls.append(row["key"])
+        if len(calls) == 3:
+            raise KeyboardInterrupt  # Ctrl-C while the other tracks are in flight
+
+    monkeypatch.setattr(TrackLog, "append", append_then_interrupt)
+    code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
+    assert code == 130
+    assert "interrupted by SIGINT; the finished tracks are recorded in" in err
+    assert "run the same command again" in err
+    assert not (out / "summary.csv").exists()
+    done = TrackLog(out / "tracks.jsonl").rows()
+    assert [r["key"] for r in done] == calls
+    # a torn last line (a crash while writing) is skipped, not fatal
+    with open(out / "tracks.jsonl", "a") as fh:
+        fh.write('{"key": "rock/drums_96", "meth')
+    monkeypatch.setattr(TrackLog, "append", real_append)
+    code, stdout, err = _run(_argv(dataset, out, "--scheduler", scheduler, "--json"), capsys)
+    assert code == 0, err
+    res = json.loads(stdout)
+    ok_before = sum(r["status"] == "ok" for r in done)
+    assert res["skipped"] == ok_before and res["scored_now"] == 6 - ok_before
+    assert res["tracks"] == 6 and len(res["failed"]) == 2
+    table = pd.read_csv(out / "tracks.csv")
+    assert sorted(table.loc[table["status"] == "ok", "key"]) == sorted(GOOD)
+
+
+def test_library_entry_in_process_threads(dataset, tmp_path):
+    found = find_tracks(*dataset)
+    assert [t.key for t in found.tracks] == sorted(t.key for t in found.tracks)
+    assert {t.group for t in found.tracks} == {".", "rock", "clicks"}
+    good = [t for t in found.tracks if t.key in ("rock/drums_96", "clicks/click_110")]
+    run = beat_dataset.evaluate_dataset(
+        good, tmp_path, method="librosa", n_workers=1, processes=False
+    )
+    assert list(run.tracks["key"]) == ["clicks/click_110", "rock/drums_96"]
+    assert (run.tracks["status"] == "ok").all()
+    assert (run.tracks["F-measure"] >= 0.9).all()
+    assert run.files["summary"].is_file()
+
+
+# ----------------------------------------------------------------------------- bad input
+
+
+def _bad(tmp_path, dataset, **change):
+    """The valid argument set with one value changed."""
+    audio, notes = change.get("audio", dataset[0]), change.get("notes", dataset[1])
+    out = change.get("out", tmp_path / "results")
+    argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    return [*argv, "--out", str(out), *change.get("extra", [])]
+
+
+def _refused(argv, match):
+    args = build_parser().parse_args(argv)
+    t0 = time.perf_counter()
+    with pytest.raises(ParameterError, match=match):
+        args.func(args)
+    assert time.perf_counter() - t0 < 10.0
+
+
+def test_empty_audio_folder(dataset, tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "notes.txt").write_text("not audio")
+    _refused(_bad(tmp_path, dataset, audio=empty), "holds no audio file")
+    assert not (tmp_path / "results").exists()
+
+
+def test_empty_annotation_folder(dataset, tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    _refused(_bad(tmp_path, dataset, notes=empty), r"holds no \.beats file")
+
+
+def test_no_audio_has_an_annotation(dataset, tmp_path):
+    notes = tmp_path / "other"
+    notes.mkdir()
+    io.write_beats(notes / "unrelated.beats", np.arange(0.5, 4.0, 0.5))
+    _refused(_bad(tmp_path, dataset, notes=notes), "none of the 7 audio files .* has an annotation")
+
+
+def test_missing_folder(dataset, tmp_path):
+    _refused(_bad(tmp_path, dataset, audio=tmp_path / "nowhere"), "audio folder .* does not exist")
+
+
+@pytest.mark.parametrize(
+    "scale, decimals, match",
+    [
+        (1000.0, 0, "looks like milliseconds"),
+        (100.0, 0, "looks like frame indices"),
+        (44100.0, 0, "looks like not beat times"),
+    ],
+)
+def test_annotation_not_in_seconds(dataset, tmp_path, scale, decimals, match):
+    notes = tmp_path / "notes"
+    shutil.copytree(dataset[1], notes)
+    ref = io.read_beats(notes / "drums_96.beats")
+    (notes / "drums_96.beats").write_text(
+        "".join(f"{v:.{decimals}f}\n" for v in np.round(ref * scale, decimals))
+    )
+    _refused(_bad(tmp_path, dataset, notes=notes), f"drums_96.beats' is not beat times.*{match}")
+    assert not (tmp_path / "results").exists()  # refused before anything is written
+
+
+def test_output_folder_is_a_file(dataset, tmp_path):
+    f = tmp_path / "results"
+    f.write_text("a file")
+    _refused(_bad(tmp_path, dataset, out=f), "is a file; give a folder")
+    assert f.read_text() == "a file"
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        (["--workers", "0"], "whole number of workers >= 1"),
+        (["--workers", "-1"], "whole number of workers >= 1"),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "give one or the other"),
+        (["--scheduler", "tcp://127.0.0.1:9"], "could not connect to the Dask scheduler"),
+        (["--scheduler", "not-an-address"], "not a Dask scheduler address"),
+        (["--min-beat-time", "-5"], "min-beat-time=-5.0 must be a finite number >= 0"),
+    ],
+)
+def test_bad_options(dataset, tmp_path, monkeypatch, extra, match):
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
+    _refused(_bad(tmp_path, dataset, extra=extra), match)
+    assert not (tmp_path / "results").exists()
+
+
+def test_optional_method_not_installed(dataset, tmp_path, monkeypatch):
+    import dataclasses
+
+    from beatsync import peers
+
+    fake = dataclasses.replace(peers.PEERS["essentia-degara"], requires="no_such_package_xyz")
+    monkeypatch.setitem(peers.PEERS, "essentia-degara", fake)
+    extra = ["--method", "essentia-degara"]
+    _refused(_bad(tmp_path, dataset, extra=extra), r"pip install 'beatsync\[peers\]'")
+
+
+def test_results_scored_otherwise_are_not_mixed(dataset, scheduler, tmp_path, capsys):
+    out = tmp_path / "results"
+    code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
+    assert code == 0, err
+    extra = ["--min-beat-time", "5", "--scheduler", scheduler]
+    _refused(_bad(tmp_path, dataset, extra=extra), "scored with min_beat_time=0 s, not 5 s")
+
+
+def test_exit_code_and_message_on_bad_input(dataset, tmp_path, capsys):
+    code, _, err = _run(_bad(tmp_path, dataset, extra=["--workers", "-1"]), capsys)
+    assert code == 3
+    assert err.startswith("beatsync evaluate: error: --workers=-1")

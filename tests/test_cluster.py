@@ -1,0 +1,78 @@
+"""The one Dask set-up: worker counts, scheduler addresses, timeouts, shutdown."""
+
+import time
+
+import pytest
+
+from beatsync import cluster
+from beatsync.errors import ParameterError
+
+
+@pytest.mark.parametrize(
+    "n, match",
+    [
+        (0, "whole number of workers >= 1"),
+        (-1, "whole number of workers >= 1"),
+        (1.5, "whole number of workers >= 1"),
+        ("two", "not a number of workers"),
+        (True, "whole number of workers"),
+        ([2], "whole number of workers"),
+    ],
+)
+def test_bad_worker_counts(n, match):
+    with pytest.raises(ParameterError, match=match):
+        cluster.check_workers(n)
+    with pytest.raises(ParameterError, match=match), cluster.dask_client(n_workers=n):
+        pass  # pragma: no cover - refused before any cluster starts
+
+
+def test_good_worker_counts():
+    assert cluster.check_workers(None) is None
+    assert cluster.check_workers(3) == 3
+    assert cluster.check_workers(2.0) == 2
+
+
+@pytest.mark.parametrize(
+    "scheduler, workers, match",
+    [
+        ("tcp://127.0.0.1:8786", 2, "give one or the other"),
+        ("", None, "not an address"),
+        ("   ", None, "not an address"),
+    ],
+)
+def test_bad_cluster_options(scheduler, workers, match):
+    with pytest.raises(ParameterError, match=match):
+        cluster.check_cluster_options(scheduler, workers)
+
+
+@pytest.mark.parametrize(
+    "address, match",
+    [
+        ("nonsense", "is not a Dask scheduler address"),
+        ("foo://127.0.0.1:8786", "is not a Dask scheduler address"),
+        ("tcp://127.0.0.1:9", "could not connect to the Dask scheduler"),
+    ],
+)
+def test_unreachable_scheduler_fails_fast_and_clearly(monkeypatch, address, match):
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
+    t0 = time.perf_counter()
+    with pytest.raises(ParameterError, match=match), cluster.dask_client(scheduler=address):
+        pass  # pragma: no cover
+    assert time.perf_counter() - t0 < 10.0
+
+
+def test_local_cluster_runs_and_shuts_down():
+    with cluster.dask_client(n_workers=2, processes=False) as client:
+        assert len(client.scheduler_info()["workers"]) == 2
+        assert client.submit(sum, [1, 2, 3]).result() == 6
+    assert client.status == "closed"
+
+
+def test_existing_scheduler_by_address():
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as lc:
+        with cluster.dask_client(scheduler=lc.scheduler_address) as client:
+            assert client.submit(max, [4, 1]).result() == 4
+        assert client.status == "closed"
+        assert lc.status.name == "running"  # an existing cluster is left running

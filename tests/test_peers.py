@@ -1,0 +1,91 @@
+"""The registry of beat trackers (ours and the peers a user would pick instead)."""
+
+import dataclasses
+import importlib.util
+
+import numpy as np
+import pytest
+
+from beatsync import peers
+from beatsync.errors import ParameterError
+from beatsync.evaluate.beats import evaluate
+from beatsync.synth.audio import beat_times, drum_pattern
+
+SR = 22050
+HAS_ESSENTIA = importlib.util.find_spec("essentia") is not None
+
+
+@pytest.fixture(scope="module")
+def song():
+    ref = beat_times(120, duration=10.0, start=0.37)
+    return drum_pattern(ref, sr=SR, duration=10.0), ref
+
+
+def test_registry_names_and_descriptions():
+    assert list(peers.PEERS) == ["psf", "librosa", "essentia-degara", "essentia-multifeature"]
+    for name, peer in peers.PEERS.items():
+        assert peer.name == name and peer.description
+    avail = peers.available()
+    assert avail["psf"] and avail["librosa"]
+    assert avail["essentia-degara"] == HAS_ESSENTIA
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "psf",
+        "librosa",
+        pytest.param(
+            "essentia-degara",
+            marks=pytest.mark.skipif(not HAS_ESSENTIA, reason="optional essentia not installed"),
+        ),
+        pytest.param(
+            "essentia-multifeature",
+            marks=pytest.mark.skipif(not HAS_ESSENTIA, reason="optional essentia not installed"),
+        ),
+    ],
+)
+def test_every_method_tracks_a_drum_pattern(song, name):
+    y, ref = song
+    est = peers.track(name, y, SR)
+    assert est.dtype == np.float64 and est.ndim == 1
+    assert np.all(np.diff(est) > 0)
+    assert evaluate(ref, est, min_beat_time=1.0)["F-measure"] >= 0.9, name
+
+
+def test_librosa_peer_at_another_rate(song):
+    import librosa
+
+    y, ref = song
+    y44 = librosa.resample(y, orig_sr=SR, target_sr=44100)
+    est = peers.track("librosa", y44, 44100)
+    assert evaluate(ref, est, min_beat_time=1.0)["F-measure"] >= 0.9
+
+
+def test_unknown_method():
+    with pytest.raises(ParameterError, match="unknown beat-tracking method 'madmom'"):
+        peers.get("madmom")
+
+
+def test_missing_optional_package_says_how_to_install(monkeypatch):
+    fake = dataclasses.replace(peers.PEERS["essentia-degara"], requires="no_such_package_xyz")
+    monkeypatch.setitem(peers.PEERS, "essentia-degara", fake)
+    assert peers.available()["essentia-degara"] is False
+    assert peers.available()["psf"] is True
+    with pytest.raises(ParameterError, match=r"pip install 'beatsync\[peers\]'"):
+        peers.get("essentia-degara")
+
+
+@pytest.mark.parametrize(
+    "y, sr, match",
+    [
+        (np.zeros(SR * 5, dtype=np.float32), SR, "silent"),
+        (np.array([], dtype=np.float32), SR, "empty|no samples"),
+        (np.full(SR * 5, np.nan, dtype=np.float32), SR, "NaN|finite"),
+        (np.ones(SR * 5, dtype=np.float32), 0, "sr"),
+    ],
+)
+def test_bad_audio_refused_for_every_method(y, sr, match):
+    for name in ("psf", "librosa"):
+        with pytest.raises(ParameterError, match=match):
+            peers.track(name, y, sr)
