@@ -297,6 +297,38 @@ class WeightedMotionGraph:
             build_time=build_time,
         )
 
+    def with_threshold(self, th: float) -> WeightedMotionGraph:
+        """The graph keeping only the transitions with ``rd < th`` (``th`` <= this TH).
+
+        A graph built once with a large TH gives the graphs of every smaller TH
+        without recomputing the distances.
+        """
+        th = check_th(th)
+        if th > self.th:
+            raise ParameterError(
+                f"TH={th:g} is larger than the TH={self.th:g} this graph was built with: "
+                "build it with the largest TH needed"
+            )
+        keep = self.trans_rd < th
+        return WeightedMotionGraph(
+            clips=self.clips,
+            node_clip=self.node_clip,
+            node_frame=self.node_frame,
+            next_node=self.next_node,
+            intensity=self.intensity,
+            z_intensity=self.z_intensity,
+            trans_src=self.trans_src[keep],
+            trans_dst=self.trans_dst[keep],
+            trans_rd=self.trans_rd[keep],
+            trans_weight=self.trans_weight[keep],
+            th=th,
+            weight_rule=self.weight_rule,
+            speed_scale=self.speed_scale,
+            min_rd=self.min_rd,
+            params={**self.params, "th": th},
+            build_time=self.build_time,
+        )
+
     def with_rule(self, weight_rule: str) -> WeightedMotionGraph:
         """The same graph with transition weights recomputed under another eq. 2 rule."""
         return WeightedMotionGraph(
