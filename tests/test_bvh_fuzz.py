@@ -179,13 +179,32 @@ def _base_text() -> str:
     text = datasets.path("motion/cmu_walk_modern/007_12.bvh").read_text()
     head, _, motion = text.partition("\nMOTION\n")
     rows = motion.splitlines()
-    return f"{head}\nMOTION\nFrames: {N_FRAMES}\n{rows[1]}\n" + "\n".join(rows[2 : 2 + N_FRAMES]) + "\n"
+    return (
+        f"{head}\nMOTION\nFrames: {N_FRAMES}\n{rows[1]}\n"
+        + "\n".join(rows[2 : 2 + N_FRAMES])
+        + "\n"
+    )
 
 
 # ---------------------------------------------------------------- mutations
 
 _CHARS = list("0123456789 .-+e\n\t{}_xn") + ["\u0663", "\r"]
-_TOKENS = ["nan", "inf", "-inf", "1e400", "", "1.2.3", "-0", "+5", ".5", "5.", "1_0", "0x1", "{", "}"]
+_TOKENS = [
+    "nan",
+    "inf",
+    "-inf",
+    "1e400",
+    "",
+    "1.2.3",
+    "-0",
+    "+5",
+    ".5",
+    "5.",
+    "1_0",
+    "0x1",
+    "{",
+    "}",
+]
 
 
 def _mutate(text: str, r: random.Random) -> bytes:

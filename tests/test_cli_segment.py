@@ -84,7 +84,7 @@ def _bad_files(tmp_path):
         ("missing", ["--fps", "25"], "does not exist"),
         ("trunc", [], "no MOTION section"),
         ("nan", ["--fps", "25"], "NaN"),
-        ("short", ["--fps", "25"], "shorter than two periods"),
+        ("short", ["--fps", "25"], "shorter than 3 periods"),
         ("noise", ["--fps", "25"], "not periodic"),
         ("pirouette", [], "not periodic"),
         ("good", ["--fps", "0"], "fps"),

@@ -13,6 +13,7 @@ from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.evaluate.composition import foot_sliding, intensity_correlation, transition_jumps
 from beatsync.graph import (
     aligned_distance_matrix,
+    aligned_pair_distance,
     beat_warp,
     build_graph,
     conventional_search,
@@ -104,6 +105,16 @@ def test_aligned_distance_invariant_to_floor_rigid_motion(rng):
     assert d[0, 0] < 1e-6  # sqrt of a difference of sums: ~1e-8 round-off
     c = b + np.array([0.0, 0.1, 0.0])  # vertical offsets are not aligned away
     np.testing.assert_allclose(aligned_distance_matrix(a, c[None])[0, 0], 0.1, rtol=1e-9)
+
+
+@pytest.mark.parametrize("height", [0.0, 100.0, 1e4])
+def test_identical_clouds_at_zero_distance_far_from_the_floor(rng, height):
+    # the closed form subtracts sums of squares of the heights: far from the floor the
+    # old formula returned 1.8e-6 (100 units) and 1.6e-4 (1e4 units) for identical clouds
+    a = rng.normal(size=(3, 300, 3)) * 0.3
+    a[:, :, 1] += height
+    assert np.diag(aligned_distance_matrix(a, a)).max() < 1e-9 * max(1.0, height)
+    assert aligned_pair_distance(a, a).max() < 1e-9 * max(1.0, height)
 
 
 def test_rd_is_scale_free():

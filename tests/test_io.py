@@ -476,3 +476,34 @@ def test_write_bvh_refuses_nan_offset(tmp_path, chain_motion):
     with pytest.raises(ParameterError, match=r"OFFSET of joint .* NaN"):
         io.write_bvh(tmp_path / "x.bvh", m)
     assert not (tmp_path / "x.bvh").exists()
+
+
+# ------------------------------------------------------------ bit-stable JSON
+
+
+def test_write_json_float_digits_hides_last_digit_noise(tmp_path):
+    a = {"score": 0.1 + 0.2, "arr": np.array([1 / 3, 2.0]), "f32": np.float32(0.25), "n": 3}
+    b = {"score": 0.3, "arr": np.array([1 / 3 + 1e-16, 2.0]), "f32": 0.25, "n": 3}
+    pa = io.write_json(tmp_path / "a.json", a, float_digits=10)
+    pb = io.write_json(tmp_path / "b.json", b, float_digits=10)
+    assert pa.read_bytes() == pb.read_bytes()
+    import json
+
+    assert json.loads(pa.read_text()) == {
+        "score": 0.3,
+        "arr": [0.3333333333, 2.0],
+        "f32": 0.25,
+        "n": 3,
+    }
+    # default: exact floats
+    exact = io.write_json(tmp_path / "e.json", {"score": 0.1 + 0.2})
+    assert "0.30000000000000004" in exact.read_text()
+
+
+@pytest.mark.parametrize(
+    "digits, match", [(0, "1-17"), (18, "1-17"), (2.5, "whole"), (True, "whole")]
+)
+def test_write_json_bad_float_digits(tmp_path, digits, match):
+    with pytest.raises(ParameterError, match=rf"float_digits={digits!r} must be"):
+        io.write_json(tmp_path / "x.json", {"a": 1.0}, float_digits=digits)
+    assert not (tmp_path / "x.json").exists()

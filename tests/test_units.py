@@ -77,14 +77,15 @@ def test_range():
 @pytest.mark.parametrize(
     "value, match",
     [
-        ("abc", r"delta='abc' is not a number \[s\]"),
+        ("abc", r"delta='abc' is text, not a number \[s\]"),
+        ("0.5", r"delta='0.5' is text, not a number \[s\]; pass a number"),
         (None, r"delta=None is not a number"),
         (True, r"delta=True is a bool"),
         (np.array([0.5, 0.6]), r"single number \[s\], got an array of shape \(2,\)"),
         ([0.5], r"single number \[s\], not a list"),
         (np.nan, r"delta=nan must be a finite number \[s\]"),
         (np.inf, r"finite"),
-        ("1e999", r"finite"),
+        (1e999, r"finite"),
     ],
 )
 def test_as_float_refuses(value, match):
@@ -93,7 +94,9 @@ def test_as_float_refuses(value, match):
 
 
 def test_as_float_accepts_numbers_and_numpy_scalars():
-    assert as_float("0.5", name="d", unit="s") == 0.5
+    assert as_float("0.5", name="d", unit="s", text=True) == 0.5
+    with pytest.raises(ParameterError, match="not a number"):
+        as_float("abc", name="d", unit="s", text=True)
     assert as_float(np.float32(2), name="d", unit="s") == 2.0
     assert as_float(np.array(3.0), name="d", unit="s") == 3.0
     assert np.isnan(as_float(np.nan, name="d", unit="s", allow_nonfinite=True))
@@ -257,3 +260,9 @@ def test_check_finite_dtype_none_keeps_float32():
 def test_check_times_refuses_strings_as_parameter_error():
     with pytest.raises(ParameterError, match="strings"):
         check_times(["a", "b"])
+
+
+def test_check_helpers_accept_numbers_written_as_text():
+    assert check_positive("2.5", name="th", unit="rd") == 2.5
+    assert check_fps("60", name="fps") == 60.0
+    assert check_bpm("120") == 120.0

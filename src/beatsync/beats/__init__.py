@@ -37,6 +37,7 @@ from .tracker import (
     beat_tempo,
     check_audio,
     check_duration,
+    mix_clicks,
     track_beats,
 )
 
@@ -51,6 +52,7 @@ __all__ = [
     "check_bpm",
     "check_duration",
     "beat_tempo",
+    "mix_clicks",
     "FRONTEND_DEFAULTS",
     "MIN_SANE_BPM",
     "MAX_SANE_BPM",

@@ -87,6 +87,9 @@ class MeterModel:
     max_measure_s: float = 4.0
 
 
+#: Fewest cycles of a beat period inside an analysis window for its salience to count.
+MIN_BEAT_CYCLES = 4
+
 #: The model used by :func:`beatsync.beats.track_beats`.
 METER_MODEL = MeterModel()
 
@@ -98,6 +101,7 @@ def resonator_salience(
     stops: Sequence[int],
     periods: np.ndarray,
     half_time_s: float,
+    max_hz: float | None = None,
 ) -> np.ndarray:
     """Normalised comb-filter resonator energy summed over bands, (n_periods, n_windows).
 
@@ -112,7 +116,13 @@ def resonator_salience(
         Comb delays (need not be whole frames).
     half_time_s : float [s]
         Feedback half-time ``T0``.
+    max_hz : float, optional [Hz]
+        Frequencies of the accent signal above this (where a smoothed accent signal
+        has almost no energy) pass every resonator with its mean gain ``gamma``
+        instead of being filtered one by one (saves time, changes nothing visible).
     """
+    import scipy.fft  # noqa: PLC0415 (batched real FFTs)
+
     n_bands = bands.shape[0]
     length = int(max(b - a for a, b in zip(starts, stops, strict=True)))
     n_fft = int(2 ** np.ceil(np.log2(max(length, 2))))
@@ -120,14 +130,21 @@ def resonator_salience(
     for i, (a, b) in enumerate(zip(starts, stops, strict=True)):
         x = bands[:, a:b]
         seg[i, :, : b - a] = (x - x.mean(axis=1, keepdims=True)) * np.hanning(b - a)
-    power = np.abs(np.fft.rfft(seg, axis=2)) ** 2  # (window, band, frequency)
-    omega = 2.0 * np.pi * np.arange(power.shape[2]) / n_fft  # [rad / frame]
+    spec = scipy.fft.rfft(seg, axis=2)
+    power = spec.real**2 + spec.imag**2  # (window, band, frequency)
+    n_bins = power.shape[2]
+    if max_hz is not None:
+        n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
+    omega = 2.0 * np.pi * np.arange(n_bins) / n_fft  # [rad / frame]
     alpha = 0.5 ** (periods / half_time_s)
     a = alpha[:, None]
     gain = (1 - a) ** 2 / (1 - 2 * a * np.cos(np.outer(periods * fps, omega)) + a**2)
     gamma = (1 - alpha) ** 2 / (1 - alpha**2)
     total = power.sum(axis=2)  # (window, band)
-    energy = np.einsum("pf,wbf->pwb", gain, power, optimize=True)
+    n_win = power.shape[0]
+    low = power[:, :, :n_bins].reshape(-1, n_bins)
+    energy = (gain @ low.T).reshape(periods.size, n_win, n_bands)
+    energy += gamma[:, None, None] * (total - low.sum(axis=1).reshape(n_win, n_bands))[None]
     ratio = np.divide(energy, total[None], out=np.zeros_like(energy), where=total[None] > 0)
     r = (ratio - gamma[:, None, None]) / (1 - gamma[:, None, None])
     # fewer than two periods inside the window: no evidence either way
@@ -173,6 +190,7 @@ def tactus_observation(
     stops: Sequence[int],
     periods: np.ndarray,
     model: MeterModel = METER_MODEL,
+    max_hz: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Log observation of each tactus period per window, tatum and measure maximised out.
 
@@ -192,8 +210,12 @@ def tactus_observation(
     tatum = _level_grid(model.min_tatum_s, float(periods.max()))
     measure = _level_grid(float(periods.min()), model.max_measure_s)
     all_p = np.concatenate([periods, tatum, measure])
-    sal = resonator_salience(bands, fps, starts, stops, all_p, model.half_time_s)
+    sal = resonator_salience(bands, fps, starts, stops, all_p, model.half_time_s, max_hz)
     s_b = sal[: periods.size]
+    # a beat period is observable only if the window holds at least four of its
+    # cycles (a measure: two); longer periods count as unsupported
+    span = (np.asarray(stops) - np.asarray(starts)) / fps
+    s_b[periods[:, None] > span[None, :] / MIN_BEAT_CYCLES] = 0.0
     s_a = sal[periods.size : periods.size + tatum.size]
     s_c = sal[periods.size + tatum.size :]
     obs_a = model.beta * s_a + _log_prior(tatum, model.tatum_median_s, model.tatum_sigma)[:, None]

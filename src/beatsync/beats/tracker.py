@@ -37,6 +37,7 @@ __all__ = [
     "BeatTrack",
     "track_beats",
     "beat_tempo",
+    "mix_clicks",
     "check_duration",
     "MIN_DURATION_S",
     "MIN_PULSE_CLARITY",
@@ -102,6 +103,24 @@ def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndar
     """
     arr, sr_f = _units_check_audio(y, sr, silence_peak=None if allow_silent else SILENCE_PEAK)
     return np.asarray(arr, dtype=np.float64), sr_f
+
+
+def mix_clicks(y: np.ndarray, sr: float, beats: np.ndarray) -> np.ndarray:
+    """The audio with a click on every beat, to listen to the beats (float32).
+
+    The audio is normalised to peak 0.8; each click is a 1 kHz tone decaying over
+    about 0.1 s at amplitude 0.5; the mix is scaled down only if it would clip.
+    Trusts its input (validated audio, beat times inside it).
+    """
+    y = np.asarray(y, dtype=np.float64)
+    t = np.arange(int(0.1 * sr)) / sr
+    click = np.sin(2 * np.pi * 1000.0 * t) * np.exp(-t / 0.02)
+    mix = 0.8 * y / max(float(np.max(np.abs(y))), 1e-9)
+    for i in np.rint(np.asarray(beats) * sr).astype(np.int64):
+        if 0 <= i < y.size:
+            seg = click[: y.size - i]
+            mix[i : i + seg.size] += 0.5 * seg
+    return (mix / max(float(np.max(np.abs(mix))), 1.0)).astype(np.float32)
 
 
 def check_duration(n_samples: int, sr: float, *, bpm: float | None = None) -> float:
@@ -296,7 +315,11 @@ def _track_psf(
         periods = np.array([60.0 / bpm])
     else:
         periods = period_grid(min_bpm, max_bpm)
-    log_obs, salience, measure = tactus_observation(accents, fps, starts, stops, periods, model)
+    # above this the 10-ms smoothing leaves < 1 % of the accent power
+    max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * sigma / fps)
+    log_obs, salience, measure = tactus_observation(
+        accents, fps, starts, stops, periods, model, max_hz=max_hz
+    )
     if bpm is None:
         clarity = float(np.median(salience.max(axis=0)))
         if clarity < MIN_PULSE_CLARITY:

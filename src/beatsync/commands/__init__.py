@@ -29,7 +29,7 @@ COMMAND_HELP = {
     "sync": "resample a periodic dance so that its periods land on the beats of a song",
     "compose": "compose a dance for a song from a library of motion clips (motion graph + DP)",
     "batch": "sync every motion clip with every song, in parallel on Dask",
-    "evaluate": "score a beat tracker over a folder of songs with annotations (mir_eval, on Dask)",
+    "evaluate": "score beat trackers against annotations over a dataset (on Dask)",
     "reproduce": "run the study's notebooks with papermill from a parameter file",
     "data": "list the bundled data files and verify their SHA-256 checksums",
 }

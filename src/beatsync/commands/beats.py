@@ -1,9 +1,10 @@
 """``beatsync beats``: track the beats of a piece of music (paper A, section 4).
 
 Reads an audio file, runs :func:`beatsync.beats.track_beats` and prints the beat
-times in seconds, one per line (or a JSON object with ``--json``). ``--out`` writes
+times in seconds, one per line (or a JSON object with ``--json``, which also gives
+the tempo curve and the meter estimate, ``beats_per_bar``). ``--out`` writes
 them to a file (one per line, :func:`beatsync.io.write_beats`); ``--click`` renders
-the beats as clicks over the audio (:func:`librosa.clicks`). All writes are atomic,
+the beats as clicks over the audio (:func:`beatsync.beats.mix_clicks`). All writes are atomic,
 happen only after tracking succeeded, and never overwrite the input.
 """
 
@@ -12,8 +13,6 @@ from __future__ import annotations
 import sys
 import warnings
 from typing import Any
-
-import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from ._common import add_json_flag, check_output_path, emit
@@ -26,8 +25,9 @@ def register(subparsers: Any) -> None:
         "beats",
         help="track the beats of a song and print their times in seconds",
         description=(
-            "Track music beats with the phase-slope (group delay) onset detector and a "
-            "tempo/phase HMM (paper A, section 4), or with librosa's beat tracker. "
+            "Track music beats with the phase-slope (group delay) onset detector, the "
+            "metrical model of Klapuri et al. (2006) and a tempo/phase HMM (paper A, "
+            "section 4), or with librosa's beat tracker. "
             "Prints beat times in seconds, one per line."
         ),
     )
@@ -68,8 +68,9 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: Any) -> int:
+    # imported here, not at module level: building the parser must stay cheap
     from .. import io
-    from ..beats import track_beats
+    from ..beats import mix_clicks, track_beats
     from ..units import check_bpm
 
     # cheap checks first, so that nothing is read or written on bad options
@@ -106,13 +107,8 @@ def run(args: Any) -> int:
     if args.out is not None:
         written.append(str(io.write_beats(args.out, track.beats)))
     if args.click is not None:
-        import librosa
-
-        clicks = librosa.clicks(times=track.beats, sr=sr, length=y.size)
-        peak = max(float(np.max(np.abs(y))), 1e-9)
-        mix = 0.8 * y / peak + 0.5 * clicks
-        mix = mix / max(float(np.max(np.abs(mix))), 1.0)
-        written.append(str(io.write_audio(args.click, mix.astype(np.float32), sr)))
+        mix = mix_clicks(y, sr, track.beats)
+        written.append(str(io.write_audio(args.click, mix, sr)))
     result = {
         "audio": args.audio,
         "method": track.method,
@@ -121,6 +117,7 @@ def run(args: Any) -> int:
         "beats": track.beats,
         "tempo_times": track.tempo_times,
         "tempo_curve_bpm": track.tempo_curve,
+        "beats_per_bar": track.beats_per_bar,
         "written": written,
         "warnings": notes,
     }

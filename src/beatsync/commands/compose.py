@@ -103,6 +103,32 @@ def register(subparsers: Any) -> None:
         help="weight of a tempo term against strong time warps (0 = paper B, intensity only)",
     )
     p.add_argument(
+        "--scale-bound",
+        type=float,
+        nargs=2,
+        default=[0.8, 1.25],
+        metavar=("LO", "HI"),
+        help="bound on every interval's time-scale factor, music duration / natural "
+        "duration (default 0.8 1.25: at most 25%% faster or slower than captured)",
+    )
+    p.add_argument(
+        "--no-scale-bound",
+        action="store_true",
+        help="no bound: any interval may be warped onto any beat (paper B as written)",
+    )
+    p.add_argument(
+        "--multiplicity",
+        default="auto",
+        metavar="M[,M...]",
+        help="music beats one motion-beat interval may cover, e.g. 1,2 or 0.5,1 "
+        "(default auto: chosen from the library's and the song's tempo)",
+    )
+    p.add_argument(
+        "--all-clips",
+        action="store_true",
+        help="use every clip, not only the tempo group that suits the song",
+    )
+    p.add_argument(
         "--blend", type=float, default=1.0 / 3.0, help="transition blend length [s] (default 1/3)"
     )
     p.add_argument(
@@ -183,6 +209,15 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
     if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
+    from ..graph.timescale import check_multiplicity, check_scale_bound
+
+    bound = (
+        None if args.no_scale_bound else check_scale_bound(args.scale_bound, name="--scale-bound")
+    )
+    mult = args.multiplicity
+    if mult != "auto":
+        mult = mult.split(",")
+    mult = check_multiplicity(mult)
     files = chk["files"]
     t_read = time.perf_counter()
     y, sr = io.read_audio(chk["audio"])
@@ -216,7 +251,24 @@ def run(args: argparse.Namespace) -> int:
     graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
     build_s = time.perf_counter() - t0
     kw = {"tempo_weight": args.tempo_weight} if args.method == "dp" and args.tempo_weight else {}
-    comp = compose_music(graph, y, sr, beats=beats, method=args.method, blend=args.blend, **kw)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BeatsyncWarning)
+        comp = compose_music(
+            graph,
+            y,
+            sr,
+            beats=beats,
+            method=args.method,
+            blend=args.blend,
+            scale_bound=bound,
+            multiplicity=mult,
+            tempo_select=not args.all_clips,
+            **kw,
+        )
+    for w in caught:
+        if issubclass(w.category, BeatsyncWarning):
+            notes.append(str(w.message))
+            print(f"beatsync compose: warning: {w.message}", file=sys.stderr)
     out = io.write_bvh(chk["out"], comp.motion)
     video_path = None
     if chk["video"] is not None:
@@ -250,6 +302,9 @@ def run(args: argparse.Namespace) -> int:
         "n_frames": comp.motion.n_frames,
         "fps": comp.motion.fps,
         "transition_times_s": comp.synthesis.transition_times,
+        "tempo": comp.tempo.report(),
+        "multiplicity_used": comp.report()["multiplicity_used"],
+        "plausibility": comp.plausibility,
         "warnings": notes,
     }
     if chk["report"] is not None:
@@ -263,10 +318,32 @@ def run(args: argparse.Namespace) -> int:
         f"{' (graph from cache)' if cached else ''}\n"
         f"music: {comp.music_beats.size} beats (~{result['tempo_bpm']:.1f} BPM)\n"
         f"path: {comp.search.path.size} intervals, {comp.n_transitions} transition(s); "
-        f"graph build {build_s:.3f} s, search ({args.method}) {comp.search.search_time:.4f} s"
+        f"graph build {build_s:.3f} s, search ({args.method}) {comp.search.search_time:.4f} s\n"
+        + _tempo_text(comp)
     )
     if video_path:
         text += f"\nvideo: {video_path}"
     if chk["report"] is not None:
         text += f"\nreport: {chk['report']}"
     return emit(result, text, args)
+
+
+def _tempo_text(comp: Any) -> str:
+    """Eligible clips, multiplicities and plausibility, for the terminal."""
+    plan = comp.tempo
+    p = comp.plausibility
+    bound = "none" if plan.bound is None else f"{plan.bound[0]:g}-{plan.bound[1]:g}"
+    used = ", ".join(f"{k} beat(s) x{v}" for k, v in comp.report()["multiplicity_used"].items())
+    lines = [
+        f"tempo: song {plan.song_bpm:.0f} BPM, library {plan.library_bpm:.0f} BPM; "
+        f"time-scale bound {bound}; intervals covering {used}"
+    ]
+    for row in plan.clip_table:
+        mark = "used" if row["eligible"] else "not used"
+        lines.append(f"  {row['clip']}: {mark}: {row['reason']}")
+    lines.append(
+        f"speed: root p99 {p['root_speed_p99']:.3g} ({p['root_speed_ratio']:.2f}x the fastest "
+        f"clip), joint rotation p99 {p['rotation_speed_p99']:.0f} deg/s "
+        f"({p['rotation_speed_ratio']:.2f}x); time-scale {p['scale_min']:.2f}-{p['scale_max']:.2f}"
+    )
+    return "\n".join(lines)

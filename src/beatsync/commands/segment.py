@@ -8,7 +8,14 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, add_period_range, check_output_path, emit
+from ._common import (
+    add_json_flag,
+    add_period_range,
+    add_position_options,
+    check_output_path,
+    emit,
+    position_options,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -61,6 +68,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="'default' (limb and spine rotations, or *_angle channels), 'all', or channel names",
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    add_position_options(p)
     p.add_argument("--out", default=None, help="write the boundaries to this .csv file")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -75,7 +83,9 @@ def run(args: argparse.Namespace) -> int:
     from ..units import time_to_frames
 
     out = check_output_path(args.out, args.motion) if args.out else None
-    motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+    motion = io.read_motion(
+        args.motion, fps=args.fps, variable=args.variable, **position_options(args)
+    )
     converted = is_marker_motion(motion)
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
     channels = args.channels

@@ -24,7 +24,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ._common import add_json_flag, check_output_path, check_side_outputs, emit
+from ._common import (
+    add_json_flag,
+    add_position_options,
+    check_output_path,
+    check_side_outputs,
+    emit,
+    position_options,
+)
 
 __all__ = ["register", "run"]
 
@@ -61,6 +68,7 @@ def register(subparsers: Any) -> None:
         "--out-fps", type=float, default=None, help="output frame rate [Hz] (default: the input's)"
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    add_position_options(p)
     p.add_argument(
         "--beats",
         default=None,
@@ -249,7 +257,9 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     try:
         steps.step("reading motion")
         t0 = time.perf_counter()
-        motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+        motion = io.read_motion(
+            args.motion, fps=args.fps, variable=args.variable, **position_options(args)
+        )
         if out.suffix.lower() == ".bvh" and motion.skeleton is None:
             alt = (
                 ".json, .npy or .c3d (joint positions, in the input's layout) or .csv"

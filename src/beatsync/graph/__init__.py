@@ -24,12 +24,12 @@ Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb`` (paper B Table 1) and
 from .build import (
     WEIGHT_RULES,
     WeightedMotionGraph,
-    aligned_distance_matrix,
     build_graph,
     check_library,
     check_th,
     transition_weight,
 )
+from .distance import aligned_distance_matrix, aligned_pair_distance
 from .search import (
     METHODS,
     SearchResult,
@@ -45,6 +45,7 @@ __all__ = [
     "WEIGHT_RULES",
     "WeightedMotionGraph",
     "aligned_distance_matrix",
+    "aligned_pair_distance",
     "build_graph",
     "check_library",
     "check_th",

@@ -19,13 +19,9 @@ Following Kovar, Gleicher and Pighin (2002, "Motion graphs"), each beat frame ``
 is represented by the point cloud of all joint positions (end sites included) over a
 window of frames ``f - h .. f + h`` (``window`` [s] long, clipped at the clip ends).
 Two clouds are compared after the rigid 2-D transform (rotation about the vertical
-axis, translation on the floor) that best aligns them, which has a closed form:
-with both clouds centred on the floor plane,
-``D^2 = (S_i + S_j - 2 sqrt(a^2 + b^2) - 2 Y_ij) / M`` where ``S`` are the summed
-squared centred coordinates, ``a = sum(x_i x_j + z_i z_j)``,
-``b = sum(x_i z_j - z_i x_j)``, ``Y_ij = sum(y_i y_j)`` and ``M`` the number of points.
-``D`` is the RMS joint distance [position unit] after aligning root position and
-heading.
+axis, translation on the floor) that best aligns them (closed form, computed stably:
+:mod:`beatsync.graph.distance`). ``D`` is the RMS joint distance [position unit]
+after aligning root position and heading.
 
 ``D`` has the units of the data, so a fixed ``TH`` would mean different things on
 different libraries. We make it scale-free::
@@ -63,6 +59,7 @@ import numpy as np
 from ..errors import BeatsyncWarning, ParameterError
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
 from ..units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
+from .distance import aligned_distance_matrix, point_clouds, typical_speed
 
 __all__ = [
     "WeightedMotionGraph",
@@ -70,140 +67,10 @@ __all__ = [
     "check_library",
     "check_th",
     "transition_weight",
-    "aligned_distance_matrix",
-    "aligned_pair_distance",
-    "typical_speed",
-    "ground_axes",
     "WEIGHT_RULES",
 ]
 
 WEIGHT_RULES = ("paper", "rd")
-
-
-# --------------------------------------------------------------------------- distances
-
-
-def _clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.ndarray:
-    """Point clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` around each frame."""
-    n = positions.shape[0]
-    idx = np.clip(frames[:, None] + np.arange(-half, half + 1)[None, :], 0, n - 1)
-    c = positions[idx]  # (m, w, J, 3)
-    return c.reshape(c.shape[0], -1, 3)
-
-
-def _center(c: np.ndarray, up: int) -> np.ndarray:
-    c = c.copy()
-    for ax in range(3):
-        if ax != up:
-            c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
-    return c
-
-
-def ground_axes(up: int) -> tuple[int, int]:
-    """The two floor axes for vertical axis ``up``, in right-handed order.
-
-    ``(g0, up, g1)`` is a cyclic rotation of ``(x, y, z)``: y up gives ``(z, x)``.
-    """
-    return {0: (1, 2), 1: (2, 0), 2: (0, 1)}[up]
-
-
-#: Squared distances below this fraction of ``S_i + S_j`` lose digits to cancellation in
-#: the closed form; they are recomputed from direct differences (see
-#: :func:`aligned_distance_matrix`).
-CANCELLATION_RATIO = 1e-4
-
-
-def _closed_form(a: np.ndarray, b: np.ndarray, up: int, pairwise: bool):
-    """Summed squares, optimal floor rotation terms and vertical products of centred clouds."""
-    g0, g1 = ground_axes(up)
-    sa = np.sum(a * a, axis=(1, 2))
-    sb = np.sum(b * b, axis=(1, 2))
-    if pairwise:
-        dot = np.sum(a[:, :, g0] * b[:, :, g0] + a[:, :, g1] * b[:, :, g1], axis=1)
-        crs = np.sum(a[:, :, g0] * b[:, :, g1] - a[:, :, g1] * b[:, :, g0], axis=1)
-        yy = np.sum(a[:, :, up] * b[:, :, up], axis=1)
-        ss = sa + sb
-    else:
-        dot = a[:, :, g0] @ b[:, :, g0].T + a[:, :, g1] @ b[:, :, g1].T
-        crs = a[:, :, g0] @ b[:, :, g1].T - a[:, :, g1] @ b[:, :, g0].T
-        yy = a[:, :, up] @ b[:, :, up].T
-        ss = sa[:, None] + sb[None, :]
-    d2 = ss - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * yy
-    return d2, ss, np.arctan2(-crs, dot)
-
-
-def _direct_d2(a: np.ndarray, b: np.ndarray, theta: np.ndarray, up: int) -> np.ndarray:
-    """``sum |a - R(theta) b|^2`` over points, row-wise (``a[k]`` vs ``b[k]``): no cancellation."""
-    g0, g1 = ground_axes(up)
-    c = np.cos(theta)[:, None]
-    s = np.sin(theta)[:, None]
-    # R(theta) rotates b on the floor plane so that it best matches a
-    r0 = c * b[:, :, g0] - s * b[:, :, g1]
-    r1 = s * b[:, :, g0] + c * b[:, :, g1]
-    return np.sum(
-        (a[:, :, g0] - r0) ** 2 + (a[:, :, g1] - r1) ** 2 + (a[:, :, up] - b[:, :, up]) ** 2,
-        axis=1,
-    )
-
-
-def aligned_distance_matrix(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
-    """RMS distance between point clouds after the best floor-plane rigid alignment.
-
-    The closed form (module docstring) is a difference of sums, which cancels when two
-    clouds are nearly identical: there the absolute error of ``D^2`` is a few ulps of
-    ``S_i + S_j``. Entries with ``D^2 < CANCELLATION_RATIO * (S_i + S_j)`` are therefore
-    recomputed from direct point differences under the optimal rotation (whose angle
-    is well conditioned), so identical clouds are at distance ~1e-8 of their size.
-
-    Parameters
-    ----------
-    a : np.ndarray [shape=(na, m, 3)] [position unit]
-    b : np.ndarray [shape=(nb, m, 3)]
-    up : int
-        Index of the vertical axis (1 = y, the BVH convention).
-
-    Returns
-    -------
-    d : np.ndarray [shape=(na, nb)] [position unit]
-    """
-    a = _center(a, up)
-    b = _center(b, up)
-    m = a.shape[1]
-    d2, ss, theta = _closed_form(a, b, up, pairwise=False)
-    ii, jj = np.nonzero(d2 < CANCELLATION_RATIO * ss)
-    for s in range(0, ii.size, 256):
-        i, j = ii[s : s + 256], jj[s : s + 256]
-        d2[i, j] = _direct_d2(a[i], b[j], theta[i, j], up)
-    return np.sqrt(np.maximum(d2, 0.0) / m)
-
-
-def aligned_pair_distance(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
-    """Row-wise version of :func:`aligned_distance_matrix` (``a[k]`` vs ``b[k]``).
-
-    Computed from direct differences under the optimal rotation (no cancellation).
-    """
-    a = _center(a, up)
-    b = _center(b, up)
-    m = a.shape[1]
-    _, _, theta = _closed_form(a, b, up, pairwise=True)
-    return np.sqrt(_direct_d2(a, b, theta, up) / m)
-
-
-def typical_speed(
-    positions_list: Sequence[np.ndarray], fps_list: Sequence[float], *, half: int, up: int = 1
-) -> float:
-    """Median aligned window distance between consecutive frames, times fps [unit / s]."""
-    vals = []
-    for pos, fps in zip(positions_list, fps_list, strict=True):
-        n = pos.shape[0]
-        step = max(1, n // 2000)  # subsample very long clips
-        f = np.arange(0, n - 1, step)
-        for s in range(0, f.size, 500):
-            ff = f[s : s + 500]
-            d = aligned_pair_distance(_clouds(pos, ff, half), _clouds(pos, ff + 1, half), up=up)
-            vals.append(d * fps)
-    v = float(np.median(np.concatenate(vals))) if vals else 0.0
-    return v
 
 
 def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
@@ -428,6 +295,38 @@ class WeightedMotionGraph:
             min_rd=min_rd,
             params=dict(params),
             build_time=build_time,
+        )
+
+    def with_threshold(self, th: float) -> WeightedMotionGraph:
+        """The graph keeping only the transitions with ``rd < th`` (``th`` <= this TH).
+
+        A graph built once with a large TH gives the graphs of every smaller TH
+        without recomputing the distances.
+        """
+        th = check_th(th)
+        if th > self.th:
+            raise ParameterError(
+                f"TH={th:g} is larger than the TH={self.th:g} this graph was built with: "
+                "build it with the largest TH needed"
+            )
+        keep = self.trans_rd < th
+        return WeightedMotionGraph(
+            clips=self.clips,
+            node_clip=self.node_clip,
+            node_frame=self.node_frame,
+            next_node=self.next_node,
+            intensity=self.intensity,
+            z_intensity=self.z_intensity,
+            trans_src=self.trans_src[keep],
+            trans_dst=self.trans_dst[keep],
+            trans_rd=self.trans_rd[keep],
+            trans_weight=self.trans_weight[keep],
+            th=th,
+            weight_rule=self.weight_rule,
+            speed_scale=self.speed_scale,
+            min_rd=self.min_rd,
+            params={**self.params, "th": th},
+            build_time=self.build_time,
         )
 
     def with_rule(self, weight_rule: str) -> WeightedMotionGraph:
@@ -673,7 +572,7 @@ def build_graph(
     if not speed > 0:
         raise ParameterError("the library does not move (zero typical speed): rd is undefined")
     clouds = np.concatenate(
-        [_clouds(p, f, half) for p, f in zip(positions, frames_list, strict=True) if f.size]
+        [point_clouds(p, f, half) for p, f in zip(positions, frames_list, strict=True) if f.size]
     )
     src_l, dst_l, rd_l = [], [], []
     min_rd = np.inf

@@ -24,10 +24,21 @@ import numpy as np
 from ..errors import BeatsyncWarning, ParameterError
 from ..motion import Motion
 from ..motion_beats import zscore
-from ..units import check_finite, check_times
+from ..units import check_finite, check_fps, check_times
+from .baselines import check_conventional_options, conventional_core, random_core
 from .build import WeightedMotionGraph
-from .search import SearchResult, search
-from .warp import SynthesisResult, synthesize
+from .objective import SearchResult, prepare_search
+from .plausibility import library_profile, plausibility
+from .search import METHODS, dp_core
+from .timescale import (
+    DEFAULT_SCALE_BOUND,
+    TempoPlan,
+    check_multiplicity,
+    check_scale_bound,
+    music_grid,
+    plan_tempo,
+)
+from .warp import SynthesisResult, synthesize_core
 
 __all__ = ["Composition", "compose", "compose_music", "check_music_beats"]
 
@@ -44,9 +55,18 @@ class Composition:
     synthesis : SynthesisResult
     music_beats : np.ndarray [s]
     music_level : np.ndarray [dB] (one per interval)
-    music_z : np.ndarray (z-scored level)
+    music_z : np.ndarray (z-scored level per beat interval)
     timings : dict [s]
         ``search_s`` and ``synthesis_s``.
+    tempo : TempoPlan
+        Eligible clips (and why), multiplicities, scale bound.
+    plausibility : dict
+        Root and joint rotation speed percentiles against the library's, time-scale
+        factors (:func:`beatsync.graph.plausibility.plausibility`).
+    warnings : list of str
+        Plausibility warnings (also issued as :class:`BeatsyncWarning`).
+    anchors : np.ndarray [s]
+        Music times on which the path's motion beats land (beats or half beats).
     """
 
     motion: Motion
@@ -56,6 +76,10 @@ class Composition:
     music_level: np.ndarray
     music_z: np.ndarray
     timings: dict = field(default_factory=dict)
+    tempo: TempoPlan | None = None
+    plausibility: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    anchors: np.ndarray | None = None
 
     @property
     def n_transitions(self) -> int:
@@ -78,7 +102,18 @@ class Composition:
             "fps": self.motion.fps,
             "transition_times_s": self.synthesis.transition_times,
             "graph": g,
+            "tempo": self.tempo.report() if self.tempo is not None else None,
+            "multiplicity_used": _counts(np.diff(self.search.boundaries), self.tempo),
+            "plausibility": self.plausibility,
+            "warnings": list(self.warnings),
         }
+
+
+def _counts(steps: np.ndarray, plan: TempoPlan | None) -> dict[str, int]:
+    """How many intervals covered each number of music beats."""
+    sub = plan.subdivision if plan is not None else 1
+    vals, counts = np.unique(steps, return_counts=True)
+    return {f"{v / sub:g}": int(c) for v, c in zip(vals, counts, strict=True)}
 
 
 def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
@@ -116,6 +151,9 @@ def compose(
     end_time: float | None = None,
     seed: int = 0,
     warp: str = "pchip",
+    scale_bound: Any = DEFAULT_SCALE_BOUND,
+    multiplicity: Any = "auto",
+    tempo_select: bool = True,
     **search_kwargs: Any,
 ) -> Composition:
     """Compose a dance for the given music beats and levels.
@@ -139,13 +177,34 @@ def compose(
         Random walk seed.
     warp : {"pchip", "linear"}
         Time warp inside runs (see :func:`beatsync.graph.warp.synthesize`).
+    scale_bound : (float, float) or None
+        Bound on every interval's time-scale factor (music / natural duration),
+        enforced by every method; ``None``: unbounded (paper B as written).
+    multiplicity : "auto" or sequence of float
+        Music beats one motion-beat interval may cover (``0.5`` = two intervals per
+        beat); ``"auto"`` chooses from the tempo ratio
+        (:func:`beatsync.graph.timescale.choose_multiplicity`). With
+        ``scale_bound=None`` and ``"auto"`` every interval covers one beat.
+    tempo_select : bool
+        Use only the clips of the tempo sub-group(s) that suit the song (True), or
+        the whole library.
     **search_kwargs
-        Passed to the search (``segment_beats``, ``tempo_weight``, ...).
+        Passed to the search: ``tempo_weight``, ``start`` (DP); ``segment_beats``
+        [beats], ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
+        (conventional).
 
     Raises
     ------
     ParameterError
-        Fewer than two music beats, level/beat count mismatch.
+        Fewer than two music beats, level/beat count mismatch, bad options, or no
+        dance within the bound (the message names the library's and the song's tempi
+        and the bound to relax).
+
+    Warns
+    -----
+    BeatsyncWarning
+        The result's 99th-percentile root or joint rotation speed exceeds the fastest
+        library clip's by more than 25 % (:mod:`beatsync.graph.plausibility`).
     """
     beats = check_music_beats(music_beats)
     level = check_finite(music_level, name="music level")
@@ -154,22 +213,83 @@ def compose(
             f"music_level has {level.size} values for {beats.size - 1} beat intervals "
             "(one per interval between successive beats)"
         )
+    if method not in METHODS:
+        raise ParameterError(f"method={method!r} is not one of {METHODS}")
+    bound = check_scale_bound(scale_bound)
+    mult = check_multiplicity(multiplicity)
+    if bound is None and mult == "auto":
+        mult = (1.0,)
+    fps = check_fps(graph.clips[0].fps if fps is None else fps)
+    blend = float(blend)
+    if not np.isfinite(blend) or blend < 0 or blend > 5:
+        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
+    end_time = float(beats[-1]) if end_time is None else float(end_time)
+    if not end_time > 0:
+        raise ParameterError(f"end_time={end_time!r} must be > 0 [s]")
+    if warp not in ("pchip", "linear"):
+        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
+    plan = plan_tempo(
+        graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
+    )
+    grid, grid_level = music_grid(beats, level, plan.subdivision)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", BeatsyncWarning)
-        z = zscore(level, name="music intensity")
-    res = search(graph, z, np.diff(beats), method=method, lam=lam, seed=seed, **search_kwargs)
+        z = zscore(grid_level, name="music intensity")
+    res = _search(graph, z, np.diff(grid), method, lam, seed, plan, search_kwargs)
     t0 = time.perf_counter()
-    syn = synthesize(graph, res.path, beats, fps=fps, blend=blend, end_time=end_time, warp=warp)
+    anchors = grid[res.boundaries]
+    syn = synthesize_core(graph, res.path, anchors, fps, blend, 0.0, end_time, warp)
     syn.info["graph_summary"] = graph.summary()
+    syn_s = time.perf_counter() - t0
+    if "speed_profile" not in graph._cache:
+        graph._cache["speed_profile"] = library_profile(graph.clips)
+    plaus, notes = plausibility(syn.motion, graph._cache["speed_profile"], res.scales, bound)
+    for note in notes:
+        warnings.warn(note, BeatsyncWarning, stacklevel=2)
     return Composition(
         motion=syn.motion,
         search=res,
         synthesis=syn,
         music_beats=beats,
         music_level=level,
-        music_z=z,
-        timings={"search_s": res.search_time, "synthesis_s": time.perf_counter() - t0},
+        music_z=z[:: plan.subdivision],
+        timings={"search_s": res.search_time, "synthesis_s": syn_s},
+        tempo=plan,
+        plausibility=plaus,
+        warnings=notes,
+        anchors=anchors,
     )
+
+
+def _search(graph, z, md, method, lam, seed, plan, kwargs):
+    """Run one search on the song's grid under the tempo plan (inputs validated here)."""
+    kwargs = dict(kwargs)
+    sub = plan.subdivision
+    if method == "conventional":
+        seg = kwargs.pop("segment_beats", 8)
+        opts = check_conventional_options(seg, **kwargs)
+        z, lam, _, md, bound, steps, mask = prepare_search(
+            graph, z, lam, 0.0, md, plan.bound, plan.steps, plan.node_mask
+        )
+        opts["seg"] = opts["seg"] * sub
+        return conventional_core(graph, z, md, lam, bound, steps, mask, **opts, subdivision=sub)
+    if method == "random":
+        if kwargs:
+            raise ParameterError(f"the random walk takes no options {sorted(kwargs)}")
+        _, _, _, md, bound, steps, mask = prepare_search(
+            graph, z, 0.0, 0.0, md, plan.bound, plan.steps, plan.node_mask
+        )
+        return random_core(graph, z.size, seed, md, bound, steps, mask, subdivision=sub)
+    start = kwargs.pop("start", "any")
+    tw = kwargs.pop("tempo_weight", 0.0)
+    if kwargs:
+        raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
+    if start not in ("any", "clip_start"):
+        raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
+    z, lam, tw, md, bound, steps, mask = prepare_search(
+        graph, z, lam, tw, md, plan.bound, plan.steps, plan.node_mask
+    )
+    return dp_core(graph, z, lam, tw, md, bound, steps, mask, start=start, subdivision=sub)
 
 
 def compose_music(

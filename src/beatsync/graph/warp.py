@@ -47,9 +47,10 @@ from ..rotations import (
     sample_motion,
 )
 from ..units import check_fps, check_times, frames_to_time, time_to_frames
-from .build import WeightedMotionGraph, ground_axes
+from .build import WeightedMotionGraph
+from .distance import ground_axes
 
-__all__ = ["SynthesisResult", "synthesize", "beat_warp", "smoothstep"]
+__all__ = ["SynthesisResult", "synthesize", "synthesize_core", "beat_warp", "smoothstep"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -190,6 +191,14 @@ def synthesize(
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > start_time >= 0:
         raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    if warp not in ("pchip", "linear"):
+        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
+    return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
+
+
+def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
+    """:func:`synthesize` on validated inputs (the compose path calls this directly)."""
+    template = graph.clips[0]
     up = "xyz".index(graph.params.get("up_axis", "y"))
     g0, g1 = ground_axes(up)
     pos_cols, rot_cols, order = _root_layout(template, up)
@@ -208,8 +217,6 @@ def synthesize(
     j0 = int(time_to_frames(start_time, fps=fps, mode="ceil"))
     j1 = int(time_to_frames(end_time, fps=fps, mode="floor"))
     t = frames_to_time(np.arange(j0, j1 + 1), fps=fps)
-    if warp not in ("pchip", "linear"):
-        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
     k_of, s_of = beat_warp(beats, src_start, src_end, t)
     run_of = run_id[k_of]
     if warp == "pchip":
@@ -223,8 +230,8 @@ def synthesize(
     shift = np.zeros((n_runs, 3))
     run_first_k = np.flatnonzero(np.concatenate([[True], trans[1:]]))
 
-    def raw_root(clip: int, s: float) -> tuple[np.ndarray, Rotation]:
-        v = sample_motion(graph.clips[clip], np.array([s]))[0]
+    def raw_root(clip: int, frame: int) -> tuple[np.ndarray, Rotation]:
+        v = graph.clips[clip].values[frame]  # beat frames lie on frames: no sampling
         return v[pos_cols], euler_to_rotation(v[rot_cols][None, :], order)
 
     def place(r: int, p: np.ndarray) -> np.ndarray:
@@ -239,8 +246,8 @@ def synthesize(
         # previous run ends on beat frame a (= next_node[path[k-1]]) of its clip
         a = graph.next_node[path[k - 1]]
         ca = graph.node_clip[a]
-        pa, ra = raw_root(ca, node_t[a])
-        pb, rb = raw_root(clip_of[k], src_start[k])
+        pa, ra = raw_root(ca, graph.node_frame[a])
+        pb, rb = raw_root(clip_of[k], graph.node_frame[path[k]])
         ha = _heading(Rotation.from_rotvec(yaw[r - 1] * _unit(up)) * ra, up)[0]
         hb = _heading(rb, up)[0]
         yaw[r] = ha - hb
@@ -250,39 +257,50 @@ def synthesize(
         shift[r, g0] = target[g0] - moved[g0]
         shift[r, g1] = target[g1] - moved[g1]
 
-    def transformed(r: int, clip: int, s: np.ndarray) -> np.ndarray:
-        v = sample_motion(graph.clips[clip], s)
-        if r == 0 and yaw[0] == 0.0:
+    def transformed(runs: np.ndarray, clips: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """Samples of the given clips at source times, placed by their runs' transforms."""
+        v = np.empty((s.size, template.n_channels))
+        for c in np.unique(clips):
+            sel = clips == c
+            v[sel] = sample_motion(graph.clips[int(c)], s[sel])
+        moved = (yaw[runs] != 0.0) | np.any(shift[runs] != 0.0, axis=1)
+        if not moved.any():
             return v
-        v = v.copy()
-        v[:, pos_cols] = place(r, v[:, pos_cols])
-        rot = Rotation.from_rotvec(yaw[r] * _unit(up)) * euler_to_rotation(v[:, rot_cols], order)
-        v[:, rot_cols] = rotation_to_euler(rot, order, reference=v[:, rot_cols])
+        vm = v[moved]
+        rm = runs[moved]
+        turn = Rotation.from_rotvec(yaw[rm][:, None] * _unit(up)[None, :])
+        p = turn.apply(vm[:, pos_cols])
+        p[:, g0] += shift[rm, g0]
+        p[:, g1] += shift[rm, g1]
+        vm[:, pos_cols] = p
+        rot = turn * euler_to_rotation(vm[:, rot_cols], order)
+        vm[:, rot_cols] = rotation_to_euler(rot, order, reference=vm[:, rot_cols])
+        v[moved] = vm
         return v
 
-    for r in range(n_runs):
-        sel = run_of == r
-        if sel.any():
-            k = run_first_k[r]
-            values[sel] = transformed(r, int(clip_of[k]), s_of[sel])
+    values[:] = transformed(run_of, clip_of[k_of], s_of)
 
-    # blends after every transition
+    # blends after every transition (windows never overlap: one per music interval)
     trans_times = beats[:-1][trans]
+    idx, runs, clips, s_old, weights = [], [], [], [], []
     for k in np.flatnonzero(trans):
-        r = run_id[k]
         length = min(blend, beats[k + 1] - beats[k])
         if length <= 0:
             continue
-        sel = (t >= beats[k]) & (t < beats[k] + length)
-        if not sel.any():
+        sel = np.flatnonzero((t >= beats[k]) & (t < beats[k] + length))
+        if not sel.size:
             continue
         a = graph.next_node[path[k - 1]]
-        ca = int(graph.node_clip[a])
         rate = (src_end[k] - src_start[k]) / (beats[k + 1] - beats[k])
-        s_old = node_t[a] + (t[sel] - beats[k]) * rate
-        old = transformed(r - 1, ca, s_old)
-        w = smoothstep((t[sel] - beats[k]) / length)
-        values[sel] = blend_values(template, old, values[sel], w)
+        idx.append(sel)
+        runs.append(np.full(sel.size, run_id[k] - 1))
+        clips.append(np.full(sel.size, graph.node_clip[a]))
+        s_old.append(node_t[a] + (t[sel] - beats[k]) * rate)
+        weights.append(smoothstep((t[sel] - beats[k]) / length))
+    if idx:
+        sel = np.concatenate(idx)
+        old = transformed(np.concatenate(runs), np.concatenate(clips), np.concatenate(s_old))
+        values[sel] = blend_values(template, old, values[sel], np.concatenate(weights))
 
     # continuous Euler curves in the output file: the root's triples were re-derived
     # after the yaw alignment, so choose each frame's triple closest to the previous one

@@ -46,11 +46,19 @@ from .positions import (
     write_positions_array,
     write_positions_json,
 )
-from .tables import read_mocap_mat, read_npz, read_table, write_npz, write_table
+from .tables import (
+    check_npy_header,
+    read_mocap_mat,
+    read_npz,
+    read_table,
+    write_npz,
+    write_table,
+)
 
 __all__ = [
     "atomic_write",
     "check_input_file",
+    "check_npy_header",
     "check_output_folder",
     "read_motion",
     "write_motion",
@@ -108,6 +116,8 @@ def read_motion(
     """
     p = Path(path)
     suffix = p.suffix.lower()
+    if suffix == ".npy":
+        check_npy_header(p)  # an .npz renamed, strings, records...: refused before any load
     positional = suffix in (".json", ".npz", ".c3d") or (
         suffix == ".npy" and p.is_file() and is_position_array(p)
     )

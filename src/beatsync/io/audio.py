@@ -120,7 +120,7 @@ def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
         if not s or s.startswith("#"):
             continue
         first = s.replace(",", " ").split()[0]
-        times.append(as_float(first, name=f"{str(p)!r} line {n}: time", unit="s"))
+        times.append(as_float(first, name=f"{str(p)!r} line {n}: time", unit="s", text=True))
     return check_times(np.array(times), name=f"beat times in {p.name}", allow_empty=False)
 
 

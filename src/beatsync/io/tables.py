@@ -132,14 +132,23 @@ def read_table(
     return Motion(values, rate, names, None, p.stem)
 
 
-def _read_npy(p: Path) -> np.ndarray:
-    """A ``.npy`` file holding one numeric ``(frames, channels)`` array, else a clear error."""
+def check_npy_header(path: str | os.PathLike[str]) -> tuple[tuple[int, ...], np.dtype]:
+    """Return the shape and dtype of a ``.npy`` file from its header, nothing else read.
+
+    Raises
+    ------
+    ParameterError
+        Not a ``.npy`` file (an ``.npz`` archive renamed is named as such), a broken
+        header, or a dtype that is not integers or floats (strings, bytes, records,
+        complex numbers, dates, Python objects).
+    """
+    p = check_input_file(path, ".npy")
     with open(p, "rb") as fh:
         magic = fh.read(6)
         if magic[:2] == b"PK":
             raise ParameterError(
                 f"{str(p)!r} is an .npz archive (a zip of arrays), not a .npy array: rename "
-                "it .npz and read it with read_npz, or save one array with numpy.save"
+                "it .npz, or save one array with numpy.save"
             )
         if magic != b"\x93NUMPY":
             raise ParameterError(f"{str(p)!r} is not a .npy file (no NumPy header)")
@@ -151,17 +160,23 @@ def _read_npy(p: Path) -> np.ndarray:
                 if version == (1, 0)
                 else np.lib.format.read_array_header_2_0
             )
-            _, _, dtype = read_header(fh)
+            shape, _, dtype = read_header(fh)
         except Exception as exc:  # numpy raises several types for broken headers
             raise ParameterError(f"{str(p)!r} has a broken .npy header: {exc}") from None
     if dtype.hasobject:
         raise ParameterError(
             f"{str(p)!r} holds Python objects (a pickled array), which are never loaded; "
-            "save a numeric (frames, channels) array"
+            "save a numeric array"
         )
     if dtype.names is not None or dtype.kind not in "iuf":
         # describe the dtype in the words of as_float_array; nothing of the file is read
         as_float_array(np.empty(0, dtype=dtype), name=f"{str(p)!r}")
+    return tuple(shape), dtype
+
+
+def _read_npy(p: Path) -> np.ndarray:
+    """A ``.npy`` file holding one numeric ``(frames, channels)`` array, else a clear error."""
+    check_npy_header(p)
     try:
         values = np.load(p, allow_pickle=False)
     except Exception as exc:  # truncated data, unsupported versions
@@ -176,7 +191,7 @@ def _read_npy(p: Path) -> np.ndarray:
 
 def _is_number(text: str) -> bool:
     try:
-        as_float(text, name="header", allow_nonfinite=True)
+        as_float(text, name="header", allow_nonfinite=True, text=True)
     except ParameterError:
         return False
     return True

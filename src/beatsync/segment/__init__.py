@@ -74,6 +74,25 @@ Documented rules (choices the paper leaves open)
   standard deviation among the selected channels, or at most 1e-9. Inside a kept
   channel, a period whose own variance is below 1e-6 of the channel's variance is
   treated as flat: its correlation is ~0 (cost ~1).
+- Period range: by default the paper's 0.25-1.25 s (``DEFAULT_PERIOD_RANGE``). Real
+  dance cycles can be longer (a waltz box: 6 beats, about 4 s):
+  ``DANCE_PERIOD_RANGE`` (0.25-6.25 s) or :func:`period_range_from_beat` (1 to 8 beats
+  of the music). A range wider than a factor 5 is searched in tiers of a factor 5,
+  shortest first (:func:`.period.period_tiers`); the first tier whose optimum passes
+  the periodicity test gives the period, the shortest repeating cycle (otherwise the
+  energy estimate prefers multiples of a step: CMU salsa 61_04 searched over
+  0.25-6 s at once gave 2.9 s, three steps). The wide range is not the default
+  because the periodicity test accepts the CMU 005_02 pirouette in the long tier
+  (4 x 1.66 s). Long periods stay within memory through the decimated search.
+- Clip length: a clip shorter than ``MIN_CLIP_PERIODS`` (3) of the shortest period
+  of the range is refused first. With the count estimated, a clip shorter than 3 of
+  its own estimated period (the optimum then has a single pair of consecutive periods)
+  is accepted only if that pair is clearly alike, mean Pearson distance below
+  ``SHORT_CLIP_MAX_ENERGY`` (0.5, i.e. mean r above 0.5), else refused as too short.
+  Calibration: the CMU walks 007_* (2.4-2.5 gait cycles) have 0.03-0.08 and are
+  segmented; a 1 s salsa excerpt (period ~1 s) estimated at 0.45 s had 0.95 and used
+  to be cut into two "periods". The period is estimated among periods that fit twice
+  in the clip. With the count given (``n_periods >= 2``) the caller vouches for it.
 - Periodicity: a clip is refused as not periodic when the optimum's mean Pearson
   distance per channel and pair, ``E / (n_channels * (p - 1))``, reaches
   ``MAX_NORMALISED_ENERGY`` (1.0: consecutive periods uncorrelated on average), or
@@ -102,9 +121,13 @@ Documented rules (choices the paper leaves open)
 
 from .channels import CONSTANT_REL_STD, select_channels
 from .core import (
+    DANCE_PERIOD_RANGE,
     DEFAULT_PERIOD_RANGE,
+    MIN_CLIP_PERIODS,
+    SHORT_CLIP_MAX_ENERGY,
     Segmentation,
     estimate_period_count,
+    period_range_from_beat,
     segment,
     segment_values,
 )
@@ -120,7 +143,11 @@ __all__ = [
     "select_channels",
     "segmentation_energy",
     "periodicity_contrast",
+    "period_range_from_beat",
     "DEFAULT_PERIOD_RANGE",
+    "DANCE_PERIOD_RANGE",
+    "MIN_CLIP_PERIODS",
+    "SHORT_CLIP_MAX_ENERGY",
     "CONSTANT_REL_STD",
     "MAX_NORMALISED_ENERGY",
     "MIN_PERIODICITY_CONTRAST",

@@ -1,0 +1,152 @@
+"""Physical plausibility of a composed dance against its library (paper B, issue of speed).
+
+A composed dance whose intervals are squeezed into short music beats moves faster
+than any real motion of its library. Two speeds are compared with the library's:
+
+- **root speed** [position unit / s]: speed of the root joint (pelvis) in 3-D, frame
+  to frame;
+- **joint rotation speed** [deg / s]: angle of each joint's local rotation change
+  between successive frames (every joint with a rotation triple, the root included),
+  pooled over joints and frames. Position-only motions have no rotations: NaN.
+
+Each is summarised by its 50th, 95th and 99th percentiles. The reference of a library
+is the *largest* 99th percentile among its clips (the fastest real clip); a result
+whose 99th percentile exceeds it by more than :data:`TOLERANCE` (25 %) gets a
+:class:`~beatsync.errors.BeatsyncWarning`. The time-scale factors of the path's
+intervals (music / natural duration) are summarised beside them.
+
+Data contract: motions are :class:`beatsync.motion.Motion`; speeds per frame step.
+
+Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..rotations import euler_to_rotation
+
+__all__ = [
+    "PERCENTILES",
+    "TOLERANCE",
+    "motion_speeds",
+    "speed_profile",
+    "library_profile",
+    "plausibility",
+]
+
+#: Percentiles reported for every speed.
+PERCENTILES = (50, 95, 99)
+#: A result may exceed the library's largest clip 99th percentile by this factor.
+TOLERANCE = 1.25
+
+
+def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
+    """Root speed per frame step and joint rotation speeds per frame step and joint.
+
+    Returns
+    -------
+    dict
+        ``root_speed`` [shape=(n - 1,)] [position unit / s];
+        ``rotation_speed`` [shape=(n - 1, n_rot_joints)] [deg / s] (empty columns for
+        position-only motions).
+    """
+    pos = np.asarray(motion.positions(), dtype=np.float64)
+    root = np.linalg.norm(np.diff(pos[:, 0, :], axis=0), axis=1) * motion.fps
+    triples = motion.rotation_triples() if getattr(motion, "skeleton", None) else []
+    n = motion.n_frames
+    rot = np.empty((max(0, n - 1), len(triples)))
+    by_order: dict[str, list[int]] = {}
+    for i, (_joint, _idx, order) in enumerate(triples):
+        by_order.setdefault(order, []).append(i)
+    for order, members in by_order.items():  # one conversion per Euler order
+        cols = [list(triples[i][1]) for i in members]
+        ang = np.stack([motion.values[:, c] for c in cols], axis=1)  # (n, J, 3)
+        r = euler_to_rotation(ang.reshape(-1, 3), order)
+        q = r.as_quat().reshape(n, len(members), 4)
+        q0 = Rotation.from_quat(q[:-1].reshape(-1, 4))
+        q1 = Rotation.from_quat(q[1:].reshape(-1, 4))
+        step = (q0.inv() * q1).magnitude().reshape(n - 1, len(members))
+        rot[:, members] = np.degrees(step) * motion.fps
+    return {"root_speed": root, "rotation_speed": rot}
+
+
+def speed_profile(motion: Any) -> dict[str, float]:
+    """Percentiles of :func:`motion_speeds` (``root_speed_p99``, ``rotation_speed_p50``...)."""
+    sp = motion_speeds(motion)
+    out = {}
+    for name, arr in sp.items():
+        vals = arr.ravel()
+        for q in PERCENTILES:
+            out[f"{name}_p{q}"] = float(np.percentile(vals, q)) if vals.size else float("nan")
+    return out
+
+
+def library_profile(clips: Sequence[Any]) -> dict[str, Any]:
+    """Per-clip speed profiles and the reference (largest clip 99th percentiles)."""
+    per_clip = [{"clip": c.name, **speed_profile(c)} for c in clips]
+    ref = {}
+    for key in ("root_speed_p99", "rotation_speed_p99"):
+        vals = np.array([p[key] for p in per_clip], dtype=np.float64)
+        ref[key] = float(np.nanmax(vals)) if np.isfinite(vals).any() else float("nan")
+    return {"clips": per_clip, "reference": ref}
+
+
+def plausibility(
+    motion: Any,
+    library: dict[str, Any],
+    scales: Any,
+    bound: tuple[float, float] | None,
+) -> tuple[dict[str, Any], list[str]]:
+    """Speeds of a result against its library, and the time-scale factors.
+
+    Parameters
+    ----------
+    motion : Motion
+        The composed dance.
+    library : dict
+        From :func:`library_profile`.
+    scales : np.ndarray
+        Time-scale factor of every interval of the path.
+    bound : (float, float) or None
+
+    Returns
+    -------
+    (report, warnings)
+        ``report`` holds the result's percentiles, the library reference, the ratios
+        ``root_speed_ratio`` and ``rotation_speed_ratio`` (result p99 / reference),
+        and ``scale_min``, ``scale_p5``, ``scale_p50``, ``scale_p95``, ``scale_max``,
+        ``scale_outside_bound`` (count); ``warnings`` the messages for ratios above
+        :data:`TOLERANCE`.
+    """
+    prof = speed_profile(motion)
+    ref = library["reference"]
+    rep: dict[str, Any] = dict(prof)
+    notes = []
+    labels = {"root_speed": "root speed", "rotation_speed": "joint rotation speed"}
+    for key, label in labels.items():
+        r = ref[f"{key}_p99"]
+        rep[f"library_{key}_p99"] = r
+        ratio = prof[f"{key}_p99"] / r if r and np.isfinite(r) else float("nan")
+        rep[f"{key}_ratio"] = ratio
+        if np.isfinite(ratio) and ratio > TOLERANCE:
+            notes.append(
+                f"the dance moves faster than its library: 99th-percentile {label} "
+                f"{prof[f'{key}_p99']:.3g} is {ratio:.2f}x the fastest clip's {r:.3g} "
+                f"(more than {TOLERANCE:g}x); tighten the time-scale bound or use a library "
+                "danced nearer the song's tempo"
+            )
+    s = np.asarray(scales, dtype=np.float64)
+    s = s[np.isfinite(s)]
+    for name, q in (("min", 0), ("p5", 5), ("p50", 50), ("p95", 95), ("max", 100)):
+        rep[f"scale_{name}"] = float(np.percentile(s, q)) if s.size else float("nan")
+    if bound is not None and s.size:
+        out = (s < bound[0] * (1 - 1e-9)) | (s > bound[1] * (1 + 1e-9))
+        rep["scale_outside_bound"] = int(out.sum())
+    else:
+        rep["scale_outside_bound"] = None
+    return rep, notes

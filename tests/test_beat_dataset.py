@@ -1,0 +1,141 @@
+"""Dataset pieces of beat evaluation without a cluster: pairing, annotations, the log."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from beatsync import io
+from beatsync.errors import ParameterError
+from beatsync.study.beat_dataset import (
+    TrackLog,
+    evaluate_track,
+    find_tracks,
+    read_annotation,
+    summarize_dataset,
+)
+from beatsync.synth.audio import beat_times, click_track
+
+SR = 22050
+
+
+def _touch_audio(path):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    io.write_audio(path, np.zeros(100, dtype=np.float32), SR)
+
+
+def test_pairing_prefers_same_relative_path_then_unique_stem(tmp_path):
+    a, b = tmp_path / "audio", tmp_path / "notes"
+    for rel in ("x.wav", "g1/y.wav", "g2/y.flac", "g2/z.mp3", "g2/lonely.wav", "w.wav", "w.flac"):
+        _touch_audio(a / rel) if not rel.endswith(".mp3") else None
+    (a / "g2" / "z.mp3").write_bytes(b"not read while pairing")
+    (a / "readme.txt").write_text("ignored")
+    for rel in ("x.beats", "g1/y.beats", "g2/y.beats", "z.beats", "w.beats"):
+        (b / rel).parent.mkdir(parents=True, exist_ok=True)
+        (b / rel).write_text("0.5\n1.0\n")
+    found = find_tracks(a, b)
+    pairs = {t.key: (t.group, t.annotation.relative_to(b).as_posix()) for t in found.tracks}
+    assert pairs == {
+        "x": (".", "x.beats"),
+        "g1/y": ("g1", "g1/y.beats"),
+        "g2/y": ("g2", "g2/y.beats"),  # same relative path wins over the ambiguous stem
+        "g2/z": ("g2", "z.beats"),  # flat annotations: the only z.beats
+        "w": (".", "w.beats"),
+    }
+    # no annotation; and w.wav beside w.flac: one key, the second file is listed
+    assert sorted(p.name for p in found.unmatched) == ["lonely.wav", "w.wav"]
+
+
+def test_ambiguous_stem_is_unmatched(tmp_path):
+    a, b = tmp_path / "audio", tmp_path / "notes"
+    _touch_audio(a / "song.wav")
+    for sub in ("s1", "s2"):
+        (b / sub).mkdir(parents=True)
+        (b / sub / "song.beats").write_text("0.5\n")
+    (b / "other.beats").write_text("0.5\n")
+    with pytest.raises(ParameterError, match="none of the 1 audio files"):
+        find_tracks(a, b)
+
+
+def test_annotation_folder_is_a_file(tmp_path):
+    _touch_audio(tmp_path / "a" / "x.wav")
+    (tmp_path / "n").write_text("x")
+    with pytest.raises(ParameterError, match="annotation folder .* is a file"):
+        find_tracks(tmp_path / "a", tmp_path / "n")
+
+
+def test_read_annotation_one_or_two_columns(tmp_path):
+    p = tmp_path / "a.beats"
+    p.write_text("# beats\n0.50\t1\n1.00\t2\n\n1.50\t3\n")
+    np.testing.assert_allclose(read_annotation(p), [0.5, 1.0, 1.5])
+    p.write_text("0.5\n1.0\n1.5\n")
+    np.testing.assert_allclose(read_annotation(p), [0.5, 1.0, 1.5])
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("500\n1000\n1500\n2000\n", "looks like milliseconds"),
+        ("43\n86\n129\n172\n", "looks like frame indices"),
+        ("0.5\nabc\n", "line 2: .*'abc' is not a number"),
+        ("1.0\n0.5\n", "strictly increasing"),
+        ("# nothing\n", "empty"),
+    ],
+)
+def test_read_annotation_refuses(tmp_path, text, match):
+    p = tmp_path / "a.beats"
+    p.write_text(text)
+    with pytest.raises(ParameterError, match=match):
+        read_annotation(p)
+
+
+def test_evaluate_track_records_failures_instead_of_raising(tmp_path):
+    ref = beat_times(120, duration=6.0, start=0.3)
+    good = io.write_audio(tmp_path / "good.wav", click_track(ref, sr=SR, duration=6.0), SR)
+    row = evaluate_track(str(good), ref, method="psf", min_beat_time=0.0, name="good")
+    assert row["status"] == "ok" and row["F-measure"] >= 0.95 and row["octave"] == "correct"
+    assert row["n_ref"] == ref.size and len(row["beats"]) == row["n_est"]
+    json.dumps(io.to_jsonable(row), allow_nan=False)  # one JSON line
+    (tmp_path / "bad.wav").write_text("not audio")
+    bad = evaluate_track(str(tmp_path / "bad.wav"), ref, method="psf", min_beat_time=0.0, name="b")
+    assert bad["status"] == "error" and "cannot read" in bad["error"]
+    short = io.write_audio(tmp_path / "short.wav", click_track(ref[:1], sr=SR, duration=0.5), SR)
+    row = evaluate_track(str(short), ref, method="psf", min_beat_time=0.0, name="s")
+    assert row["status"] == "error" and "0.500 s long" in row["error"]
+
+
+def test_track_log_appends_and_skips_a_torn_line(tmp_path):
+    log = TrackLog(tmp_path / "tracks.jsonl")
+    assert log.rows() == []
+    log.append({"key": "a", "method": "psf", "v": 1.0})
+    with open(log.path, "a") as fh:
+        fh.write('{"key": "b", "meth')  # a crash in the middle of a line
+    log.append({"key": "c", "method": "psf", "v": float("nan")})
+    log.append({"key": "a", "method": "psf", "v": 2.0})
+    assert [r["key"] for r in log.rows()] == ["a", "c", "a"]
+    assert log.latest()[("psf", "a")]["v"] == 2.0
+    assert log.latest()[("psf", "c")]["v"] is None
+    log.rewrite([{"key": "z", "method": "librosa"}])
+    assert [r["key"] for r in log.rows()] == ["z"]
+
+
+def test_summarize_dataset_per_folder_and_all():
+    rows = [
+        {"key": "g/a", "group": "g", "method": "psf", "status": "ok", "F-measure": 1.0,
+         "octave": "correct"},
+        {"key": "g/b", "group": "g", "method": "psf", "status": "ok", "F-measure": 0.5,
+         "octave": "double"},
+        {"key": "h/c", "group": "h", "method": "psf", "status": "error", "error": "silent"},
+        {"key": "h/d", "group": "h", "method": "psf", "status": "ok", "F-measure": 0.0,
+         "octave": "other"},
+    ]  # fmt: skip
+    s = summarize_dataset(rows).set_index("group")
+    assert s.loc["g", "tracks"] == 2 and s.loc["g", "F-measure"] == pytest.approx(0.75)
+    assert s.loc["h", "failed"] == 1 and s.loc["h", "F-measure"] == pytest.approx(0.0)
+    assert s.loc["all", "tracks"] == 4 and s.loc["all", "failed"] == 1
+    assert s.loc["all", "F-measure"] == pytest.approx(0.5)
+    assert s.loc["all", "octave errors"] == 1 and s.loc["all", "other tempo"] == 1
+    assert pd.isna(s.loc["all", "Goto"])  # a metric no row has
+    one_folder = summarize_dataset([dict(r, group=".") for r in rows])
+    assert list(one_folder["group"]) == ["all"]
