@@ -144,6 +144,7 @@ def test_resume_after_interrupted_run(dataset, scheduler, tmp_path, capsys, monk
     monkeypatch.setattr(TrackLog, "append", append_then_interrupt)
     code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
     assert code == 130
+    assert "interrupted by SIGINT; the finished tracks are recorded in" in err
     assert "run the same command again" in err
     assert not (out / "summary.csv").exists()
     done = TrackLog(out / "tracks.jsonl").rows()
@@ -284,5 +285,5 @@ def test_results_scored_otherwise_are_not_mixed(dataset, scheduler, tmp_path, ca
 
 def test_exit_code_and_message_on_bad_input(dataset, tmp_path, capsys):
     code, _, err = _run(_bad(tmp_path, dataset, extra=["--workers", "-1"]), capsys)
-    assert code == 2
+    assert code == 3  # bad input (2 is for usage errors)
     assert err.startswith("beatsync evaluate: error: --workers=-1")

@@ -314,7 +314,7 @@ def test_cli_tempo_matched_end_to_end(slow_lib, capsys):
     ],
 )
 def test_cli_bad_bounds_write_nothing(slow_lib, capsys, extra, message):
-    assert main(_argv(slow_lib, *extra)) == 2
+    assert main(_argv(slow_lib, *extra)) == 3
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
     assert not (slow_lib / "dance.bvh").exists()

@@ -127,17 +127,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = args.command
     from .commands._common import error_report, signals_as_exceptions
 
-    try:
-        with signals_as_exceptions():
+    with signals_as_exceptions():
+        try:
             return int(args.func(args) or 0)
-    except BrokenPipeError:
-        # stdout closed early (e.g. `beatsync beats song.wav | head -1`): not an error
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-    except BaseException as exc:  # noqa: BLE001 - every failure becomes a report
-        if isinstance(exc, SystemExit):
+        except BrokenPipeError:
+            # stdout closed early (e.g. `beatsync beats song.wav | head -1`): not an error
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 0
+        except SystemExit:
             raise
-        return error_report(exc, command, as_json=as_json)
+        except BaseException as exc:  # noqa: BLE001 - every failure becomes a report
+            return error_report(exc, command, as_json=as_json)
 
 
 def _usage_error(exc: UsageError, command: str | None, as_json: bool) -> int:

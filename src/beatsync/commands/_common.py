@@ -52,11 +52,11 @@ __all__ = [
     "position_options",
     "emit",
     "feedback",
-    "check_input_file",
     "check_output",
     "check_output_path",
     "check_side_outputs",
     "signals_as_exceptions",
+    "interrupted_by",
     "error_report",
 ]
 
@@ -74,8 +74,12 @@ ProgressCallback = Callable[..., None]
 """``progress(done, total=None)``: ``done`` of ``total`` units of a step are finished."""
 
 _CAUGHT_SIGNALS = tuple(
-    getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
+    getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)
 )
+# Signals received while a command runs. The exception a signal raises can be lost
+# (Python code called back from C, e.g. soundfile's writer, swallows it), so the
+# record also stops Outputs.commit and makes the error that follows a report of it.
+_RECEIVED: list[int] = []
 
 
 # --------------------------------------------------------------------- options
@@ -123,19 +127,6 @@ def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text.rstrip("\n") + "\n")
     return EXIT_OK
-
-
-# ---------------------------------------------------------------------- inputs
-
-
-def check_input_file(path: str | os.PathLike[str], what: str) -> Path:
-    """Refuse an input that does not exist or is not a file (before anything is read)."""
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"{what} {str(path)!r} does not exist")
-    if p.is_dir():
-        raise ParameterError(f"{what} {str(path)!r} is a folder; give a file")
-    return p
 
 
 # --------------------------------------------------------------------- outputs
@@ -265,7 +256,7 @@ def position_options(args: argparse.Namespace) -> dict[str, Any]:
 @contextlib.contextmanager
 def _signals_blocked() -> Iterator[None]:
     """Hold SIGINT/SIGTERM/SIGHUP until the block ends (renames and clean-up finish)."""
-    sigs = {signal.SIGINT, *_CAUGHT_SIGNALS}
+    sigs = set(_CAUGHT_SIGNALS)
     if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
         yield
         return
@@ -399,6 +390,8 @@ class Outputs:
     def commit(self) -> list[Path]:
         """Rename every staged file into place; return the destinations written."""
         with _signals_blocked():
+            if interrupted_by() is not None:  # a signal whose exception was swallowed
+                raise Interrupted(interrupted_by())  # type: ignore[arg-type]
             moves = []
             for key, staged in self._staged.items():
                 out, option = self._declared[key]
@@ -431,6 +424,12 @@ class Outputs:
                     break
                 time.sleep(0.05)
         self._staging.clear()
+
+    def forget(self, final: str | os.PathLike[str]) -> None:
+        """Withdraw a declared output (a writer chose another file, see :meth:`adopt`)."""
+        key = Path(final).resolve()
+        self._staged.pop(key, None)
+        self._declared.pop(key, None)
 
     def adopt(self, staged: str | os.PathLike[str], *, option: str) -> Path:
         """Declare a file found in a staging folder (e.g. named by a worker) and stage it."""
@@ -507,6 +506,8 @@ class Feedback:
         ticker = threading.Thread(target=tick, daemon=True)
         ticker.start()
 
+        last = [0.0]
+
         def progress(done: float, total: float | None = None) -> None:
             if total is not None and total != bar.total:
                 bar.total = total
@@ -514,7 +515,10 @@ class Feedback:
                     "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]"
                 )
             bar.n = done
-            bar.refresh()
+            now = time.monotonic()
+            if now - last[0] >= 0.1 or (bar.total and done >= bar.total):
+                last[0] = now  # cheap when called in a tight loop
+                bar.refresh()
 
         try:
             yield progress
@@ -537,7 +541,7 @@ def feedback(args: argparse.Namespace) -> Feedback:
 
 
 class Interrupted(KeyboardInterrupt):
-    """SIGTERM or SIGHUP, raised in the main thread like Ctrl-C's KeyboardInterrupt."""
+    """SIGINT, SIGTERM or SIGHUP, raised in the main thread (a KeyboardInterrupt)."""
 
     def __init__(self, signum: int):
         super().__init__(signum)
@@ -546,15 +550,18 @@ class Interrupted(KeyboardInterrupt):
 
 @contextlib.contextmanager
 def signals_as_exceptions() -> Iterator[None]:
-    """Turn SIGTERM and SIGHUP into :class:`Interrupted` while the block runs.
+    """Turn SIGINT, SIGTERM and SIGHUP into :class:`Interrupted` while the block runs.
 
-    So ``finally`` blocks and :class:`Outputs` clean up as they do on Ctrl-C.
+    So ``finally`` blocks and :class:`Outputs` clean up on every one of them, and each
+    signal is recorded (see :func:`interrupted_by`).
     """
+    _RECEIVED.clear()
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def handler(signum: int, frame: Any) -> None:
+        _RECEIVED.append(signum)
         raise Interrupted(signum)
 
     old = {s: signal.signal(s, handler) for s in _CAUGHT_SIGNALS}
@@ -563,6 +570,12 @@ def signals_as_exceptions() -> Iterator[None]:
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+        _RECEIVED.clear()
+
+
+def interrupted_by() -> int | None:
+    """The first signal received by the running command, if any."""
+    return _RECEIVED[0] if _RECEIVED else None
 
 
 def error_report(
@@ -570,17 +583,26 @@ def error_report(
 ) -> int:
     """Print ``exc`` for the user (text or a JSON object on stderr); return the exit code.
 
-    =====================  ==================  =========
-    exception              ``kind``            exit code
-    =====================  ==================  =========
-    ParameterError         ``bad-input``       3
-    OSError                ``os-error``        4
-    KeyboardInterrupt      ``interrupted``     128 + signal (130, 143, 129)
-    anything else          ``internal``        70, with the traceback
-    =====================  ==================  =========
+    =================  ===============  ============================================
+    exception          ``kind``         exit code
+    =================  ===============  ============================================
+    ParameterError     ``bad-input``    3
+    OSError            ``os-error``     4
+    KeyboardInterrupt  ``interrupted``  128 + signal (130 SIGINT, 143 SIGTERM)
+    anything else      ``internal``     70, with the traceback
+    =================  ===============  ============================================
+
+    An error that follows a signal whose exception was lost is reported as the signal.
     """
-    stream = sys.stderr if stream is None else stream
+    with _signals_blocked():  # a second signal must not cut the report short
+        return _report(exc, command, as_json, sys.stderr if stream is None else stream)
+
+
+def _report(exc: BaseException, command: str | None, as_json: bool, stream: TextIO) -> int:
     tb = None
+    signum = interrupted_by()
+    if signum is not None and not isinstance(exc, KeyboardInterrupt):
+        exc = Interrupted(signum)  # the error that followed a swallowed interruption
     if isinstance(exc, ParameterError):
         kind, code, msg = "bad-input", EXIT_BAD_INPUT, str(exc)
     elif isinstance(exc, KeyboardInterrupt):

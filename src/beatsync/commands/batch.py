@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ._common import add_json_flag, add_period_range, emit
 
@@ -14,8 +13,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="sync every motion clip with every song, in parallel on Dask",
         description="Track each song's beats once, segment each clip once, then sync every "
         "(clip, song) pair on a Dask cluster (local by default). Writes "
-        "OUT_DIR/<clip>__<song>.bvh and a summary CSV; a pair that fails on bad input "
-        "records its error in the summary instead of stopping the run.",
+        "OUT_DIR/<clip>__<song>.bvh and a summary CSV, all at the end (an error or Ctrl-C "
+        "leaves OUT_DIR as it was); a pair that fails on bad input records its error in "
+        "the summary instead of stopping the run. Workers of an existing cluster "
+        "(--scheduler) must see the same paths.",
     )
     p.add_argument("--clips", nargs="+", required=True, help="motion files (.bvh/.mat/.csv/.npy)")
     p.add_argument("--songs", nargs="+", required=True, help="audio files")
@@ -40,23 +41,36 @@ def run(args: argparse.Namespace) -> int:
     from .. import io
     from ..batch import sync_grid
     from ..cluster import check_cluster_options
-    from ._common import check_output_path
+    from ._common import Outputs, check_input_file, check_output, feedback
 
     workers = check_cluster_options(args.scheduler, args.workers)
-    summary = Path(args.summary) if args.summary else Path(args.out_dir) / "summary.csv"
-    check_output_path(summary, *args.clips, *args.songs)
-    table = sync_grid(
-        args.clips,
-        args.songs,
-        args.out_dir,
-        scheduler=args.scheduler,
-        n_workers=workers,
-        fps=args.fps,
-        bpm=args.bpm,
-        period_range=tuple(args.period_range),
-        progress=sys.stderr.isatty() and not args.json and not getattr(args, "quiet", False),
-    )
-    io.write_csv(summary, table)
+    inputs = [check_input_file(p, "clip") for p in args.clips]
+    inputs += [check_input_file(p, "song") for p in args.songs]
+    # all or nothing: the pairs are written into a staging folder inside --out-dir and
+    # moved into place with the summary only when the whole grid has run
+    with Outputs(inputs=inputs) as outs:
+        out_dir = outs.add_folder(args.out_dir, option="--out-dir")
+        summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
+        for c in args.clips:
+            for s in args.songs:
+                for suffix in (".bvh", ".csv"):  # the pair's output, whichever it will be
+                    name = f"{Path(c).stem}__{Path(s).stem}{suffix}"
+                    check_output(out_dir / name, option="--out-dir", inputs=inputs)
+        with feedback(args).step("batch") as progress:
+            table = sync_grid(
+                args.clips,
+                args.songs,
+                outs.staging_folder(out_dir),
+                scheduler=args.scheduler,
+                n_workers=workers,
+                fps=args.fps,
+                bpm=args.bpm,
+                period_range=tuple(args.period_range),
+                progress=progress,
+            )
+        for i in table.index[table["status"] == "ok"]:
+            table.loc[i, "output"] = str(outs.adopt(table.loc[i, "output"], option="--out-dir"))
+        io.write_csv(outs.path(summary), table)
     n_ok = int((table["status"] == "ok").sum())
     text = table.to_string(index=False) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
     emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
