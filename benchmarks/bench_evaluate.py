@@ -231,6 +231,11 @@ def main() -> int:
         f"| Dask overhead per track beyond the reading + tracking done in the worker | "
         f"{overhead_beyond_work_ms:.1f} ms | | |",
         "",
+        "Reading the table: the 2-worker ratio needs two idle cores. The summed reading + "
+        "tracking time of the workers tells whether they had them: with two free cores it "
+        "stays near the 1-worker figure; if it doubles, the cores were shared with other "
+        "work and the ratio says nothing about Dask.",
+        "",
     ]
     (HERE / "results").mkdir(exist_ok=True)
     io.write_json(HERE / "results" / "evaluate.json", data)
