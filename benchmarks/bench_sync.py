@@ -233,7 +233,9 @@ def main() -> int:
         f"Command: `{facts['command']}`  ",
         f"Machine: {facts['platform']}, {facts['processor']}, {facts['cpu_count']} CPUs "
         f"(1 used), Python {facts['python']}, numpy {facts['numpy']}, beatsync "
-        f"{facts['beatsync']}; {facts['date_utc']}; median of {args.repeats} runs.",
+        f"{facts['beatsync']}; {facts['date_utc']}; median of {args.repeats} runs; load "
+        f"average {facts['load_average']} (a shared machine inflates absolute times: read "
+        "the ratios).",
         "",
         f"Input: {data['input']['motion']}; {data['input']['music']}. "
         "Baseline: beat tracking alone (`track_beats`, phase-slope + HMM) in the same run.",
