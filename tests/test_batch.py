@@ -161,7 +161,7 @@ def test_batch_bad_cluster_options_fail_fast(inputs, tmp_path, monkeypatch, extr
 
 def test_batch_cli_bad_cluster_option_exit_code(inputs, tmp_path, capsys):
     code = main(_batch_args(inputs, tmp_path, "--workers", "-1"))
-    assert code == 3
+    assert code == 3  # a well-formed number that cannot be used: bad input
     assert "--workers=-1 must be a whole number of workers >= 1" in capsys.readouterr().err
 
 

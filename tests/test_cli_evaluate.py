@@ -285,5 +285,5 @@ def test_results_scored_otherwise_are_not_mixed(dataset, scheduler, tmp_path, ca
 
 def test_exit_code_and_message_on_bad_input(dataset, tmp_path, capsys):
     code, _, err = _run(_bad(tmp_path, dataset, extra=["--workers", "-1"]), capsys)
-    assert code == 3
+    assert code == 3  # bad input (2 is for usage errors)
     assert err.startswith("beatsync evaluate: error: --workers=-1")

@@ -229,7 +229,7 @@ def test_sync_unknown_choice_is_a_usage_error(inputs, tmp_path, capsys, option, 
     d, _, _ = inputs
     code = main(["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(tmp_path / "x.bvh"),
                  option, value])
-    assert code == 2  # usage error
+    assert code == 2
     assert "invalid choice" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
 

@@ -52,7 +52,6 @@ __all__ = [
     "position_options",
     "emit",
     "feedback",
-    "check_input_file",
     "check_output",
     "check_output_path",
     "check_side_outputs",
@@ -128,19 +127,6 @@ def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text.rstrip("\n") + "\n")
     return EXIT_OK
-
-
-# ---------------------------------------------------------------------- inputs
-
-
-def check_input_file(path: str | os.PathLike[str], what: str) -> Path:
-    """Refuse an input that does not exist or is not a file (before anything is read)."""
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"{what} {str(path)!r} does not exist")
-    if p.is_dir():
-        raise ParameterError(f"{what} {str(path)!r} is a folder; give a file")
-    return p
 
 
 # --------------------------------------------------------------------- outputs
@@ -438,6 +424,12 @@ class Outputs:
                     break
                 time.sleep(0.05)
         self._staging.clear()
+
+    def forget(self, final: str | os.PathLike[str]) -> None:
+        """Withdraw a declared output (a writer chose another file, see :meth:`adopt`)."""
+        key = Path(final).resolve()
+        self._staged.pop(key, None)
+        self._declared.pop(key, None)
 
     def adopt(self, staged: str | os.PathLike[str], *, option: str) -> Path:
         """Declare a file found in a staging folder (e.g. named by a worker) and stage it."""

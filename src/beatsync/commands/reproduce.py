@@ -13,7 +13,7 @@ import contextlib
 from pathlib import Path
 
 from . import COMMAND_HELP
-from ._common import Outputs, add_output_flags, check_input_file, emit, feedback
+from ._common import Outputs, add_output_flags, emit, feedback
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -46,9 +46,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
+    from ..io import check_input_file
     from ..runner import check_params, load_params, planned_outputs, run_notebooks
 
-    check_input_file(args.params, "parameter file")
+    check_input_file(args.params, "parameter")
     if not Path(args.notebooks).is_dir():
         raise ParameterError(f"--notebooks {args.notebooks!r} is not a folder of notebooks")
     if args.check and args.in_place:

@@ -6,12 +6,10 @@ annotations in ``data/``), track and score them with every method, summarise per
 group, check the targets, plot the tempo curves of the tempo-change items, and sweep
 the phase-slope front end on the development recordings and the synthetic set.
 
-Methods: ``psf`` (our tracker, :func:`beatsync.beats.track_beats`), ``librosa``
-(:func:`librosa.beat.beat_track`) and, when the optional peers module and the
-``essentia`` package are installed, essentia's ``BeatTrackerDegara`` and
-``BeatTrackerMultiFeature`` (:func:`available_methods` says which ran).
-
-Scores are mir_eval's (:func:`beatsync.evaluate.beats.evaluate_beats`). Synthetic
+Methods (:mod:`beatsync.peers`): ``psf`` (ours), ``librosa`` and, when the optional
+``essentia`` package is installed, essentia's ``BeatTrackerDegara`` and
+``BeatTrackerMultiFeature`` (:func:`available_methods` says which ran). Items are
+tracked and scored by :mod:`beatsync.study.beat_evaluation` (mir_eval metrics). Synthetic
 items use the notebook's ``min_beat_time``; the two long real recordings use
 mir_eval's default 5 s (their annotations' convention), the 2.8 s madmom sample 0 s.
 Two or three recordings are a sanity check, not a benchmark.
@@ -20,19 +18,18 @@ Two or three recordings are a sanity check, not a benchmark.
 from __future__ import annotations
 
 import itertools
-import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from .. import datasets
+from .. import datasets, peers
 from ..beats import FRONTEND_DEFAULTS, beat_tempo, track_beats
 from ..errors import BeatsyncWarning
-from ..evaluate.beats import evaluate_beats, octave_relation
 from ..synth.audio import BeatTestItem, make_beat_test_set
+from . import beat_evaluation
 
 __all__ = [
     "SHORT_NAMES",
@@ -41,6 +38,7 @@ __all__ = [
     "synthetic_items",
     "real_items",
     "score_items",
+    "meter_estimates",
     "summarize",
     "check_targets",
     "tempo_change_figure",
@@ -71,50 +69,13 @@ TARGETS = (
 _REAL_MIN_BEAT_TIME = {"hainsworth_001": 5.0, "ballroom_waltz": 5.0, "madmom_sample": 0.0}
 
 
-def _psf(y, sr, **kw):
-    bt = track_beats(y, sr, **kw)
-    return bt.beats, bt.beats_per_bar
+def available_methods() -> list[str]:
+    """Trackers that can run here, ours first (:func:`beatsync.peers.available`).
 
-
-def _librosa(y, sr):
-    return track_beats(y, sr, method="librosa").beats, 0
-
-
-def available_methods() -> dict[str, Callable[..., tuple[np.ndarray, int]]]:
-    """Trackers to compare: ``name -> f(y, sr) -> (beats [s], beats per bar or 0)``.
-
-    Always ``psf`` and ``librosa``; essentia's trackers are added when the optional
-    ``beatsync.peers`` module reports them available (``essentia`` installed).
+    Always ``psf`` and ``librosa``; essentia's two trackers when the optional
+    ``essentia`` package is installed.
     """
-    methods: dict[str, Callable[..., tuple[np.ndarray, int]]] = {
-        "psf": _psf,
-        "librosa": _librosa,
-    }
-    try:
-        from .. import peers  # noqa: PLC0415 (optional)
-    except ImportError:
-        return methods
-    for name, fn in _peer_trackers(peers).items():
-        methods.setdefault(name, fn)
-    return methods
-
-
-def _peer_trackers(peers: Any) -> dict[str, Callable[..., tuple[np.ndarray, int]]]:
-    """Wrap the peers module's methods that can run here (essentia only when installed)."""
-    out = {}
-    available = getattr(peers, "available", None)
-    track = getattr(peers, "track", None)
-    if available is None or track is None:
-        return out
-    for name, ok in available().items():
-        if not ok or name in ("psf", "librosa"):
-            continue
-
-        def fn(y, sr, _name=name):
-            return np.asarray(track(_name, y, sr), dtype=np.float64), 0
-
-        out[name] = fn
-    return out
+    return [name for name, ok in peers.available().items() if ok]
 
 
 def synthetic_items(**kwargs: Any) -> list[BeatTestItem]:
@@ -149,46 +110,43 @@ def _min_beat_time(item: BeatTestItem, default: float) -> float:
 def score_items(
     items: Sequence[BeatTestItem],
     *,
-    methods: dict[str, Callable[..., tuple[np.ndarray, int]]] | None = None,
+    methods: Sequence[str] | None = None,
     min_beat_time: float = 0.0,
     **track_kwargs: Any,
 ) -> pd.DataFrame:
     """Track and score every item with every method; one row per item and method.
 
-    Columns: item, group, method, tempo_ref, tempo_est (60 / median beat interval
-    [bpm]), octave (:func:`beatsync.evaluate.beats.octave_relation`), beats,
-    beats_per_bar (``psf`` only), F, CMLt, AMLt, seconds (tracking time).
-    ``track_kwargs`` go to the ``psf`` tracker (front-end parameters).
+    :func:`beatsync.study.beat_evaluation.score_items`, with each real recording
+    scored from its own ``min_beat_time`` and the study's short metric names.
+    Columns: item, group, method, tempo_ref, tempo_est, octave, F, CMLt, AMLt,
+    seconds. ``track_kwargs`` go to the ``psf`` tracker (front-end parameters).
     """
-    methods = available_methods() if methods is None else methods
+    methods = available_methods() if methods is None else list(methods)
+    frames = []
+    by_time: dict[float, list[BeatTestItem]] = {}
+    for it in items:
+        by_time.setdefault(_min_beat_time(it, min_beat_time), []).append(it)
+    for mbt, group in by_time.items():
+        frames.append(
+            beat_evaluation.score_items(
+                group, methods=methods, min_beat_time=mbt, track_kwargs=track_kwargs
+            )
+        )
+    scores = pd.concat(frames, ignore_index=True).rename(columns=SHORT_NAMES)
+    order = {it.name: i for i, it in enumerate(items)}
+    scores = scores.sort_values("item", key=lambda c: c.map(order), kind="stable")
+    cols = ["item", "group", "method", "tempo_ref", "tempo_est", "octave", "F", "CMLt", "AMLt"]
+    return scores[[*cols, "seconds"]].reset_index(drop=True)
+
+
+def meter_estimates(items: Sequence[BeatTestItem]) -> pd.DataFrame:
+    """Our meter estimate (beats per bar) and tempo for each item (``psf`` only)."""
     rows = []
     for it in items:
-        mbt = _min_beat_time(it, min_beat_time)
-        for name, fn in methods.items():
-            t0 = time.perf_counter()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", BeatsyncWarning)
-                beats, per_bar = (
-                    fn(it.y, it.sr, **track_kwargs) if name == "psf" else fn(it.y, it.sr)
-                )
-            seconds = time.perf_counter() - t0
-            s = evaluate_beats(it.beats, beats, min_beat_time=mbt)
-            ref_tempo = it.bpm if it.group != "change" else float("nan")
-            est = 60.0 / float(np.median(np.diff(beats))) if beats.size > 1 else float("nan")
-            rows.append(
-                {
-                    "item": it.name,
-                    "group": it.group,
-                    "method": name,
-                    "tempo_ref": it.bpm,
-                    "tempo_est": est,
-                    "octave": octave_relation(est, ref_tempo) if it.group != "change" else "",
-                    "beats": int(beats.size),
-                    "beats_per_bar": per_bar,
-                    **{SHORT_NAMES[k]: float(s[k]) for k in _METRICS},
-                    "seconds": seconds,
-                }
-            )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BeatsyncWarning)
+            bt = track_beats(it.y, it.sr)
+        rows.append({"item": it.name, "tempo": bt.tempo, "beats_per_bar": bt.beats_per_bar})
     return pd.DataFrame(rows)
 
 
@@ -273,7 +231,6 @@ def frontend_sweep(
     """
     keys = list(grid)
     rows = []
-    methods = {"psf": _psf}
     for combo in itertools.product(*(grid[k] for k in keys)):
         params = dict(zip(keys, combo, strict=True))
         if params.get("hop_s", 0.0) > params.get("win_s", FRONTEND_DEFAULTS["win_s"]) / 2:
@@ -283,9 +240,9 @@ def frontend_sweep(
             for k, v in params.items()
         )
         for set_name, items in item_sets.items():
-            sc = score_items(items, methods=methods, min_beat_time=min_beat_time, **params)
+            sc = score_items(items, methods=["psf"], min_beat_time=min_beat_time, **params)
             row = {
-                k: (str(list(v)) if isinstance(v, (list, tuple)) else v) for k, v in params.items()
+                k: str(list(v)) if isinstance(v, (list, tuple)) else v for k, v in params.items()
             }
             row.update({"set": set_name, "default": default})
             row.update({m: float(sc[m].mean()) for m in ("F", "CMLt", "AMLt")})
