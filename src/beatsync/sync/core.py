@@ -242,7 +242,7 @@ def synchronize(
         (``AUTO_PERIOD_RANGE``): periods are used for dances periodic at the step
         level; longer, varying figures (ballroom) go to ``"beats"``, which on the four
         real Dance-with-Melody dancers aligned their motion beats with a new song
-        clearly better (see :mod:`beatsync.study.paper_a_real_dancers`).
+        clearly better (see :mod:`beatsync.study.paper_a_dancers`).
 
     Returns
     -------
