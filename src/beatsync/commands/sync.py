@@ -147,8 +147,9 @@ def register(subparsers: Any) -> None:
         type=float,
         default=None,
         metavar=("LO", "HI"),
-        help="shortest and longest motion period searched [s] (default: one to eight beats "
-        "of the song, so real dance cycles such as a 4 s waltz box are found)",
+        help="shortest and longest motion period searched [s] (default: with --mode periods "
+        "one to eight beats of the song, so real dance cycles such as a 4 s waltz box are "
+        "found; with --mode auto paper A's 0.25 1.25, periods for step-periodic dances)",
     )
     p.add_argument(
         "--video",

@@ -14,7 +14,7 @@ for the paper's tables lives here, the scores themselves in
   dancer's accents put on the beat), :func:`sync_table` (every clip on every song),
   :func:`frame_count_view`, :func:`alignment_view`, :func:`alignment_summary`.
 - Figure 3: :func:`residual_table`, :func:`figure3`, :func:`animation_video`.
-- Real dancers re-synchronised to other songs: :mod:`.paper_a_real_dancers`.
+- Real dancers re-synchronised to other songs: :mod:`.paper_a_dancers`.
 - Artefacts: :func:`beatsync.study.artifacts.write_artifacts`.
 
 Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb``,

@@ -32,6 +32,8 @@ FILLS = ("stop", "loop")
 JOIN_S = 0.2
 #: default period range when segmenting, in music beats: one to eight beats
 PERIOD_BEATS = (0.9, 8.5)
+#: period range of the periodicity test in mode="auto": paper A's (steps, not figures)
+AUTO_PERIOD_RANGE = (0.25, 1.25)
 #: share of periods that must hold the same number of motion beats to call it a meter
 METER_AGREEMENT = 0.6
 
@@ -233,9 +235,14 @@ def synchronize(
     phase_offset : float [s]
         Land the boundaries this long after their beats (negative: before).
     period_range : (float, float) [s], optional
-        Shortest and longest period when segmenting here (``boundaries=None``);
-        default from the music: one to eight of its beats (``PERIOD_BEATS``), so real
-        dance cycles (a waltz box is 6 beats, about 4 s) are found.
+        Shortest and longest period when segmenting here (``boundaries=None``).
+        Default in ``mode="periods"``: one to eight of the music's beats
+        (``PERIOD_BEATS``), so real dance cycles (a waltz box is 6 beats, about 4 s)
+        are found. Default in ``mode="auto"``: paper A's 0.25-1.25 s
+        (``AUTO_PERIOD_RANGE``): periods are used for dances periodic at the step
+        level; longer, varying figures (ballroom) go to ``"beats"``, which on the four
+        real Dance-with-Melody dancers aligned their motion beats with a new song
+        clearly better (see :mod:`beatsync.study.paper_a_dancers`).
 
     Returns
     -------
@@ -308,7 +315,9 @@ def synchronize(
 
         delta = check_positive(delta, name="delta", unit="s")
     beat_period = float(np.median(np.diff(beats)))
-    if period_range is None:
+    if period_range is None and mode == "auto":
+        period_range = AUTO_PERIOD_RANGE
+    elif period_range is None:
         period_range = (PERIOD_BEATS[0] * beat_period, PERIOD_BEATS[1] * beat_period)
     else:
         try:
