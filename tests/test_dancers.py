@@ -66,6 +66,9 @@ def test_cli_reads_a_real_dancer(tmp_path, capsys):
     assert main(args + ["--up", "y", "--units", "cm"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["n_periods"] >= 5
+    assert res["positions"].startswith("json file in cm (given), y up (given)")
+    assert main(args[:-1]) == 0  # detected, and said so in the text output
+    assert "json file in cm (detected), y up (detected)" in capsys.readouterr().out
     beats = tmp_path / "beats.txt"
     beats.write_text("\n".join(f"{0.5 + 0.7 * k:.3f}" for k in range(60)))
     audio = str(datasets.path("motion/dance_with_melody/DANCE_W_5/audio.ogg"))
@@ -74,6 +77,13 @@ def test_cli_reads_a_real_dancer(tmp_path, capsys):
     assert main(sync + ["--period-range", "1", "5", "--json"]) == 0
     synced = io.read_motion(out, fps=25)
     assert synced.n_channels == 69 and synced.n_frames > 100
+    capsys.readouterr()
+    out_json = tmp_path / "synced.json"  # joint positions back in the input's layout
+    assert main(sync[:4] + [str(out_json)] + sync[5:] + ["--period-range", "1", "5"]) == 0
+    assert "json file in cm (detected)" in capsys.readouterr().out
+    back = json.loads(out_json.read_text())
+    assert list(back) == ["length", "center", "skeletons"]
+    assert np.asarray(back["skeletons"]).shape == (synced.n_frames, 23, 3)
 
 
 def test_cli_refuses_position_options_for_bvh(capsys):

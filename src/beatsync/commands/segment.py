@@ -106,6 +106,7 @@ def run(args: argparse.Namespace) -> int:
         args.motion, fps=args.fps, variable=args.variable, **position_options(args)
     )
     converted = is_marker_motion(motion)
+    positions = None if motion.position_info is None else motion.position_info.describe()
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
     channels = args.channels
     chan: str | list[str] = (
@@ -148,6 +149,7 @@ def run(args: argparse.Namespace) -> int:
         "period_range_s": list(period_range),
         "channels": list(seg.channels),
         "marker_angles": converted,
+        "positions": positions,
         "search_decimation": seg.search_decimation,
         "out": str(out) if out is not None else None,
     }
@@ -157,6 +159,7 @@ def run(args: argparse.Namespace) -> int:
             f"({60.0 / seg.mean_period:.1f} per minute), method {seg.period_method}, "
             f"{len(seg.channels)} channels",
             "boundaries [s]: " + " ".join(f"{t:.4f}" for t in seg.boundaries),
+            *([f"joint positions: {positions}"] if positions else []),
         ]
         + ([f"wrote {out}"] if out is not None else [])
     )

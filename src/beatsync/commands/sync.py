@@ -351,6 +351,7 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
     rep = dict(res.report)
     result: dict[str, Any] = {
         "motion": str(args.motion),
+        "positions": None if motion.position_info is None else motion.position_info.describe(),
         "audio": str(args.audio),
         "beats_source": beat_source,
         "n_music_beats": int(beats.size),
@@ -398,6 +399,7 @@ def _text(result: dict[str, Any]) -> str:
         f"{result['segmentation']['n_periods']} {unit} of "
         f"{result['segmentation']['mean_period_s']:.3f} s "
         f"({'mean' if r['mode'] == 'periods' else 'median'})",
+        *([f"         {result['positions']}"] if result.get("positions") else []),
         f"music    {result['audio']}: {result['music_duration_s']:.2f} s, "
         f"{result['n_music_beats']} beats ({result['beats_source']}), "
         f"beat period {r['beat_period_s']:.3f} s",
