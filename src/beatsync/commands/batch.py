@@ -3,19 +3,28 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ._common import add_json_flag, add_period_range, emit
+from . import COMMAND_HELP
+from ._common import (
+    EXIT_FAILED_ITEMS,
+    EXIT_OK,
+    Outputs,
+    add_output_flags,
+    add_period_range,
+    emit,
+    feedback,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "batch",
-        help="sync every motion clip with every song, in parallel on Dask",
+        help=COMMAND_HELP["batch"],
         description="Track each song's beats once, segment each clip once, then sync every "
         "(clip, song) pair on a Dask cluster (local by default). Writes "
         "OUT_DIR/<clip>__<song>.bvh and a summary CSV; a pair that fails on bad input "
-        "records its error in the summary instead of stopping the run.",
+        "records its error in the summary instead of stopping the run. The clips and the "
+        "summary appear in OUT_DIR only when the whole run finished.",
     )
     p.add_argument("--clips", nargs="+", required=True, help="motion files (.bvh/.mat/.csv/.npy)")
     p.add_argument("--songs", nargs="+", required=True, help="audio files")
@@ -30,7 +39,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
     )
     p.add_argument("--summary", default=None, help="summary CSV (default OUT_DIR/summary.csv)")
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
@@ -40,24 +49,35 @@ def run(args: argparse.Namespace) -> int:
     from .. import io
     from ..batch import sync_grid
     from ..cluster import check_cluster_options
-    from ._common import check_output_path
 
     workers = check_cluster_options(args.scheduler, args.workers)
-    summary = Path(args.summary) if args.summary else Path(args.out_dir) / "summary.csv"
-    check_output_path(summary, *args.clips, *args.songs)
-    table = sync_grid(
-        args.clips,
-        args.songs,
-        args.out_dir,
-        scheduler=args.scheduler,
-        n_workers=workers,
-        fps=args.fps,
-        bpm=args.bpm,
-        period_range=tuple(args.period_range),
-        progress=sys.stderr.isatty() and not args.json and not getattr(args, "quiet", False),
-    )
-    io.write_csv(summary, table)
+    outs = Outputs(inputs=[*args.clips, *args.songs])
+    out_dir = outs.add_folder(args.out_dir, option="--out-dir")
+    summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
+    suffix = {c: ".bvh" if c.lower().endswith(".bvh") else ".csv" for c in args.clips}
+    pair_files = {
+        out_dir / f"{Path(c).stem}__{Path(s).stem}{suffix[c]}"
+        for c in args.clips
+        for s in args.songs
+    }  # (repeated names are refused by sync_grid, with the reason)
+    for f in sorted(pair_files):
+        outs.add(f, option="--out-dir")
+    with outs:  # every synchronised clip and the summary appear together, or none
+        table = sync_grid(
+            args.clips,
+            args.songs,
+            outs.staging_folder(out_dir),
+            scheduler=args.scheduler,
+            n_workers=workers,
+            fps=args.fps,
+            bpm=args.bpm,
+            period_range=tuple(args.period_range),
+            progress=feedback(args).bars,
+        )
+        for i in table.index[table["status"] == "ok"]:
+            table.at[i, "output"] = str(outs.adopt(table.at[i, "output"], option="--out-dir"))
+        io.write_csv(outs.path(summary), table)
     n_ok = int((table["status"] == "ok").sum())
     text = table.to_string(index=False) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
     emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
-    return 0 if n_ok else 1
+    return EXIT_OK if n_ok else EXIT_FAILED_ITEMS

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, add_period_range, check_output_path, emit
+from . import COMMAND_HELP
+from ._common import Outputs, add_output_flags, add_period_range, emit, feedback
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "segment",
-        help="find the period boundaries of a periodic motion (paper A, section 3)",
+        help=COMMAND_HELP["segment"],
         description=(
             "Globally optimal segmentation of a periodic motion into its periods: "
             "consecutive periods are as similar as possible (Pearson correlation of joint "
@@ -62,7 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
     p.add_argument("--out", default=None, help="write the boundaries to this .csv file")
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
@@ -74,8 +75,11 @@ def run(args: argparse.Namespace) -> int:
     from ..segment import segment
     from ..units import time_to_frames
 
-    out = check_output_path(args.out, args.motion) if args.out else None
-    motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+    fb = feedback(args)
+    outs = Outputs(inputs=[args.motion])
+    out = outs.add(args.out, option="--out") if args.out else None
+    with fb.step("reading motion"):
+        motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
     converted = is_marker_motion(motion)
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
     channels = args.channels
@@ -89,22 +93,24 @@ def run(args: argparse.Namespace) -> int:
         )
         else list(channels)
     )
-    seg = segment(
-        motion,
-        alpha=args.alpha,
-        n_periods=args.periods,
-        period_range=tuple(args.period_range),
-        period_method="given" if args.periods is not None else args.period_method,
-        channels=chan,
-    )
+    with fb.step("segmenting periods"):
+        seg = segment(
+            motion,
+            alpha=args.alpha,
+            n_periods=args.periods,
+            period_range=tuple(args.period_range),
+            period_method="given" if args.periods is not None else args.period_method,
+            channels=chan,
+        )
     frames = time_to_frames(seg.boundaries, fps=seg.fps)
     if out is not None:
-        io.write_csv(
-            out,
-            pd.DataFrame(
-                {"boundary": range(frames.size), "time_s": seg.boundaries, "frame": frames}
-            ),
-        )
+        with outs:
+            io.write_csv(
+                outs.path(out),
+                pd.DataFrame(
+                    {"boundary": range(frames.size), "time_s": seg.boundaries, "frame": frames}
+                ),
+            )
     result = {
         "motion": str(args.motion),
         "fps": seg.fps,
