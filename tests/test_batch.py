@@ -163,3 +163,20 @@ def test_batch_cli_bad_cluster_option_exit_code(inputs, tmp_path, capsys):
     code = main(_batch_args(inputs, tmp_path, "--workers", "-1"))
     assert code == 3  # a well-formed number that cannot be used: bad input
     assert "--workers=-1 must be a whole number of workers >= 1" in capsys.readouterr().err
+
+
+def test_batch_writes_all_or_nothing(inputs, scheduler, tmp_path, monkeypatch, capsys):
+    """A failure after the pairs were synchronised (here: writing the summary) leaves
+    the output folder as it was: no pair's BVH behind, no staging folder."""
+    from beatsync.io import _files
+
+    (tmp_path / "keep.txt").write_text("before")
+
+    def fail(*a, **k):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(_files, "write_csv", fail)
+    monkeypatch.setattr(io, "write_csv", fail)
+    code = main(_batch_args(inputs, tmp_path, "--fps", "60", "--scheduler", scheduler))
+    assert code == 4, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]

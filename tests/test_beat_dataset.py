@@ -78,7 +78,7 @@ def test_read_annotation_one_or_two_columns(tmp_path):
     [
         ("500\n1000\n1500\n2000\n", "looks like milliseconds"),
         ("43\n86\n129\n172\n", "looks like frame indices"),
-        ("0.5\nabc\n", "'abc' is not a time in seconds"),
+        ("0.5\nabc\n", "line 2: .*'abc' is not a number"),
         ("1.0\n0.5\n", "strictly increasing"),
         ("# nothing\n", "empty"),
     ],

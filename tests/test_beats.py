@@ -319,3 +319,18 @@ def test_mix_clicks_puts_a_click_on_each_beat():
     env = np.abs(mix.astype(np.float64))
     assert env[int(0.5 * SR) : int(0.52 * SR)].max() > 0.3
     assert env[int(1.0 * SR) : int(1.4 * SR)].max() < 1e-3
+
+
+def test_study_scores_and_targets_on_a_small_set():
+    from beatsync.study import paper_a_beats as study
+
+    items = make_beat_test_set(duration=8.0, bpms=[120], kinds=["click"], groups=["clean"])
+    assert study.available_methods()[:2] == ["psf", "librosa"]
+    scores = study.score_items(items, methods=["psf"], min_beat_time=0.0)
+    assert list(scores["method"]) == ["psf"]
+    assert scores.loc[0, "F"] >= 0.95 and scores.loc[0, "octave"] == "correct"
+    targets = study.check_targets(scores)
+    clean = targets[targets["target"].str.contains("clean")]
+    assert clean["result"].tolist() == ["PASS"]
+    # targets of items that are not in the scores are left out, not failed
+    assert not targets["target"].str.contains("hainsworth").any()

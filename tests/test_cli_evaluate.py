@@ -144,6 +144,7 @@ def test_resume_after_interrupted_run(dataset, scheduler, tmp_path, capsys, monk
     monkeypatch.setattr(TrackLog, "append", append_then_interrupt)
     code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
     assert code == 130
+    assert "interrupted by SIGINT; the finished tracks are recorded in" in err
     assert "run the same command again" in err
     assert not (out / "summary.csv").exists()
     done = TrackLog(out / "tracks.jsonl").rows()

@@ -36,6 +36,9 @@ def inputs(tmp_path_factory):
     rng = np.random.default_rng(0)
     noise = salsa.with_values(rng.normal(0, 30.0, salsa.values.shape))
     io.write_bvh(d / "noise.bvh", noise)
+    # a real dancer (Dance-with-Melody waltz excerpt, joint positions, 25 fps), 12 s of it
+    dancer = datasets.load_dance_pair("DANCE_W_5").motion
+    io.write_motion(d / "dancer.json", dancer.slice_frames(0, 300))
     return d, salsa, beats
 
 
@@ -186,7 +189,13 @@ BAD = [
     (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
       "--mode", "periods"], "periodic.*--mode beats"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
-      "--beats-per-bar", "0"], "beats_per_bar"),
+      "--beats-per-bar", "0"], "beats-per-bar"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--period-range", "2", "1"],
+     "period-range"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--dance-beats", "-3"], "dance-beats"),
+    (["{d}/dancer.json", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "25"], "json.*npy"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.json", "--beats", "{d}/song.beats"],
+     "not joint positions"),
     (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.csv", "--fps", "60", "--beats",
       "{d}/song.beats", "--mode", "beats"], "positions"),
     (["{d}/salsa.bvh", "{d}/silence.wav", "-o", "{o}/x.bvh"], "silen"),
@@ -223,3 +232,31 @@ def test_sync_unknown_choice_is_a_usage_error(inputs, tmp_path, capsys, option, 
     assert code == 2
     assert "invalid choice" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
+    d, _, beats = inputs  # 12 s of a real waltz dancer on a 20 s song
+    out = tmp_path / "out.json"
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(out), "--fps", "25",
+            "--beats", str(d / "song.beats"), "--json", "--beats-per-bar", "3"]
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    result = json.loads(stdout)
+    r = result["report"]
+    assert r["fill"] == "loop" and r["output_duration_s"] >= beats[-1] - 1 / 25
+    assert r["max_abs_residual_frames"] <= 1.0
+    assert result["beats_per_bar"] == 3 and r["meter_fit"] is not False
+    assert r["beats_per_period"] in (1, 3, 6, 9)  # never 4 or 5 on a 3/4 song
+    back = io.read_motion(out, fps=25)
+    assert back.is_positional and back.n_frames == r["output_frames"]
+    src = io.read_motion(d / "dancer.json", fps=25)
+    bones = src.bones
+
+    def lengths(m):
+        p = m.positions()
+        return np.linalg.norm(p[:, bones[:, 0]] - p[:, bones[:, 1]], axis=-1)
+
+    # bone lengths through resampling: within 1 % of the source's range per bone
+    lo, hi = lengths(src).min(axis=0), lengths(src).max(axis=0)
+    got = lengths(back)
+    assert np.all(got >= 0.99 * lo) and np.all(got <= 1.01 * hi)

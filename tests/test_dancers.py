@@ -56,3 +56,29 @@ def test_real_excerpt_written_back_in_its_layout(tmp_path):
     assert a["length"] == b["length"] == 600
     np.testing.assert_allclose(a["skeletons"], b["skeletons"], atol=1e-9)
     np.testing.assert_allclose(a["center"], b["center"], atol=1e-9)
+
+
+def test_cli_reads_a_real_dancer(tmp_path, capsys):
+    from beatsync.cli import main
+
+    src = str(datasets.path("motion/dance_with_melody/DANCE_W_5/skeletons.json"))
+    args = ["segment", src, "--fps", "25", "--period-range", "1", "5", "--json"]
+    assert main(args + ["--up", "y", "--units", "cm"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["n_periods"] >= 5
+    beats = tmp_path / "beats.txt"
+    beats.write_text("\n".join(f"{0.5 + 0.7 * k:.3f}" for k in range(60)))
+    audio = str(datasets.path("motion/dance_with_melody/DANCE_W_5/audio.ogg"))
+    out = tmp_path / "synced.csv"
+    sync = ["sync", src, audio, "-o", str(out), "--fps", "25", "--beats", str(beats)]
+    assert main(sync + ["--period-range", "1", "5", "--json"]) == 0
+    synced = io.read_motion(out, fps=25)
+    assert synced.n_channels == 69 and synced.n_frames > 100
+
+
+def test_cli_refuses_position_options_for_bvh(capsys):
+    from beatsync.cli import main
+
+    bvh = str(datasets.path("motion/cmu_salsa/60_01_scaled.bvh"))
+    assert main(["segment", bvh, "--fps", "60", "--units", "cm"]) != 0
+    assert "units='cm' apply to joint-position files" in capsys.readouterr().err

@@ -492,3 +492,16 @@ def test_intensity_correlation_known_answers():
     assert intensity_correlation(inten, -inten) == pytest.approx(-1.0)
     with pytest.warns(BeatsyncWarning, match="fewer than two"):
         assert np.isnan(intensity_correlation(inten[:1], inten[:1]))
+
+
+def test_with_threshold_equals_a_build_at_that_threshold(library):
+    clips, beats = library
+    wide = build_graph(clips, beats=beats, th=10.0)
+    g3 = build_graph(clips, beats=beats, th=3.0)
+    cut = wide.with_threshold(3.0)
+    assert cut.th == 3.0 and cut.n_transitions == g3.n_transitions
+    np.testing.assert_array_equal(cut.trans_src, g3.trans_src)
+    np.testing.assert_allclose(cut.trans_weight, g3.trans_weight)
+    np.testing.assert_array_equal(cut.successors()[1], g3.successors()[1])
+    with pytest.raises(ParameterError, match="larger than the TH"):
+        g3.with_threshold(5.0)

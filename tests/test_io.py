@@ -170,7 +170,7 @@ def test_beats_files(tmp_path):
     with pytest.raises(ParameterError, match="increasing"):
         io.read_beats(tmp_path / "bad.beats")
     (tmp_path / "ms.beats").write_text("abc\n")
-    with pytest.raises(ParameterError, match=r"line 1: time='abc' is not a number \[s\]"):
+    with pytest.raises(ParameterError, match=r"line 1: 'abc' is not a time in seconds"):
         io.read_beats(tmp_path / "ms.beats")
     with pytest.raises(ParameterError, match="increasing"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
@@ -476,3 +476,67 @@ def test_write_bvh_refuses_nan_offset(tmp_path, chain_motion):
     with pytest.raises(ParameterError, match=r"OFFSET of joint .* NaN"):
         io.write_bvh(tmp_path / "x.bvh", m)
     assert not (tmp_path / "x.bvh").exists()
+
+
+# ------------------------------------------------------------ bit-stable JSON
+
+
+def test_write_json_float_digits_hides_last_digit_noise(tmp_path):
+    a = {"score": 0.1 + 0.2, "arr": np.array([1 / 3, 2.0]), "f32": np.float32(0.25), "n": 3}
+    b = {"score": 0.3, "arr": np.array([1 / 3 + 1e-16, 2.0]), "f32": 0.25, "n": 3}
+    pa = io.write_json(tmp_path / "a.json", a, float_digits=10)
+    pb = io.write_json(tmp_path / "b.json", b, float_digits=10)
+    assert pa.read_bytes() == pb.read_bytes()
+    import json
+
+    assert json.loads(pa.read_text()) == {
+        "score": 0.3,
+        "arr": [0.3333333333, 2.0],
+        "f32": 0.25,
+        "n": 3,
+    }
+    # default: exact floats
+    exact = io.write_json(tmp_path / "e.json", {"score": 0.1 + 0.2})
+    assert "0.30000000000000004" in exact.read_text()
+
+
+@pytest.mark.parametrize(
+    "digits, match", [(0, "1-17"), (18, "1-17"), (2.5, "whole"), (True, "whole")]
+)
+def test_write_json_bad_float_digits(tmp_path, digits, match):
+    with pytest.raises(ParameterError, match=rf"float_digits={digits!r} must be"):
+        io.write_json(tmp_path / "x.json", {"a": 1.0}, float_digits=digits)
+    assert not (tmp_path / "x.json").exists()
+
+
+def test_npy_renamed_npz_refused(tmp_path):
+    np.save(tmp_path / "a.npy", np.zeros((3, 2)))
+    p = (tmp_path / "a.npy").rename(tmp_path / "a.npz")
+    with pytest.raises(ParameterError, match=r"is a single \.npy array, not an \.npz archive"):
+        io.read_npz(p)
+    (tmp_path / "t.npz").write_bytes(b"PK\x03\x04 broken zip")
+    with pytest.raises(ParameterError, match=r"cannot read .* as an \.npz archive"):
+        io.read_npz(tmp_path / "t.npz")
+
+
+def test_mat_without_marker_struct_refused(tmp_path):
+    import scipy.io
+
+    scipy.io.savemat(tmp_path / "m.mat", {"rec": {"data": np.zeros((10, 3)), "freq": 100.0}})
+    with pytest.raises(ParameterError, match=r"no MoCap Toolbox marker recording .*\['rec'\]"):
+        io.read_mocap_mat(tmp_path / "m.mat")
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [("a,b\n1,2\n3\n", r"line 3: 1 fields, but the header"), ("a,b\n1,2,5\n3,4\n", "line 2: 3")],
+)
+def test_csv_row_with_wrong_field_count_refused(tmp_path, text, match):
+    (tmp_path / "t.csv").write_text(text)
+    with pytest.raises(ParameterError, match=match):
+        io.read_motion(tmp_path / "t.csv", fps=25)
+
+
+def test_csv_with_byte_order_mark_read(tmp_path):
+    (tmp_path / "t.csv").write_text("a,b\n1,2\n3,4\n", encoding="utf-8-sig")
+    assert io.read_motion(tmp_path / "t.csv", fps=25).channels == ("a", "b")

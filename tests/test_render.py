@@ -149,7 +149,5 @@ def test_position_only_motion_is_drawn_with_bones():
     pos[:, 2, 2] = 1.0
     names = tuple(f"{j}_{a}" for j in ("a", "b", "c") for a in "xyz")
     m = Motion(pos.reshape(4, -1), FPS, names, None, "positions")
-    if not hasattr(m, "is_positional"):
-        pytest.skip("Motion has no position-only form yet")
     _, bones = render.pose_positions(m)
     assert len(bones) == 2  # a-b and b-c: drawn as bones, not dots

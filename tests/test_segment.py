@@ -12,9 +12,11 @@ from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.evaluate.segmentation import boundary_errors
 from beatsync.motion import Motion, marker_angles
 from beatsync.segment import (
+    DANCE_PERIOD_RANGE,
     SEARCH_MEMORY_BUDGET,
     Segmentation,
     estimate_period_count,
+    period_range_from_beat,
     segment,
     segment_values,
     segmentation_energy,
@@ -23,7 +25,7 @@ from beatsync.segment import (
 from beatsync.segment import core as segment_core
 from beatsync.segment.channels import standardise
 from beatsync.segment.costs import edge_costs, pair_costs, resample_weights
-from beatsync.segment.period import estimate_period, estimation_band
+from beatsync.segment.period import estimate_period, estimation_band, period_tiers
 from beatsync.segment.reference import segment_literal
 from beatsync.segment.search import (
     count_fits,
@@ -507,3 +509,53 @@ def test_resample_weights_vectorised_equals_scalar():
         np.testing.assert_array_equal(w[row], ws)
         # resampling a ramp is exact: k * d1 / d0
         np.testing.assert_allclose(js + ws, np.arange(11) * d / 10)
+
+
+# ------------------------------------------------------- period range (dance cycles)
+def test_period_range_from_beat():
+    assert period_range_from_beat(0.5) == (0.5, 4.0)
+    assert period_range_from_beat(0.7, beats=(3, 6)) == pytest.approx((2.1, 4.2))
+
+
+@pytest.mark.parametrize(
+    "beat,kw,match",
+    [
+        (120.0, {}, "BPM"),  # a tempo, not a beat period
+        (0.0, {}, "> 0"),
+        (float("nan"), {}, "finite"),
+        ("fast", {}, "not a number"),
+        (0.5, {"beats": (8, 1)}, "reversed"),
+        (0.5, {"beats": (0, 8)}, "> 0"),
+        (0.5, {"beats": 8}, "two numbers"),
+    ],
+)
+def test_period_range_from_beat_bad_input(beat, kw, match):
+    with pytest.raises(ParameterError, match=match):
+        period_range_from_beat(beat, **kw)
+
+
+def test_period_tiers():
+    assert period_tiers(0.25, 1.25) == [(0.25, 1.25)]
+    assert period_tiers(*DANCE_PERIOD_RANGE) == [(0.25, 1.25), (1.25, 6.25)]
+    assert period_tiers(0.5, 4.0) == [(0.5, 2.5), (2.5, 4.0)]
+
+
+def test_long_cycle_found_in_the_dance_range():
+    """A 4 s figure (like a waltz box) with no shorter repetition."""
+    s = periodic_motion(n_frames=1001, n_channels=12, fps=25.0, n_periods=10, snr_db=20, seed=2)
+    with pytest.raises(ParameterError, match="not periodic"):
+        segment(s.motion)  # the paper's 0.25-1.25 s
+    seg = segment(s.motion, period_range=DANCE_PERIOD_RANGE)
+    assert seg.mean_period == pytest.approx(4.0, rel=0.03)
+    assert np.abs(seg.boundary_frames - s.boundary_frames[: seg.n_periods + 1]).max() <= 2
+    seg_b = segment(s.motion, period_range=period_range_from_beat(0.5))  # 1-8 beats
+    assert seg_b.mean_period == pytest.approx(4.0, rel=0.03)
+
+
+@pytest.mark.slow
+def test_dance_range_keeps_the_step_period_of_salsa():
+    """Searched at once over 0.25-6 s, salsa 61_04 came out as 9 periods of 2.9 s."""
+    m = datasets.load_salsa("61_04")
+    seg = segment(m, period_range=DANCE_PERIOD_RANGE)
+    assert seg.mean_period == pytest.approx(segment(m).mean_period, abs=1e-9)
+    assert 0.95 <= seg.mean_period <= 1.1

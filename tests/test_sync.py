@@ -226,7 +226,7 @@ def test_no_warning_in_normal_case():
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": 99}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": -1}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": 0}, "beats"),
-        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": "2"}, "beats"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": "two"}, "beats"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": 1.5}, "beats"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": "x"}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"phase_offset": "x"}, "phase"),
@@ -403,9 +403,11 @@ def test_sync_waltz_step_on_3_4_keeps_the_step_whole():
     m = _waltz_motion()
     bounds = np.arange(0.0, 14.3, 2.4)
     beats = np.arange(0.2, 60.0, 0.5)  # 120 BPM: a step is 4.8 beats
-    res = synchronize(m, bounds, beats, beats_per_bar=3)
-    assert res.report["dance_beats_per_period"] == 3
+    res = synchronize(m, bounds, beats, beats_per_bar=3, dance_beats_per_period=3)
+    assert res.report["motion_beats_per_period_counted"] == 3  # the speed minima agree
     assert res.report["beats_per_period"] == 6 and res.report["meter_fit"] is True
+    # the song's 3/4 alone: 4.8 beats -> 6, never 5
+    assert synchronize(m, bounds, beats, beats_per_bar=3).report["beats_per_period"] == 6
 
 
 def test_sync_waltz_step_on_4_4_says_the_meters_do_not_fit():
@@ -413,7 +415,7 @@ def test_sync_waltz_step_on_4_4_says_the_meters_do_not_fit():
     bounds = np.arange(0.0, 14.3, 2.4)
     beats = np.arange(0.2, 60.0, 0.5)
     with pytest.warns(BeatsyncWarning, match="do not fit"):
-        res = synchronize(m, bounds, beats, beats_per_bar=4)
+        res = synchronize(m, bounds, beats, beats_per_bar=4, dance_beats_per_period=3)
     assert res.report["beats_per_period"] in (3, 6)  # the step stays whole, never 5 or 4
     assert res.report["meter_fit"] is False and "do not fit" in res.report["meter_note"]
 
@@ -467,23 +469,62 @@ def test_mode_beats_lands_the_dancers_own_beats():
     assert np.median(d) <= 1.0 / 25 + 1e-9  # the dancer's beats now sit on the music's
 
 
-def test_mode_auto_falls_back_to_beats_and_says_so():
-    rng = np.random.default_rng(3)
-    turns = np.cumsum(rng.uniform(0.45, 0.8, 30))
-    m = _arm_positions(fps=25.0, seconds=15.0, beat_times=np.r_[0.0, turns])
+@pytest.fixture(scope="module")
+def waltz_dancer() -> Motion:
+    """12 s of a real waltz dancer (Dance-with-Melody, joint positions, 25 fps)."""
+    from beatsync import datasets
+
+    return datasets.load_dance_pair("DANCE_W_5").motion.slice_frames(0, 300)
+
+
+def test_mode_auto_falls_back_to_beats_and_says_so(waltz_dancer):
+    # paper A's period range (0.25-1.25 s) holds no cycle of this waltz: not periodic
     beats = np.arange(0.5, 30.0, 0.5)
     with pytest.warns(BeatsyncWarning, match="fell back"):
-        res = synchronize(m, None, beats, mode="auto", fill="loop")
-    assert res.report["mode"] == "beats" and "refused" in res.report["mode_note"]
-    assert res.report["output_duration_s"] >= beats[-1] - 1.0 / 25
+        res = synchronize(
+            waltz_dancer, None, beats, mode="auto", fill="loop", period_range=(0.25, 1.25)
+        )
+    r = res.report
+    assert r["mode"] == "beats" and "refused" in r["mode_note"]
+    assert r["output_duration_s"] >= beats[-1] - 1.0 / 25 and r["repetitions"] >= 2
+    assert r["max_abs_residual_frames"] <= 0.5 + 1e-6
 
 
-def test_mode_periods_refuses_a_motion_that_is_not_periodic():
-    rng = np.random.default_rng(3)
-    turns = np.cumsum(rng.uniform(0.45, 0.8, 30))
-    m = _arm_positions(fps=25.0, seconds=15.0, beat_times=np.r_[0.0, turns])
+def test_mode_periods_refuses_a_motion_that_is_not_periodic(waltz_dancer):
     with pytest.raises(ParameterError, match="not look periodic.*mode='beats'"):
-        synchronize(m, None, np.arange(0.5, 30.0, 0.5), mode="periods")
+        synchronize(
+            waltz_dancer, None, np.arange(0.5, 30.0, 0.5), mode="periods", period_range=(0.25, 1.25)
+        )
+
+
+@pytest.mark.parametrize("mode", ["periods", "beats"])
+def test_real_dancer_positions_both_modes_keep_bones(waltz_dancer, mode):
+    # the period range from the song (one to eight beats) holds the waltz's cycle
+    beats = np.arange(0.3, 40.0, 60 / 84)  # 84 BPM, 40 s: longer than the clip
+    res = synchronize(waltz_dancer, None, beats, mode=mode, fill="loop", beats_per_bar=3)
+    r = res.report
+    assert r["mode"] == mode and r["max_abs_residual_frames"] <= 0.5 + 1e-6
+    assert r["output_duration_s"] >= beats[-1] - 1.0 / 25
+    assert res.motion.is_positional
+    if mode == "periods":  # a waltz bar (about 2 s) on the 3/4 song: 3 beats
+        assert r["meter_fit"] is True and r["beats_per_period"] == 3
+    bones = waltz_dancer.bones
+
+    def lengths(m):
+        p = m.positions()
+        return np.linalg.norm(p[:, bones[:, 0]] - p[:, bones[:, 1]], axis=-1)
+
+    src, out = lengths(waltz_dancer), lengths(res.motion)
+    # each output frame's bones: within 1 % of the source's lengths near the frames shown
+    assert np.all(out >= 0.99 * src.min(axis=0)) and np.all(out <= 1.01 * src.max(axis=0))
+    # frame by frame (no loop): each bone as long as in the source at the time shown
+    stop = synchronize(waltz_dancer, None, beats, mode=mode, fill="stop", beats_per_bar=3)
+    f = np.clip(stop.warp_src_times * waltz_dancer.fps, 0, waltz_dancer.n_frames - 1)
+    i0 = np.floor(f).astype(int)
+    i1 = np.minimum(i0 + 1, waltz_dancer.n_frames - 1)
+    u = (f - i0)[:, None]
+    expected = src[i0] * (1 - u) + src[i1] * u
+    assert np.abs(lengths(stop.motion) / expected - 1).max() <= 0.01
 
 
 def test_mode_beats_needs_positions():

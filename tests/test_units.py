@@ -162,7 +162,7 @@ def test_check_between_accepts_closed_bounds():
         (0, r"sr=0 must be a finite sample rate > 0 \[Hz\]"),
         (-22050, "> 0"),
         (np.nan, "> 0"),
-        ("fast", r"sr='fast' is text, not a number \[Hz\]"),
+        ("fast", r"sr='fast' is not a number \[Hz\]"),
         (44.1, r"not kHz; did you mean sr=44100\?"),
         (None, "not a number"),
     ],
@@ -260,3 +260,9 @@ def test_check_finite_dtype_none_keeps_float32():
 def test_check_times_refuses_strings_as_parameter_error():
     with pytest.raises(ParameterError, match="strings"):
         check_times(["a", "b"])
+
+
+def test_check_helpers_accept_numbers_written_as_text():
+    assert check_positive("2.5", name="th", unit="rd") == 2.5
+    assert check_fps("60", name="fps") == 60.0
+    assert check_bpm("120") == 120.0

@@ -16,8 +16,7 @@ skeleton); inputs are never written.
 from __future__ import annotations
 
 import os
-import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -132,7 +131,7 @@ def sync_grid(
     bpm: float | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
-    progress: bool = False,
+    progress: Callable[..., None] | None = None,
 ) -> Any:
     """Synchronise every clip with every song on Dask; return a table of reports.
 
@@ -155,8 +154,8 @@ def sync_grid(
         Frame-rate override for every clip (e.g. 60 for the CMU salsa files).
     bpm : float, optional [BPM]
         Known tempo of every song.
-    progress : bool
-        A tqdm bar of finished pairs on stderr.
+    progress : callable ``progress(done, total=None)``, optional
+        Called as pairs finish (e.g. a command's progress bar).
 
     Returns
     -------
@@ -231,12 +230,11 @@ def sync_grid(
             for c in clips
             for s in songs
         ]
-        if progress:
+        if progress is not None:
             from dask.distributed import as_completed
-            from tqdm import tqdm
 
-            with tqdm(total=len(pairs), desc="batch", unit="pair", file=sys.stderr) as bar:
-                for _ in as_completed(pairs):
-                    bar.update()
+            progress(0, total=len(pairs))
+            for done, _ in enumerate(as_completed(pairs), 1):
+                progress(done)
         rows = client.gather(pairs)
     return pd.DataFrame(rows)

@@ -1,9 +1,12 @@
 """Time bases and every validation helper of beatsync (the lowest layer but ``errors``).
 
 Every public entry of the package checks its inputs here, once; private functions
-trust them. Each helper raises :class:`~beatsync.errors.ParameterError` naming the
-value and the likely mistake (a period given for a rate, frames for seconds, kHz for
-Hz, a percentage for a fraction) and returns the value converted to its working type.
+trust them. The ``check_*`` helpers accept a number written as text (``"2.5"``, as
+the checks they replaced did); :func:`as_float` and :func:`as_int` refuse text unless
+``text=True`` (a count passed as ``"2"`` is a likely mistake in a call). Each helper
+raises :class:`~beatsync.errors.ParameterError` naming the value and the likely
+mistake (a period given for a rate, frames for seconds, kHz for Hz, a percentage for a
+fraction) and returns the value converted to its working type.
 
 Helpers
 -------
@@ -147,7 +150,7 @@ def check_fps(fps: Any, *, name: str = "fps") -> float:
     ParameterError
         If ``fps`` is not a finite positive number.
     """
-    value = as_float(fps, name=name, unit="Hz", allow_nonfinite=True)
+    value = as_float(fps, name=name, unit="Hz", allow_nonfinite=True, text=True)
     if not np.isfinite(value) or value <= 0:
         raise ParameterError(
             f"{name}={fps!r} must be a finite frame rate > 0 [Hz] "
@@ -167,7 +170,7 @@ def check_positive(value: Any, *, name: str, unit: str, allow_zero: bool = False
     Use for durations, widths, window lengths: anything positive that is not a rate
     (see :func:`check_fps`, :func:`check_sample_rate`, :func:`check_bpm`).
     """
-    v = as_float(value, name=name, unit=unit, allow_nonfinite=True)
+    v = as_float(value, name=name, unit=unit, allow_nonfinite=True, text=True)
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         bound = ">= 0" if allow_zero else "> 0"
         raise ParameterError(f"{name}={value!r} must be a finite number {bound} [{unit}]")
@@ -361,8 +364,8 @@ def check_times(
 def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float]:
     """Validate an interval ``lo < hi``, both finite and > 0, in ``unit``."""
     try:
-        lo_f = as_float(lo, name=name, unit=unit, allow_nonfinite=True)
-        hi_f = as_float(hi, name=name, unit=unit, allow_nonfinite=True)
+        lo_f = as_float(lo, name=name, unit=unit, allow_nonfinite=True, text=True)
+        hi_f = as_float(hi, name=name, unit=unit, allow_nonfinite=True, text=True)
     except ParameterError:
         raise ParameterError(f"{name}=({lo!r}, {hi!r}) must be two numbers [{unit}]") from None
     if not (np.isfinite(lo_f) and np.isfinite(hi_f)) or lo_f <= 0 or hi_f <= 0:
@@ -404,7 +407,7 @@ def check_between(
     """
     if closed not in ("neither", "low", "high", "both"):
         raise ValueError(f"closed={closed!r} must be 'neither', 'low', 'high' or 'both'")
-    v = as_float(value, name=name, unit=unit)
+    v = as_float(value, name=name, unit=unit, text=True)
     low_ok = v >= low if closed in ("low", "both") else v > low
     high_ok = v <= high if closed in ("high", "both") else v < high
     if not (low_ok and high_ok):
@@ -433,7 +436,7 @@ def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
     >>> check_sample_rate(22050)
     22050.0
     """
-    v = as_float(sr, name=name, unit="Hz", allow_nonfinite=True)
+    v = as_float(sr, name=name, unit="Hz", allow_nonfinite=True, text=True)
     if not np.isfinite(v) or v <= 0:
         raise ParameterError(
             f"{name}={sr!r} must be a finite sample rate > 0 [Hz] (a file header saying 0 "
@@ -462,7 +465,7 @@ def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
     >>> check_bpm(120)
     120.0
     """
-    v = as_float(bpm, name=name, unit="bpm", allow_nonfinite=True)
+    v = as_float(bpm, name=name, unit="bpm", allow_nonfinite=True, text=True)
     if not np.isfinite(v) or not MIN_BPM <= v <= MAX_BPM:
         hint = "did you give a beat period in seconds, or beats per second?"
         if np.isfinite(v) and v > MAX_BPM:

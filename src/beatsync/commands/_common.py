@@ -48,6 +48,8 @@ __all__ = [
     "add_output_flags",
     "add_json_flag",
     "add_period_range",
+    "add_position_options",
+    "position_options",
     "emit",
     "feedback",
     "check_output",
@@ -191,6 +193,40 @@ def check_output(
     except ParameterError as exc:
         raise ParameterError(f"{name}: {exc}") from None
     return p
+
+
+def add_position_options(parser: argparse.ArgumentParser) -> None:
+    """``--up``, ``--units``, ``--max-gap`` for commands that read joint-position motion.
+
+    Pass them on with ``io.read_motion(path, fps=args.fps, variable=args.variable,
+    **position_options(args))``; ``--fps`` stays each command's own option (required
+    for .json and .npy joint positions; a C3D file's own rate may not be contradicted).
+    """
+    parser.add_argument(
+        "--up",
+        choices=("y", "z"),
+        default=None,
+        help="vertical axis of joint positions (.json/.npy/.npz/.c3d); default detected",
+    )
+    parser.add_argument(
+        "--units",
+        choices=("m", "cm", "mm"),
+        default=None,
+        help="length unit of joint positions; default detected from the body's size",
+    )
+    parser.add_argument(
+        "--max-gap",
+        type=float,
+        default=0.25,
+        metavar="SECONDS",
+        help="longest run of missing (NaN) joint values filled by interpolation [s] "
+        "(default 0.25); a longer gap is refused with the joint named",
+    )
+
+
+def position_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The keyword arguments of ``io.read_motion`` given by :func:`add_position_options`."""
+    return {"up": args.up, "units": args.units, "max_gap": args.max_gap}
 
 
 @contextlib.contextmanager

@@ -4,27 +4,19 @@ from __future__ import annotations
 
 import argparse
 
-from . import COMMAND_HELP
-from ._common import (
-    EXIT_FAILED_ITEMS,
-    EXIT_OK,
-    Outputs,
-    add_output_flags,
-    add_period_range,
-    emit,
-    feedback,
-)
+from ._common import add_json_flag, add_period_range, emit
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "batch",
-        help=COMMAND_HELP["batch"],
+        help="sync every motion clip with every song, in parallel on Dask",
         description="Track each song's beats once, segment each clip once, then sync every "
         "(clip, song) pair on a Dask cluster (local by default). Writes "
-        "OUT_DIR/<clip>__<song>.bvh and a summary CSV; a pair that fails on bad input "
-        "records its error in the summary instead of stopping the run. The clips and the "
-        "summary appear in OUT_DIR only when the whole run finished.",
+        "OUT_DIR/<clip>__<song>.bvh and a summary CSV, all at the end (an error or Ctrl-C "
+        "leaves OUT_DIR as it was); a pair that fails on bad input records its error in "
+        "the summary instead of stopping the run. Workers of an existing cluster "
+        "(--scheduler) must see the same paths.",
     )
     p.add_argument("--clips", nargs="+", required=True, help="motion files (.bvh/.mat/.csv/.npy)")
     p.add_argument("--songs", nargs="+", required=True, help="audio files")
@@ -39,7 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
     )
     p.add_argument("--summary", default=None, help="summary CSV (default OUT_DIR/summary.csv)")
-    add_output_flags(p)
+    add_json_flag(p)
     p.set_defaults(func=run)
 
 
@@ -49,35 +41,38 @@ def run(args: argparse.Namespace) -> int:
     from .. import io
     from ..batch import sync_grid
     from ..cluster import check_cluster_options
+    from ..io import check_input_file
+    from ._common import Outputs, check_output, feedback
 
     workers = check_cluster_options(args.scheduler, args.workers)
-    outs = Outputs(inputs=[*args.clips, *args.songs])
-    out_dir = outs.add_folder(args.out_dir, option="--out-dir")
-    summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
-    suffix = {c: ".bvh" if c.lower().endswith(".bvh") else ".csv" for c in args.clips}
-    pair_files = {
-        out_dir / f"{Path(c).stem}__{Path(s).stem}{suffix[c]}"
-        for c in args.clips
-        for s in args.songs
-    }  # (repeated names are refused by sync_grid, with the reason)
-    for f in sorted(pair_files):
-        outs.add(f, option="--out-dir")
-    with outs:  # every synchronised clip and the summary appear together, or none
-        table = sync_grid(
-            args.clips,
-            args.songs,
-            outs.staging_folder(out_dir),
-            scheduler=args.scheduler,
-            n_workers=workers,
-            fps=args.fps,
-            bpm=args.bpm,
-            period_range=tuple(args.period_range),
-            progress=feedback(args).bars,
-        )
+    inputs = [check_input_file(p, "clip") for p in args.clips]
+    inputs += [check_input_file(p, "song") for p in args.songs]
+    # all or nothing: the pairs are written into a staging folder inside --out-dir and
+    # moved into place with the summary only when the whole grid has run
+    with Outputs(inputs=inputs) as outs:
+        out_dir = outs.add_folder(args.out_dir, option="--out-dir")
+        summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
+        for c in args.clips:
+            for s in args.songs:
+                for suffix in (".bvh", ".csv"):  # the pair's output, whichever it will be
+                    name = f"{Path(c).stem}__{Path(s).stem}{suffix}"
+                    check_output(out_dir / name, option="--out-dir", inputs=inputs)
+        with feedback(args).step("batch") as progress:
+            table = sync_grid(
+                args.clips,
+                args.songs,
+                outs.staging_folder(out_dir),
+                scheduler=args.scheduler,
+                n_workers=workers,
+                fps=args.fps,
+                bpm=args.bpm,
+                period_range=tuple(args.period_range),
+                progress=progress,
+            )
         for i in table.index[table["status"] == "ok"]:
-            table.at[i, "output"] = str(outs.adopt(table.at[i, "output"], option="--out-dir"))
+            table.loc[i, "output"] = str(outs.adopt(table.loc[i, "output"], option="--out-dir"))
         io.write_csv(outs.path(summary), table)
     n_ok = int((table["status"] == "ok").sum())
     text = table.to_string(index=False) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
     emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
-    return EXIT_OK if n_ok else EXIT_FAILED_ITEMS
+    return 0 if n_ok else 1

@@ -5,10 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._common import add_json_flag, emit
+from ._common import add_output_flags, emit
 
 #: Unmatched audio files named in the text output before "... and N more".
 SHOWN = 10
+
+EXIT_FAILED_ITEMS = 1  # as beatsync.commands._common (not imported: --help stays light)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -58,7 +60,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
     )
     b.add_argument("--force", action="store_true", help="re-run tracks already scored")
-    add_json_flag(b)
+    add_output_flags(b)
     b.set_defaults(func=run_beats)
 
 
@@ -68,44 +70,43 @@ def run_beats(args: argparse.Namespace) -> int:
     from .. import peers
     from ..cluster import check_cluster_options
     from ..errors import ParameterError
-    from ..study.beat_dataset import evaluate_dataset, find_tracks
+    from ..study.beat_dataset import RESULT_FILES, evaluate_dataset, find_tracks
     from ..units import check_positive
+    from ._common import check_output, feedback
 
+    fb = feedback(args)
     # cheapest first: options, then the output folder, then the inputs
     workers = check_cluster_options(args.scheduler, args.workers)
     mbt = check_positive(args.min_beat_time, name="--min-beat-time", unit="s", allow_zero=True)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out {args.out!r} is a file; give a folder for the results")
+    if out.is_dir():  # the files it will hold must be writable files
+        for name in RESULT_FILES:
+            check_output(out / name, option="--out")
     peers.get(args.method)
     found = find_tracks(args.audio, args.annotations)
     if found.unmatched:
         names = [str(p) for p in found.unmatched]
         more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
-        print(
-            f"beatsync evaluate beats: {len(names)} audio file(s) without an annotation "
-            f"(NAME.beats) are skipped: {', '.join(names[:SHOWN])}{more}",
-            file=sys.stderr,
+        fb.warn(
+            f"{len(names)} audio file(s) without an annotation (NAME.beats) are skipped: "
+            f"{', '.join(names[:SHOWN])}{more}"
         )
-    progress = sys.stderr.isatty() and not args.json and not getattr(args, "quiet", False)
     try:
-        run = evaluate_dataset(
-            found.tracks,
-            out,
-            method=args.method,
-            min_beat_time=mbt,
-            force=args.force,
-            scheduler=args.scheduler,
-            n_workers=workers,
-            progress=progress,
-        )
-    except KeyboardInterrupt:
-        print(
-            f"the finished tracks are in {str(out / 'tracks.jsonl')!r}; run the same command "
-            "again to score the others",
-            file=sys.stderr,
-        )
-        raise
+        with fb.step(f"evaluate {args.method}") as progress:
+            run = evaluate_dataset(
+                found.tracks,
+                out,
+                method=args.method,
+                min_beat_time=mbt,
+                force=args.force,
+                scheduler=args.scheduler,
+                n_workers=workers,
+                progress=progress,
+            )
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc, out / "tracks.jsonl", args)
     t = run.tracks
     failed = t[t["status"] != "ok"]
     result = {
@@ -132,4 +133,23 @@ def run_beats(args: argparse.Namespace) -> int:
         f"({run.scored} run now{skipped}); results in {run.files['summary'].parent}"
     )
     emit(result, "\n".join(lines), args)
-    return 0 if len(failed) < len(t) else 1
+    return 0 if len(failed) < len(t) else EXIT_FAILED_ITEMS
+
+
+def _interrupted(exc: KeyboardInterrupt, log: object, args: argparse.Namespace) -> int:
+    """Ctrl-C or SIGTERM: the finished tracks stay recorded; say so and how to go on."""
+    import json
+    import signal
+
+    signum = int(getattr(exc, "signum", signal.SIGINT))
+    msg = (
+        f"interrupted by {signal.Signals(signum).name}; the finished tracks are recorded in "
+        f"{str(log)!r}: run the same command again to score the others"
+    )
+    if args.json:
+        obj = {"error": msg, "kind": "interrupted", "command": "evaluate",
+               "exit_code": 128 + signum}  # fmt: skip
+        print(json.dumps(obj), file=sys.stderr, flush=True)
+    else:
+        print(f"beatsync evaluate: error: {msg}", file=sys.stderr, flush=True)
+    return 128 + signum

@@ -9,7 +9,15 @@ from __future__ import annotations
 import argparse
 
 from . import COMMAND_HELP
-from ._common import Outputs, add_output_flags, add_period_range, emit, feedback
+from ._common import (
+    Outputs,
+    add_output_flags,
+    add_period_range,
+    add_position_options,
+    emit,
+    feedback,
+    position_options,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -62,6 +70,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="'default' (limb and spine rotations, or *_angle channels), 'all', or channel names",
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    add_position_options(p)
     p.add_argument("--out", default=None, help="write the boundaries to this .csv file")
     add_output_flags(p)
     p.set_defaults(func=run)
@@ -79,7 +88,9 @@ def run(args: argparse.Namespace) -> int:
     outs = Outputs(inputs=[args.motion])
     out = outs.add(args.out, option="--out") if args.out else None
     with fb.step("reading motion"):
-        motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+        motion = io.read_motion(
+            args.motion, fps=args.fps, variable=args.variable, **position_options(args)
+        )
     converted = is_marker_motion(motion)
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
     channels = args.channels

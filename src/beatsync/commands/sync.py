@@ -20,11 +20,19 @@ import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from . import COMMAND_HELP
-from ._common import Feedback, Outputs, add_output_flags, add_period_range, emit, feedback
+from ._common import (
+    Feedback,
+    Outputs,
+    add_output_flags,
+    add_position_options,
+    emit,
+    feedback,
+    position_options,
+)
 
 __all__ = ["register", "run"]
 
-_MOTION_OUT = (".bvh", ".csv")
+_MOTION_OUT = (".bvh", ".csv", ".json", ".npy", ".npz", ".c3d")
 #: shortest song the beat tracker is asked about [s]
 MIN_MUSIC_S = 1.0
 
@@ -57,6 +65,7 @@ def register(subparsers: Any) -> None:
         "--out-fps", type=float, default=None, help="output frame rate [Hz] (default: the input's)"
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    add_position_options(p)
     p.add_argument(
         "--beats",
         default=None,
@@ -117,9 +126,27 @@ def register(subparsers: Any) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="the music's meter (3 for a waltz); beats per period then respect it",
+        help="the music's meter (3 for a waltz; default: estimated by the beat tracker); "
+        "beats per period then respect it",
     )
-    add_period_range(p)
+    p.add_argument(
+        "--dance-beats",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
+        "a waltz box); beats per period are then a multiple of it, and a warning says so "
+        "when the song's meter does not fit",
+    )
+    p.add_argument(
+        "--period-range",
+        nargs=2,
+        type=float,
+        default=None,
+        metavar=("LO", "HI"),
+        help="shortest and longest motion period searched [s] (default: one to eight beats "
+        "of the song, so real dance cycles such as a 4 s waltz box are found)",
+    )
     p.add_argument(
         "--video",
         default=None,
@@ -139,6 +166,21 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
         raise ParameterError(
             "--align-accents measures the phase offset itself; do not also give --phase-offset"
         )
+    if args.beats_per_bar is not None and args.beats_per_bar < 1:
+        raise ParameterError(
+            f"--beats-per-bar {args.beats_per_bar} must be a whole number of beats >= 1 "
+            "(3 for a waltz, 4 for most pop)"
+        )
+    if args.dance_beats is not None and args.dance_beats < 1:
+        raise ParameterError(
+            f"--dance-beats {args.dance_beats} must be a whole number of beats >= 1 "
+            "(3 for a waltz step)"
+        )
+    if args.period_range is not None and not 0 < args.period_range[0] < args.period_range[1]:
+        raise ParameterError(
+            f"--period-range {args.period_range[0]:g} {args.period_range[1]:g} must be "
+            "LO HI with 0 < LO < HI [s]"
+        )
     if args.beats is not None and args.bpm is not None:
         raise ParameterError(
             "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
@@ -147,7 +189,8 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
     out = Path(args.output)
     if out.suffix.lower() not in _MOTION_OUT:
         raise ParameterError(
-            f"output {args.output!r} must end in .bvh or .csv (the motion is written there)"
+            f"output {args.output!r} must end in .bvh or .csv, or for joint positions .json, "
+            ".npy, .npz or .c3d (the motion is written there)"
         )
     for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
         if inp is not None and not Path(inp).is_file():
@@ -188,16 +231,29 @@ def _pipeline(
     timings: dict[str, float] = {}
     with fb.step("reading motion"):
         t0 = time.perf_counter()
-        motion = io.read_motion(args.motion, fps=args.fps, variable=args.variable)
+        motion = io.read_motion(
+            args.motion, fps=args.fps, variable=args.variable, **position_options(args)
+        )
         if out.suffix.lower() == ".bvh" and motion.skeleton is None:
+            alt = (
+                ".json, .npy or .c3d (joint positions, in the input's layout) or .csv"
+                if motion.is_positional
+                else ".csv"
+            )
             raise ParameterError(
-                f"{args.motion!r} has no skeleton (marker data or a joint-angle table), so it "
-                "cannot be written as BVH; give an output ending in .csv instead"
+                f"{args.motion!r} has no skeleton (joint positions, markers or a joint-angle "
+                f"table), so it cannot be written as BVH; give an output ending in {alt}"
+            )
+        if out.suffix.lower() in (".json", ".npz", ".c3d") and not motion.is_positional:
+            raise ParameterError(
+                f"{args.motion!r} is not joint positions, so it cannot be written as "
+                f"{out.suffix}; give an output ending in .bvh (with a skeleton) or .csv"
             )
         y, sr = io.read_audio(args.audio)
         timings["read_s"] = time.perf_counter() - t0
 
     music_s = y.size / sr
+    meter = (args.beats_per_bar, "--beats-per-bar" if args.beats_per_bar else "unknown")
     with fb.step("finding beats"):
         t0 = time.perf_counter()
         if args.beats is not None:
@@ -213,6 +269,8 @@ def _pipeline(
                 )
             track = track_beats(y, sr, bpm=args.bpm)
             beats = np.asarray(track.beats, dtype=np.float64)
+            if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
+                meter = (int(track.beats_per_bar), "estimated by track_beats")
             beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
         if beats.size < 2:
             raise ParameterError(
@@ -231,11 +289,12 @@ def _pipeline(
             land="accents" if args.align_accents else "boundaries",
             fill=args.fill,
             beats_per_period=args.beats_per_period,
-            beats_per_bar=args.beats_per_bar,
+            beats_per_bar=meter[0],
+            dance_beats_per_period=args.dance_beats,
             first_beat=args.first_beat,
             out_fps=args.out_fps,
             phase_offset=args.phase_offset,
-            period_range=tuple(args.period_range),
+            period_range=None if args.period_range is None else tuple(args.period_range),
         )
         timings["sync_s"] = time.perf_counter() - t0
 
@@ -256,10 +315,7 @@ def _pipeline(
         timings["video_s"] = time.perf_counter() - t0
 
     with fb.step("writing motion"):
-        if out.suffix.lower() == ".bvh":
-            io.write_bvh(outs.path(out), res.motion)
-        else:
-            io.write_table(outs.path(out), res.motion)
+        io.write_motion(outs.path(out), res.motion)
         written["motion"] = str(out)
 
     timings["total_s"] = time.perf_counter() - t_start
@@ -269,6 +325,8 @@ def _pipeline(
         "audio": str(args.audio),
         "beats_source": beat_source,
         "n_music_beats": int(beats.size),
+        "beats_per_bar": meter[0],
+        "beats_per_bar_source": meter[1],
         "music_duration_s": music_s,
         "segmentation": {
             "mode": rep["mode"],
@@ -316,9 +374,9 @@ def _text(result: dict[str, Any]) -> str:
         f"beat period {r['beat_period_s']:.3f} s",
         f"mode     {r['mode']}"
         + (
-            f" (asked {r['mode_requested']}: not periodic, fell back)"
-            if r["mode"] != r["mode_requested"]
-            else ""
+            (" (auto: not periodic, fell back to motion beats)" if r["mode"] == "beats"
+             else " (auto: periodic)")
+            if r["mode_requested"] == "auto" else ""
         )
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
         f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "

@@ -48,6 +48,7 @@ Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from collections.abc import Sequence
@@ -184,6 +185,21 @@ class WeightedMotionGraph:
             "build_time_s": self.build_time,
         }
 
+    def _kept_cache(self) -> dict:
+        """Cache entries that survive a change of edges (they depend on the clips only)."""
+        return {k: v for k, v in self._cache.items() if k == "speeds"}
+
+    def speed_reference(self) -> dict:
+        """Root and joint rotation speed percentiles of every clip (computed once).
+
+        See :func:`beatsync.graph.plausibility.library_profile`.
+        """
+        if "speeds" not in self._cache:
+            from .plausibility import library_profile
+
+            self._cache["speeds"] = library_profile(self.clips)
+        return self._cache["speeds"]
+
     # -- successor structure for searches ------------------------------------
     def successors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Edges between interval nodes: ``(src, dst, weight)``.
@@ -297,25 +313,38 @@ class WeightedMotionGraph:
             build_time=build_time,
         )
 
+    def with_threshold(self, th: float) -> WeightedMotionGraph:
+        """The graph keeping only the transitions with ``rd < th`` (``th`` <= this TH).
+
+        A graph built once with a large TH gives the graphs of every smaller TH
+        without recomputing the distances.
+        """
+        th = check_th(th)
+        if th > self.th:
+            raise ParameterError(
+                f"TH={th:g} is larger than the TH={self.th:g} this graph was built with: "
+                "build it with the largest TH needed"
+            )
+        keep = self.trans_rd < th
+        return dataclasses.replace(
+            self,
+            trans_src=self.trans_src[keep],
+            trans_dst=self.trans_dst[keep],
+            trans_rd=self.trans_rd[keep],
+            trans_weight=self.trans_weight[keep],
+            th=th,
+            params={**self.params, "th": th},
+            _cache=self._kept_cache(),
+        )
+
     def with_rule(self, weight_rule: str) -> WeightedMotionGraph:
         """The same graph with transition weights recomputed under another eq. 2 rule."""
-        return WeightedMotionGraph(
-            clips=self.clips,
-            node_clip=self.node_clip,
-            node_frame=self.node_frame,
-            next_node=self.next_node,
-            intensity=self.intensity,
-            z_intensity=self.z_intensity,
-            trans_src=self.trans_src,
-            trans_dst=self.trans_dst,
-            trans_rd=self.trans_rd,
+        return dataclasses.replace(
+            self,
             trans_weight=transition_weight(self.trans_rd, weight_rule),
-            th=self.th,
             weight_rule=weight_rule,
-            speed_scale=self.speed_scale,
-            min_rd=self.min_rd,
             params={**self.params, "weight_rule": weight_rule},
-            build_time=self.build_time,
+            _cache=self._kept_cache(),
         )
 
 

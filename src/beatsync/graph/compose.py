@@ -28,7 +28,7 @@ from ..units import check_finite, check_fps, check_times
 from .baselines import check_conventional_options, conventional_core, random_core
 from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
-from .plausibility import library_profile, plausibility
+from .plausibility import plausibility
 from .search import METHODS, dp_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
@@ -241,9 +241,7 @@ def compose(
     syn = synthesize_core(graph, res.path, anchors, fps, blend, 0.0, end_time, warp)
     syn.info["graph_summary"] = graph.summary()
     syn_s = time.perf_counter() - t0
-    if "speed_profile" not in graph._cache:
-        graph._cache["speed_profile"] = library_profile(graph.clips)
-    plaus, notes = plausibility(syn.motion, graph._cache["speed_profile"], res.scales, bound)
+    plaus, notes = plausibility(syn.motion, graph.speed_reference(), res.scales, bound)
     for note in notes:
         warnings.warn(note, BeatsyncWarning, stacklevel=2)
     return Composition(

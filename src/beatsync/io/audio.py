@@ -120,7 +120,12 @@ def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
         if not s or s.startswith("#"):
             continue
         first = s.replace(",", " ").split()[0]
-        times.append(as_float(first, name=f"{str(p)!r} line {n}: time", unit="s", text=True))
+        try:
+            times.append(as_float(first, name="time", unit="s", text=True))
+        except ParameterError:
+            raise ParameterError(
+                f"{str(p)!r} line {n}: {first!r} is not a time in seconds"
+            ) from None
     return check_times(np.array(times), name=f"beat times in {p.name}", allow_empty=False)
 
 

@@ -340,7 +340,12 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
 
 
 def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.ndarray:
-    """Stream the frame lines into a preallocated ``(n_declared, n_ch)`` array."""
+    """Stream the frame lines into a preallocated ``(n_declared, n_ch)`` array.
+
+    Lines are gathered in chunks; each chunk is parsed by numpy's C text reader, and
+    only a chunk it refuses (or reads to another shape) is split line by line in
+    Python to name the first bad line.
+    """
     # A frame line holds n_ch numbers: at least 2 * n_ch - 1 characters and a newline,
     # so the file's size bounds the number of frames it can hold: a huge declared count
     # in a small file allocates no more than the file could fill.
@@ -348,62 +353,75 @@ def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.nd
     values = np.empty((capacity, n_ch), dtype=np.float64)
     chunk: list[str] = []
     chunk_lines: list[int] = []
-    row = 0  # frame lines read so far
+    stored = 0  # frame lines converted into values
+    row = 0  # frame lines seen
 
     def flush() -> None:
-        start = row - len(chunk_lines)
-        try:
-            block = np.array(chunk, dtype=np.float64)
-        except ValueError:
-            for i, lineno in enumerate(chunk_lines):
-                toks = chunk[i * n_ch : (i + 1) * n_ch]
-                bad = next((t for t in toks if not _is_plain_number(t)), None)
-                if bad is not None:
-                    raise ParameterError(
-                        f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} "
-                        "in a frame line"
-                    ) from None
-            raise RuntimeError("a frame chunk failed to convert but no token is bad") from None
-        values[start:row] = block.reshape(-1, n_ch)
+        nonlocal stored
+        block = _parse_chunk(chunk, chunk_lines, stored, n_ch, path)
+        values[stored : stored + len(chunk)] = block
+        stored += len(chunk)
         chunk.clear()
         chunk_lines.clear()
 
     for lineno, line in lines:
-        toks = line.split()
-        if not toks:
+        if not line.strip():
             continue
-        if len(toks) != n_ch:
-            raise ParameterError(
-                f"BVH {str(path)!r}, line {lineno}: frame line {row + 1} has {len(toks)} values "
-                f"but the hierarchy defines {n_ch} channels"
-            )
         if row >= capacity:  # more frame lines than declared: count them, store nothing
             if chunk:
                 flush()
             row += 1
             continue
         if not line.isascii() or "_" in line:  # Python and numpy read "1_0" and Unicode digits
-            bad = next((t for t in toks if not _is_plain_number(t)), None)
+            bad = next((t for t in line.split() if not _is_plain_number(t)), None)
             if bad is not None:
                 raise ParameterError(
                     f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
                     "frame line"
                 )
-        chunk.extend(toks)
+        chunk.append(line)
         chunk_lines.append(lineno)
         row += 1
-        if len(chunk_lines) == _CHUNK_ROWS:
+        if len(chunk) == _CHUNK_ROWS:
             flush()
     if chunk:
         flush()
-    if row == n_declared and row > capacity:
-        raise RuntimeError(f"BVH frame capacity {capacity} below the {row} frames read")
+    if row == n_declared and stored != n_declared:
+        raise RuntimeError(f"BVH frames stored {stored} of the {row} frames read")
     if row != n_declared:
         raise ParameterError(
             f"BVH {str(path)!r} declares {n_declared} frames but has {row} frame lines "
             "(file truncated or edited?)"
         )
     return values
+
+
+def _parse_chunk(
+    chunk: list[str], linenos: list[int], first_row: int, n_ch: int, path: Path
+) -> np.ndarray:
+    """Frame lines as a ``(len(chunk), n_ch)`` array, or the first bad line named."""
+    try:
+        block = np.loadtxt(chunk, dtype=np.float64, comments=None, ndmin=2)
+        if block.shape == (len(chunk), n_ch):
+            return block
+    except ValueError:
+        pass
+    rows = []
+    for k, (lineno, line) in enumerate(zip(linenos, chunk, strict=True)):
+        toks = line.split()
+        if len(toks) != n_ch:
+            raise ParameterError(
+                f"BVH {str(path)!r}, line {lineno}: frame line {first_row + k + 1} has "
+                f"{len(toks)} values but the hierarchy defines {n_ch} channels"
+            )
+        bad = next((t for t in toks if not _is_plain_number(t)), None)
+        if bad is not None:
+            raise ParameterError(
+                f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
+                "frame line"
+            )
+        rows.append(toks)
+    return np.array(rows, dtype=np.float64)
 
 
 def _fmt(x: float) -> str:

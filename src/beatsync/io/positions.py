@@ -379,7 +379,10 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
 
 
 def is_position_array(path: str | os.PathLike[str]) -> bool:
-    """True if an ``.npy`` file holds a ``(n_frames, n_joints, 3)`` array (header only)."""
+    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only).
+
+    Other shapes are left to the table reader, which explains what it needs.
+    """
     p = check_input_file(path, ".npy")
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)

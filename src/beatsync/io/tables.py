@@ -41,6 +41,12 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
         for k, v in mat.items()
         if not k.startswith("__") and hasattr(v, "data") and hasattr(v, "markerName")
     ]
+    if not cands:
+        found = [k for k in mat if not k.startswith("__")]
+        raise ParameterError(
+            f"{str(p)!r} holds no MoCap Toolbox marker recording (a struct with fields "
+            f"'data', 'markerName' and 'freq'); its variables are {found}"
+        )
     if variable is None:
         if len(cands) != 1:
             raise ParameterError(
@@ -107,6 +113,7 @@ def read_table(
     else:
         import pandas as pd
 
+        _check_csv_rows(p)
         try:
             df = pd.read_csv(p)
         except Exception as exc:
@@ -204,13 +211,40 @@ def write_table(path: str | os.PathLike[str], motion: Motion) -> Path:
     return write_csv(path, pd.DataFrame(motion.values, columns=list(motion.channels)))
 
 
+def _check_csv_rows(p: Path) -> None:
+    """Refuse a CSV row with more or fewer fields than the header, naming its line
+    (pandas would fill a short row with NaN, which reads as a gap in the motion)."""
+    import csv
+
+    try:
+        with open(p, newline="", encoding="utf-8-sig") as fh:
+            reader = csv.reader(fh)
+            header = next(reader, [])
+            for row in reader:
+                if row and len(row) != len(header):
+                    raise ParameterError(
+                        f"{str(p)!r} line {reader.line_num}: {len(row)} fields, but the header "
+                        f"row names {len(header)} channels"
+                    )
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise ParameterError(f"cannot read {str(p)!r} as a UTF-8 CSV table: {exc}") from None
+
+
 def read_npz(path: str | os.PathLike[str]) -> dict[str, np.ndarray]:
     """Read every array of an ``.npz`` file (no pickles)."""
     p = check_input_file(path, "npz")
+    with open(p, "rb") as fh:
+        magic = fh.read(6)
+    if magic == b"\x93NUMPY":
+        raise ParameterError(
+            f"{str(p)!r} is a single .npy array, not an .npz archive: rename it .npy"
+        )
+    if magic[:2] != b"PK":
+        raise ParameterError(f"{str(p)!r} is not an .npz archive (not a zip file)")
     try:
         with np.load(p, allow_pickle=False) as data:
             return {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
+    except Exception as exc:  # zipfile and numpy raise several types for broken archives
         raise ParameterError(f"cannot read {str(p)!r} as an .npz archive: {exc}") from None
 
 

@@ -74,6 +74,16 @@ Documented rules (choices the paper leaves open)
   standard deviation among the selected channels, or at most 1e-9. Inside a kept
   channel, a period whose own variance is below 1e-6 of the channel's variance is
   treated as flat: its correlation is ~0 (cost ~1).
+- Period range: by default the paper's 0.25-1.25 s (``DEFAULT_PERIOD_RANGE``). Real
+  dance cycles can be longer (a waltz box: 6 beats, about 4 s):
+  ``DANCE_PERIOD_RANGE`` (0.25-6.25 s) or :func:`period_range_from_beat` (1 to 8 beats
+  of the music). A range wider than a factor 5 is searched in tiers of a factor 5,
+  shortest first (:func:`.period.period_tiers`); the first tier whose optimum passes
+  the periodicity test gives the period, the shortest repeating cycle (otherwise the
+  energy estimate prefers multiples of a step: CMU salsa 61_04 searched over
+  0.25-6 s at once gave 2.9 s, three steps). The wide range is not the default
+  because the periodicity test accepts the CMU 005_02 pirouette in the long tier
+  (4 x 1.66 s). Long periods stay within memory through the decimated search.
 - Clip length: a clip shorter than ``MIN_CLIP_PERIODS`` (3) of the shortest period
   of the range is refused first. With the count estimated, a clip shorter than 3 of
   its own estimated period (the optimum then has a single pair of consecutive periods)
@@ -111,11 +121,13 @@ Documented rules (choices the paper leaves open)
 
 from .channels import CONSTANT_REL_STD, select_channels
 from .core import (
+    DANCE_PERIOD_RANGE,
     DEFAULT_PERIOD_RANGE,
     MIN_CLIP_PERIODS,
     SHORT_CLIP_MAX_ENERGY,
     Segmentation,
     estimate_period_count,
+    period_range_from_beat,
     segment,
     segment_values,
 )
@@ -131,7 +143,9 @@ __all__ = [
     "select_channels",
     "segmentation_energy",
     "periodicity_contrast",
+    "period_range_from_beat",
     "DEFAULT_PERIOD_RANGE",
+    "DANCE_PERIOD_RANGE",
     "MIN_CLIP_PERIODS",
     "SHORT_CLIP_MAX_ENERGY",
     "CONSTANT_REL_STD",

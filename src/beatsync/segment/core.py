@@ -24,7 +24,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_finite, check_fps, frames_to_time, time_to_frames
+from ..units import (
+    check_finite,
+    check_fps,
+    check_positive,
+    check_range,
+    frames_to_time,
+    time_to_frames,
+)
 from .channels import nonconstant_channels, select_channels, standardise, unwrap_rotations
 from .checks import (
     check_alpha,
@@ -38,6 +45,7 @@ from .period import (
     MIN_PERIODICITY_CONTRAST,
     estimate_period,
     estimation_band,
+    period_tiers,
     periodicity_contrast,
 )
 from .search import SEARCH_MEMORY_BUDGET, optimum, period_band, search_decimation
@@ -47,16 +55,30 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_PERIOD_RANGE",
+    "DANCE_PERIOD_RANGE",
     "MIN_CLIP_PERIODS",
     "SHORT_CLIP_MAX_ENERGY",
     "Segmentation",
+    "period_range_from_beat",
     "segment",
     "segment_values",
     "estimate_period_count",
 ]
 
 DEFAULT_PERIOD_RANGE = (0.25, 1.25)
-"""Shortest and longest period [s] searched when the count is estimated."""
+"""Shortest and longest period [s] searched by default when the count is estimated.
+
+The paper's range: dance steps and gait cycles. Longer cycles (dance figures: a
+waltz box of 6 beats lasts about 4 s) need a wider range, :data:`DANCE_PERIOD_RANGE`
+or :func:`period_range_from_beat` when the music is known. It is not the default
+because the periodicity test cannot yet tell a long figure from a non-periodic motion:
+with :data:`DANCE_PERIOD_RANGE`, the CMU 005_02 pirouette is accepted as 4 periods
+of 1.66 s (periodicity contrast 0.20, in the range of real figures, 0.14-0.26)."""
+
+DANCE_PERIOD_RANGE = (0.25, 6.25)
+"""Steps (0.25-1.25 s) and figures (1.25-6.25 s), searched shortest first (see
+:func:`~beatsync.segment.period.period_tiers`): covers a slow waltz box (6 beats at
+60 BPM, 6 s)."""
 
 MIN_CLIP_PERIODS = 3
 """A clip shorter than this many of its estimated periods needs :data:`SHORT_CLIP_MAX_ENERGY`.
@@ -158,6 +180,10 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
 # ---------------------------------------------------------------------- the entry
 
 
+class _NotPeriodic(ParameterError):
+    """The periodicity test refused the optimum (a longer tier may still be periodic)."""
+
+
 def _segment(
     vals: np.ndarray,
     names: tuple[str, ...],
@@ -168,17 +194,56 @@ def _segment(
     period_range: tuple[float, float],
     method: str,
 ) -> Segmentation:
-    """Segmentation of validated values (finite, 2-D, named); data checks and the search."""
+    """Segmentation of validated values (finite, 2-D, named); data checks and the search.
+
+    With the count estimated, the period range is searched tier by tier
+    (:func:`period_tiers`), shortest first; the first tier whose optimum passes the
+    periodicity test gives the result, so the period is the shortest repeating cycle.
+    """
     n = vals.shape[0]
-    if n_periods is None:
-        lo_f, hi_f = _frame_band(n, fps, period_range)  # the clip's length first (cheap)
-    x, used = _motion_channels(vals, names)
     if n_periods is not None:
-        p = n_periods
-        nominal = (n - 1) / p  # [frames]
-    else:
-        nominal = estimate_period(x, lo_f, hi_f, method)
-        p = max(2, int(np.floor((n - 1) / nominal + 1e-9)))
+        x, used = _motion_channels(vals, names)
+        return _search(x, used, fps=fps, alpha=alpha, nominal=(n - 1) / n_periods,
+                       count=n_periods, period_range=period_range)  # fmt: skip
+    tiers = period_tiers(*period_range)
+    bands = [_frame_band(n, fps, tiers[0])]  # the clip's length first (cheap)
+    x, used = _motion_channels(vals, names)
+    refusal = None
+    for i, tier in enumerate(tiers):
+        if i:
+            lo_p, hi_p = time_to_frames(tier, fps=fps, round_to_int=False)
+            lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
+            if hi_f < lo_f:  # the clip cannot show two periods of this tier
+                break
+            bands.append((lo_f, hi_f))
+        nominal = estimate_period(x, *bands[i], method)
+        try:
+            return _search(x, used, fps=fps, alpha=alpha, nominal=nominal, count=None,
+                           period_range=tier, method=method)  # fmt: skip
+        except _NotPeriodic as exc:
+            refusal = exc
+    if refusal is None:
+        raise RuntimeError("no tier of the period range was searched")
+    if len(bands) > 1:
+        searched = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
+        raise ParameterError(f"{refusal} (period tiers searched, shortest first: {searched})")
+    raise ParameterError(str(refusal))
+
+
+def _search(
+    x: np.ndarray,
+    used: tuple[str, ...],
+    *,
+    fps: float,
+    alpha: float,
+    nominal: float,
+    count: int | None,
+    period_range: tuple[float, float],
+    method: str = "given",
+) -> Segmentation:
+    """The optimum around ``nominal`` [frames], the clip-length and periodicity tests."""
+    n = x.shape[1]
+    p = count if count is not None else max(2, int(np.floor((n - 1) / nominal + 1e-9)))
     lo, hi = period_band(nominal, alpha)
     if lo < 2:
         raise ParameterError(
@@ -190,7 +255,6 @@ def _segment(
             f"alpha={alpha:g} allows no whole-frame period length around {nominal:.2f} "
             "frames; increase alpha"
         )
-    count = p if method == "given" else None
     factor = search_decimation(n, lo, hi, x.shape[0], count, SEARCH_MEMORY_BUDGET)
     if factor is None:
         raise ParameterError(
@@ -220,7 +284,7 @@ def _segment(
         if method == "given":
             lo_p, hi_p = time_to_frames(period_range, fps=fps, round_to_int=False)
             lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
-            if lo_f <= hi_f:
+            if lo_f <= hi_f:  # the count the data suggest, for the message
                 est = estimate_period(x, lo_f, hi_f, "energy")
                 hint = (
                     f"; n_periods={p} was given: is it right? The energy estimate of the "
@@ -229,7 +293,7 @@ def _segment(
                 )
             else:
                 hint = f"; n_periods={p} was given: check the count"
-        raise ParameterError(
+        raise _NotPeriodic(
             f"the motion is not periodic: the best segmentation into {n_found} periods of "
             f"~{float(frames_to_time((frames[-1] - frames[0]) / n_found, fps=fps)):.3f} s has "
             f"mean Pearson distance "
@@ -278,8 +342,12 @@ def segment_values(
         ``(n_frames - 1) / n_periods`` frames (or a ParameterError if they do not fit
         or the forced segmentation is not periodic).
     period_range : (float, float) [s]
-        Shortest and longest period for estimating the count
-        (default :data:`DEFAULT_PERIOD_RANGE`).
+        Shortest and longest period for estimating the count (default
+        :data:`DEFAULT_PERIOD_RANGE`, the paper's 0.25-1.25 s). A range spanning more
+        than a factor 5 is searched in tiers, shortest first, and the first tier whose
+        optimum is periodic gives the result (the shortest repeating cycle):
+        :data:`DANCE_PERIOD_RANGE` (0.25-6.25 s) for dance figures, or
+        :func:`period_range_from_beat` when the music's beat is known.
     period_method : {"energy", "fft", "given"}
         How to get the count when ``n_periods`` is None (see
         :func:`estimate_period_count`). ``"given"`` requires ``n_periods``.
@@ -350,8 +418,9 @@ def segment(
         Period count if known (e.g. from the music); the result has exactly this many
         periods (see :func:`segment_values`).
     period_range : (float, float) [s]
-        Shortest and longest period when estimating the count
-        (default :data:`DEFAULT_PERIOD_RANGE`).
+        Shortest and longest period when estimating the count (default
+        :data:`DEFAULT_PERIOD_RANGE`, 0.25-1.25 s; searched in tiers, shortest first, see
+        :func:`segment_values`).
     period_method : {"energy", "fft", "given"}
     channels : "default", "all" or list of str
         See :func:`~beatsync.segment.select_channels`.
@@ -404,7 +473,8 @@ def estimate_period_count(
         Channels to analyse (near-constant channels are ignored).
     fps : float > 0 [Hz]
     period_range : (float, float) [s]
-        Shortest and longest period considered (default :data:`DEFAULT_PERIOD_RANGE`).
+        Shortest and longest period considered (default :data:`DEFAULT_PERIOD_RANGE`),
+        all at once (no tiers: the count of the best uniform segmentation in the range).
     method : {"energy", "fft"}
         ``"fft"``: the peak of the channel-summed power spectrum (z-scored channels,
         Hann window, 8x zero padding) within ``1/period_range``. ``"energy"``: the
@@ -437,3 +507,48 @@ def estimate_period_count(
     x, _ = _motion_channels(vals, tuple(f"ch{i}" for i in range(vals.shape[1])))
     per = estimate_period(x, lo_f, hi_f, method)
     return max(2, int(np.floor((n - 1) / per + 1e-9)))
+
+
+def period_range_from_beat(
+    beat_period: float, *, beats: tuple[float, float] = (1.0, 8.0)
+) -> tuple[float, float]:
+    """Period range [s] of a dance to music with this beat period: ``beats`` beats.
+
+    A dance cycle lasts a whole number of beats, from one step per beat to a figure
+    of a few bars (a waltz box: 6 beats; a salsa basic: 8). The range is searched
+    shortest first (:func:`~beatsync.segment.period.period_tiers`).
+
+    Parameters
+    ----------
+    beat_period : float > 0 [s]
+        The music's beat period (60 / BPM), e.g. the median inter-beat interval.
+    beats : (float, float)
+        Fewest and most beats per motion period (default 1 to 8).
+
+    Returns
+    -------
+    (float, float) [s]
+
+    Raises
+    ------
+    ParameterError
+        A beat period that is not a positive number of seconds (a BPM value, say), or
+        a reversed or non-positive ``beats`` range.
+
+    Examples
+    --------
+    >>> period_range_from_beat(0.5)
+    (0.5, 4.0)
+    """
+    bp = check_positive(beat_period, name="beat_period", unit="s")
+    if bp > 5.0:
+        raise ParameterError(
+            f"beat_period={beat_period!r} s is longer than 5 s (12 BPM): is it a tempo in "
+            f"BPM? The beat period is 60 / BPM ({60.0 / bp:.3f} s for {bp:g} BPM)"
+        )
+    try:
+        b_lo, b_hi = beats
+    except (TypeError, ValueError):
+        raise ParameterError(f"beats={beats!r} must be two numbers (fewest, most)") from None
+    b_lo, b_hi = check_range(b_lo, b_hi, name="beats", unit="beats")
+    return b_lo * bp, b_hi * bp

@@ -30,6 +30,8 @@ __all__ = [
     "MIN_PERIODICITY_CONTRAST",
     "OFF_PERIOD_FACTORS",
     "PERIOD_METHODS",
+    "TIER_FACTOR",
+    "period_tiers",
     "estimation_band",
     "uniform_frames",
     "uniform_energy",
@@ -49,7 +51,30 @@ OFF_PERIOD_FACTORS = (0.5, 0.75, 1.25, 1.5)
 PERIOD_METHODS = ("energy", "fft", "given")
 """How the period count is obtained (``"given"``: from the caller's ``n_periods``)."""
 
+TIER_FACTOR = 5.0
+"""Ratio of the longest to the shortest period of one search tier (the paper's 0.25-1.25 s)."""
+
 _MAX_COUNT_CANDIDATES = 400  # candidate periods of the "energy" method (then log-spaced)
+
+
+def period_tiers(lo: float, hi: float) -> list[tuple[float, float]]:
+    """Consecutive tiers ``(lo, 5 lo), (5 lo, 25 lo), ... , (.., hi)`` of a period range.
+
+    A range wider than :data:`TIER_FACTOR` is searched tier by tier, shortest first,
+    so that a motion periodic at a step (say 1 s) is not described by a multiple of it
+    (a 3 s figure, whose uniform segmentation is often as good or better); a motion
+    that repeats only over a longer figure (a 4 s waltz box) is found in a later tier.
+    Any unit; the paper's range (0.25, 1.25) is one tier.
+    """
+    tiers = []
+    a = float(lo)
+    while True:
+        b = a * TIER_FACTOR
+        if b >= hi * (1 - 1e-9):
+            tiers.append((a, float(hi)))
+            return tiers
+        tiers.append((a, b))
+        a = b
 
 
 def estimation_band(n: int, lo_frames: float, hi_frames: float) -> tuple[float, float]:

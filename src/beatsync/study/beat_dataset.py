@@ -19,11 +19,10 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import sys
 import time
 import uuid
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -53,8 +52,12 @@ __all__ = [
     "evaluate_dataset",
     "summarize_dataset",
     "ANNOTATION_SUFFIX",
+    "RESULT_FILES",
 ]
 
+
+#: Files a run writes in its output folder.
+RESULT_FILES = ("tracks.jsonl", "tracks.csv", "summary.csv")
 
 #: Suffix of beat annotation files: one time [s] per line, optionally a second column.
 ANNOTATION_SUFFIX = ".beats"
@@ -389,7 +392,7 @@ def evaluate_dataset(
     scheduler: str | None = None,
     n_workers: int | None = None,
     processes: bool = True,
-    progress: bool = False,
+    progress: Callable[..., None] | None = None,
 ) -> DatasetRun:
     """Track and score every track on Dask; record each row as soon as it finishes.
 
@@ -410,8 +413,8 @@ def evaluate_dataset(
     scheduler, n_workers, processes
         See :func:`beatsync.cluster.dask_client`. Workers of an existing cluster must
         see the audio files at the same paths.
-    progress : bool
-        A tqdm bar on stderr.
+    progress : callable ``progress(done, total=None)``, optional
+        Called as tracks finish (e.g. a command's progress bar).
 
     Raises
     ------
@@ -466,7 +469,6 @@ def evaluate_dataset(
 
 def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
     from dask.distributed import as_completed
-    from tqdm import tqdm
 
     futures = {
         client.submit(
@@ -481,16 +483,10 @@ def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
         ): t
         for t in todo
     }
-    bar = tqdm(
-        total=len(todo),
-        desc=f"evaluate {method}",
-        unit="track",
-        file=sys.stderr,
-        disable=not progress,
-        leave=False,
-    )
+    if progress is not None:
+        progress(0, total=len(todo))
     try:
-        for fut in as_completed(futures):
+        for done, fut in enumerate(as_completed(futures), 1):
             t = futures[fut]
             try:
                 row = fut.result()
@@ -506,8 +502,8 @@ def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
                     "warning": "",
                 }
             log.append(row)
-            bar.update()
+            if progress is not None:
+                progress(done)
     finally:
-        bar.close()
         for fut in futures:
             fut.cancel()

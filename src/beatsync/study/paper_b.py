@@ -14,6 +14,11 @@ The notebooks only call these functions.
 - :func:`threshold_table` counts transition edges for several TH under two
   normalisations of ``rd`` (per frame-to-frame distance, and per 0.1 s of typical
   movement, our default).
+- :func:`library_graphs` builds each library's graph once per run (the largest TH
+  needed; smaller TH by filtering).
+- :func:`eligibility_table` says which clips a song of each tempo uses and why;
+  :func:`plausibility_targets` checks root and joint rotation speeds and time-scale
+  factors against the library (:mod:`beatsync.graph.plausibility`).
 - :func:`quality_table` scores compositions with the proxies of
   :mod:`beatsync.evaluate.composition` (:func:`composition_proxies` computes the
   arrays they need: kinematic beats, positions, intensities).
@@ -36,6 +41,7 @@ from ..errors import BeatsyncWarning, ParameterError
 from ..graph.build import WeightedMotionGraph, build_graph
 from ..graph.compose import compose
 from ..graph.search import conventional_search, dp_search
+from ..graph.timescale import DEFAULT_SCALE_BOUND
 from .artifacts import write_artifacts
 
 __all__ = [
@@ -46,7 +52,13 @@ __all__ = [
     "speed_table",
     "ratio_table",
     "threshold_table",
+    "QUALITY_METHODS",
+    "library_graphs",
     "quality_table",
+    "quality_means",
+    "plausibility_targets",
+    "eligibility_table",
+    "example_composition",
     "composition_proxies",
     "library_reference",
     "summary_graphs",
@@ -108,6 +120,33 @@ def load_library(
     raise ParameterError(f"unknown library {name!r}; choose from {sorted(LIBRARIES)}")
 
 
+def library_graphs(
+    names: Sequence[str],
+    *,
+    th: float = 3.0,
+    th_max: float | None = None,
+    duration: float = 30.0,
+    seed: int = 0,
+) -> tuple[dict[str, WeightedMotionGraph], dict[str, WeightedMotionGraph]]:
+    """The graph of each study library at TH, and the graph at ``th_max`` it comes from.
+
+    Each library's distances are computed once, with the largest threshold the
+    notebook needs (``th_max``, default ``th``); the TH graph keeps the transitions
+    below ``th`` (:meth:`WeightedMotionGraph.with_threshold`).
+
+    Returns
+    -------
+    (graphs, full) : dicts of library name -> graph at ``th`` / at ``th_max``.
+    """
+    top = max(th, th_max) if th_max is not None else th
+    graphs, full = {}, {}
+    for name in names:
+        clips, beats = load_library(name, duration=duration, seed=seed)
+        full[name] = build_graph(clips, beats=beats, th=top, require_transitions=False)
+        graphs[name] = full[name].with_threshold(th) if top > th else full[name]
+    return graphs, full
+
+
 def song(duration: float, *, bpm: float = 100.0, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Beats [s] and level per beat interval [dB] of a synthetic drum song."""
     from ..music import beat_rms_db
@@ -125,6 +164,22 @@ def _z(level: np.ndarray) -> np.ndarray:
         return zscore(level)
 
 
+def _song_grid(graph: WeightedMotionGraph, beats: np.ndarray, level: np.ndarray, bound: Any):
+    """What compose searches for a song: the tempo plan, z per grid interval, durations."""
+    from ..graph.timescale import music_grid, plan_tempo
+
+    mult = "auto" if bound is not None else (1.0,)
+    plan = plan_tempo(graph, beats, scale_bound=bound, multiplicity=mult)
+    grid, glevel = music_grid(beats, level, plan.subdivision)
+    search_kw = {
+        "music_durations": np.diff(grid),
+        "scale_bound": plan.bound,
+        "steps": plan.steps,
+        "node_mask": plan.node_mask,
+    }
+    return plan, _z(glevel), search_kw
+
+
 def speed_table(
     graphs: dict[str, WeightedMotionGraph],
     durations: Sequence[float] = (30.0, 60.0),
@@ -135,11 +190,20 @@ def speed_table(
     segment_beats: int = 8,
     max_candidates: int = 20000,
     dp_inner: int = 10,
+    scale_bound: Any = DEFAULT_SCALE_BOUND,
+    conventional_repeats: int = 2,
 ) -> Any:
-    """Search times of the DP and the conventional method (best of ``repeats``) [s].
+    """Search times of the DP (best of ``repeats``) and the conventional method [s].
 
-    Each DP timing sample is the mean of ``dp_inner`` consecutive runs (one DP takes
-    about a millisecond, too short to time alone on a shared machine).
+    The conventional search takes seconds, so the best of ``conventional_repeats``
+    (at most ``repeats``) runs times it well enough; the DP takes milliseconds and
+    gets every repeat.
+
+    Both searches run as :func:`beatsync.graph.compose.compose` runs them: on the
+    song's grid, with the tempo plan's clips, multiplicities and ``scale_bound``
+    (``None``: unbounded, one beat per interval, paper B as written). Each DP timing
+    sample is the mean of ``dp_inner`` consecutive runs (one DP takes about a
+    millisecond, too short to time alone on a shared machine).
 
     Times are the searches' own clocks (:attr:`SearchResult.search_time`): the graph
     build and its successor/predecessor tables (built once per graph, offline) are
@@ -149,8 +213,8 @@ def speed_table(
     -------
     pandas.DataFrame
         One row per (library, music length): ``library``, ``stands_in_for``,
-        ``music_s``, ``n_beats``, ``nodes``, ``transitions``, ``dp_s``,
-        ``conventional_s``, ``speedup``, ``dp_cost``, ``conventional_cost``.
+        ``music_s``, ``n_beats``, ``nodes``, ``transitions``, ``multiplicity``,
+        ``dp_s``, ``conventional_s``, ``speedup``, ``dp_cost``, ``conventional_cost``.
     """
     import pandas as pd
 
@@ -160,15 +224,24 @@ def speed_table(
         g.successor_lists()
         for dur in durations:
             beats, level = song(float(dur), bpm=bpm, seed=seed)
-            z = _z(level)
-            md = np.diff(beats)
+            plan, z, kw = _song_grid(g, beats, level, scale_bound)
+            md = kw.pop("music_durations")
             t_dp, t_cv = [], []
-            for _ in range(int(repeats)):
-                runs = [dp_search(g, z) for _ in range(max(1, int(dp_inner)))]
+            for i in range(int(repeats)):
+                runs = [
+                    dp_search(g, z, music_durations=md, **kw) for _ in range(max(1, int(dp_inner)))
+                ]
                 dp = runs[-1]
                 t_dp.append(float(np.mean([r.search_time for r in runs])))
+                if i >= max(1, int(conventional_repeats)):
+                    continue
                 cv = conventional_search(
-                    g, z, md, segment_beats=segment_beats, max_candidates=max_candidates
+                    g,
+                    z,
+                    md,
+                    segment_beats=segment_beats * plan.subdivision,
+                    max_candidates=max_candidates,
+                    **kw,
                 )
                 t_cv.append(cv.search_time)
             rows.append(
@@ -179,6 +252,7 @@ def speed_table(
                     "n_beats": int(beats.size),
                     "nodes": g.n_nodes,
                     "transitions": g.n_transitions,
+                    "multiplicity": "/".join(f"{m:g}" for m in plan.multiplicity),
                     "dp_s": min(t_dp),
                     "conventional_s": min(t_cv),
                     "speedup": min(t_cv) / min(t_dp),
@@ -214,20 +288,19 @@ def ratio_table(speed: Any) -> Any:
 
 
 def threshold_table(
-    clips: Sequence[Any],
-    *,
-    beats: Sequence[np.ndarray] | None = None,
-    ths: Sequence[float] = (1.0, 2.0, 3.0, 5.0, 10.0),
+    graph: WeightedMotionGraph, *, ths: Sequence[float] = (1.0, 2.0, 3.0, 5.0, 10.0)
 ) -> Any:
     """Transition edges for each TH under two ``rd`` normalisations.
 
     ``rd_unit = 0.1 s`` is our default (module :mod:`beatsync.graph.build`);
-    ``rd_unit = 1 / fps`` measures the pose jump in frame-to-frame distances.
+    ``rd_unit = 1 / fps`` measures the pose jump in frame-to-frame distances (TH
+    ``x`` in frames is ``x / (0.1 fps)`` in our unit). ``graph`` must have been built
+    with a TH at least ``max(ths)`` (in our unit; :func:`library_graphs`).
     """
     import pandas as pd
 
-    g = build_graph(clips, beats=beats, th=1e12, require_transitions=False)
-    fps = float(clips[0].fps)
+    g = graph
+    fps = float(g.clips[0].fps)
     n_pairs = g.n_nodes * (g.n_nodes - 1) // 2
     rows = []
     for unit_name, factor in (("0.1 s of typical movement", 1.0), ("1 frame", 0.1 * fps)):
@@ -247,49 +320,191 @@ def threshold_table(
     return pd.DataFrame(rows)
 
 
+#: Methods of :func:`quality_table`: label, search method, compose options.
+QUALITY_METHODS: dict[str, tuple[str, str, dict]] = {
+    "dp": ("proposed DP, tempo-matched (default)", "dp", {}),
+    "conventional": ("conventional multi-stage, tempo-matched", "conventional", {}),
+    "random": ("random walk, tempo-matched (control)", "random", {}),
+    "dp_unbounded": ("proposed DP, unbounded (paper B as written)", "dp", {"scale_bound": None}),
+    "dp_rd_unbounded": ("proposed DP (w2 = rd), unbounded", "dp", {"scale_bound": None}),
+    "dp_tempo_unbounded": (
+        "proposed DP + tempo term, unbounded (extension)",
+        "dp",
+        {"scale_bound": None, "tempo_weight": 1.0},
+    ),
+    "conventional_unbounded": (
+        "conventional multi-stage, unbounded",
+        "conventional",
+        {"scale_bound": None},
+    ),
+    "random_unbounded": ("random walk, unbounded (control)", "random", {"scale_bound": None}),
+}
+
+#: Tempo-matched DP compositions of the last quality_table, by (graph, bpm, s, seed).
+_COMPOSED: dict[tuple, Any] = {}
+
+_PLAUSIBILITY_COLUMNS = (
+    "root_speed_p99",
+    "rotation_speed_p99",
+    "root_speed_ratio",
+    "rotation_speed_ratio",
+    "scale_min",
+    "scale_p50",
+    "scale_max",
+)
+
+
 def quality_table(
     graph: WeightedMotionGraph,
     *,
-    durations: Sequence[float] = (30.0,),
+    bpms: Sequence[float] = (120.0,),
+    durations: Sequence[float] = (60.0,),
     seeds: Sequence[int] = (0,),
-    bpm: float = 100.0,
-    methods: Sequence[str] = ("dp", "dp_rd", "conventional", "random"),
+    methods: Sequence[str] = ("dp", "conventional", "random", "dp_unbounded"),
     sigma: float = 0.05,
 ) -> Any:
-    """Quality proxies per method, one row per (method, song).
+    """Quality proxies and physical plausibility per method, one row per (method, song).
 
-    Methods: ``"dp"`` (proposed, eq. 2 as written), ``"dp_rd"`` (proposed with
-    ``w2 = rd``), ``"dp_tempo"`` (extension: DP with a tempo term, weight 1),
-    ``"conventional"``, ``"random"``.
+    Methods: keys of :data:`QUALITY_METHODS`; the tempo-matched ones use the
+    defaults of :func:`~beatsync.graph.compose.compose` (tempo group, multiplicity,
+    time-scale bound 0.8-1.25), the unbounded ones paper B as written (every interval
+    warped onto one beat). Plausibility columns come from the composition's report
+    (:mod:`beatsync.graph.plausibility`); ``scale_outside`` counts the intervals
+    outside the default bound (for every method alike).
     """
     import pandas as pd
 
-    labels = {
-        "dp": "proposed DP (w2 = max(rd, 2))",
-        "dp_rd": "proposed DP (w2 = rd)",
-        "dp_tempo": "proposed DP + tempo term (extension)",
-        "conventional": "conventional multi-stage",
-        "random": "random walk (control)",
-    }
+    for m in methods:
+        if m not in QUALITY_METHODS:
+            raise ParameterError(f"unknown method {m!r}; choose from {sorted(QUALITY_METHODS)}")
     g_rd = graph.with_rule("rd")
+    lo, hi = DEFAULT_SCALE_BOUND
     rows = []
-    for dur in durations:
-        for seed in seeds:
-            beats, level = song(float(dur), bpm=bpm, seed=int(seed))
-            for m in methods:
-                if m not in labels:
-                    raise ParameterError(f"unknown method {m!r}; choose from {sorted(labels)}")
-                g = g_rd if m == "dp_rd" else graph
-                kw: dict[str, Any] = {}
-                method = m
-                if m in ("dp_rd", "dp_tempo"):
-                    method = "dp"
-                if m == "dp_tempo":
-                    kw["tempo_weight"] = 1.0
-                comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
-                q = composition_proxies(comp, sigma=sigma)
-                rows.append({"method": labels[m], "music_s": float(dur), "seed": int(seed), **q})
+    _COMPOSED.clear()
+    for bpm in bpms:
+        for dur in durations:
+            for seed in seeds:
+                beats, level = song(float(dur), bpm=float(bpm), seed=int(seed))
+                for m in methods:
+                    label, method, kw = QUALITY_METHODS[m]
+                    g = g_rd if m.startswith("dp_rd") else graph
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", BeatsyncWarning)
+                        comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
+                    if m == "dp":  # kept for example_composition (no second search)
+                        _COMPOSED[(id(graph), float(bpm), float(dur), int(seed))] = comp
+                    q = composition_proxies(comp, sigma=sigma)
+                    p = comp.plausibility
+                    s = comp.search.scales
+                    rows.append(
+                        {
+                            "method": label,
+                            "bpm": float(bpm),
+                            "music_s": float(dur),
+                            "seed": int(seed),
+                            **q,
+                            **{k: p[k] for k in _PLAUSIBILITY_COLUMNS},
+                            "scale_outside": int(np.sum((s < lo - 1e-9) | (s > hi + 1e-9))),
+                            "two_beat_share": float(np.mean(np.diff(comp.search.boundaries) > 1))
+                            if comp.tempo.subdivision == 1
+                            else 0.0,
+                            "speed_warning": bool(comp.warnings),
+                        }
+                    )
     return pd.DataFrame(rows)
+
+
+def quality_means(quality: Any, *, by: Sequence[str] = ("method",)) -> Any:
+    """Mean of every numeric column of :func:`quality_table` per method (and ``by``)."""
+    drop = [c for c in ("seed", "music_s", "bpm") if c not in by]
+    num = quality.drop(columns=drop)
+    return num.groupby(list(by), sort=False).mean(numeric_only=True).reset_index()
+
+
+def plausibility_targets(quality: Any, *, bound: tuple[float, float] = DEFAULT_SCALE_BOUND) -> Any:
+    """The issue's targets per tempo-matched method and song tempo, PASS or FAIL.
+
+    99th-percentile root and joint rotation speed at most 1.25x the fastest library
+    clip's, every time-scale factor within ``bound``, and the DP's beat alignment
+    (both scores) no lower than the unbounded DP's on the same songs.
+    """
+    import pandas as pd
+
+    rows = []
+    unb = quality[quality.method == QUALITY_METHODS["dp_unbounded"][0]]
+    for key in ("dp", "conventional", "random"):
+        label = QUALITY_METHODS[key][0]
+        for bpm, grp in quality[quality.method == label].groupby("bpm", sort=True):
+            row = {
+                "method": label,
+                "bpm": float(bpm),
+                "root_speed_ratio_max": float(grp.root_speed_ratio.max()),
+                "rotation_speed_ratio_max": float(grp.rotation_speed_ratio.max()),
+                "scale_min": float(grp.scale_min.min()),
+                "scale_max": float(grp.scale_max.max()),
+            }
+            ok = (
+                row["root_speed_ratio_max"] <= 1.25
+                and row["rotation_speed_ratio_max"] <= 1.25
+                and row["scale_min"] >= bound[0] - 1e-9
+                and row["scale_max"] <= bound[1] + 1e-9
+            )
+            if key == "dp" and not unb.empty:
+                ref = unb[unb.bpm == bpm]
+                row["alignment_motion_vs_unbounded"] = float(
+                    grp.alignment_motion.mean() - ref.alignment_motion.mean()
+                )
+                row["alignment_music_vs_unbounded"] = float(
+                    grp.alignment_music.mean() - ref.alignment_music.mean()
+                )
+            row["speed_and_bound"] = "PASS" if ok else "FAIL"
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def eligibility_table(
+    graph: WeightedMotionGraph, *, bpms: Sequence[float] = (120.0,), duration: float = 60.0
+) -> Any:
+    """Which clips a song of each tempo uses, and why (the tempo plan of compose)."""
+    import pandas as pd
+
+    from ..graph.timescale import plan_tempo
+
+    rows = []
+    for bpm in bpms:
+        beats, _ = song(float(duration), bpm=float(bpm))
+        plan = plan_tempo(graph, beats)
+        mult = "/".join(f"{m:g}" for m in plan.multiplicity)
+        for r in plan.clip_table:
+            rows.append(
+                {
+                    "song_bpm": float(bpm),
+                    "clip": r["clip"],
+                    "clip_bpm": r["tempo_bpm"],
+                    "group": r["group"],
+                    "eligible": r["eligible"],
+                    "multiplicity": mult,
+                    "reason": r["reason"],
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def example_composition(
+    graph: WeightedMotionGraph, *, bpm: float, duration: float, seed: int = 0, **kwargs: Any
+) -> Any:
+    """One composition (DP by default) of the study's drum song, warnings silenced.
+
+    The tempo-matched DP composition of the last :func:`quality_table` for the same
+    graph and song is reused when no other option is given.
+    """
+    key = (id(graph), float(bpm), float(duration), int(seed))
+    if not kwargs and key in _COMPOSED:
+        return _COMPOSED[key]
+    beats, level = song(float(duration), bpm=float(bpm), seed=int(seed))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        return compose(graph, beats, level, **kwargs)
 
 
 def composition_proxies(
@@ -338,13 +553,16 @@ def composition_proxies(
 
 
 def library_reference(clips: Sequence[Any]) -> Any:
-    """Foot sliding and velocity-change statistics of the captured clips themselves.
+    """Foot sliding, velocity-change and speed statistics of the captured clips themselves.
 
-    The reference for :func:`quality_table`: what the proxies read on real capture.
+    The reference for :func:`quality_table`: what the proxies read on real capture,
+    and the root and joint rotation speed percentiles the plausibility ratios divide
+    by (the largest clip 99th percentiles).
     """
     import pandas as pd
 
     from ..evaluate.composition import foot_joints, foot_sliding, velocity_change
+    from ..graph.plausibility import speed_profile
     from ..motion_beats import motion_positions
 
     rows = []
@@ -356,6 +574,7 @@ def library_reference(clips: Sequence[Any]) -> Any:
                 "clip": c.name,
                 "foot_sliding": foot_sliding(feet, fps=c.fps),
                 "velocity_change_p99_over_median": float(np.percentile(dv, 99) / np.median(dv)),
+                **speed_profile(c),
             }
         )
     return pd.DataFrame(rows)

@@ -15,13 +15,23 @@ from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
 from .positions import restore_bone_lengths
 from .warp import TimeWarp, integrate_warp
 
-__all__ = ["MODES", "LANDINGS", "FILLS", "SyncResult", "position_bones", "synchronize"]
+__all__ = [
+    "MODES",
+    "LANDINGS",
+    "FILLS",
+    "SyncResult",
+    "motion_beat_count",
+    "position_bones",
+    "synchronize",
+]
 
 MODES = ("periods", "beats", "auto")
 LANDINGS = ("boundaries", "accents")
 FILLS = ("stop", "loop")
 #: width of the blended window at each loop join [s] (capped at half an interval)
 JOIN_S = 0.2
+#: default period range when segmenting, in music beats: one to eight beats
+PERIOD_BEATS = (0.9, 8.5)
 #: share of periods that must hold the same number of motion beats to call it a meter
 METER_AGREEMENT = 0.6
 
@@ -46,7 +56,8 @@ class SyncResult:
         segments in beats mode, counted over all repetitions),
         ``beats_per_period`` (per motion beat in beats mode),
         ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
-        ``dance_beats_per_period``, ``beats_per_bar``, ``first_beat``,
+        ``dance_beats_per_period``, ``motion_beats_per_period_counted``,
+        ``beats_per_bar``, ``period_range_s``, ``first_beat``,
         ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
         ``beat_period_s``, ``delta_s``, ``rate_range`` (target/source),
         ``tempo_ratio_range`` (playback speed, source/target), ``target_beats_s``,
@@ -132,28 +143,26 @@ def _motion_beats(motion: Any, what: str) -> np.ndarray:
     return mb
 
 
-def _dance_meter(motion: Any, events: np.ndarray, given: int | None, mode: str) -> int | None:
-    """Motion beats per period: given, or counted from the kinematic beats when the
-    count is the same in at least :data:`METER_AGREEMENT` of the periods (else None:
-    a count that varies from period to period is no meter)."""
-    if mode == "beats":
-        return None
-    if given is not None:
-        return given
+def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
+    """Motion beats per period, counted from the kinematic beats (informative only).
+
+    The count that holds in at least :data:`METER_AGREEMENT` of the periods, else None
+    (also None without joint positions). Speed minima do not mark every step of a
+    real dance (a real waltz bar shows 2 of its 3 steps), so this count is reported,
+    never used to choose the beats per period: give the dance's meter instead.
+    """
     from ..motion_beats import kinematic_beats
 
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)  # no beats: no meter, no news
+            warnings.simplefilter("ignore", BeatsyncWarning)  # no beats: no count, no news
             mb = kinematic_beats(motion)
-    except ParameterError:  # no positions: the dance's meter is unknown
+    except ParameterError:  # no positions
         return None
     counts = np.histogram(mb, bins=events)[0]
     values, freq = np.unique(counts, return_counts=True)
     k = int(values[np.argmax(freq)])
-    if k >= 2 and freq.max() >= METER_AGREEMENT * counts.size:
-        return k
-    return None
+    return k if k >= 1 and freq.max() >= METER_AGREEMENT * counts.size else None
 
 
 def synchronize(
@@ -171,7 +180,7 @@ def synchronize(
     out_fps: float | None = None,
     delta: float | None = None,
     phase_offset: float = 0.0,
-    period_range: tuple[float, float] = (0.25, 1.25),
+    period_range: tuple[float, float] | None = None,
 ) -> SyncResult:
     """Resample a dance so that its periods (or its own motion beats) land on music beats.
 
@@ -211,8 +220,10 @@ def synchronize(
     beats_per_bar : int >= 1, optional
         The music's meter (e.g. ``track.beats_per_bar``); respected when choosing.
     dance_beats_per_period : int >= 1, optional
-        Motion beats per period (3 for a waltz step); default counted from the
-        kinematic beats when the motion has positions.
+        The dance's meter: beats of one period of the dance (3 for a waltz step, 6
+        for a waltz box); the count then is a multiple of it (or it halved), and a
+        warning says so when it cannot also respect ``beats_per_bar``. The report's
+        ``motion_beats_per_period_counted`` (kinematic beats per period) is a hint.
     first_beat : int >= 0
         Index of the beat the first boundary lands on.
     out_fps : float > 0, optional [Hz]
@@ -221,8 +232,10 @@ def synchronize(
         Gaussian width of eq. 9; default the mean motion period (or beat interval).
     phase_offset : float [s]
         Land the boundaries this long after their beats (negative: before).
-    period_range : (float, float) [s]
-        Shortest and longest period when segmenting here (``boundaries=None``).
+    period_range : (float, float) [s], optional
+        Shortest and longest period when segmenting here (``boundaries=None``);
+        default from the music: one to eight of its beats (``PERIOD_BEATS``), so real
+        dance cycles (a waltz box is 6 beats, about 4 s) are found.
 
     Returns
     -------
@@ -294,16 +307,25 @@ def synchronize(
         from ..units import check_positive
 
         delta = check_positive(delta, name="delta", unit="s")
-    period_range = check_range(*period_range, name="period_range", unit="s")
+    beat_period = float(np.median(np.diff(beats)))
+    if period_range is None:
+        period_range = (PERIOD_BEATS[0] * beat_period, PERIOD_BEATS[1] * beat_period)
+    else:
+        try:
+            lo, hi = period_range
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"period_range={period_range!r} must be (shortest, longest) [s]"
+            ) from None
+        period_range = check_range(lo, hi, name="period_range", unit="s")
     duration = float(frames_to_time(n_frames - 1, fps=fps))  # sample_motion clips here
 
     events, used_mode, note = _events(
         motion, boundaries, mode, period_range, float(motion.duration)
     )
     intervals = np.diff(events)
-    beat_period = float(np.median(np.diff(beats)))
     unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
-    dance = _dance_meter(motion, events, dance, used_mode)
+    counted = motion_beat_count(motion, events) if used_mode == "periods" else None
     if override is not None:
         count = BeatCount(override, "override", unit / beat_period)
     else:
@@ -363,7 +385,9 @@ def synchronize(
             "meter_fit": count.meter_fit,
             "meter_note": count.note,
             "dance_beats_per_period": dance,
+            "motion_beats_per_period_counted": counted,
             "beats_per_bar": bar,
+            "period_range_s": None if boundaries is not None else list(period_range),
             "mean_motion_period_s": unit,
             "beat_period_s": beat_period,
         }
@@ -405,15 +429,15 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         )
     used = events[: p + 1]
     end = None
-    if p == events.size - 1:
-        if duration > used[-1]:
-            end = duration  # the clip's tail after its last boundary
-    elif plan["fill"] == "loop":
-        # cover the beats after the last whole interval with part of the next one
-        rest = last_beat - first_beat - int(cum[p])
-        if rest > 0:
-            end = float(used[-1] + rest / int(counts[p]) * (events[p + 1] - events[p]))
+    if p == events.size - 1 and duration > used[-1]:
+        end = duration  # the clip's tail after its last boundary
     warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+    if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
+        # cover the beats after the last whole interval with part of the next one: the
+        # warp goes on at its end rate up to the last beat (within that interval)
+        need = beats[last_beat] + phase_offset - targets[-1]
+        end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
+        warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
     tau_end = float(warp.tgt[-1])
     if tau_end <= 0:
         raise ParameterError(

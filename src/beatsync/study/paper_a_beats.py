@@ -1,0 +1,250 @@
+"""Paper A, section 4: the beat-tracking study (our tracker beside the peers).
+
+One function per step of ``notebooks/paper_a_sec4_beat_tracking.ipynb``: build the
+items (the synthetic set with exact beats, and every real recording with human
+annotations in ``data/``), track and score them with every method, summarise per
+group, check the targets, plot the tempo curves of the tempo-change items, and sweep
+the phase-slope front end on the development recordings and the synthetic set.
+
+Methods (:mod:`beatsync.peers`): ``psf`` (ours), ``librosa`` and, when the optional
+``essentia`` package is installed, essentia's ``BeatTrackerDegara`` and
+``BeatTrackerMultiFeature`` (:func:`available_methods` says which ran). Items are
+tracked and scored by :mod:`beatsync.study.beat_evaluation` (mir_eval metrics). Synthetic
+items use the notebook's ``min_beat_time``; the two long real recordings use
+mir_eval's default 5 s (their annotations' convention), the 2.8 s madmom sample 0 s.
+Two or three recordings are a sanity check, not a benchmark.
+"""
+
+from __future__ import annotations
+
+import itertools
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import datasets, peers
+from ..beats import FRONTEND_DEFAULTS, beat_tempo, track_beats
+from ..errors import BeatsyncWarning
+from ..synth.audio import BeatTestItem, make_beat_test_set
+from . import beat_evaluation
+
+__all__ = [
+    "SHORT_NAMES",
+    "TARGETS",
+    "available_methods",
+    "synthetic_items",
+    "real_items",
+    "score_items",
+    "meter_estimates",
+    "summarize",
+    "check_targets",
+    "tempo_change_figure",
+    "frontend_sweep",
+]
+
+#: Column names of the study tables.
+SHORT_NAMES = {
+    "F-measure": "F",
+    "Correct Metric Level Total": "CMLt",
+    "Any Metric Level Total": "AMLt",
+}
+_METRICS = tuple(SHORT_NAMES)
+
+#: Targets of the tracker: (description, item selection, metric, threshold).
+TARGETS = (
+    ("synthetic: mean F, clean items", "group == 'clean'", "F", 0.98),
+    ("synthetic: mean AMLt, all items", "group != 'real'", "AMLt", 0.98),
+    ("synthetic: mean F, tempo-change items", "group == 'change'", "F", 0.95),
+    ("hainsworth_001: F", "item == 'hainsworth_001'", "F", 0.95),
+    ("hainsworth_001: CMLt", "item == 'hainsworth_001'", "CMLt", 0.90),
+    ("ballroom_waltz: F", "item == 'ballroom_waltz'", "F", 0.95),
+    ("ballroom_waltz: CMLt", "item == 'ballroom_waltz'", "CMLt", 0.90),
+    ("madmom_sample: at its own level (tempo octave)", "item == 'madmom_sample'", "octave", 1.0),
+)
+
+#: mir_eval's ``min_beat_time`` per real recording [s].
+_REAL_MIN_BEAT_TIME = {"hainsworth_001": 5.0, "ballroom_waltz": 5.0, "madmom_sample": 0.0}
+
+
+def available_methods() -> list[str]:
+    """Trackers that can run here, ours first (:func:`beatsync.peers.available`).
+
+    Always ``psf`` and ``librosa``; essentia's two trackers when the optional
+    ``essentia`` package is installed.
+    """
+    return [name for name, ok in peers.available().items() if ok]
+
+
+def synthetic_items(**kwargs: Any) -> list[BeatTestItem]:
+    """The synthetic test set (:func:`beatsync.synth.audio.make_beat_test_set`)."""
+    return make_beat_test_set(**kwargs)
+
+
+def real_items() -> list[BeatTestItem]:
+    """Every bundled real recording with human beat annotations, as test items.
+
+    Hainsworth 001 and the Ballroom waltz (``datasets.load_real_dev``) and the madmom
+    sample; group ``"real"``, ``bpm`` the median annotated tempo.
+    """
+    out = []
+    for name in datasets.REAL_DEV_ITEMS:
+        y, sr, ref = datasets.load_real_dev(name)
+        out.append(_real_item(name, y, sr, ref))
+    y, sr, ref = datasets.load_madmom_sample()
+    out.append(_real_item("madmom_sample", y, sr, ref))
+    return out
+
+
+def _real_item(name, y, sr, ref) -> BeatTestItem:
+    bpm = 60.0 / float(np.median(np.diff(ref)))
+    return BeatTestItem(name, "real", "recording", y, int(sr), ref, bpm, bpm)
+
+
+def _min_beat_time(item: BeatTestItem, default: float) -> float:
+    return _REAL_MIN_BEAT_TIME.get(item.name, default) if item.group == "real" else default
+
+
+def score_items(
+    items: Sequence[BeatTestItem],
+    *,
+    methods: Sequence[str] | None = None,
+    min_beat_time: float = 0.0,
+    **track_kwargs: Any,
+) -> pd.DataFrame:
+    """Track and score every item with every method; one row per item and method.
+
+    :func:`beatsync.study.beat_evaluation.score_items`, with each real recording
+    scored from its own ``min_beat_time`` and the study's short metric names.
+    Columns: item, group, method, tempo_ref, tempo_est, octave, F, CMLt, AMLt,
+    seconds. ``track_kwargs`` go to the ``psf`` tracker (front-end parameters).
+    """
+    methods = available_methods() if methods is None else list(methods)
+    frames = []
+    by_time: dict[float, list[BeatTestItem]] = {}
+    for it in items:
+        by_time.setdefault(_min_beat_time(it, min_beat_time), []).append(it)
+    for mbt, group in by_time.items():
+        frames.append(
+            beat_evaluation.score_items(
+                group, methods=methods, min_beat_time=mbt, track_kwargs=track_kwargs
+            )
+        )
+    scores = pd.concat(frames, ignore_index=True).rename(columns=SHORT_NAMES)
+    order = {it.name: i for i, it in enumerate(items)}
+    scores = scores.sort_values("item", key=lambda c: c.map(order), kind="stable")
+    cols = ["item", "group", "method", "tempo_ref", "tempo_est", "octave", "F", "CMLt", "AMLt"]
+    return scores[[*cols, "seconds"]].reset_index(drop=True)
+
+
+def meter_estimates(items: Sequence[BeatTestItem]) -> pd.DataFrame:
+    """Our meter estimate (beats per bar) and tempo for each item (``psf`` only)."""
+    rows = []
+    for it in items:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BeatsyncWarning)
+            bt = track_beats(it.y, it.sr)
+        rows.append({"item": it.name, "tempo": bt.tempo, "beats_per_bar": bt.beats_per_bar})
+    return pd.DataFrame(rows)
+
+
+def summarize(scores: pd.DataFrame, by: str = "group") -> pd.DataFrame:
+    """Mean F, CMLt, AMLt per ``by`` and method, with the count of tempo-octave errors."""
+    octave_err = scores["octave"].isin(["double", "half", "triple", "third"])
+    df = scores.assign(octave_errors=octave_err.astype(int), n=1)
+    agg = {"F": "mean", "CMLt": "mean", "AMLt": "mean", "octave_errors": "sum", "n": "sum"}
+    return df.groupby([by, "method"], sort=False).agg(agg).reset_index()
+
+
+def check_targets(scores: pd.DataFrame) -> pd.DataFrame:
+    """The tracker's targets per method: value, threshold and PASS/FAIL.
+
+    The madmom target is 1 when the tempo is at the annotated level (``octave`` is
+    ``"correct"``), else 0.
+    """
+    rows = []
+    for method, sc in scores.groupby("method", sort=False):
+        for desc, query, metric, threshold in TARGETS:
+            sel = sc.query(query)
+            if sel.empty:
+                continue
+            if metric == "octave":
+                value = float((sel["octave"] == "correct").mean())
+            else:
+                value = float(sel[metric].mean())
+            rows.append(
+                {
+                    "target": desc,
+                    "method": method,
+                    "n": len(sel),
+                    "value": value,
+                    "threshold": threshold,
+                    "result": "PASS" if value >= threshold else "FAIL",
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def tempo_change_figure(items: Sequence[BeatTestItem], max_items: int = 4):
+    """Tempo curves of the ``psf`` tempo HMM against the true tempo on tempo-change items."""
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    change = [it for it in items if it.group == "change"][:max_items]
+    fig, axes = plt.subplots(
+        1, max(len(change), 1), figsize=(3.2 * max(len(change), 1), 2.6), squeeze=False
+    )
+    for ax, it in zip(axes[0], change, strict=False):
+        track = track_beats(it.y, it.sr)
+        ax.step(*beat_tempo(it.beats), where="post", color="0.6", label="truth")
+        ax.plot(track.tempo_times, track.tempo_curve, "o-", ms=3, label="psf tempo HMM")
+        ax.set_title(it.name, fontsize=9)
+        ax.set_xlabel("time [s]")
+    axes[0, 0].set_ylabel("tempo [BPM]")
+    axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def frontend_sweep(
+    item_sets: dict[str, Sequence[BeatTestItem]],
+    grid: dict[str, Sequence[Any]],
+    *,
+    min_beat_time: float = 0.0,
+) -> pd.DataFrame:
+    """Score the ``psf`` tracker for every front-end combination on each item set.
+
+    Parameters
+    ----------
+    item_sets : dict of name -> items
+        E.g. ``{"real": real_items(), "synthetic": ...}``.
+    grid : dict
+        Front-end parameter (``win_s``, ``hop_s``, ``band_edges_hz``, ...) -> values;
+        combinations with ``hop_s > win_s / 2`` are skipped.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per combination and item set: the parameters, whether they are the
+        defaults, mean F, CMLt and AMLt.
+    """
+    keys = list(grid)
+    rows = []
+    for combo in itertools.product(*(grid[k] for k in keys)):
+        params = dict(zip(keys, combo, strict=True))
+        if params.get("hop_s", 0.0) > params.get("win_s", FRONTEND_DEFAULTS["win_s"]) / 2:
+            continue
+        default = all(
+            np.allclose(np.asarray(v, float), np.asarray(FRONTEND_DEFAULTS[k], float))
+            for k, v in params.items()
+        )
+        for set_name, items in item_sets.items():
+            sc = score_items(items, methods=["psf"], min_beat_time=min_beat_time, **params)
+            row = {
+                k: str(list(v)) if isinstance(v, (list, tuple)) else v for k, v in params.items()
+            }
+            row.update({"set": set_name, "default": default})
+            row.update({m: float(sc[m].mean()) for m in ("F", "CMLt", "AMLt")})
+            rows.append(row)
+    return pd.DataFrame(rows)
