@@ -142,3 +142,30 @@ def test_segment_periods_is_honoured(synth_csv, capsys):
     rc = main(["segment", str(path), "--fps", "25", "--periods", "15"])
     assert rc == 3
     assert "n_periods=15 was given" in capsys.readouterr().err
+
+
+def test_segment_bpm_searches_one_to_eight_beats(tmp_path, capsys):
+    """A 4 s figure: refused in the default 0.25-1.25 s, found with the music's tempo."""
+    s = periodic_motion(n_frames=1001, n_channels=12, fps=25.0, n_periods=10, snr_db=20, seed=2)
+    path = tmp_path / "figure.csv"
+    pd.DataFrame(s.motion.values, columns=list(s.motion.channels)).to_csv(path, index=False)
+    assert main(["segment", str(path), "--fps", "25"]) == 3
+    assert "not periodic" in capsys.readouterr().err
+    assert main(["segment", str(path), "--fps", "25", "--bpm", "120", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["period_range_s"] == [0.5, 4.0]
+    assert res["mean_period_s"] == pytest.approx(4.0, rel=0.03)
+
+
+@pytest.mark.parametrize(
+    "extra,match",
+    [
+        (["--bpm", "0.5"], "--bpm=0.5 is outside the plausible range"),
+        (["--bpm", "120", "--period-range", "0.3", "2"], "either --bpm or --period-range"),
+        (["--bpm", "120", "--periods", "12"], "leave out --bpm"),
+    ],
+)
+def test_segment_bpm_bad_input(synth_csv, capsys, extra, match):
+    path, _ = synth_csv
+    assert main(["segment", str(path), "--fps", "25", *extra]) == 3
+    assert re.search(match, capsys.readouterr().err)

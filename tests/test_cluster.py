@@ -76,3 +76,15 @@ def test_existing_scheduler_by_address():
             assert client.submit(max, [4, 1]).result() == 4
         assert client.status == "closed"
         assert lc.status.name == "running"  # an existing cluster is left running
+
+
+def test_local_workers_keep_glibc_default_malloc():
+    """Dask's MALLOC_TRIM_THRESHOLD_=65536 made every track about 1.8x slower."""
+    import os
+
+    def environ():
+        return os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("OMP_NUM_THREADS")
+
+    with cluster.dask_client(n_workers=1, processes=True) as client:
+        (env,) = client.run(environ).values()
+    assert env == (None, "1")

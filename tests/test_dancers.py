@@ -82,3 +82,29 @@ def test_cli_refuses_position_options_for_bvh(capsys):
     bvh = str(datasets.path("motion/cmu_salsa/60_01_scaled.bvh"))
     assert main(["segment", bvh, "--fps", "60", "--units", "cm"]) != 0
     assert "units='cm' apply to joint-position files" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_resynchronised_waltzes_beat_control_and_own_song():
+    from beatsync.study import paper_a_dancers as study
+
+    pairs = study.load_pairs(["DANCE_W_5", "DANCE_W_10"])
+    songs = study.track_songs(pairs)
+    table, results = study.dancer_table(pairs, songs, modes=("beats",), n_control=20)
+    summary = study.summary_table(table, mode="beats")
+    assert summary["beats_motion_target"].all() and summary["beats_music_target"].all()
+    res = results[("DANCE_W_5", "beats")]
+    assert res.report["mode"] == "beats" and res.report["repetitions"] >= 1
+    # the loop covers the song to its last beat
+    assert res.motion.duration >= songs["DANCE_W_10"]["beats"][-1] - 0.1
+    assert res.motion.is_positional and res.motion.position_info.layout == "json"
+
+
+def test_video_html_embeds_the_mp4(tmp_path):
+    from beatsync.study.paper_a_dancers import video_html
+
+    mp4 = tmp_path / "v.mp4"
+    mp4.write_bytes(b"\x00\x00\x00\x18ftypmp42")
+    html = video_html(mp4, width=300).data
+    assert html.startswith('<video width="300" controls>') and "data:video/mp4;base64," in html
+    assert "No MP4" in video_html(tmp_path / "v.gif").data

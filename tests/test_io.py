@@ -170,7 +170,7 @@ def test_beats_files(tmp_path):
     with pytest.raises(ParameterError, match="increasing"):
         io.read_beats(tmp_path / "bad.beats")
     (tmp_path / "ms.beats").write_text("abc\n")
-    with pytest.raises(ParameterError, match=r"line 1: 'abc' is not a time in seconds"):
+    with pytest.raises(ParameterError, match=r"line 1: 'abc' is not a number; a beat file"):
         io.read_beats(tmp_path / "ms.beats")
     with pytest.raises(ParameterError, match="increasing"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])

@@ -165,3 +165,20 @@ def test_salsa_beats_plausible():
     inten = beat_interval_intensity(m, beats)
     assert inten.shape == (beats.size - 1,)
     assert np.all(inten > 0)
+
+
+def test_position_only_motion_uses_its_joint_positions():
+    from beatsync.motion import Motion
+    from beatsync.motion_beats import motion_positions
+
+    t = np.arange(240) / 60.0
+    pos = np.zeros((240, 3, 3))
+    pos[:, 1, 2] = 1.0
+    pos[:, 2, 2] = 1.5
+    pos[:, 2, 0] = 0.3 * np.sin(2 * np.pi * t)  # the hand swings at 1 Hz
+    channels = tuple(f"{j}_{a}" for j in ("root", "neck", "hand") for a in "xyz")
+    m = Motion(pos.reshape(240, -1), 60.0, channels, None, "positions")
+    assert m.is_positional
+    np.testing.assert_allclose(motion_positions(m), pos)
+    np.testing.assert_allclose(kinematic_beats(m), np.arange(0.25, 4.0, 0.5), atol=1.5 / 60)
+    assert motion_positions(m, joints=["hand"]).shape == (240, 1, 3)

@@ -57,3 +57,17 @@ def test_sync_table_and_views():
 def test_make_songs_bad_source():
     with pytest.raises(ParameterError, match="beat_source"):
         study.make_songs([96.0, 132.0], beat_source="guess")
+
+
+@pytest.mark.slow
+def test_real_dancer_resynchronised_beats_land_better_than_chance():
+    from beatsync import datasets
+
+    a, b = datasets.load_dance_pair("DANCE_W_10"), datasets.load_dance_pair("DANCE_C_4")
+    from beatsync.study.paper_a_real_dancers import real_dancer_row
+
+    row, res = real_dancer_row(a, (b.y, b.sr), song_name="cha-cha", mode="beats",
+                                     land="boundaries", n_control=20)
+    assert row["mode"] == "beats" and row["max residual [frames]"] <= 0.5 + 1e-6
+    assert row["after_motion"] > row["control_motion"] + 0.1
+    assert row["after_motion"] > row["own_motion"]

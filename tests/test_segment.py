@@ -520,8 +520,8 @@ def test_period_range_from_beat():
 @pytest.mark.parametrize(
     "beat,kw,match",
     [
-        (120.0, {}, "BPM"),  # a tempo, not a beat period
-        (0.0, {}, "> 0"),
+        (120.0, {}, "tempo in BPM"),  # a tempo, not a beat period
+        (0.0, {}, r"beat_period=0.0 must be in \[0.15, 3\]"),
         (float("nan"), {}, "finite"),
         ("fast", {}, "not a number"),
         (0.5, {"beats": (8, 1)}, "reversed"),

@@ -234,7 +234,8 @@ def test_no_path_error_names_both_tempi_and_the_bound():
     with pytest.raises(ParameterError, match="scale-bound"):
         dp_search(g, np.zeros(md.size), music_durations=md, scale_bound=(0.8, 1.25))
     # relaxing the bound as suggested composes
-    comp = compose(g, song.beats, level, multiplicity=[1], scale_bound=(0.4, 1.25))
+    with pytest.warns(BeatsyncWarning, match="faster than its library"):
+        comp = compose(g, song.beats, level, multiplicity=[1], scale_bound=(0.4, 1.25))
     assert comp.search.scales.min() >= 0.4
 
 

@@ -266,3 +266,27 @@ def test_check_helpers_accept_numbers_written_as_text():
     assert check_positive("2.5", name="th", unit="rd") == 2.5
     assert check_fps("60", name="fps") == 60.0
     assert check_bpm("120") == 120.0
+
+
+@pytest.mark.parametrize(
+    "pair, match",
+    [
+        (0.5, r"period_range=0.5 must be two numbers \(lower, upper\) \[s\]"),
+        ((0.5, 1.0, 2.0), "two numbers"),
+        ("ab", "two numbers"),
+        ((2.0, 0.5), "reversed"),
+        ((0.0, 1.0), "finite and > 0"),
+    ],
+)
+def test_check_interval_refuses(pair, match):
+    from beatsync.units import check_interval
+
+    with pytest.raises(ParameterError, match=match):
+        check_interval(pair, name="period_range", unit="s")
+
+
+def test_check_interval_accepts_arrays_and_lists():
+    from beatsync.units import check_interval
+
+    assert check_interval(np.array([0.5, 2.0]), name="r", unit="s") == (0.5, 2.0)
+    assert check_interval([1, 3], name="r", unit="s") == (1.0, 3.0)

@@ -6,7 +6,8 @@ scheduler given by address (``"tcp://10.0.0.5:8786"``). It checks its arguments
 before starting anything, gives up on an unreachable scheduler after
 ``timeout`` seconds with a :class:`~beatsync.errors.ParameterError` (not a hang, not
 a traceback), and closes the client and the local cluster on the way out, also on
-Ctrl-C.
+Ctrl-C. Local workers run with glibc's default memory-allocator settings (Dask's
+``MALLOC_TRIM_THRESHOLD_`` makes our work about 1.8x slower).
 
 Workers of an existing cluster must see the same file paths as the client (a shared
 file system) and have beatsync installed.
@@ -124,7 +125,9 @@ def dask_client(
     from dask.distributed import Client, LocalCluster
 
     cluster = None
+    stack = contextlib.ExitStack()
     if scheduler is None:
+        stack.enter_context(_glibc_default_malloc())
         cluster = LocalCluster(
             n_workers=n or default_workers(),
             threads_per_worker=1,
@@ -145,6 +148,24 @@ def dask_client(
         if cluster is not None:
             with contextlib.suppress(Exception):
                 cluster.close()
+        stack.close()
+
+
+def _glibc_default_malloc() -> Any:
+    """Start local workers without Dask's ``MALLOC_TRIM_THRESHOLD_=65536``.
+
+    Dask sets it in its worker processes to hand freed memory back to the system at
+    once; glibc then stops adapting its thresholds, and beat tracking (arrays of a few
+    MB allocated and freed per call) runs about 1.8x slower: 1.29 s against 0.72 s
+    per 30 s song, measured in one process with and without the variable. The other
+    variables (one thread for OpenMP, MKL, OpenBLAS) are kept.
+    """
+    import dask
+
+    key = "distributed.nanny.pre-spawn-environ"
+    env = dict(dask.config.get(key, default={}) or {})
+    env.pop("MALLOC_TRIM_THRESHOLD_", None)
+    return dask.config.set({key: env})
 
 
 def _connect(address: str, timeout: float) -> Any:

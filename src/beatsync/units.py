@@ -11,7 +11,7 @@ fraction) and returns the value converted to its working type.
 Helpers
 -------
 - numbers: :func:`as_float`, :func:`as_int`, :func:`check_positive`,
-  :func:`check_between`, :func:`check_range`;
+  :func:`check_between`, :func:`check_range`, :func:`check_interval` (one pair);
 - rates: :func:`check_fps` [Hz], :func:`check_sample_rate` [Hz], :func:`check_bpm`
   [bpm] (one range, :data:`MIN_BPM`-:data:`MAX_BPM`);
 - arrays: :func:`check_finite`, :func:`check_times` [s], :func:`check_audio`.
@@ -48,6 +48,7 @@ __all__ = [
     "check_bpm",
     "check_audio",
     "as_float_array",
+    "check_interval",
     "MIN_PLAUSIBLE_FPS",
     "MIN_PLAUSIBLE_SR",
     "MIN_BPM",
@@ -559,3 +560,22 @@ def beat_phase(events: Any, beats: Any) -> np.ndarray:
     e = e[(e >= b[0]) & (e < b[-1])]
     i = np.searchsorted(b, e, side="right") - 1
     return (e - b[i]) / (b[i + 1] - b[i])
+
+
+def check_interval(pair: Any, *, name: str, unit: str) -> tuple[float, float]:
+    """Validate an interval given as one pair ``(lo, hi)``: see :func:`check_range`.
+
+    Refuses what is not a pair (a single number, three values, a string) with the
+    expected form in the message, so callers need no ``lo, hi = pair`` of their own.
+
+    Examples
+    --------
+    >>> check_interval((0.5, 2.0), name="period_range", unit="s")
+    (0.5, 2.0)
+    """
+    if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+        raise ParameterError(
+            f"{name}={pair!r} must be two numbers (lower, upper) [{unit}], e.g. (0.5, 2.0)"
+        )
+    lo, hi = pair
+    return check_range(lo, hi, name=name, unit=unit)

@@ -58,6 +58,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     add_period_range(p)
     p.add_argument(
+        "--bpm",
+        type=float,
+        default=None,
+        help="tempo of the music the dance goes with [BPM]: search periods of 1 to 8 beats "
+        "(steps to figures such as a 6-beat waltz box), shortest first; instead of "
+        "--period-range",
+    )
+    p.add_argument(
         "--period-method",
         choices=("energy", "fft"),
         default="energy",
@@ -80,10 +88,21 @@ def run(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from .. import io
+    from ..errors import ParameterError
     from ..motion import is_marker_motion, segmentation_view
-    from ..segment import segment
-    from ..units import time_to_frames
+    from ..segment import period_range_from_beat, segment
+    from ..units import check_bpm, time_to_frames
 
+    period_range = tuple(args.period_range)
+    if args.bpm is not None:
+        if isinstance(args.period_range, list):  # given on the command line
+            raise ParameterError("give either --bpm or --period-range, not both")
+        if args.periods is not None:
+            raise ParameterError(
+                "--bpm sets the period range for estimating the count; with --periods "
+                "the count is given, so leave out --bpm"
+            )
+        period_range = period_range_from_beat(60.0 / check_bpm(args.bpm, name="--bpm"))
     fb = feedback(args)
     outs = Outputs(inputs=[args.motion])
     out = outs.add(args.out, option="--out") if args.out else None
@@ -109,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
             motion,
             alpha=args.alpha,
             n_periods=args.periods,
-            period_range=tuple(args.period_range),
+            period_range=period_range,
             period_method="given" if args.periods is not None else args.period_method,
             channels=chan,
         )
@@ -133,6 +152,7 @@ def run(args: argparse.Namespace) -> int:
         "normalised_energy": seg.normalised_energy,
         "period_method": seg.period_method,
         "alpha": args.alpha,
+        "period_range_s": list(period_range),
         "channels": list(seg.channels),
         "marker_angles": converted,
         "search_decimation": seg.search_decimation,

@@ -1,11 +1,15 @@
-"""``beatsync sync``: make a periodic dance follow a song (paper A, section 5).
+"""``beatsync sync``: make a dance follow a song (paper A, section 5, and real dances).
 
-Reads a motion file (BVH, MoCap Toolbox ``.mat``, CSV/NPY table) and a song, finds
-the motion's periods (:func:`beatsync.segment.segment`), the music's beats
-(:func:`beatsync.beats.track_beats`, or a beats file / a known BPM), resamples the
-motion so that every period boundary lands on a beat (:func:`beatsync.sync.synchronize`)
-and writes it as BVH with the input skeleton (or CSV), optionally a video with the
-music, and the report.
+Reads a motion file (BVH; MoCap Toolbox ``.mat``; joint positions as Dance-with-Melody
+``.json``, ``.npy``/``.npz`` or C3D; CSV/NPY angle tables) and a song, finds the
+music's beats (:func:`beatsync.beats.track_beats` with its meter estimate, or a beats
+file / a known BPM) and calls :func:`beatsync.sync.synchronize` with ``boundaries=None``:
+it finds the motion's periods (``--mode periods``, paper A), or warps the dancer's own
+motion beats (``--mode beats``), or tries periods and falls back to beats with a
+warning (``--mode auto``, default), and with ``--fill loop`` (default) repeats whole
+periods with blended joins until the dance reaches the song's last beat. Writes the
+motion (BVH with the input skeleton; joint positions in the input's layout; or CSV),
+optionally a video with the music that lasts as long as the song, and the report.
 """
 
 from __future__ import annotations
@@ -373,11 +377,8 @@ def _text(result: dict[str, Any]) -> str:
         f"{result['n_music_beats']} beats ({result['beats_source']}), "
         f"beat period {r['beat_period_s']:.3f} s",
         f"mode     {r['mode']}"
-        + (
-            (" (auto: not periodic, fell back to motion beats)" if r["mode"] == "beats"
-             else " (auto: periodic)")
-            if r["mode_requested"] == "auto" else ""
-        )
+        + (" (auto: not periodic, fell back to motion beats)" if r["mode_note"] else "")
+        + (" (auto: periodic)" if r["mode_requested"] == "auto" and not r["mode_note"] else "")
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
         f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "
         f"{r['beats_per_period']} beat(s) per {unit[:-1]} ({r['beats_per_period_rule']})"

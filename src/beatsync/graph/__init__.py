@@ -1,13 +1,22 @@
 """Music-driven dance composition over weighted motion graphs (paper B).
 
 Xu, Takagi, Kawada, "Automatic composition of motion capture animation for music
-synchronization". A motion library becomes a :class:`WeightedMotionGraph` whose
-nodes are beat frames (:mod:`beatsync.graph.build`); a dynamic programme over the
-music's beat intervals chooses the path whose motion intensity follows the music's
-(:mod:`beatsync.graph.search`: the DP, the multi-stage baseline and the random walk);
-the chosen intervals are time-warped onto the music beats and blended at transitions
-(:mod:`beatsync.graph.warp`); :mod:`beatsync.graph.compose` is the public entry that
-runs the whole chain, and :mod:`beatsync.graph.cache` keeps built graphs on disk.
+synchronization". Modules:
+
+- :mod:`~beatsync.graph.build`: a motion library becomes a :class:`WeightedMotionGraph`
+  whose nodes are beat frames; :mod:`~beatsync.graph.distance`: the frame distance
+  of eq. 1 (stable floor-aligned point-cloud distance).
+- :mod:`~beatsync.graph.timescale`: tempo-matched composition (clip tempi, tempo
+  sub-groups, beat multiplicity, the time-scale bound).
+- :mod:`~beatsync.graph.search`: the DP over the music's beats (and the dispatcher);
+  :mod:`~beatsync.graph.baselines`: the multi-stage search and the random walk;
+  :mod:`~beatsync.graph.objective`: their shared objective, result and checks.
+- :mod:`~beatsync.graph.warp`: the chosen intervals time-warped onto the music and
+  blended at transitions.
+- :mod:`~beatsync.graph.plausibility`: root and joint rotation speeds against the
+  library's.
+- :mod:`~beatsync.graph.compose`: the public entry that runs the whole chain;
+  :mod:`~beatsync.graph.cache`: built graphs kept on disk.
 
 Outside this stage: quality proxies are metrics in
 :mod:`beatsync.evaluate.composition`, synthetic dances live in

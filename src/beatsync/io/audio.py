@@ -124,7 +124,8 @@ def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
             times.append(as_float(first, name="time", unit="s", text=True))
         except ParameterError:
             raise ParameterError(
-                f"{str(p)!r} line {n}: {first!r} is not a time in seconds"
+                f"{str(p)!r} line {n}: {first!r} is not a number; a beat file holds one "
+                "time in seconds per line"
             ) from None
     return check_times(np.array(times), name=f"beat times in {p.name}", allow_empty=False)
 

@@ -104,6 +104,9 @@ Documented rules (choices the paper leaves open)
   0.14-0.90; the CMU 005_02 pirouette -0.16 and -0.12; white noise (4 or 29 channels,
   16 trials) <= 0.04. Known limits: the margin is small (salsa 61_04 with the FFT
   period: 0.053), and a random walk (integrated noise) passed in 7 of 16 trials.
+  Re-measured on 750 frames at 25 fps, seeds 1000-1015, default range: white noise
+  accepted in 2 of 16 trials with 4 channels and 0 of 16 with 29; a random walk in 1
+  of 16 with 4 channels and 0 of 16 with 29.
 - Free ends: real clips do not start or end on a period boundary, so the first
   boundary may lie anywhere in the lead-in ``t_0 < lo`` and the last in the tail
   ``t_p >= n - lo`` (``lo``: shortest allowed period); the band of eq. 3 is rounded

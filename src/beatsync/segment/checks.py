@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_finite, check_range
+from ..units import as_float, as_float_array, as_int, check_finite, check_range
 from .period import PERIOD_METHODS
 
 __all__ = [
@@ -27,10 +27,7 @@ __all__ = [
 
 def check_values(values: Any) -> np.ndarray:
     """Values as a finite float64 ``(n_frames, n_channels)`` array (1-D: one channel)."""
-    try:
-        arr = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ParameterError("values must be a numeric array (n_frames, n_channels)") from None
+    arr = as_float_array(values, name="motion values")
     if arr.ndim == 1:
         arr = arr[:, None]
     if arr.ndim != 2:
@@ -42,11 +39,8 @@ def check_values(values: Any) -> np.ndarray:
 
 def check_alpha(alpha: Any) -> float:
     """The alpha of eq. 3: a fraction of the period in (0, 0.5)."""
-    try:
-        a = float(alpha)
-    except (TypeError, ValueError):
-        raise ParameterError(f"alpha={alpha!r} is not a number in (0, 0.5)") from None
-    if not (np.isfinite(a) and 0.0 < a < 0.5):
+    a = as_float(alpha, name="alpha", unit="")
+    if not 0.0 < a < 0.5:
         hint = " (a fraction of the period, e.g. 0.1, not a percentage)" if a >= 0.5 else ""
         raise ParameterError(f"alpha={alpha!r} must be in (0, 0.5){hint}")
     return a
@@ -67,13 +61,7 @@ def check_n_periods(n_periods: Any) -> int | None:
     """A period count: None (estimate it) or an integer >= 2."""
     if n_periods is None:
         return None
-    try:
-        p = int(n_periods)
-    except (TypeError, ValueError):
-        raise ParameterError(f"n_periods={n_periods!r} must be an integer >= 2") from None
-    if p != n_periods or p < 2:
-        raise ParameterError(f"n_periods={n_periods!r} must be an integer >= 2")
-    return p
+    return as_int(n_periods, name="n_periods", minimum=2)
 
 
 def check_period_method(period_method: Any, n_periods: int | None) -> str:

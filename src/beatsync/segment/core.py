@@ -25,9 +25,11 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..units import (
+    MAX_BPM,
+    MIN_BPM,
+    check_between,
     check_finite,
     check_fps,
-    check_positive,
     check_range,
     frames_to_time,
     time_to_frames,
@@ -520,8 +522,9 @@ def period_range_from_beat(
 
     Parameters
     ----------
-    beat_period : float > 0 [s]
-        The music's beat period (60 / BPM), e.g. the median inter-beat interval.
+    beat_period : float in [0.15, 3] [s]
+        The music's beat period (60 / BPM, within the package's 20-400 BPM), e.g. the
+        median inter-beat interval.
     beats : (float, float)
         Fewest and most beats per motion period (default 1 to 8).
 
@@ -540,12 +543,9 @@ def period_range_from_beat(
     >>> period_range_from_beat(0.5)
     (0.5, 4.0)
     """
-    bp = check_positive(beat_period, name="beat_period", unit="s")
-    if bp > 5.0:
-        raise ParameterError(
-            f"beat_period={beat_period!r} s is longer than 5 s (12 BPM): is it a tempo in "
-            f"BPM? The beat period is 60 / BPM ({60.0 / bp:.3f} s for {bp:g} BPM)"
-        )
+    hint = "a beat period in seconds is 60 / BPM; is it a tempo in BPM?"
+    bp = check_between(beat_period, name="beat_period", unit="s", low=60.0 / MAX_BPM,
+                       high=60.0 / MIN_BPM, closed="both", hint=hint)  # fmt: skip
     try:
         b_lo, b_hi = beats
     except (TypeError, ValueError):

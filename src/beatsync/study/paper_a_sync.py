@@ -14,6 +14,7 @@ for the paper's tables lives here, the scores themselves in
   dancer's accents put on the beat), :func:`sync_table` (every clip on every song),
   :func:`frame_count_view`, :func:`alignment_view`, :func:`alignment_summary`.
 - Figure 3: :func:`residual_table`, :func:`figure3`, :func:`animation_video`.
+- Real dancers re-synchronised to other songs: :mod:`.paper_a_real_dancers`.
 - Artefacts: :func:`beatsync.study.artifacts.write_artifacts`.
 
 Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb``,
@@ -36,6 +37,7 @@ from ..evaluate.alignment import (
     offset_control,
 )
 from ..motion import Motion
+from ..motion_beats import kinematic_beats
 from ..units import check_positive, frames_to_time, time_to_frames
 from .artifacts import write_artifacts
 
@@ -61,34 +63,16 @@ __all__ = [
 
 #: Columns of Table 1 as the notebook shows it.
 FRAME_COUNT_COLUMNS = [
-    "clip",
-    "fps",
-    "input frames",
-    "song",
-    "periods",
-    "periods used",
-    "beats/period",
-    "output frames",
-    "paper output frames",
-    "max residual [frames]",
-    "note",
-]
+    "clip", "fps", "input frames", "song", "periods", "periods used", "beats/period",
+    "output frames", "paper output frames", "max residual [frames]", "note",
+]  # fmt: skip
 #: Alignment columns (``_motion``: averaged over motion beats, Siyao et al. 2022;
 #: ``_music``: averaged over music beats, Li et al. 2021).
 ALIGNMENT_COLUMNS = [
-    "clip",
-    "song",
-    "before_motion",
-    "after_motion",
-    "aligned_motion",
-    "control_motion",
-    "before_music",
-    "after_music",
-    "aligned_music",
-    "control_music",
-    "before_phase",
+    "clip", "song", "before_motion", "after_motion", "aligned_motion", "control_motion",
+    "before_music", "after_music", "aligned_music", "control_music", "before_phase",
     "after_phase",
-]
+]  # fmt: skip
 
 # score columns in the order of the published CSV
 _TABLE_SCORES = [
@@ -336,12 +320,6 @@ def segment_clip(
 # ------------------------------------------------------------------------ Table 1
 
 
-def _kinematic_beats(motion: Motion) -> np.ndarray:
-    from ..motion_beats import kinematic_beats
-
-    return kinematic_beats(motion)
-
-
 def evaluate_sync(
     motion: Motion,
     beats: Any,
@@ -435,8 +413,8 @@ def evaluate_sync(
         "aligned_music",
     )
     try:
-        mb_before = _kinematic_beats(motion)
-        mb_after = _kinematic_beats(res.motion)
+        mb_before = kinematic_beats(motion)
+        mb_after = kinematic_beats(res.motion)
     except ParameterError:  # no positions: a plain joint-angle table
         row.update({k: float("nan") for k in keys})
         row["result"] = res
@@ -452,7 +430,7 @@ def evaluate_sync(
     )
     res_al = synchronize(motion, boundaries, yb, land="accents", **sync_kwargs)
     aligned = alignment_scores(
-        _kinematic_beats(res_al.motion),
+        kinematic_beats(res_al.motion),
         yb,
         sigma=sigma,
         span=(0.0, min(float(res_al.motion.duration), yb[-1])),
@@ -653,7 +631,7 @@ def figure3(
         motion,
         beats=beats,
         boundaries=result.report["target_beats_s"],
-        motion_beats=_kinematic_beats(motion),
+        motion_beats=kinematic_beats(motion),
         ax=axes[1],
     )
     if xlim is not None:

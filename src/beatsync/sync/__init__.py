@@ -70,6 +70,9 @@ Beyond the paper (for real dances)
   beats (:func:`beats_per_unit`), with the same smooth rate of eq. 9.
   ``mode="auto"`` uses periods when the periodicity test accepts the motion and
   falls back to beats, with a warning, when it refuses.
+- ``boundaries=None``: the motion is segmented here, by default over periods of one
+  to eight of the song's beats (a waltz box is 6 beats, about 4 s), so real dance
+  cycles are found; paper A's range (0.25-1.25 s) refuses most real dancers.
 - ``fill="loop"``: whole periods (or beat segments) are repeated with blended joins
   (:mod:`beatsync.sync.fill`) until the dance covers the song to its last beat;
   ``fill="stop"`` (paper A) ends with the last period that fits.

@@ -247,8 +247,8 @@ def synchronize(
         Boundaries outside the motion (frames instead of seconds?), fewer than two
         boundaries (not periodic) in ``mode="periods"``, no motion beats in
         ``mode="beats"``, fewer than two music beats, music too short for one period
-        after ``first_beat``, an unknown mode/land/fill, ``land="accents"`` or
-        ``fill``/``mode`` together with ``phase_offset`` misuse, bad ``out_fps``.
+        after ``first_beat``, an unknown mode/land/fill, ``land="accents"`` together
+        with a ``phase_offset``, a bad ``period_range``, meter or ``out_fps``.
 
     Examples
     --------
@@ -472,6 +472,11 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     ys = np.concatenate([warp.tgt[:1], out_times[live], warp.tgt[-1:]])
     realised = np.interp(used, xs, ys)
     residual = (realised - targets) * 1e3
+    if np.abs(residual).max() > 1e3 / out_fps:  # the warp lands boundaries to rounding
+        raise RuntimeError(
+            f"internal error: a boundary lands {np.abs(residual).max():.3f} ms from its beat, "
+            "more than one output frame; please report this with the inputs"
+        )
     nearest = np.clip(time_to_frames(realised, fps=out_fps), 0, n_out - 1)
     nearest_res = (frames_to_time(nearest, fps=out_fps) - targets) * 1e3
     frame_ms = 1e3 / out_fps

@@ -1,0 +1,249 @@
+"""Benchmark of dataset-scale beat evaluation on Dask (``beatsync evaluate beats``).
+
+Generates a dataset of synthetic songs (drum patterns at tempi spread over 70-180 BPM,
+with their exact beats as ``.beats`` annotations) in a temporary folder, then
+measures, in the same run:
+
+1. the baseline: a plain in-process loop over the tracks (read, track with ``psf``,
+   score), after one warm-up track (imports, compilation);
+2. the same work through the Dask path (:func:`beatsync.study.beat_dataset
+   .evaluate_dataset`, which also appends every row to ``tracks.jsonl``) on a local
+   cluster of 1 and of 2 single-threaded worker processes, each worker warmed by one
+   untimed track, so the times are the steady-state throughput of a long run;
+   the per-track overhead of the Dask path is (Dask, 1 worker - plain loop) / tracks;
+3. the whole command as a user runs it (``beatsync evaluate beats --workers 1`` and
+   ``--workers 2`` in fresh processes: cluster start-up, worker imports and
+   compilation included).
+
+Target: 2 workers >= 1.7x the throughput of 1 worker (steady state). The machine
+has 2 cores; the ratio is only meaningful when nothing else runs.
+
+Usage::
+
+    .venv/bin/python benchmarks/bench_evaluate.py [--tracks 40] [--seconds 30] [--repeats 1]
+
+Writes ``benchmarks/results/evaluate.md`` and ``benchmarks/results/evaluate.json``.
+"""
+
+from __future__ import annotations
+
+import os
+
+import _machine  # noqa: E402  (benchmarks/ is on sys.path when a script runs)
+
+_machine.pin_one_core()  # one thread per process (workers inherit it), before numpy
+
+import argparse  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+TARGET_SPEEDUP = 1.7
+SR = 22050
+
+
+def make_dataset(root: Path, n: int, seconds: float, seed: int = 0) -> tuple[Path, Path]:
+    """``n`` drum songs with exact beats: ``root/audio/*.wav``, ``root/annotations``."""
+    from beatsync import io
+    from beatsync.synth.audio import beat_times, drum_pattern
+
+    rng = np.random.default_rng(seed)
+    audio, notes = root / "audio", root / "annotations"
+    audio.mkdir(parents=True)
+    notes.mkdir()
+    for i in range(n):
+        bpm = float(rng.uniform(70.0, 180.0))
+        ref = beat_times(bpm, duration=seconds, start=float(rng.uniform(0.2, 0.6)))
+        y = drum_pattern(ref, sr=SR, duration=seconds, seed=i)
+        io.write_audio(audio / f"song{i:03d}.wav", y, SR)
+        io.write_beats(notes / f"song{i:03d}.beats", ref)
+    return audio, notes
+
+
+def _warm(path: str, reference: np.ndarray) -> None:
+    from beatsync.study.beat_dataset import evaluate_track
+
+    evaluate_track(path, reference, method="psf", min_beat_time=0.0, name="warm-up")
+
+
+def time_dask(tracks, refs, out: Path, n_workers: int) -> tuple[float, float, float]:
+    """Steady-state time of the Dask path on ``n_workers`` warmed workers, start-up time,
+    and the summed time the tasks spent reading and tracking (measured in the workers)."""
+    from beatsync.cluster import dask_client
+    from beatsync.study.beat_dataset import evaluate_dataset
+
+    t0 = time.perf_counter()
+    with dask_client(n_workers=n_workers) as client:  # the local cluster of the command
+        client.run(_warm, str(tracks[0].audio), refs[tracks[0].key])  # on every worker
+        t_start = time.perf_counter() - t0
+        t1 = time.perf_counter()
+        run = evaluate_dataset(tracks, out, scheduler=client.scheduler.address)
+        t_run = time.perf_counter() - t1
+    assert (run.tracks["status"] == "ok").all()
+    return t_run, t_start, float(run.tracks["seconds"].sum())
+
+
+def time_command(audio: Path, notes: Path, out: Path, n_workers: int) -> float:
+    cmd = [
+        sys.executable,
+        "-m",
+        "beatsync.cli",
+        "evaluate",
+        "beats",
+        "--audio",
+        str(audio),
+        "--annotations",
+        str(notes),
+        "--out",
+        str(out),
+        "--workers",
+        str(n_workers),
+    ]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--tracks", type=int, default=40)
+    ap.add_argument("--seconds", type=float, default=30.0, help="length of each song [s]")
+    ap.add_argument("--repeats", type=int, default=1, help="runs of each measurement (median)")
+    args = ap.parse_args()
+
+    from beatsync import io
+    from beatsync.study.beat_dataset import evaluate_track, find_tracks, read_annotation
+
+    load_before = os.getloadavg()
+    res: dict[str, list[float]] = {k: [] for k in ("loop", "dask1", "dask2", "cmd1", "cmd2")}
+    startup: dict[str, list[float]] = {"dask1": [], "dask2": []}
+    work: dict[str, list[float]] = {"loop": [], "dask1": [], "dask2": []}
+    with tempfile.TemporaryDirectory(prefix="bench-evaluate-") as tmp:
+        tmp = Path(tmp)
+        audio, notes = make_dataset(tmp / "data", args.tracks, args.seconds)
+        tracks = find_tracks(audio, notes).tracks
+        refs = {t.key: read_annotation(t.annotation) for t in tracks}
+        _warm(str(tracks[0].audio), refs[tracks[0].key])
+        for r in range(args.repeats):
+            t0 = time.perf_counter()
+            rows = [
+                evaluate_track(
+                    str(t.audio), refs[t.key], method="psf", min_beat_time=0.0, name=t.key
+                )
+                for t in tracks
+            ]
+            res["loop"].append(time.perf_counter() - t0)
+            assert all(row["status"] == "ok" for row in rows)
+            work["loop"].append(sum(row["seconds"] for row in rows))
+            for n in (1, 2):
+                t_run, t_start, t_work = time_dask(tracks, refs, tmp / f"dask{n}_{r}", n)
+                res[f"dask{n}"].append(t_run)
+                startup[f"dask{n}"].append(t_start)
+                work[f"dask{n}"].append(t_work)
+            for n in (1, 2):
+                res[f"cmd{n}"].append(time_command(audio, notes, tmp / f"cmd{n}_{r}", n))
+        f_mean = float(np.mean([row["F-measure"] for row in rows]))
+    med = {k: float(np.median(v)) for k, v in res.items()}
+    n = len(tracks)
+    speedup = med["dask1"] / med["dask2"]
+    speedup_cmd = med["cmd1"] / med["cmd2"]
+    overhead_ms = 1000.0 * (med["dask1"] - med["loop"]) / n
+    med_work = {k: float(np.median(v)) for k, v in work.items()}
+    # wall time of 1 worker beyond the reading and tracking it did: scheduling, transfer,
+    # the log and the tables (the same work is slower in a worker if the cores are shared)
+    overhead_beyond_work_ms = 1000.0 * (med["dask1"] - med_work["dask1"]) / n
+    passed = speedup >= TARGET_SPEEDUP
+    load_after = os.getloadavg()
+    facts = {
+        "command": f"python benchmarks/bench_evaluate.py --tracks {args.tracks} "
+        f"--seconds {args.seconds:g} --repeats {args.repeats}",
+        **_machine.machine_facts(),
+        "cores_used": 2,
+        "load_average_before": [round(x, 2) for x in load_before],
+        "load_average_after": [round(x, 2) for x in load_after],
+    }
+    data = {
+        "facts": facts,
+        "input": f"{n} synthetic drum songs of {args.seconds:g} s at {SR} Hz, 70-180 BPM",
+        "seconds": res,
+        "startup_seconds": startup,
+        "median": med,
+        "speedup_2_vs_1_workers": speedup,
+        "speedup_command": speedup_cmd,
+        "dask_overhead_ms_per_track": overhead_ms,
+        "work_seconds_in_tasks": work,
+        "dask_overhead_beyond_work_ms_per_track": overhead_beyond_work_ms,
+        "mean_f_measure": f_mean,
+        "targets": {f"2 workers >= {TARGET_SPEEDUP}x 1 worker": passed},
+    }
+    rows_md = [
+        (
+            "plain in-process loop (baseline)",
+            med["loop"],
+            f"reading + tracking {med_work['loop']:.1f} s",
+        ),
+        (
+            "Dask path, 1 worker (warmed)",
+            med["dask1"],
+            f"start-up + warm-up {np.median(startup['dask1']):.1f} s; reading + tracking "
+            f"in the worker {med_work['dask1']:.1f} s",
+        ),
+        (
+            "Dask path, 2 workers (warmed)",
+            med["dask2"],
+            f"start-up + warm-up {np.median(startup['dask2']):.1f} s; reading + tracking "
+            f"in the workers {med_work['dask2']:.1f} s (sum of both)",
+        ),
+        ("`beatsync evaluate beats --workers 1` (whole process)", med["cmd1"], ""),
+        ("`beatsync evaluate beats --workers 2` (whole process)", med["cmd2"], ""),
+    ]
+    lines = [
+        "## evaluate: dataset-scale beat evaluation on Dask (`beatsync evaluate beats`)",
+        "",
+        f"Command: `{facts['command']}`  ",
+        f"Machine: {facts['platform']}, {facts['processor']}, {facts['cpu_count']} CPUs, "
+        f"Python {facts['python']}, numpy {facts['numpy']}, beatsync {facts['beatsync']}; "
+        f"{facts['date_utc']}; load average {facts['load_average_before']} before, "
+        f"{facts['load_average_after']} after; median of {args.repeats} run(s).",
+        "",
+        f"Input: {data['input']} (generated by the benchmark; exact beats as annotations); "
+        f"method `psf`; mean F-measure {f_mean:.3f}. Each worker is a single-threaded "
+        "process. Baseline: a plain loop over the same tracks in one process, same run.",
+        "",
+        "| run | time [s] | tracks/s | note |",
+        "|---|---:|---:|---|",
+    ]
+    for name, t, note in rows_md:
+        lines.append(f"| {name} | {t:.2f} | {n / t:.2f} | {note} |")
+    lines += [
+        "",
+        "| measure | value | target | result |",
+        "|---|---:|---|---|",
+        f"| throughput 2 workers / 1 worker (steady state) | {speedup:.2f}x | >= "
+        f"{TARGET_SPEEDUP}x | {'PASS' if passed else 'FAIL'} |",
+        f"| whole command, 1 worker / 2 workers | {speedup_cmd:.2f}x | (start-up included) | |",
+        f"| Dask overhead per track (1 worker - plain loop) / tracks | {overhead_ms:.1f} ms | | |",
+        f"| Dask overhead per track beyond the reading + tracking done in the worker | "
+        f"{overhead_beyond_work_ms:.1f} ms | | |",
+        "",
+        "Reading the table: the 2-worker ratio needs two idle cores. The summed reading + "
+        "tracking time of the workers tells whether they had them: with two free cores it "
+        "stays near the 1-worker figure; if it doubles, the cores were shared with other "
+        "work and the ratio says nothing about Dask.",
+        "",
+    ]
+    (HERE / "results").mkdir(exist_ok=True)
+    io.write_json(HERE / "results" / "evaluate.json", data)
+    with io.atomic_write(HERE / "results" / "evaluate.md") as fh:
+        fh.write("\n".join(lines))
+    print("\n".join(lines))
+    return 0 if passed else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,404 @@
+"""Real dancers and their music: beat alignment before and after re-synchronisation.
+
+An extension of paper A's study to real dance data: the four Dance-with-Melody excerpts
+bundled in ``data/`` (:func:`beatsync.datasets.load_dance_pair`: a cha-cha, a rumba and
+two waltzes, joint positions at 25 fps, each with the song it was danced to). For each
+dancer:
+
+(a) how well the dancer's own motion beats (kinematic beats,
+    :func:`beatsync.motion_beats.kinematic_beats`) align with the beats of their own
+    song (tracked with :func:`beatsync.beats.track_beats`), with both published
+    beat-alignment scores (:mod:`beatsync.evaluate.alignment`; sigma in seconds);
+(b) the same after :func:`beatsync.sync.synchronize` re-synchronises the dancer to
+    another song (the other dance of the same meter: cha-cha <-> rumba, waltz <-> waltz),
+    covering that song with ``fill="loop"``;
+(c) a random-offset control (:func:`beatsync.evaluate.alignment.offset_control`: the
+    motion beats shifted by one random offset within a beat period), for (a) and (b);
+(d) the dance's period and motion-beat interval against the song's beat period.
+
+What the data can and cannot show: the dataset says which part of each song was
+danced (25 fps frame ranges), not that the steps sit on its beats; its own
+alignment of dance and music is approximate, and the songs' beats here are tracked,
+not annotated. So (a) is a measurement of this data, not of the dancers' skill, and
+four 24 s excerpts are four examples, not a benchmark. The songs are short (28 s), so
+the re-synchronised dancer covers at most that; the scores count only beats inside
+the span both the dance and the song play.
+
+Notebook: ``notebooks/paper_a_ext_real_dancers.ipynb``.
+"""
+
+from __future__ import annotations
+
+import base64
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..datasets import DANCE_PAIRS, DancePair, load_dance_pair
+from ..errors import BeatsyncWarning, ParameterError
+from ..evaluate.alignment import DEFAULT_SIGMA, alignment_scores, offset_control
+from .artifacts import write_artifacts
+
+__all__ = [
+    "OTHER_SONG",
+    "load_pairs",
+    "track_songs",
+    "song_table",
+    "own_song_scores",
+    "resynchronise",
+    "resync_scores",
+    "dancer_table",
+    "period_table",
+    "summary_table",
+    "beats_figure",
+    "dancer_video",
+    "video_html",
+    "write_artifacts",
+]
+
+#: The song each dancer is re-synchronised to: the other dance of the same meter.
+OTHER_SONG = {
+    "DANCE_C_4": "DANCE_R_3",
+    "DANCE_R_3": "DANCE_C_4",
+    "DANCE_W_5": "DANCE_W_10",
+    "DANCE_W_10": "DANCE_W_5",
+}
+
+
+def _kinematic_beats(motion: Any) -> np.ndarray:
+    from ..motion_beats import kinematic_beats
+
+    return kinematic_beats(motion)
+
+
+def load_pairs(names: list[str] | tuple[str, ...] = DANCE_PAIRS) -> dict[str, DancePair]:
+    """The bundled dancer + song excerpts, checksum-verified, by name."""
+    unknown = [n for n in names if n not in DANCE_PAIRS]
+    if unknown:
+        raise ParameterError(f"unknown dance pair(s) {unknown}; choose from {DANCE_PAIRS}")
+    return {n: load_dance_pair(n) for n in names}
+
+
+def track_songs(pairs: dict[str, DancePair]) -> dict[str, dict[str, Any]]:
+    """Beats of every song (tracked; times in the excerpt's audio [s]) and its meter.
+
+    Returns
+    -------
+    dict
+        name -> ``{"beats", "tempo_bpm", "beats_per_bar", "warning"}``.
+    """
+    from ..beats import track_beats
+
+    songs = {}
+    for name, pair in pairs.items():
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            track = track_beats(pair.y, pair.sr)
+        beats = np.asarray(track.beats, dtype=np.float64)
+        songs[name] = {
+            "beats": beats,
+            "tempo_bpm": 60.0 / float(np.median(np.diff(beats))),
+            "beats_per_bar": getattr(track, "beats_per_bar", None),
+            "warning": "; ".join(str(w.message) for w in caught),
+        }
+    return songs
+
+
+def song_table(pairs: dict[str, DancePair], songs: dict[str, dict[str, Any]]) -> Any:
+    """One row per song: style, length, tracked beats, tempo, meter, tracker warning."""
+    import pandas as pd
+
+    return pd.DataFrame(
+        [
+            {
+                "song of": name,
+                "style": pair.style,
+                "seconds": len(pair.y) / pair.sr,
+                "beats": int(songs[name]["beats"].size),
+                "tempo [BPM]": songs[name]["tempo_bpm"],
+                "beats/bar": songs[name]["beats_per_bar"],
+                "tracker note": songs[name]["warning"] or "",
+            }
+            for name, pair in pairs.items()
+        ]
+    )
+
+
+def _scores(mb: np.ndarray, yb: np.ndarray, span: tuple[float, float], **kw: Any) -> dict:
+    """Both scores and their random-offset control, on the beats inside ``span``."""
+    sigma, n_control, seed = kw["sigma"], kw["n_control"], kw["seed"]
+    sc = alignment_scores(mb, yb, sigma=sigma, span=span)
+    inside = (mb >= span[0]) & (mb <= span[1])
+    ctrl = offset_control(
+        mb[inside], yb[(yb >= span[0]) & (yb <= span[1])], sigma=sigma,
+        n_trials=n_control, seed=seed,
+    )  # fmt: skip
+    return {
+        "motion": sc["alignment_motion"],
+        "music": sc["alignment_music"],
+        "control_motion": ctrl["alignment_motion_mean"],
+        "control_music": ctrl["alignment_music_mean"],
+        "n_motion_beats": sc["n_motion_beats"],
+        "n_music_beats": sc["n_music_beats"],
+    }
+
+
+def own_song_scores(
+    pair: DancePair,
+    beats: Any,
+    *,
+    sigma: float = DEFAULT_SIGMA,
+    n_control: int = 200,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """(a) and (c): the real dancer against their own song, as the dataset aligns them.
+
+    Motion beats are moved to the excerpt's audio time (``+ pair.audio_offset``) and
+    compared with the song's beats while the dance plays.
+    """
+    mb = _kinematic_beats(pair.motion) + pair.audio_offset
+    yb = np.asarray(beats, dtype=np.float64)
+    span = (pair.audio_offset, pair.audio_offset + float(pair.motion.duration))
+    return _scores(mb, yb, span, sigma=sigma, n_control=n_control, seed=seed)
+
+
+def resynchronise(
+    pair: DancePair,
+    beats: Any,
+    *,
+    mode: str = "beats",
+    land: str = "boundaries",
+    period_range: tuple[float, float] = (0.8, 5.0),
+    beats_per_bar: int | None = None,
+) -> Any:
+    """(b): :func:`beatsync.sync.synchronize` the dancer to a song, covering it (loop).
+
+    Returns the :class:`~beatsync.sync.SyncResult`; frame ``k`` of its motion plays at
+    time ``k / fps`` of the song's audio. Warnings (e.g. ``mode="auto"`` falling back)
+    are kept in ``report["warnings"]``.
+    """
+    from ..sync import synchronize
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BeatsyncWarning)
+        res = synchronize(
+            pair.motion,
+            None,
+            np.asarray(beats, dtype=np.float64),
+            mode=mode,
+            land=land,
+            fill="loop",
+            period_range=period_range,
+            beats_per_bar=beats_per_bar,
+        )
+    res.report["warnings"] = [str(w.message) for w in caught]
+    return res
+
+
+def resync_scores(
+    result: Any, beats: Any, *, sigma: float = DEFAULT_SIGMA, n_control: int = 200, seed: int = 0
+) -> dict[str, Any]:
+    """(b) and (c): scores of the re-synchronised dancer on the song's beats it covers."""
+    yb = np.asarray(beats, dtype=np.float64)
+    span = (float(yb[0]), min(float(yb[-1]), float(result.motion.duration)))
+    mb = _kinematic_beats(result.motion)
+    return _scores(mb, yb, span, sigma=sigma, n_control=n_control, seed=seed)
+
+
+def dancer_table(
+    pairs: dict[str, DancePair],
+    songs: dict[str, dict[str, Any]],
+    *,
+    modes: tuple[str, ...] = ("beats", "auto"),
+    sigma: float = DEFAULT_SIGMA,
+    n_control: int = 200,
+    seed: int = 0,
+    period_range: tuple[float, float] = (0.8, 5.0),
+) -> tuple[Any, dict[tuple[str, str], Any]]:
+    """(a)-(c) for every dancer: one row per dancer and sync mode.
+
+    Columns ``own_*`` are the dancer with their own song, ``after_*`` re-synchronised
+    to :data:`OTHER_SONG`, ``*_control_*`` the random-offset control of each; ``_motion``
+    averages over motion beats (Siyao et al. 2022), ``_music`` over music beats (Li et
+    al. 2021); ``sigma`` in seconds.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+    results : dict
+        ``(dancer, mode) -> SyncResult``.
+    """
+    import pandas as pd
+
+    rows, results = [], {}
+    kw = {"sigma": sigma, "n_control": n_control, "seed": seed}
+    for name, pair in pairs.items():
+        other = OTHER_SONG[name]
+        if other not in songs:
+            raise ParameterError(f"{name} is re-synchronised to {other}'s song: load {other} too")
+        own = own_song_scores(pair, songs[name]["beats"], **kw)
+        for mode in modes:
+            res = resynchronise(
+                pair,
+                songs[other]["beats"],
+                mode=mode,
+                period_range=period_range,
+                beats_per_bar=songs[other]["beats_per_bar"],
+            )
+            results[(name, mode)] = res
+            after = resync_scores(res, songs[other]["beats"], **kw)
+            rep = res.report
+            rows.append(
+                {
+                    "dancer": name,
+                    "style": pair.style,
+                    "song": other,
+                    "mode": mode,
+                    "mode used": rep["mode"],
+                    "beats per unit": rep["beats_per_period"],
+                    "repetitions": rep["repetitions"],
+                    "own_motion": own["motion"],
+                    "own_control_motion": own["control_motion"],
+                    "after_motion": after["motion"],
+                    "after_control_motion": after["control_motion"],
+                    "own_music": own["music"],
+                    "own_control_music": own["control_music"],
+                    "after_music": after["music"],
+                    "after_control_music": after["control_music"],
+                    "sigma_s": sigma,
+                    "note": "; ".join(rep["warnings"])[:160],
+                }
+            )
+    return pd.DataFrame(rows), results
+
+
+def period_table(
+    pairs: dict[str, DancePair],
+    songs: dict[str, dict[str, Any]],
+    *,
+    period_range: tuple[float, float] = (0.8, 5.0),
+) -> Any:
+    """(d) The dance's period and motion-beat interval against its song's beat period.
+
+    The period comes from paper A's segmentation of the dancer's joint angles (angles
+    between inferred bones, :func:`beatsync.motion.segmentation_view`) searched in
+    ``period_range``; the motion-beat interval is the median interval of its
+    kinematic beats; the song's beat period is the median interval of its tracked beats.
+    """
+    import pandas as pd
+
+    from ..motion import segmentation_view
+    from ..segment import segment
+
+    rows = []
+    for name, pair in pairs.items():
+        seg = segment(segmentation_view(pair.motion), period_range=period_range)
+        mb = _kinematic_beats(pair.motion)
+        beat = 60.0 / songs[name]["tempo_bpm"]
+        period = float(np.mean(np.diff(seg.boundaries)))
+        interval = float(np.median(np.diff(mb)))
+        rows.append(
+            {
+                "dancer": name,
+                "style": pair.style,
+                "dance period [s]": period,
+                "motion-beat interval [s]": interval,
+                "song beat period [s]": beat,
+                "period / beat": period / beat,
+                "motion-beat interval / beat": interval / beat,
+                "song beats/bar": songs[name]["beats_per_bar"],
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def summary_table(table: Any, *, mode: str = "beats") -> Any:
+    """Per dancer for one sync mode: after re-sync vs control vs own song (both scores),
+    and whether the target holds (after > both, on both scores)."""
+    t = table[table["mode"] == mode].copy()
+    for s in ("motion", "music"):
+        t[f"beats_{s}_target"] = (t[f"after_{s}"] > t[f"after_control_{s}"]) & (
+            t[f"after_{s}"] > t[f"own_{s}"]
+        )
+    cols = ["dancer", "style", "song"]
+    cols += [f"{w}_{s}" for s in ("motion", "music") for w in ("own", "after", "after_control")]
+    return t[cols + ["beats_motion_target", "beats_music_target"]].reset_index(drop=True)
+
+
+def beats_figure(
+    pair: DancePair,
+    own_beats: Any,
+    result: Any,
+    new_beats: Any,
+    *,
+    seconds: float = 12.0,
+) -> Any:
+    """Motion beats against music beats, before (own song) and after re-synchronisation.
+
+    Top: the dancer's kinematic beats and their own song's beats over the first
+    ``seconds`` of the dance (audio time). Bottom: the re-synchronised dancer's
+    kinematic beats and the new song's beats over its first ``seconds``.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(10, 3.6), sharex=False)
+    before = _kinematic_beats(pair.motion) + pair.audio_offset
+    lo = pair.audio_offset
+    panels = [
+        (axes[0], before, np.asarray(own_beats), lo, f"{pair.name} with its own song"),
+        (axes[1], _kinematic_beats(result.motion), np.asarray(new_beats), 0.0,
+         f"{pair.name} re-synchronised ({result.report['mode']} mode) to another song"),
+    ]  # fmt: skip
+    for ax, mb, yb, t0, title in panels:
+        ax.vlines(yb, 0.0, 1.0, color="tab:red", lw=1.5, label="music beats")
+        ax.vlines(mb, 0.15, 0.85, color="tab:blue", lw=3, alpha=0.7, label="motion beats")
+        ax.set_xlim(t0, t0 + seconds)
+        ax.set_yticks([])
+        ax.set_title(title, fontsize=10)
+    axes[1].set_xlabel("song time [s]")
+    axes[0].legend(loc="upper right", fontsize=8, ncols=2)
+    fig.tight_layout()
+    return fig
+
+
+def dancer_video(
+    result: Any,
+    pair_of_song: DancePair,
+    beats: Any,
+    path: str | Path,
+    *,
+    seconds: float,
+    fps: float = 15.0,
+    size: tuple[int, int] = (320, 240),
+    title: str | None = None,
+) -> Path:
+    """The re-synchronised dancer over the first ``seconds`` of the new song, as MP4."""
+    from .paper_a_sync import animation_video
+
+    return animation_video(
+        result,
+        (pair_of_song.y, pair_of_song.sr),
+        beats,
+        path,
+        seconds=min(float(seconds), float(result.motion.duration)),
+        fps=fps,
+        size=size,
+        azimuth=0.0,
+        title=title,
+    )
+
+
+def video_html(path: str | Path, *, width: int = 400) -> Any:
+    """An HTML5 ``<video>`` element with the MP4 embedded (plays inside JupyterLab)."""
+    from IPython.display import HTML
+
+    p = Path(path)
+    if p.suffix.lower() != ".mp4":
+        return HTML(f"<p>No MP4 was written (ffmpeg missing?): {p.name}</p>")
+    data = base64.b64encode(p.read_bytes()).decode("ascii")
+    return HTML(
+        f'<video width="{int(width)}" controls><source src="data:video/mp4;base64,{data}" '
+        'type="video/mp4">Your browser cannot play this MP4.</video>'
+    )
