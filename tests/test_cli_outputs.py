@@ -45,10 +45,10 @@ def inputs(tmp_path):
 
 # (subcommand argv with {out} for the output under test, the option named in the message)
 OUTPUT_OPTIONS = {
-    "segment --out": (["segment", "{clip}", "--out", "{out}.csv"], "output"),
-    "beats --out": (["beats", "{song}", "--out", "{out}.beats"], "output"),
-    "beats --click": (["beats", "{song}", "--click", "{out}.wav"], "output"),
-    "sync -o": (["sync", "{clip}", "{song}", "-o", "{out}.bvh"], "output"),
+    "segment --out": (["segment", "{clip}", "--out", "{out}.csv"], "--out"),
+    "beats --out": (["beats", "{song}", "--out", "{out}.beats"], "--out"),
+    "beats --click": (["beats", "{song}", "--click", "{out}.wav"], "--click"),
+    "sync -o": (["sync", "{clip}", "{song}", "-o", "{out}.bvh"], "-o/--output"),
     "sync --video": (
         ["sync", "{clip}", "{song}", "-o", "{o}/ok.bvh", "--video", "{out}.mp4"],
         "--video",
@@ -57,7 +57,10 @@ OUTPUT_OPTIONS = {
         ["sync", "{clip}", "{song}", "-o", "{o}/ok.bvh", "--report", "{out}.json"],
         "--report",
     ),
-    "compose -o": (["compose", "{song}", "--library", "{clip}", "-o", "{out}.bvh"], "output"),
+    "compose -o": (
+        ["compose", "{song}", "--library", "{clip}", "-o", "{out}.bvh"],
+        "-o/--output",
+    ),
     "compose --video": (
         ["compose", "{song}", "--library", "{clip}", "-o", "{o}/ok.bvh", "--video", "{out}.mp4"],
         "--video",
@@ -78,7 +81,7 @@ OUTPUT_OPTIONS = {
             "--summary",
             "{out}.csv",
         ],
-        "output",
+        "--summary",
     ),  # fmt: skip
 }
 
@@ -150,10 +153,10 @@ def test_output_in_missing_folder_is_refused(case, inputs, tmp_path, capsys):
 @pytest.mark.parametrize(
     "argv, option",
     [
-        (["beats", "{song}", "--click", "{song}"], "output"),
-        (["sync", "{clip}", "{song}", "-o", "{clip}", "--beats", "{beats}"], "output"),
-        (["compose", "{song}", "--library", "{clip}", "-o", "{clip}"], "output"),
-        (["segment", "{clip}", "--out", "{link}"], "output"),  # a link to the input
+        (["beats", "{song}", "--click", "{song}"], "--click"),
+        (["sync", "{clip}", "{song}", "-o", "{clip}", "--beats", "{beats}"], "-o/--output"),
+        (["compose", "{song}", "--library", "{clip}", "-o", "{clip}"], "-o/--output"),
+        (["segment", "{clip}", "--out", "{link}"], "--out"),  # a link to the input
     ],
 )
 def test_output_same_as_input_is_refused(argv, option, inputs, tmp_path, capsys):

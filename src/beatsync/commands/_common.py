@@ -53,8 +53,6 @@ __all__ = [
     "emit",
     "feedback",
     "check_output",
-    "check_output_path",
-    "check_side_outputs",
     "signals_as_exceptions",
     "interrupted_by",
     "error_report",
@@ -80,6 +78,9 @@ _CAUGHT_SIGNALS = tuple(
 # (Python code called back from C, e.g. soundfile's writer, swallows it), so the
 # record also stops Outputs.commit and makes the error that follows a report of it.
 _RECEIVED: list[int] = []
+# Set when an Outputs transaction was rolled back: the error report can then say that
+# nothing was written (a command that writes incrementally, like evaluate, has none).
+_ROLLED_BACK: list[bool] = []
 
 
 # --------------------------------------------------------------------- options
@@ -192,31 +193,6 @@ def check_output(
     except ParameterError as exc:
         raise ParameterError(f"{name}: {exc}") from None
     return p
-
-
-def check_output_path(out: str | Path, *inputs: str | Path | None) -> Path:
-    """:func:`check_output` for a command's main output (no transaction)."""
-    return check_output(out, inputs=inputs)
-
-
-def check_side_outputs(
-    video: str | Path | None,
-    report: str | Path | None,
-    inputs: tuple[str | Path | None, ...],
-    out: Path,
-) -> tuple[Path | None, Path | None]:
-    """Check the optional ``--video`` (.mp4) and ``--report`` (.json) outputs of a command.
-
-    Neither may equal an input or the main output, nor each other.
-    """
-    video_p = report_p = None
-    if video is not None:
-        video_p = check_output(video, option="--video", inputs=(*inputs, out), suffixes=[".mp4"])
-    if report is not None:
-        report_p = check_output(
-            report, option="--report", inputs=(*inputs, out, video), suffixes=[".json"]
-        )
-    return video_p, report_p
 
 
 def add_position_options(parser: argparse.ArgumentParser) -> None:
@@ -413,6 +389,8 @@ class Outputs:
         with _signals_blocked():
             self._staged.clear()
             self._remove_staging()
+            if self._declared:
+                _ROLLED_BACK.append(True)
 
     def _remove_staging(self) -> None:
         import shutil
@@ -556,6 +534,7 @@ def signals_as_exceptions() -> Iterator[None]:
     signal is recorded (see :func:`interrupted_by`).
     """
     _RECEIVED.clear()
+    _ROLLED_BACK.clear()
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -571,6 +550,7 @@ def signals_as_exceptions() -> Iterator[None]:
         for s, h in old.items():
             signal.signal(s, h)
         _RECEIVED.clear()
+        _ROLLED_BACK.clear()
 
 
 def interrupted_by() -> int | None:
@@ -600,6 +580,7 @@ def error_report(
 
 def _report(exc: BaseException, command: str | None, as_json: bool, stream: TextIO) -> int:
     tb = None
+    nothing = "; no output was written" if _ROLLED_BACK else ""
     signum = interrupted_by()
     if signum is not None and not isinstance(exc, KeyboardInterrupt):
         exc = Interrupted(signum)  # the error that followed a swallowed interruption
@@ -608,11 +589,11 @@ def _report(exc: BaseException, command: str | None, as_json: bool, stream: Text
     elif isinstance(exc, KeyboardInterrupt):
         signum = getattr(exc, "signum", signal.SIGINT)
         kind, code = "interrupted", 128 + int(signum)
-        msg = f"interrupted by {signal.Signals(signum).name}; no output was written"
+        msg = f"interrupted by {signal.Signals(signum).name}{nothing}"
     elif isinstance(exc, OSError):
         kind, code = "os-error", EXIT_OS_ERROR
         where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
-        msg = f"{exc.strerror or exc}{where}; no output was written"
+        msg = f"{exc.strerror or exc}{where}{nothing}"
     else:
         kind, code = "internal", EXIT_INTERNAL
         msg = (

@@ -10,12 +10,12 @@ happen only after tracking succeeded, and never overwrite the input.
 
 from __future__ import annotations
 
-import sys
 import warnings
 from typing import Any
 
 from ..errors import BeatsyncWarning, ParameterError
-from ._common import add_json_flag, check_output_path, emit
+from . import COMMAND_HELP
+from ._common import Outputs, add_output_flags, emit, feedback
 
 __all__ = ["register", "run"]
 
@@ -23,7 +23,7 @@ __all__ = ["register", "run"]
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "beats",
-        help="track the beats of a song and print their times in seconds",
+        help=COMMAND_HELP["beats"],
         description=(
             "Track music beats with the phase-slope (group delay) onset detector, the "
             "metrical model of Klapuri et al. (2006) and a tempo/phase HMM (paper A, "
@@ -63,7 +63,7 @@ def register(subparsers: Any) -> None:
         metavar="OUT.wav",
         help="write the audio with a click on every beat (.wav or .flac)",
     )
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
@@ -80,35 +80,36 @@ def run(args: Any) -> int:
         raise ParameterError(
             f"--min-bpm {args.min_bpm:g} must be smaller than --max-bpm {args.max_bpm:g}"
         )
-    outs = [o for o in (args.out, args.click) if o is not None]
-    for out in outs:
-        check_output_path(out, args.audio)
-    if args.out is not None and args.click is not None:
-        from pathlib import Path
-
-        if Path(args.out).resolve() == Path(args.click).resolve():
-            raise ParameterError("--out and --click name the same file; choose two names")
-
-    y, sr = io.read_audio(args.audio)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", BeatsyncWarning)
-        track = track_beats(
-            y, sr, method=args.method, bpm=args.bpm, min_bpm=args.min_bpm, max_bpm=args.max_bpm
+    fb = feedback(args)
+    with Outputs(inputs=[args.audio]) as outs:  # both files are written, or neither
+        out = outs.add(args.out, option="--out") if args.out is not None else None
+        click = (
+            outs.add(args.click, option="--click", suffixes=(".wav", ".flac"))
+            if args.click is not None
+            else None
         )
-    notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
-    for note in notes:
-        print(f"beatsync beats: warning: {note}", file=sys.stderr)
-    if track.beats.size == 0:
-        raise ParameterError(
-            f"no beats found in {args.audio!r} (no onsets: a steady tone or near silence?); "
-            "nothing written"
-        )
-    written = []
-    if args.out is not None:
-        written.append(str(io.write_beats(args.out, track.beats)))
-    if args.click is not None:
-        mix = mix_clicks(y, sr, track.beats)
-        written.append(str(io.write_audio(args.click, mix, sr)))
+        with fb.step("reading audio"):
+            y, sr = io.read_audio(args.audio)
+        with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
+            warnings.simplefilter("always", BeatsyncWarning)
+            track = track_beats(
+                y, sr, method=args.method, bpm=args.bpm, min_bpm=args.min_bpm, max_bpm=args.max_bpm
+            )
+        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        for note in notes:
+            fb.warn(note)
+        if track.beats.size == 0:
+            raise ParameterError(
+                f"no beats found in {args.audio!r} (no onsets: a steady tone or near silence?); "
+                "nothing written"
+            )
+        written = []
+        if out is not None:
+            io.write_beats(outs.path(out), track.beats)
+            written.append(str(out))
+        if click is not None:
+            io.write_audio(outs.path(click), mix_clicks(y, sr, track.beats), sr)
+            written.append(str(click))
     result = {
         "audio": args.audio,
         "method": track.method,

@@ -15,7 +15,6 @@ Graph cache (on by default, :mod:`beatsync.graph.cache`): built graphs are store
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -24,7 +23,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ._common import add_json_flag, check_output_path, check_side_outputs, emit
+from . import COMMAND_HELP
+from ._common import Outputs, add_output_flags, emit, feedback
 
 __all__ = ["register", "run"]
 
@@ -34,7 +34,7 @@ _AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "compose",
-        help="compose a dance for a song from a library of motion clips (motion graph + DP)",
+        help=COMMAND_HELP["compose"],
         description=(
             "Compose a dance for a song from a library of BVH clips (paper B): the clips' "
             "beat frames form a weighted motion graph (cached on disk), a dynamic programme "
@@ -144,7 +144,7 @@ def register(subparsers: Any) -> None:
         help="neither read nor write the graph cache (folder: $BEATSYNC_CACHE_DIR, "
         "default ~/.cache/beatsync)",
     )
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
@@ -194,21 +194,31 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     out = Path(args.output)
     if out.suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
-    inputs = (audio, args.beats, *files)
-    check_output_path(out, *inputs)
-    video, report = check_side_outputs(args.video, args.report, inputs, out)
-    return {"audio": audio, "files": files, "out": out, "video": video, "report": report, "th": th}
+    outs = Outputs(inputs=(audio, args.beats, *files))
+    outs.add(out, option="-o/--output")
+    video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
+    report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
+    return {
+        "audio": audio,
+        "files": files,
+        "out": out,
+        "video": video,
+        "report": report,
+        "th": th,
+        "outs": outs,
+    }
 
 
 def run(args: argparse.Namespace) -> int:
     from .. import io
     from ..graph.compose import check_music_beats, compose_music
 
-    chk = _check_inputs(args)
     if not (np.isfinite(args.tempo_weight) and args.tempo_weight >= 0):
         raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
     if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
+    chk = _check_inputs(args)  # files after the options: cheapest first
+    fb = feedback(args)
     from ..graph.timescale import check_multiplicity, check_scale_bound
 
     bound = (
@@ -227,7 +237,11 @@ def run(args: argparse.Namespace) -> int:
             beats = check_music_beats(io.read_beats(args.beats), duration=y.size / float(sr))
         except ParameterError as exc:
             raise ParameterError(f"beats file {args.beats!r}: {exc}") from None
-    clips = [io.read_bvh(f, fps=args.fps) for f in files]
+    with fb.step("reading the library", total=len(files)) as progress:
+        clips = []
+        for f in files:
+            clips.append(io.read_bvh(f, fps=args.fps))
+            progress(len(clips))
     read_s = time.perf_counter() - t_read
     from ..graph import check_library
     from ..graph.cache import load_or_build
@@ -236,22 +250,23 @@ def run(args: argparse.Namespace) -> int:
     check_library(clips)
     notes: list[str] = []
     if beats is None:
-        with warnings.catch_warnings(record=True) as caught:
+        with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
             warnings.simplefilter("always", BeatsyncWarning)
             beats = track_music_beats(y, sr, bpm=args.bpm)
         notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
         for note in notes:
-            print(f"beatsync compose: warning: {note}", file=sys.stderr)
+            fb.warn(note)
     params = {
         "th": chk["th"],
         "weight_rule": args.weight_rule,
         "fps": args.fps,
     }
     t0 = time.perf_counter()
-    graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
+    with fb.step("building the motion graph"):
+        graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
     build_s = time.perf_counter() - t0
     kw = {"tempo_weight": args.tempo_weight} if args.method == "dp" and args.tempo_weight else {}
-    with warnings.catch_warnings(record=True) as caught:
+    with warnings.catch_warnings(record=True) as caught, fb.step("composing"):
         warnings.simplefilter("always", BeatsyncWarning)
         comp = compose_music(
             graph,
@@ -268,19 +283,9 @@ def run(args: argparse.Namespace) -> int:
     for w in caught:
         if issubclass(w.category, BeatsyncWarning):
             notes.append(str(w.message))
-            print(f"beatsync compose: warning: {w.message}", file=sys.stderr)
-    out = io.write_bvh(chk["out"], comp.motion)
-    video_path = None
-    if chk["video"] is not None:
-        from ..render import write_video
-
-        video_path = write_video(
-            comp.motion,
-            chk["video"],
-            audio=(y, sr),
-            beats=comp.music_beats,
-            progress=sys.stderr.isatty(),
-        )
+            fb.warn(str(w.message))
+    out = chk["out"]
+    video_path = chk["video"]
     result = {
         "output": str(out),
         "video": str(video_path) if video_path else None,
@@ -307,8 +312,24 @@ def run(args: argparse.Namespace) -> int:
         "plausibility": comp.plausibility,
         "warnings": notes,
     }
-    if chk["report"] is not None:
-        io.write_json(chk["report"], result)
+    outs = chk["outs"]
+    with outs:  # the dance, video and report are all written, or none of them
+        io.write_bvh(outs.path(out), comp.motion)
+        if video_path is not None:
+            from .. import render
+
+            staged = outs.path(video_path)
+            written = render.write_video(
+                comp.motion, staged, audio=(y, sr), beats=comp.music_beats, progress=fb.bars
+            )
+            if written != staged:  # no ffmpeg: a GIF and a WAV instead of the MP4
+                outs.forget(video_path)
+                video_path = outs.adopt(written, option="--video")
+                if staged.with_suffix(".wav").is_file():
+                    outs.adopt(staged.with_suffix(".wav"), option="--video")
+                result["video"] = str(video_path)
+        if chk["report"] is not None:
+            io.write_json(outs.path(chk["report"]), result)
     g = graph.summary()
     text = (
         f"wrote {out} ({comp.motion.n_frames} frames at {comp.motion.fps:g} fps, "

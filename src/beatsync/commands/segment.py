@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import argparse
 
+from . import COMMAND_HELP
 from ._common import (
-    add_json_flag,
+    Outputs,
+    add_output_flags,
     add_period_range,
     add_position_options,
-    check_output_path,
     emit,
+    feedback,
     position_options,
 )
 
@@ -21,7 +23,7 @@ from ._common import (
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "segment",
-        help="find the period boundaries of a periodic motion (paper A, section 3)",
+        help=COMMAND_HELP["segment"],
         description=(
             "Globally optimal segmentation of a periodic motion into its periods: "
             "consecutive periods are as similar as possible (Pearson correlation of joint "
@@ -78,7 +80,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
     add_position_options(p)
     p.add_argument("--out", default=None, help="write the boundaries to this .csv file")
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
@@ -101,10 +103,13 @@ def run(args: argparse.Namespace) -> int:
                 "the count is given, so leave out --bpm"
             )
         period_range = period_range_from_beat(60.0 / check_bpm(args.bpm, name="--bpm"))
-    out = check_output_path(args.out, args.motion) if args.out else None
-    motion = io.read_motion(
-        args.motion, fps=args.fps, variable=args.variable, **position_options(args)
-    )
+    fb = feedback(args)
+    outs = Outputs(inputs=[args.motion])
+    out = outs.add(args.out, option="--out") if args.out else None
+    with fb.step("reading motion"):
+        motion = io.read_motion(
+            args.motion, fps=args.fps, variable=args.variable, **position_options(args)
+        )
     converted = is_marker_motion(motion)
     positions = None if motion.position_info is None else motion.position_info.describe()
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
@@ -119,22 +124,24 @@ def run(args: argparse.Namespace) -> int:
         )
         else list(channels)
     )
-    seg = segment(
-        motion,
-        alpha=args.alpha,
-        n_periods=args.periods,
-        period_range=period_range,
-        period_method="given" if args.periods is not None else args.period_method,
-        channels=chan,
-    )
+    with fb.step("segmenting periods"):
+        seg = segment(
+            motion,
+            alpha=args.alpha,
+            n_periods=args.periods,
+            period_range=period_range,
+            period_method="given" if args.periods is not None else args.period_method,
+            channels=chan,
+        )
     frames = time_to_frames(seg.boundaries, fps=seg.fps)
     if out is not None:
-        io.write_csv(
-            out,
-            pd.DataFrame(
-                {"boundary": range(frames.size), "time_s": seg.boundaries, "frame": frames}
-            ),
-        )
+        with outs:
+            io.write_csv(
+                outs.path(out),
+                pd.DataFrame(
+                    {"boundary": range(frames.size), "time_s": seg.boundaries, "frame": frames}
+                ),
+            )
     result = {
         "motion": str(args.motion),
         "fps": seg.fps,

@@ -15,7 +15,6 @@ optionally a video with the music that lasts as long as the song, and the report
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -24,12 +23,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
+from . import COMMAND_HELP
 from ._common import (
-    add_json_flag,
+    Feedback,
+    Outputs,
+    add_output_flags,
     add_position_options,
-    check_output_path,
-    check_side_outputs,
     emit,
+    feedback,
     position_options,
 )
 
@@ -43,7 +44,7 @@ MIN_MUSIC_S = 1.0
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "sync",
-        help="resample a periodic dance so that its periods land on the beats of a song",
+        help=COMMAND_HELP["sync"],
         description=(
             "Make a periodic dance follow a song: find the motion's periods and the "
             "music's beats, then resample the motion (quaternion slerp) so that every "
@@ -161,37 +162,11 @@ def register(subparsers: Any) -> None:
         "--video-fps", type=float, default=30.0, help="frame rate of the video [Hz] (default 30)"
     )
     p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
-class _Steps:
-    """A tqdm bar over the pipeline steps on stderr (only on a terminal)."""
-
-    def __init__(self, total: int):
-        from tqdm import tqdm
-
-        self.bar = tqdm(
-            total=total,
-            file=sys.stderr,
-            disable=None,
-            leave=False,
-            bar_format="{desc:<24}{bar}| {n_fmt}/{total_fmt} [{elapsed}]",
-        )
-        self.interactive = not self.bar.disable
-
-    def step(self, desc: str) -> None:
-        self.bar.set_description_str(desc)
-        self.bar.refresh()
-
-    def done(self) -> None:
-        self.bar.update(1)
-
-    def close(self) -> None:
-        self.bar.close()
-
-
-def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | None]:
+def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None, Path | None]:
     if args.align_accents and args.phase_offset != 0.0:
         raise ParameterError(
             "--align-accents measures the phase offset itself; do not also give --phase-offset"
@@ -225,38 +200,41 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Path, Path | None, Path | N
     for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
         if inp is not None and not Path(inp).is_file():
             raise ParameterError(f"{what} file {inp!r} does not exist")
-    inputs = (args.motion, args.audio, args.beats)
-    check_output_path(out, *inputs)
-    video, report = check_side_outputs(args.video, args.report, inputs, out)
-    return out, video, report
+    outs = Outputs(inputs=(args.motion, args.audio, args.beats))
+    out = outs.add(out, option="-o/--output")
+    video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
+    report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
+    return outs, out, video, report
 
 
 def run(args: argparse.Namespace) -> int:
     from .. import io
 
-    out, video, report_path = _check_inputs(args)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", BeatsyncWarning)
-        result = _pipeline(args, out, video)
-    notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
-    for note in notes:
-        print(f"beatsync sync: warning: {note}", file=sys.stderr)
-    result["warnings"] = notes
-    if report_path is not None:
-        io.write_json(report_path, result)
-        result["outputs"]["report"] = str(report_path)
+    outs, out, video, report_path = _check_inputs(args)
+    fb = feedback(args)
+    with outs:  # the motion, video and report are all written, or none of them
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            result = _pipeline(args, outs, out, video, fb)
+        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        for note in notes:
+            fb.warn(note)
+        result["warnings"] = notes
+        if report_path is not None:
+            io.write_json(outs.path(report_path), result)
+            result["outputs"]["report"] = str(report_path)
     return emit(result, _text(result), args)
 
 
-def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[str, Any]:
+def _pipeline(
+    args: argparse.Namespace, outs: Outputs, out: Path, video: Path | None, fb: Feedback
+) -> dict[str, Any]:
     from .. import io
     from ..sync import synchronize
 
     t_start = time.perf_counter()
-    steps = _Steps(4 + (video is not None))
     timings: dict[str, float] = {}
-    try:
-        steps.step("reading motion")
+    with fb.step("reading motion"):
         t0 = time.perf_counter()
         motion = io.read_motion(
             args.motion, fps=args.fps, variable=args.variable, **position_options(args)
@@ -278,11 +256,10 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
             )
         y, sr = io.read_audio(args.audio)
         timings["read_s"] = time.perf_counter() - t0
-        steps.done()
 
-        music_s = y.size / sr
-        meter = (args.beats_per_bar, "--beats-per-bar" if args.beats_per_bar else "unknown")
-        steps.step("finding beats")
+    music_s = y.size / sr
+    meter = (args.beats_per_bar, "--beats-per-bar" if args.beats_per_bar else "unknown")
+    with fb.step("finding beats"):
         t0 = time.perf_counter()
         if args.beats is not None:
             beats = io.read_beats(args.beats)
@@ -306,9 +283,8 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
                 "or without rhythm? give --bpm or --beats FILE"
             )
         timings["beats_s"] = time.perf_counter() - t0
-        steps.done()
 
-        steps.step("synchronising motion")
+    with fb.step("synchronising motion"):
         t0 = time.perf_counter()
         res = synchronize(
             motion,
@@ -326,26 +302,26 @@ def _pipeline(args: argparse.Namespace, out: Path, video: Path | None) -> dict[s
             period_range=None if args.period_range is None else tuple(args.period_range),
         )
         timings["sync_s"] = time.perf_counter() - t0
-        steps.done()
 
-        written: dict[str, str] = {}
-        if video is not None:
-            steps.step("writing video")
-            t0 = time.perf_counter()
-            vid = _render_video(
-                res.motion, video, (y, sr), beats, args.video_fps, steps.interactive,
-                music_s if args.fill == "loop" else None,
-            )
-            written["video"] = str(vid)
-            timings["video_s"] = time.perf_counter() - t0
-            steps.done()
+    written: dict[str, str] = {}
+    if video is not None:
+        t0 = time.perf_counter()
+        staged = outs.path(video)
+        duration = music_s if args.fill == "loop" else None
+        vid = _render_video(res.motion, staged, (y, sr), beats, args.video_fps, fb.bars, duration)
+        if vid == staged:
+            vid = video
+        else:  # no ffmpeg: a GIF and a WAV instead of the MP4
+            outs.forget(video)
+            vid = outs.adopt(vid, option="--video")
+            if staged.with_suffix(".wav").is_file():
+                outs.adopt(staged.with_suffix(".wav"), option="--video")
+        written["video"] = str(vid)
+        timings["video_s"] = time.perf_counter() - t0
 
-        steps.step("writing motion")
-        io.write_motion(out, res.motion)
+    with fb.step("writing motion"):
+        io.write_motion(outs.path(out), res.motion)
         written["motion"] = str(out)
-        steps.done()
-    finally:
-        steps.close()
 
     timings["total_s"] = time.perf_counter() - t_start
     rep = dict(res.report)
