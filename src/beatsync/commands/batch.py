@@ -41,7 +41,8 @@ def run(args: argparse.Namespace) -> int:
     from .. import io
     from ..batch import sync_grid
     from ..cluster import check_cluster_options
-    from ._common import Outputs, check_input_file, check_output, feedback
+    from ..io import check_input_file
+    from ._common import Outputs, check_output, feedback
 
     workers = check_cluster_options(args.scheduler, args.workers)
     inputs = [check_input_file(p, "clip") for p in args.clips]
