@@ -125,15 +125,6 @@ def test_octave_counts():
     assert count_octave_errors([]) == 0
 
 
-def test_study_helpers_still_importable_from_the_old_path():
-    from beatsync.study import beat_evaluation
-
-    for name in ev.MOVED_TO_STUDY:
-        assert getattr(ev, name) is getattr(beat_evaluation, name)
-    with pytest.raises(AttributeError, match="no attribute"):
-        ev.no_such_name  # noqa: B018
-
-
 def test_evaluate_never_runs_a_tracker():
     import ast
     from pathlib import Path

@@ -298,17 +298,3 @@ def tempo_octave(reference: Any, estimated: Any) -> dict[str, Any]:
     ref, est = validate(reference, estimated)
     t_ref, t_est = median_tempo(ref), median_tempo(est)
     return {"tempo_ref": t_ref, "tempo_est": t_est, "octave": octave_relation(t_est, t_ref)}
-
-
-#: Study helpers that run trackers; they live in :mod:`beatsync.study.beat_evaluation`.
-#: Importable from here (lazily, nothing is imported at load time) only until the
-#: beat-tracking notebook and benchmark import them from the study layer.
-MOVED_TO_STUDY = ("score_items", "summarize_scores", "beat_targets", "sweep_frontend")
-
-
-def __getattr__(name: str) -> Any:
-    if name in MOVED_TO_STUDY:
-        import importlib
-
-        return getattr(importlib.import_module("beatsync.study.beat_evaluation"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
