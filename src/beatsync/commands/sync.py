@@ -46,18 +46,28 @@ def register(subparsers: Any) -> None:
         "sync",
         help=COMMAND_HELP["sync"],
         description=(
-            "Make a periodic dance follow a song: find the motion's periods and the "
-            "music's beats, then resample the motion (quaternion slerp) so that every "
-            "period boundary lands on a beat. Writes BVH with the input skeleton (or "
-            "CSV for marker/table input), optionally an MP4 with the music, and prints "
+            "Make a dance follow a song: find the motion's periods (or, for a dance "
+            "that is not strictly periodic, its own motion beats) and the music's beats, "
+            "then resample the motion (quaternion slerp for rotations, linear for joint "
+            "positions) so that every period boundary (or motion beat) lands on a beat. "
+            "Writes BVH with the input skeleton, joint positions in the input's layout, "
+            "or CSV for marker/table input; optionally an MP4 with the music; and prints "
             "a report (frames, periods, beats per period, tempo ratios, boundary "
             "residuals in ms). The output's time 0 is the music's time 0."
         ),
     )
-    p.add_argument("motion", help="motion file: .bvh, .mat (MoCap Toolbox), .csv or .npy")
+    p.add_argument(
+        "motion",
+        help="motion file: .bvh, .mat (MoCap Toolbox), .csv or .npy angle tables, or joint "
+        "positions (.json, (frames, joints, 3) .npy/.npz, .c3d)",
+    )
     p.add_argument("audio", help="music file: .wav, .flac, .ogg, .mp3")
     p.add_argument(
-        "-o", "--output", required=True, help="output motion: .bvh (needs a skeleton) or .csv"
+        "-o",
+        "--output",
+        required=True,
+        help="output motion: .bvh (needs a skeleton), .csv, or for joint positions "
+        ".json/.npy/.npz/.c3d",
     )
     p.add_argument(
         "--fps",
