@@ -33,6 +33,7 @@ from ..units import check_positive, check_times
 __all__ = [
     "validate",
     "diagnose_times",
+    "not_seconds_detail",
     "f_measure",
     "cemgil",
     "goto",
@@ -126,14 +127,25 @@ def validate(reference: Any, estimated: Any) -> tuple[np.ndarray, np.ndarray]:
     return _check(reference, "reference beats"), _check(estimated, "estimated beats")
 
 
+def not_seconds_detail(times: np.ndarray) -> str | None:
+    """Why increasing event times look like something other than seconds, or ``None``.
+
+    The text names the last time, the median spacing and what they look like
+    (:func:`diagnose_times`), for an error message.
+    """
+    looks = diagnose_times(times)
+    if looks is None:
+        return None
+    step = float(np.median(np.diff(times))) if times.size > 1 else float("nan")
+    return f"{times[-1]:g} with a median spacing of {step:g}, which looks like {looks}"
+
+
 def _check(beats: Any, name: str) -> np.ndarray:
     arr = check_times(beats, name=name)
-    looks = diagnose_times(arr)
-    if looks is not None:
-        step = float(np.median(np.diff(arr))) if arr.size > 1 else float("nan")
+    detail = not_seconds_detail(arr)
+    if detail is not None:
         raise ParameterError(
-            f"{name} are not times in seconds: they end at {arr[-1]:g} with a median "
-            f"spacing of {step:g}, which looks like {looks}; convert them to seconds"
+            f"{name} are not times in seconds: they end at {detail}; convert them to seconds"
         )
     return arr
 

@@ -36,8 +36,8 @@ from ..evaluate.beats import (
     METRICS,
     count_octave_errors,
     count_other_tempo,
-    diagnose_times,
     evaluate,
+    not_seconds_detail,
     tempo_octave,
 )
 
@@ -167,12 +167,10 @@ def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
         values that look like frame indices or milliseconds (the message says which).
     """
     times = io.read_beats(path)
-    looks = diagnose_times(times)
-    if looks is not None:
-        step = float(np.median(np.diff(times))) if times.size > 1 else float("nan")
+    detail = not_seconds_detail(times)
+    if detail is not None:
         raise ParameterError(
-            f"annotation {str(path)!r} is not beat times in seconds: it ends at "
-            f"{times[-1]:g} with a median spacing of {step:g}, which looks like {looks}"
+            f"annotation {str(path)!r} is not beat times in seconds: it ends at {detail}"
         )
     return times
 
