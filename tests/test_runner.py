@@ -96,7 +96,6 @@ SPAN = (
 def test_parallel_jobs_run_notebooks_side_by_side(tmp_path, monkeypatch):
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         monkeypatch.delenv(var, raising=False)
-    monkeypatch.setattr("beatsync.runner.usable_cpus", lambda: 4)
     d = tmp_path / "notebooks"
     d.mkdir()
     for name in ("one", "two"):
@@ -109,7 +108,7 @@ def test_parallel_jobs_run_notebooks_side_by_side(tmp_path, monkeypatch):
     spans = [_outputs(out / f"{name}.ipynb").split() for name in ("one", "two")]
     (a0, a1, threads), (b0, b1, _) = spans
     assert float(a0) < float(b1) and float(b0) < float(a1)  # they overlapped
-    assert threads == "2"  # 4 CPUs shared by 2 notebooks
+    assert threads == "1"  # one BLAS thread per kernel: sums independent of the cores
     manifest = json.loads((out / "run_manifest.json").read_text())
     assert [n["name"] for n in manifest["notebooks"]] == ["one", "two"]
     assert sorted(x.name for x in out.iterdir()) == ["one.ipynb", "run_manifest.json", "two.ipynb"]
@@ -146,3 +145,22 @@ def test_cli_refuses_zero_jobs(nbdir, tmp_path, capsys):
     p.write_text("tiny: {}\n")
     code = main(["reproduce", "--params", str(p), "--notebooks", str(nbdir), "--jobs", "0"])
     assert code == 3 and "--jobs 0" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("preset", [None, "3"])
+def test_kernels_get_one_blas_thread_unless_the_user_chose(tmp_path, monkeypatch, preset):
+    import os
+
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        monkeypatch.delenv(var, raising=False)
+    if preset:
+        monkeypatch.setenv("OPENBLAS_NUM_THREADS", preset)
+    d = tmp_path / "notebooks"
+    d.mkdir()
+    _notebook(d / "one.ipynb", SPAN)
+    p = tmp_path / "p.yaml"
+    p.write_text("one: {n: 0}\n")
+    run_notebooks(p, notebooks_dir=d, output_dir=tmp_path / "out", jobs=1)
+    assert _outputs(tmp_path / "out" / "one.ipynb").split()[2] == (preset or "1")
+    assert os.environ.get("OPENBLAS_NUM_THREADS") == preset  # ours restored
+    assert "OMP_NUM_THREADS" not in os.environ

@@ -14,17 +14,21 @@ notebook in ``notebooks/`` that the file does not list. Notebooks run with their
 folder as working directory. A manifest (``run_manifest.json``) records the
 parameters, package version and time of every notebook.
 
-With ``jobs`` > 1 the notebooks run side by side, each in a worker process of its
-own (``python -m beatsync.runner``), the longest first (by the previous manifest's
-times), every kernel with ``cpus // jobs`` BLAS threads (unless the caller set
-``OMP_NUM_THREADS`` and friends); the notebooks write separate artefact folders, so
-the order changes nothing but the wall time. A failing notebook stops the others; an
-interruption (Ctrl-C, SIGTERM) is passed on to the workers, which shut their kernels
-down and delete their partial output.
+Every kernel runs with one BLAS/OpenMP thread (unless the caller set
+``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS``): a threaded BLAS
+sums in an order that depends on the thread count, and one result of the study (a
+composition's search) moved in its third digit between one and two threads. So the
+artefacts do not depend on the machine's core count. With ``jobs`` > 1 the notebooks
+run side by side, each in a worker process of its own (``python -m beatsync.runner``),
+the longest first (by the previous manifest's times); the notebooks write separate
+artefact folders, so the order changes nothing but the wall time. A failing notebook
+stops the others; an interruption (Ctrl-C, SIGTERM) is passed on to the workers, which
+shut their kernels down and delete their partial output.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -32,7 +36,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -46,6 +50,7 @@ __all__ = [
     "run_notebooks",
     "default_jobs",
     "usable_cpus",
+    "kernel_env",
     "NotebookRun",
     "NotebookFailed",
 ]
@@ -221,12 +226,25 @@ def _previous_seconds(output_dir: Path | None) -> dict[str, float]:
         return {}
 
 
-def _worker_env(jobs: int) -> dict[str, str]:
+def kernel_env() -> dict[str, str]:
+    """The environment notebook kernels run with: ours, one BLAS thread unless set."""
     env = dict(os.environ)
-    threads = str(max(1, usable_cpus() // jobs))
     for var in THREAD_VARIABLES:
-        env.setdefault(var, threads)
+        env.setdefault(var, "1")
     return env
+
+
+@contextlib.contextmanager
+def _environment(env: dict[str, str]) -> Iterator[None]:
+    """Set ``os.environ`` to ``env`` while the block runs (kernels inherit it)."""
+    saved = dict(os.environ)
+    os.environ.update(env)
+    try:
+        yield
+    finally:
+        for key in set(os.environ) - set(saved):
+            del os.environ[key]
+        os.environ.update(saved)
 
 
 def _run_parallel(
@@ -243,7 +261,7 @@ def _run_parallel(
     seconds: dict[str, float] = {}
     pending = list(order)
     running: dict[str, tuple[subprocess.Popen[bytes], float, Path, Any]] = {}
-    env = _worker_env(jobs)
+    env = kernel_env()
     with tempfile.TemporaryDirectory(prefix="beatsync-runner-") as scratch:
         try:
             while pending or running:
@@ -308,6 +326,33 @@ def _stop_workers(workers: list[tuple[subprocess.Popen[bytes], Any]]) -> None:
         log.close()
 
 
+def _run_in_process(
+    todo: dict[str, Path],
+    params: dict[str, dict[str, Any]],
+    nb_dir: Path,
+    dests: dict[str, Path],
+    planned: dict[str, Path],
+    target: Callable[[Path], Path],
+    progress: Callable[[str], None] | None,
+) -> dict[str, float]:
+    """Run the notebooks of ``todo`` one after the other in this process; their times."""
+    seconds: dict[str, float] = {}
+    for name, path in todo.items():
+        if progress:
+            progress(f"running {name} ...")
+        start = time.perf_counter()
+        try:
+            _execute(name, path, params[name], nb_dir, dests[name], target(planned[name]))
+        except Exception:
+            if progress:
+                progress(f"  {name} FAILED; executed notebook kept next to {dests[name]}")
+            raise
+        seconds[name] = time.perf_counter() - start
+        if progress:
+            progress(f"  {name} done in {seconds[name]:.1f} s -> {planned[name]}")
+    return seconds
+
+
 def run_notebooks(
     params_file: str | Path,
     *,
@@ -362,26 +407,14 @@ def run_notebooks(
         out_dir.mkdir(parents=True, exist_ok=True)
     target = write_to or (lambda p: p)
     dests = {name: planned[name].resolve() for name in todo}
-    seconds: dict[str, float] = {}
     if jobs > 1 and len(todo) > 1:
         before = _previous_seconds(out_dir)
         order = sorted(todo, key=lambda n: -before.get(n, 0.0))  # longest first (stable)
         targets = {name: target(planned[name]) for name in todo}
         seconds = _run_parallel(todo, params, nb_dir, dests, targets, jobs, order, progress)
     else:
-        for name, path in todo.items():
-            if progress:
-                progress(f"running {name} ...")
-            start = time.perf_counter()
-            try:
-                _execute(name, path, params[name], nb_dir, dests[name], target(planned[name]))
-            except Exception:
-                if progress:
-                    progress(f"  {name} FAILED; executed notebook kept next to {dests[name]}")
-                raise
-            seconds[name] = time.perf_counter() - start
-            if progress:
-                progress(f"  {name} done in {seconds[name]:.1f} s -> {planned[name]}")
+        with _environment(kernel_env()):
+            seconds = _run_in_process(todo, params, nb_dir, dests, planned, target, progress)
     runs = [NotebookRun(n, planned[n], params[n], seconds[n]) for n in todo]
     if MANIFEST in planned:
         write_json(
