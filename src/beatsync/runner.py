@@ -182,7 +182,7 @@ def _check_jobs(jobs: Any) -> int:
 
 
 def _execute(
-    name: str, path: Path, parameters: dict[str, Any], nb_dir: Path, dest: Path, write_to: Path
+    path: Path, parameters: dict[str, Any], nb_dir: Path, dest: Path, write_to: Path
 ) -> None:
     """Run one notebook into ``write_to``; a failed run is kept as ``<dest>.failed.ipynb``."""
     import nbformat
@@ -342,7 +342,7 @@ def _run_in_process(
             progress(f"running {name} ...")
         start = time.perf_counter()
         try:
-            _execute(name, path, params[name], nb_dir, dests[name], target(planned[name]))
+            _execute(path, params[name], nb_dir, dests[name], target(planned[name]))
         except Exception:
             if progress:
                 progress(f"  {name} FAILED; executed notebook kept next to {dests[name]}")
@@ -447,7 +447,6 @@ def _worker_main(argv: list[str]) -> int:
     spec, result = json.loads(argv[0]), Path(argv[1])
     try:
         _execute(
-            spec["name"],
             Path(spec["notebook"]),
             spec["parameters"],
             Path(spec["cwd"]),
