@@ -21,8 +21,12 @@ Speed, each as a ratio against librosa measured in the same run:
 Usage::
 
     .venv/bin/python benchmarks/bench_beats.py [--repeats 5] [--seeds 0 1 2]
+    .venv/bin/python benchmarks/bench_beats.py --accuracy-only [--seeds 0 1 2] [--methods psf]
 
 Writes ``benchmarks/results/beats.md`` and ``benchmarks/results/beats.json``.
+``--accuracy-only`` skips every timing and the real recordings: it scores the
+synthetic set per seed (targets, and the items under F 0.95) with ``--methods``
+(default ``psf``), prints the tables and writes nothing.
 """
 
 from __future__ import annotations
@@ -169,11 +173,37 @@ def startup_speed(repeats: int, wav: Path) -> list[dict]:
     return rows
 
 
+def accuracy_only(seeds: list[int], methods: list[str]) -> int:
+    """Targets of the synthetic set per seed, and the items under F 0.95 (printed)."""
+    from beatsync.study import paper_a_beats as study
+    from beatsync.synth.audio import make_beat_test_set
+
+    for seed in seeds:
+        items = make_beat_test_set(duration=DURATION, seed=seed)
+        scores = study.score_items(items, methods=methods, min_beat_time=0.0)
+        targets = study.check_targets(scores)
+        print(f"## seed {seed}\n")
+        print(_md_table(targets[["target", "method", "value", "threshold", "result"]]))
+        low = scores[scores["F"] < 0.95][["item", "method", "tempo_ref", "tempo_est", "F", "AMLt"]]
+        print("\nitems with F < 0.95:\n")
+        print(_md_table(low) if len(low) else "none")
+        print()
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    ap.add_argument(
+        "--accuracy-only",
+        action="store_true",
+        help="score the synthetic set per seed only (no timing, nothing written)",
+    )
+    ap.add_argument("--methods", nargs="+", default=["psf"], help="with --accuracy-only")
     args = ap.parse_args()
+    if args.accuracy_only:
+        return accuracy_only(args.seeds, args.methods)
     with contextlib.suppress(AttributeError, OSError):
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
 
