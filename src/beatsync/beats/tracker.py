@@ -33,7 +33,13 @@ from ..units import (
 )
 from ..units import check_audio as _units_check_audio
 from .filters import gaussian_smooth
-from .metrical import METER_MODEL, MeterModel, estimate_meter, tactus_observation
+from .metrical import (
+    METER_MODEL,
+    MeterModel,
+    beat_observation,
+    estimate_meter,
+    tactus_observation,
+)
 from .onset import SILENCE_PEAK, OnsetSignal, compute_onsets, frontend_settings
 from .phase import place_beats
 from .tempo import analysis_windows, period_grid, tempo_hmm
@@ -68,16 +74,16 @@ MIN_DURATION_S = 1.5
 #: audio's own onsets in random order (:func:`pulse_clarity_null`, the null); below
 #: ``MIN_PULSE_CLARITY`` times the null a warning says the beats may be meaningless.
 #: Calibrated on 84 noises (white, 10 seeds, and brown, 2 seeds, at 2, 3, 5, 7, 10, 15
-#: and 30 s: ratios 0.6-2.56) and the seven bundled real recordings (Hainsworth 001, the
-#: Ballroom waltz, the madmom sample and the four Dance-with-Melody songs: ratios
-#: 2.93-15.8, the lowest the waltz DANCE_W_10); the synthetic set (path salience
-#: above 0.9) and the madmom sample (0.79) need no null.
-MIN_PULSE_CLARITY = 2.7
-#: Path salience above which the pulse is clear without the null (noises of 2-30 s
-#: reached at most 0.61, the 2 s ones; 3-30 s at most 0.48).
+#: and 30 s: ratios 0.36-1.97) and the seven bundled real recordings (Hainsworth 001,
+#: the Ballroom waltz, the madmom sample and the four Dance-with-Melody songs: ratios
+#: 3.22-12.5, the lowest the waltz DANCE_W_10); 2.5 is about their geometric middle.
+#: The synthetic set (path salience above 0.9) and the madmom sample (0.79) need no null.
+MIN_PULSE_CLARITY = 2.5
+#: Path salience above which the pulse is clear without the null (noises of 2 s
+#: reached 0.61, of 3-30 s at most 0.48).
 CLEAR_PULSE = 0.7
 #: Seconds of shuffled onsets the null is averaged over, and the most draws.
-NULL_AUDIO_S = 30.0
+NULL_AUDIO_S = 15.0
 NULL_MAX_DRAWS = 8
 #: Tempo HMM: standard deviation of the log period ratio per window, jump probability.
 TRANS_SIGMA = 0.02
@@ -391,9 +397,11 @@ def pulse_clarity_null(
     """Pulse clarity of the same onsets in random order: what no pulse looks like.
 
     The band onset signals are permuted in time (one fixed permutation per draw,
-    seeded: the result is reproducible), smoothed, observed and decoded exactly as
-    the audio was; the null is the mean path salience over the draws, enough draws
-    for :data:`NULL_AUDIO_S` seconds of shuffled audio (at most :data:`NULL_MAX_DRAWS`).
+    seeded: the result is reproducible), smoothed, observed with the tactus terms of
+    the metrical model (:func:`beatsync.beats.metrical.beat_observation`: salience
+    and prior, without tatum and measure, a third of the cost) and decoded by the
+    tempo HMM; the null is the mean path salience over the draws, enough draws for
+    :data:`NULL_AUDIO_S` seconds of shuffled audio (at most :data:`NULL_MAX_DRAWS`).
     It has the onset density, window lengths and decoding bias of the audio.
     """
     fps = ons.fps
@@ -404,7 +412,7 @@ def pulse_clarity_null(
     for _ in range(n_draws):
         perm = rng.permutation(n)
         accents = _accents(ons.bands[:, perm], fps)
-        log_obs, sal, _ = tactus_observation(accents, fps, starts, stops, periods, model, max_hz)
+        log_obs, sal = beat_observation(accents, fps, starts, stops, periods, model, max_hz)
         path = tempo_hmm(log_obs, periods, trans_sigma=TRANS_SIGMA, p_jump=P_JUMP)
         values.append(float(np.mean(sal[path, np.arange(path.size)])))
     return float(np.mean(values))
@@ -417,9 +425,9 @@ def _warn_if_no_clear_pulse(ons, path_salience, starts, stops, periods, model, m
     null = pulse_clarity_null(ons, starts, stops, periods, model, max_hz)
     if clarity < MIN_PULSE_CLARITY * null:
         warnings.warn(
-            f"no clear pulse in the audio (pulse clarity {clarity:.2f}, the same onsets "
-            f"in random order {null:.2f}; margin < {MIN_PULSE_CLARITY}): noise or free "
-            "rhythm? the beats may be meaningless",
+            f"no clear pulse in the audio (pulse clarity {clarity:.2f}, less than "
+            f"{MIN_PULSE_CLARITY} times the {null:.2f} of the same onsets in random order): "
+            "noise, free rhythm or too short? the beats may be meaningless",
             BeatsyncWarning,
             stacklevel=4,
         )
