@@ -14,6 +14,10 @@ EXTRAS     ?= --extra test --extra dev --extra peers
 PARAMS     ?= params/paper.yaml
 # Pass e.g. PYTEST_ARGS="-x -q" to change pytest's options.
 PYTEST_ARGS ?= -q
+# Tests run on every CPU (pytest-xdist); --dist loadscope keeps a notebook's cells
+# (and a module's tests) on one worker. XDIST= runs them in one process.
+XDIST      ?= -n auto --dist loadscope
+NBVAL       = -p no:cacheprovider --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
 
 # uv never downloads a Python of its own: the machine's Python 3.11 is used.
 export UV_PYTHON_DOWNLOADS = never
@@ -48,17 +52,19 @@ lock: | $(UV)
 reproduce: setup
 	$(BIN)/beatsync reproduce --params $(PARAMS) --output results/notebooks
 
-test: setup test-unit test-notebooks
-
-test-unit: setup
-	$(BIN)/python -m pytest $(PYTEST_ARGS) tests
-
+# The unit tests and nbval in one run, so that both CPUs stay busy to the end.
 # nbval re-executes every committed notebook and compares its text outputs;
 # cells tagged nbval-ignore-output (timings) are run but not compared.
+test: setup
+	$(BIN)/beatsync reproduce --params params/ci.yaml --check
+	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) $(NBVAL) tests notebooks
+
+test-unit: setup
+	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) tests
+
 test-notebooks: setup
 	$(BIN)/beatsync reproduce --params params/ci.yaml --check
-	$(BIN)/python -m pytest $(PYTEST_ARGS) -p no:cacheprovider --nbval \
-	    --nbval-sanitize-with notebooks/nbval_sanitize.cfg notebooks
+	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) $(NBVAL) notebooks
 
 bench: setup
 	$(BIN)/python benchmarks/run_all.py

@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
-import os
-
+import matplotlib
 import numpy as np
 import pytest
 
 from beatsync.motion import Joint, Motion, Skeleton
 
-# Tests never use a user's cache.
-os.environ.setdefault("MPLBACKEND", "Agg")
+# Figures drawn by the tests open no window. matplotlib.use rather than the MPLBACKEND
+# variable: the notebook kernels that nbval starts in the same pytest process would
+# inherit the variable and stop showing their figures inline.
+matplotlib.use("Agg")
 
 
 @pytest.fixture

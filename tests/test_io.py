@@ -540,3 +540,20 @@ def test_csv_row_with_wrong_field_count_refused(tmp_path, text, match):
 def test_csv_with_byte_order_mark_read(tmp_path):
     (tmp_path / "t.csv").write_text("a,b\n1,2\n3,4\n", encoding="utf-8-sig")
     assert io.read_motion(tmp_path / "t.csv", fps=25).channels == ("a", "b")
+
+
+def test_jsonl_append_survives_a_torn_line(tmp_path):
+    from beatsync.io import append_jsonl, read_jsonl, write_jsonl
+
+    p = tmp_path / "rows.jsonl"
+    assert read_jsonl(p) == []
+    append_jsonl(p, {"a": 1, "x": np.float32(0.5)})
+    with open(p, "a") as fh:
+        fh.write('{"a": 2, "x"')  # a run killed while appending
+    append_jsonl(p, {"a": 3})
+    assert read_jsonl(p) == [{"a": 1, "x": 0.5}, {"a": 3}]
+    assert p.read_text().count("\n") == 3  # the torn line stays a line of its own
+    write_jsonl(p, [{"a": 4}, {"b": [1, 2]}])
+    assert read_jsonl(p) == [{"a": 4}, {"b": [1, 2]}]
+    append_jsonl(p, {"c": float("nan")})  # JSON has no NaN: null
+    assert read_jsonl(p)[-1] == {"c": None}

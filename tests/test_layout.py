@@ -23,6 +23,7 @@ LAYER = {
     "io": 1,
     "motion": 1,
     "rotations": 1,
+    "quaternions": 0,
     "joints": 1,
     "segment": 2,
     "beats": 2,

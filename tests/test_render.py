@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
+from pathlib import Path
 
 import matplotlib
 
@@ -151,3 +153,35 @@ def test_position_only_motion_is_drawn_with_bones():
     m = Motion(pos.reshape(4, -1), FPS, names, None, "positions")
     _, bones = render.pose_positions(m)
     assert len(bones) == 2  # a-b and b-c: drawn as bones, not dots
+
+
+def _children() -> set[int]:
+    pid = os.getpid()
+    kids: set[int] = set()
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        text = (task / "children").read_text().split()
+        kids.update(int(k) for k in text)
+    return kids
+
+
+@pytest.mark.skipif(render.find_ffmpeg() is None, reason="no ffmpeg")
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs /proc")
+def test_write_video_progress_callable_and_interruption_leaves_no_ffmpeg(tmp_path):
+    seen = []
+
+    def progress(done, total):
+        seen.append((done, total))
+        if done == 5:
+            raise KeyboardInterrupt  # as a Ctrl-C during the video
+
+    before = _children()
+    with pytest.raises(KeyboardInterrupt):
+        render.write_video(_motion(), tmp_path / "v.mp4", size=(64, 64), progress=progress)
+    assert seen == [(k, seen[0][1]) for k in range(1, 6)] and seen[0][1] > 5
+    assert _children() - before == set()  # ffmpeg was killed and reaped
+    assert list(tmp_path.iterdir()) == []  # no temporary folder, no partial video
+    # the same callable, not interrupted, counts every frame
+    done = []
+    render.write_video(_motion(), tmp_path / "v.mp4", size=(64, 64),
+                       progress=lambda d, t: done.append((d, t)))
+    assert done[-1] == (done[-1][1], done[-1][1]) and len(done) == done[-1][1]

@@ -79,3 +79,30 @@ def test_continuous_euler_removes_flips():
         (euler_to_rotation(out, "ZXY").inv() * r).magnitude(), 0.0, atol=1e-9
     )
     np.testing.assert_allclose(nearest_euler(e[:1], e[:1]), e[:1])
+
+
+@pytest.mark.parametrize("axes", ["ZXY", "XYZ", "ZYX", "YXZ", "ZX", "Y", "ZXZ", "zxy"])
+def test_quaternions_match_scipy(axes):
+    from scipy.spatial.transform import Rotation
+
+    from beatsync.quaternions import quat_from_euler, quat_multiply, quat_rotate
+
+    rng = np.random.default_rng(3)
+    a = rng.uniform(-400, 400, (200, len(axes)))
+    ref = Rotation.from_euler(axes.upper(), a, degrees=True)
+    q = quat_from_euler(a, axes)
+    assert np.allclose(Rotation.from_quat(q).as_matrix(), ref.as_matrix(), atol=1e-12)
+    v = rng.normal(size=(200, 3))
+    assert np.allclose(quat_rotate(q, v), ref.apply(v), atol=1e-12)
+    b = Rotation.random(200, random_state=4)
+    prod = quat_multiply(q, b.as_quat())
+    assert np.allclose(Rotation.from_quat(prod).as_matrix(), (ref * b).as_matrix(), atol=1e-12)
+
+
+@pytest.mark.parametrize("axes, shape", [("ZXW", (3, 3)), ("", (3, 0)), ("ZXYZ", (3, 4)),
+                                         ("ZXY", (3, 2))])
+def test_quat_from_euler_refuses_bad_axes_or_shapes(axes, shape):
+    from beatsync.quaternions import quat_from_euler
+
+    with pytest.raises(ParameterError, match="axes"):
+        quat_from_euler(np.zeros(shape), axes)

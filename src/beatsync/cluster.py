@@ -170,8 +170,13 @@ def _glibc_default_malloc() -> Any:
 
 def _connect(address: str, timeout: float) -> Any:
     from dask.distributed import Client
+    from distributed.comm import parse_address
+    from distributed.comm.registry import get_backend
 
     try:
+        # an unknown scheme is refused here, not inside the client's connection retries
+        # (which, on a busy machine, can time out before they report the scheme)
+        get_backend(parse_address(address)[0])
         return Client(address, timeout=timeout)
     except ValueError as exc:  # malformed address: unknown scheme, no port
         raise ParameterError(

@@ -29,10 +29,10 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .errors import ParameterError
 from .joints import bone_lengths, check_bones, fill_joint_gaps, infer_bones
+from .quaternions import quat_from_euler, quat_multiply, quat_rotate
 from .units import check_finite, check_fps
 
 __all__ = [
@@ -407,7 +407,7 @@ class Motion:
         n = self.n_frames
         joints = self.skeleton.joints
         pos = np.zeros((n, len(joints), 3))
-        glob: list[Rotation] = []
+        glob: list[np.ndarray | None] = []  # world rotation per joint (None: identity)
         col = 0
         for j_idx, joint in enumerate(joints):
             trans = np.broadcast_to(joint.offset, (n, 3)).copy()
@@ -420,19 +420,20 @@ class Motion:
                     rot_axes.append(c[0])
                     rot_cols.append(col)
                 col += 1
-            if rot_axes:
-                local = Rotation.from_euler(
-                    "".join(rot_axes), self.values[:, rot_cols], degrees=True
-                )
-            else:
-                local = Rotation.identity(n)
+            local = (
+                quat_from_euler(self.values[:, rot_cols], "".join(rot_axes)) if rot_axes else None
+            )
             if joint.parent < 0:
                 pos[:, j_idx] = trans
                 glob.append(local)
+                continue
+            parent_rot = glob[joint.parent]
+            moved = trans if parent_rot is None else quat_rotate(parent_rot, trans)
+            pos[:, j_idx] = pos[:, joint.parent] + moved
+            if parent_rot is None or local is None:
+                glob.append(local if parent_rot is None else parent_rot)
             else:
-                parent_rot = glob[joint.parent]
-                pos[:, j_idx] = pos[:, joint.parent] + parent_rot.apply(trans)
-                glob.append(parent_rot * local)
+                glob.append(quat_multiply(parent_rot, local))
         self._cache["positions"] = pos
         return pos
 

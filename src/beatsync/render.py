@@ -30,6 +30,7 @@ import shutil
 import subprocess
 import tempfile
 import warnings
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -425,7 +426,7 @@ def write_video(
     azimuth: float = 0.0,
     title: str | None = None,
     ffmpeg: str | bool | None = None,
-    progress: bool = False,
+    progress: bool | Callable[[int, int], None] = False,
     duration: float | None = None,
 ) -> Path:
     """Write a stick-figure video of ``motion``, with the music as soundtrack.
@@ -453,8 +454,9 @@ def write_video(
     ffmpeg : str or bool, optional
         Path of an ffmpeg binary; ``None`` finds one (:func:`find_ffmpeg`); ``False``
         forces the GIF + WAV fallback.
-    progress : bool
-        Show a tqdm progress bar on stderr.
+    progress : bool or callable
+        True: a tqdm progress bar on stderr; a callable: ``progress(done, total)``
+        after each frame drawn.
     duration : float > 0, optional [s]
         Length of the video; default the motion's. Longer: the last pose is held
         (e.g. to the end of the song, whose last beat the dance reaches).
@@ -498,7 +500,9 @@ def write_video(
     renderer = _FrameRenderer(xy, bones, (w, h), motion.name if title is None else title)
     exe = find_ffmpeg() if ffmpeg is None else (ffmpeg or None)
     frames_iter: Any = range(len(t))
-    if progress:
+    if callable(progress):
+        frames_iter = _reporting(frames_iter, progress)
+    elif progress:
         from tqdm import tqdm
 
         frames_iter = tqdm(frames_iter, desc="video", unit="frame", leave=False)
@@ -536,12 +540,24 @@ def write_video(
             proc.stdin.close()
         except BrokenPipeError:
             pass
+        except BaseException:  # Ctrl-C, SIGTERM, a drawing error: no ffmpeg left behind
+            proc.kill()
+            proc.wait()
+            raise
         err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
         code = proc.wait()
         if code != 0 or not tmp_video.is_file():
             raise ParameterError(f"ffmpeg failed (exit {code}) writing {str(dest)!r}: {err[-400:]}")
         os.replace(tmp_video, dest)
     return dest
+
+
+def _reporting(frames: range, progress: Callable[[int, int], None]) -> Iterator[int]:
+    """The frame indices, calling ``progress(done, total)`` after each one."""
+    total = len(frames)
+    for done, k in enumerate(frames, start=1):
+        yield k
+        progress(done, total)
 
 
 def _write_gif_fallback(

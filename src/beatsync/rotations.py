@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from .errors import ParameterError
 from .motion import Motion
+from .quaternions import quat_from_euler
 from .units import check_finite, time_to_frames
 
 __all__ = [
@@ -77,10 +78,12 @@ def continuous_euler(euler: np.ndarray) -> np.ndarray:
 
 
 def euler_to_rotation(angles_deg: np.ndarray, order: str) -> Rotation:
-    """Rotations from intrinsic Euler angles [deg] in BVH channel ``order`` (e.g. ``"ZXY"``)."""
-    return Rotation.from_euler(
-        order.upper(), np.asarray(angles_deg, dtype=np.float64), degrees=True
-    )
+    """Rotations from intrinsic Euler angles [deg] in BVH channel ``order`` (e.g. ``"ZXY"``).
+
+    Built from :func:`beatsync.quaternions.quat_from_euler` (the same rotations as
+    ``Rotation.from_euler(order.upper(), ...)``, several times faster).
+    """
+    return Rotation.from_quat(quat_from_euler(angles_deg, order))
 
 
 def rotation_to_euler(rot: Rotation, order: str, reference: np.ndarray | None = None) -> np.ndarray:
@@ -129,8 +132,8 @@ def _interp_values(motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray
         out[:, partial] = v0[:, partial] + w[:, None] * d
     for _joint, idx, order in motion.rotation_triples():
         cols = list(idx)
-        q0 = euler_to_rotation(v0[:, cols], order).as_quat()
-        q1 = euler_to_rotation(v1[:, cols], order).as_quat()
+        q0 = quat_from_euler(v0[:, cols], order)
+        q1 = quat_from_euler(v1[:, cols], order)
         q = slerp(q0, q1, w)
         ref = np.where(w[:, None] < 0.5, v0[:, cols], v1[:, cols])
         out[:, cols] = rotation_to_euler(Rotation.from_quat(q), order, reference=ref)

@@ -13,11 +13,24 @@ notebook's ``parameters`` cell does not declare, a notebook that is missing, and
 notebook in ``notebooks/`` that the file does not list. Notebooks run with their own
 folder as working directory. A manifest (``run_manifest.json``) records the
 parameters, package version and time of every notebook.
+
+With ``jobs`` > 1 the notebooks run side by side, each in a worker process of its
+own (``python -m beatsync.runner``), the longest first (by the previous manifest's
+times), every kernel with ``cpus // jobs`` BLAS threads (unless the caller set
+``OMP_NUM_THREADS`` and friends); the notebooks write separate artefact folders, so
+the order changes nothing but the wall time. A failing notebook stops the others; an
+interruption (Ctrl-C, SIGTERM) is passed on to the workers, which shut their kernels
+down and delete their partial output.
 """
 
 from __future__ import annotations
 
+import json
 import os
+import signal
+import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -26,9 +39,26 @@ from typing import Any
 
 from .errors import ParameterError
 
-__all__ = ["load_params", "check_params", "planned_outputs", "run_notebooks", "NotebookRun"]
+__all__ = [
+    "load_params",
+    "check_params",
+    "planned_outputs",
+    "run_notebooks",
+    "default_jobs",
+    "usable_cpus",
+    "NotebookRun",
+    "NotebookFailed",
+]
 
 MANIFEST = "run_manifest.json"
+
+
+#: Environment variables that set the BLAS/OpenMP thread count of a kernel.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+class NotebookFailed(RuntimeError):
+    """A notebook raised an error in one of its cells (its message is kept)."""
 
 
 @dataclass(frozen=True)
@@ -124,6 +154,160 @@ def planned_outputs(
     return planned
 
 
+def usable_cpus() -> int:
+    """CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def default_jobs(n_notebooks: int | None = None) -> int:
+    """Notebooks to run at once by default: the usable CPUs, at most 4 (and ``n_notebooks``)."""
+    jobs = max(1, min(usable_cpus(), 4))
+    return min(jobs, n_notebooks) if n_notebooks else jobs
+
+
+def _check_jobs(jobs: Any) -> int:
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ParameterError(
+            f"jobs={jobs!r}: the number of notebooks run at once must be a whole number >= 1"
+        )
+    return jobs
+
+
+def _execute(
+    name: str, path: Path, parameters: dict[str, Any], nb_dir: Path, dest: Path, write_to: Path
+) -> None:
+    """Run one notebook into ``write_to``; a failed run is kept as ``<dest>.failed.ipynb``."""
+    import nbformat
+    import papermill as pm
+
+    from .io import atomic_write
+
+    tmp = dest.with_name(f".{dest.name}.running.ipynb")
+    try:
+        pm.execute_notebook(
+            str(path),
+            str(tmp),
+            parameters=parameters,
+            cwd=str(nb_dir),
+            progress_bar=False,
+            report_mode=False,
+        )
+    except Exception:
+        # keep the executed notebook with its traceback cells for the user to read
+        if tmp.exists():
+            os.replace(tmp, dest.with_name(f"{dest.stem}.failed.ipynb"))
+        raise
+    except BaseException:  # Ctrl-C, SIGTERM: leave nothing behind
+        tmp.unlink(missing_ok=True)
+        raise
+    executed = nbformat.read(tmp, as_version=4)
+    executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
+    with atomic_write(write_to) as fh:
+        nbformat.write(executed, fh)
+    tmp.unlink(missing_ok=True)
+
+
+def _previous_seconds(output_dir: Path | None) -> dict[str, float]:
+    """Each notebook's time in the previous manifest of ``output_dir`` (empty if none)."""
+    if output_dir is None:
+        return {}
+    try:
+        data = json.loads((output_dir / MANIFEST).read_text())
+        return {str(n["name"]): float(n["seconds"]) for n in data["notebooks"]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
+
+
+def _worker_env(jobs: int) -> dict[str, str]:
+    env = dict(os.environ)
+    threads = str(max(1, usable_cpus() // jobs))
+    for var in THREAD_VARIABLES:
+        env.setdefault(var, threads)
+    return env
+
+
+def _run_parallel(
+    todo: dict[str, Path],
+    params: dict[str, dict[str, Any]],
+    nb_dir: Path,
+    dests: dict[str, Path],
+    targets: dict[str, Path],
+    jobs: int,
+    order: list[str],
+    progress: Callable[[str], None] | None,
+) -> dict[str, float]:
+    """Run the notebooks of ``todo`` in up to ``jobs`` worker processes; return their times."""
+    seconds: dict[str, float] = {}
+    pending = list(order)
+    running: dict[str, tuple[subprocess.Popen[bytes], float, Path, Any]] = {}
+    env = _worker_env(jobs)
+    with tempfile.TemporaryDirectory(prefix="beatsync-runner-") as scratch:
+        try:
+            while pending or running:
+                while pending and len(running) < jobs:
+                    name = pending.pop(0)
+                    spec = {
+                        "name": name,
+                        "notebook": str(todo[name].resolve()),
+                        "parameters": params[name],
+                        "cwd": str(nb_dir),
+                        "dest": str(dests[name]),
+                        "write_to": str(targets[name].resolve()),
+                    }
+                    result = Path(scratch) / f"{name}.result.json"
+                    log = open(Path(scratch) / f"{name}.log", "wb")  # noqa: SIM115
+                    proc = subprocess.Popen(
+                        [sys.executable, "-m", "beatsync.runner", json.dumps(spec), str(result)],
+                        stdin=subprocess.DEVNULL,
+                        stdout=log,
+                        stderr=subprocess.STDOUT,
+                        env=env,
+                    )
+                    running[name] = (proc, time.perf_counter(), result, log)
+                    if progress:
+                        progress(f"running {name} ...")
+                time.sleep(0.1)
+                for name, (proc, start, result, log) in list(running.items()):
+                    if proc.poll() is None:
+                        continue
+                    del running[name]
+                    log.close()
+                    if proc.returncode != 0:
+                        raise NotebookFailed(_failure_text(name, result, Path(log.name)))
+                    seconds[name] = time.perf_counter() - start
+                    if progress:
+                        progress(f"  {name} done in {seconds[name]:.1f} s -> {dests[name]}")
+        finally:
+            _stop_workers([(p, lg) for p, _, _, lg in running.values()])
+    return seconds
+
+
+def _failure_text(name: str, result: Path, log: Path) -> str:
+    try:
+        return f"notebook {name!r} failed:\n{json.loads(result.read_text())['error'].strip()}"
+    except (OSError, ValueError, KeyError):
+        tail = log.read_text(errors="replace").strip().splitlines()[-20:]
+        return f"notebook {name!r} failed; its worker printed:\n" + "\n".join(tail)
+
+
+def _stop_workers(workers: list[tuple[subprocess.Popen[bytes], Any]]) -> None:
+    """Ask the running workers to stop (they shut their kernels down), then make sure."""
+    for proc, _ in workers:
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGTERM)
+    deadline = time.monotonic() + 20.0
+    for proc, log in workers:
+        try:
+            proc.wait(timeout=max(0.1, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+        log.close()
+
+
 def run_notebooks(
     params_file: str | Path,
     *,
@@ -131,6 +315,7 @@ def run_notebooks(
     output_dir: str | Path | None = "results/notebooks",
     only: list[str] | None = None,
     in_place: bool = False,
+    jobs: int = 1,
     progress: Callable[[str], None] | None = None,
     write_to: Callable[[Path], Path] | None = None,
 ) -> list[NotebookRun]:
@@ -147,6 +332,9 @@ def run_notebooks(
     in_place : bool
         Overwrite the notebooks themselves with their executed versions (used to
         refresh the committed, CI-parameter notebooks).
+    jobs : int
+        Notebooks run at once (1: one after the other, in this process; more: in
+        worker processes, see the module docstring; :func:`default_jobs` suggests one).
     progress : callable, optional
         Called with a line of text before and after each notebook.
     write_to : callable, optional
@@ -154,56 +342,47 @@ def run_notebooks(
         (a command writing all-or-nothing passes its staging paths); default: the
         destination itself. A notebook that fails is kept, with its traceback cells,
         as ``<name>.failed.ipynb`` next to its destination.
+
+    Raises
+    ------
+    NotebookFailed
+        With ``jobs`` > 1, a notebook that raised (with ``jobs`` = 1 papermill's own
+        error is raised).
     """
-    import nbformat
-    import papermill as pm
-
     from . import __version__
-    from .io import atomic_write, write_json
+    from .io import write_json
 
+    jobs = _check_jobs(jobs)
     params = load_params(params_file)
     todo = check_params(params, notebooks_dir, only=only)
     nb_dir = Path(notebooks_dir).resolve()
     planned = planned_outputs(todo, output_dir=output_dir, in_place=in_place)
-    if not in_place:
-        Path(output_dir or "results/notebooks").mkdir(parents=True, exist_ok=True)
+    out_dir = None if in_place else Path(output_dir or "results/notebooks")
+    if out_dir is not None:
+        out_dir.mkdir(parents=True, exist_ok=True)
     target = write_to or (lambda p: p)
-    runs: list[NotebookRun] = []
-    for name, path in todo.items():
-        dest = planned[name].resolve()
-        if progress:
-            progress(f"running {name} ...")
-        start = time.perf_counter()
-        tmp = dest.with_name(f".{dest.name}.running.ipynb")
-        try:
-            pm.execute_notebook(
-                str(path),
-                str(tmp),
-                parameters=params[name],
-                cwd=str(nb_dir),
-                progress_bar=False,
-                report_mode=False,
-            )
-        except Exception:
-            # keep the executed notebook with its traceback cells for the user to read
-            failed = dest.with_name(f"{dest.stem}.failed.ipynb")
-            if tmp.exists():
-                os.replace(tmp, failed)
+    dests = {name: planned[name].resolve() for name in todo}
+    seconds: dict[str, float] = {}
+    if jobs > 1 and len(todo) > 1:
+        before = _previous_seconds(out_dir)
+        order = sorted(todo, key=lambda n: -before.get(n, 0.0))  # longest first (stable)
+        targets = {name: target(planned[name]) for name in todo}
+        seconds = _run_parallel(todo, params, nb_dir, dests, targets, jobs, order, progress)
+    else:
+        for name, path in todo.items():
+            if progress:
+                progress(f"running {name} ...")
+            start = time.perf_counter()
+            try:
+                _execute(name, path, params[name], nb_dir, dests[name], target(planned[name]))
+            except Exception:
                 if progress:
-                    progress(f"  {name} FAILED; executed notebook kept in {failed}")
-            raise
-        except BaseException:  # Ctrl-C, SIGTERM: leave nothing behind
-            tmp.unlink(missing_ok=True)
-            raise
-        executed = nbformat.read(tmp, as_version=4)
-        executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
-        with atomic_write(target(planned[name])) as fh:
-            nbformat.write(executed, fh)
-        tmp.unlink(missing_ok=True)
-        seconds = time.perf_counter() - start
-        runs.append(NotebookRun(name, planned[name], params[name], seconds))
-        if progress:
-            progress(f"  {name} done in {seconds:.1f} s -> {planned[name]}")
+                    progress(f"  {name} FAILED; executed notebook kept next to {dests[name]}")
+                raise
+            seconds[name] = time.perf_counter() - start
+            if progress:
+                progress(f"  {name} done in {seconds[name]:.1f} s -> {planned[name]}")
+    runs = [NotebookRun(n, planned[n], params[n], seconds[n]) for n in todo]
     if MANIFEST in planned:
         write_json(
             target(planned[MANIFEST]),
@@ -217,3 +396,38 @@ def run_notebooks(
             },
         )
     return runs
+
+
+def _worker_main(argv: list[str]) -> int:
+    """``python -m beatsync.runner SPEC_JSON RESULT_FILE``: run one notebook (a worker).
+
+    SIGTERM and SIGHUP become KeyboardInterrupt, so papermill shuts the kernel down
+    and the partial output is deleted. The error of a failed notebook is written to
+    ``RESULT_FILE`` as ``{"error": text}``.
+    """
+
+    def stop(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, stop)
+    spec, result = json.loads(argv[0]), Path(argv[1])
+    try:
+        _execute(
+            spec["name"],
+            Path(spec["notebook"]),
+            spec["parameters"],
+            Path(spec["cwd"]),
+            Path(spec["dest"]),
+            Path(spec["write_to"]),
+        )
+    except Exception as exc:
+        result.write_text(json.dumps({"error": str(exc) or type(exc).__name__}))
+        return 1
+    except KeyboardInterrupt:
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_worker_main(sys.argv[1:]))

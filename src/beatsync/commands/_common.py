@@ -46,6 +46,7 @@ __all__ = [
     "Outputs",
     "Feedback",
     "add_output_flags",
+    "add_music_beat_options",
     "add_json_flag",
     "add_period_range",
     "add_position_options",
@@ -103,6 +104,22 @@ def add_output_flags(parser: argparse.ArgumentParser) -> None:
 
 
 add_json_flag = add_output_flags  # the name the subcommands used before --quiet existed
+
+
+def add_music_beat_options(parser: argparse.ArgumentParser) -> None:
+    """``--beats FILE`` (known beat times: no tracking) and ``--bpm`` (known tempo)."""
+    parser.add_argument(
+        "--beats",
+        default=None,
+        metavar="FILE",
+        help="music beat times [s], one per line (first column): skip beat tracking",
+    )
+    parser.add_argument(
+        "--bpm",
+        type=float,
+        default=None,
+        help="known tempo of the music [BPM]: the tracker only finds the phase",
+    )
 
 
 def add_period_range(parser: argparse.ArgumentParser) -> None:

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from . import COMMAND_HELP
-from ._common import Outputs, add_output_flags, emit, feedback
+from ._common import Outputs, add_music_beat_options, add_output_flags, emit, feedback
 
 __all__ = ["register", "run"]
 
@@ -84,18 +84,7 @@ def register(subparsers: Any) -> None:
         default="dp",
         help="search: dp (paper B), conventional (multi-stage baseline), random walk",
     )
-    p.add_argument(
-        "--beats",
-        default=None,
-        metavar="FILE",
-        help="music beat times [s], one per line: skip beat tracking",
-    )
-    p.add_argument(
-        "--bpm",
-        type=float,
-        default=None,
-        help="known tempo of the music [BPM]: the tracker only finds the phase",
-    )
+    add_music_beat_options(p)
     p.add_argument(
         "--tempo-weight",
         type=float,

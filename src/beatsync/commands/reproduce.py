@@ -38,6 +38,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="overwrite the notebooks with their executed versions (refresh committed ones)",
     )
     p.add_argument(
+        "--jobs",
+        type=int,
+        metavar="N",
+        help="notebooks run at once, each in a process of its own (default: the number of "
+        "CPUs, at most 4; 1 runs them one after the other in this process)",
+    )
+    p.add_argument(
         "--check", action="store_true", help="only check the parameter file, run nothing"
     )
     add_output_flags(p)
@@ -47,14 +54,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..io import check_input_file
-    from ..runner import check_params, load_params, planned_outputs, run_notebooks
+    from ..runner import check_params, default_jobs, load_params, planned_outputs, run_notebooks
 
     check_input_file(args.params, "parameter")
     if not Path(args.notebooks).is_dir():
         raise ParameterError(f"--notebooks {args.notebooks!r} is not a folder of notebooks")
     if args.check and args.in_place:
         raise ParameterError("--check runs nothing, so --in-place has nothing to overwrite")
+    if args.jobs is not None and args.jobs < 1:
+        raise ParameterError(f"--jobs {args.jobs}: run at least one notebook at a time")
     todo = check_params(load_params(args.params), args.notebooks, only=args.only)
+    jobs = args.jobs if args.jobs is not None else default_jobs(len(todo))
     if args.check:
         return emit(
             {"params": args.params, "notebooks": sorted(todo)},
@@ -83,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
                 output_dir=out_dir,
                 only=args.only,
                 in_place=args.in_place,
+                jobs=jobs,
                 progress=fb.info,
                 write_to=outs.path,
             )

@@ -27,6 +27,7 @@ from . import COMMAND_HELP
 from ._common import (
     Feedback,
     Outputs,
+    add_music_beat_options,
     add_output_flags,
     add_position_options,
     emit,
@@ -80,18 +81,7 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
     add_position_options(p)
-    p.add_argument(
-        "--beats",
-        default=None,
-        metavar="FILE",
-        help="music beat times [s], one per line (first column): skip beat tracking",
-    )
-    p.add_argument(
-        "--bpm",
-        type=float,
-        default=None,
-        help="known tempo of the music [BPM]: the tracker only finds the phase",
-    )
+    add_music_beat_options(p)
     p.add_argument(
         "--beats-per-period",
         type=int,

@@ -26,9 +26,8 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from ..rotations import euler_to_rotation
+from ..quaternions import quat_from_euler, quat_multiply
 
 __all__ = [
     "PERCENTILES",
@@ -43,6 +42,9 @@ __all__ = [
 PERCENTILES = (50, 95, 99)
 #: A result may exceed the library's largest clip 99th percentile by this factor.
 TOLERANCE = 1.25
+
+# multiplying a unit quaternion by this gives its inverse (the conjugate)
+_CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
 
 
 def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
@@ -66,11 +68,10 @@ def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
     for order, members in by_order.items():  # one conversion per Euler order
         cols = [list(triples[i][1]) for i in members]
         ang = np.stack([motion.values[:, c] for c in cols], axis=1)  # (n, J, 3)
-        r = euler_to_rotation(ang.reshape(-1, 3), order)
-        q = r.as_quat().reshape(n, len(members), 4)
-        q0 = Rotation.from_quat(q[:-1].reshape(-1, 4))
-        q1 = Rotation.from_quat(q[1:].reshape(-1, 4))
-        step = (q0.inv() * q1).magnitude().reshape(n - 1, len(members))
+        q = quat_from_euler(ang.reshape(-1, 3), order).reshape(n, len(members), 4)
+        rel = quat_multiply(q[:-1] * _CONJUGATE, q[1:])  # frame-to-frame rotation
+        # its angle, as Rotation.magnitude computes it (precise for small angles)
+        step = 2.0 * np.arctan2(np.linalg.norm(rel[..., :3], axis=-1), np.abs(rel[..., 3]))
         rot[:, members] = np.degrees(step) * motion.fps
     return {"root_speed": root, "rotation_speed": rot}
 

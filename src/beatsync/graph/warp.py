@@ -39,6 +39,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
 from ..motion import Motion
+from ..quaternions import quat_from_euler, quat_multiply
 from ..rotations import (
     blend_values,
     continuous_euler,
@@ -273,7 +274,9 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         p[:, g0] += shift[rm, g0]
         p[:, g1] += shift[rm, g1]
         vm[:, pos_cols] = p
-        rot = turn * euler_to_rotation(vm[:, rot_cols], order)
+        rot = Rotation.from_quat(
+            quat_multiply(turn.as_quat(), quat_from_euler(vm[:, rot_cols], order))
+        )
         vm[:, rot_cols] = rotation_to_euler(rot, order, reference=vm[:, rot_cols])
         v[moved] = vm
         return v

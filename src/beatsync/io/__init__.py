@@ -27,13 +27,16 @@ import numpy as np
 from ..errors import ParameterError
 from ..motion import Motion
 from ._files import (
+    append_jsonl,
     atomic_write,
     check_input_file,
     check_output_folder,
+    read_jsonl,
     sha256_file,
     to_jsonable,
     write_csv,
     write_json,
+    write_jsonl,
 )
 from .audio import read_audio, read_beats, write_audio, write_beats
 from .bvh import read_bvh, write_bvh
@@ -78,6 +81,9 @@ __all__ = [
     "read_beats",
     "write_beats",
     "write_json",
+    "read_jsonl",
+    "write_jsonl",
+    "append_jsonl",
     "to_jsonable",
     "write_csv",
     "sha256_file",

@@ -159,6 +159,59 @@ def write_csv(
     return Path(path)
 
 
+def read_jsonl(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """The JSON objects of a JSON-lines file, one per line ([] if it does not exist).
+
+    A line that is not a complete JSON object (the torn last line of a run that was
+    killed while appending) is skipped.
+    """
+    p = Path(path)
+    if not p.is_file():
+        return []
+    rows = []
+    with open(p, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            try:
+                row = json.loads(line)
+            except ValueError:
+                continue
+            if isinstance(row, dict):
+                rows.append(row)
+    return rows
+
+
+def _jsonl_line(row: dict[str, Any]) -> str:
+    return json.dumps(to_jsonable(row), allow_nan=False) + "\n"
+
+
+def write_jsonl(path: str | os.PathLike[str], rows: Any) -> Path:
+    """Write ``rows`` (dicts) as a JSON-lines file, one object per line (atomic)."""
+    with atomic_write(path) as fh:
+        for row in rows:
+            fh.write(_jsonl_line(row))
+    return Path(path)
+
+
+def append_jsonl(path: str | os.PathLike[str], row: dict[str, Any]) -> Path:
+    """Append one object to a JSON-lines file and flush it to disk (``fsync``).
+
+    So a crash loses at most the line being written; a torn last line left by an
+    earlier crash is ended first, so that it stays a line of its own.
+    """
+    p = Path(path)
+    line = _jsonl_line(row)
+    torn = False
+    if p.is_file() and p.stat().st_size > 0:
+        with open(p, "rb") as fh:
+            fh.seek(-1, os.SEEK_END)
+            torn = fh.read(1) != b"\n"
+    with open(p, "a", encoding="utf-8") as fh:
+        fh.write(("\n" if torn else "") + line)
+        fh.flush()
+        os.fsync(fh.fileno())
+    return p
+
+
 def sha256_file(path: str | os.PathLike[str]) -> str:
     """SHA-256 hex digest of a file's bytes."""
     import hashlib

@@ -17,7 +17,6 @@ Methods are named as in :data:`beatsync.peers.PEERS` (``psf`` is ours); scores a
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import time
 import uuid
@@ -263,18 +262,7 @@ class TrackLog:
 
     def rows(self) -> list[dict[str, Any]]:
         """Every complete row, in the order written."""
-        if not self.path.is_file():
-            return []
-        out = []
-        with open(self.path, encoding="utf-8", errors="replace") as fh:
-            for line in fh:
-                try:
-                    row = json.loads(line)
-                except ValueError:
-                    continue  # torn last line of an interrupted run
-                if isinstance(row, dict) and "key" in row and "method" in row:
-                    out.append(row)
-        return out
+        return [r for r in io.read_jsonl(self.path) if "key" in r and "method" in r]
 
     def latest(self) -> dict[tuple[str, str], dict[str, Any]]:
         """The last row of each ``(method, key)``."""
@@ -282,23 +270,11 @@ class TrackLog:
 
     def rewrite(self, rows: Sequence[dict[str, Any]]) -> None:
         """Replace the record with ``rows`` (atomic)."""
-        with io.atomic_write(self.path) as fh:
-            for r in rows:
-                fh.write(json.dumps(io.to_jsonable(r), allow_nan=False) + "\n")
+        io.write_jsonl(self.path, rows)
 
     def append(self, row: dict[str, Any]) -> None:
         """Append one row and flush it to disk."""
-        line = json.dumps(io.to_jsonable(row), allow_nan=False) + "\n"
-        torn = self.path.is_file() and self.path.stat().st_size > 0 and not self._ends_in_newline()
-        with open(self.path, "a", encoding="utf-8") as fh:
-            fh.write(("\n" if torn else "") + line)
-            fh.flush()
-            os.fsync(fh.fileno())
-
-    def _ends_in_newline(self) -> bool:
-        with open(self.path, "rb") as fh:
-            fh.seek(-1, os.SEEK_END)
-            return fh.read(1) == b"\n"
+        io.append_jsonl(self.path, row)
 
 
 #: Columns of ``summary.csv`` after the keys (means of the metrics over ``ok`` tracks).
