@@ -198,6 +198,25 @@ def _log_conditional(
     return log_g - log_z
 
 
+def _tactus_terms(
+    s_b: np.ndarray,
+    fps: float,
+    starts: Sequence[int],
+    stops: Sequence[int],
+    periods: np.ndarray,
+    model: MeterModel,
+) -> np.ndarray:
+    """``beta s(tB) + log p(tB)``; zeroes (in place) the salience of unobservable periods.
+
+    A beat period is observable only if the window holds at least four of its cycles
+    (a measure: two); longer periods count as unsupported.
+    """
+    span = (np.asarray(stops) - np.asarray(starts)) / fps
+    s_b[periods[:, None] > span[None, :] / MIN_BEAT_CYCLES] = 0.0
+    prior = _log_prior(periods, model.tactus_median_s, model.tactus_sigma)
+    return model.beta * s_b + prior[:, None]
+
+
 def tactus_observation(
     bands: np.ndarray,
     fps: float,
@@ -227,10 +246,7 @@ def tactus_observation(
     all_p = np.concatenate([periods, tatum, measure])
     sal = resonator_salience(bands, fps, starts, stops, all_p, model.half_time_s, max_hz)
     s_b = sal[: periods.size]
-    # a beat period is observable only if the window holds at least four of its
-    # cycles (a measure: two); longer periods count as unsupported
-    span = (np.asarray(stops) - np.asarray(starts)) / fps
-    s_b[periods[:, None] > span[None, :] / MIN_BEAT_CYCLES] = 0.0
+    log_b = _tactus_terms(s_b, fps, starts, stops, periods, model)
     s_a = sal[periods.size : periods.size + tatum.size]
     s_c = sal[periods.size + tatum.size :]
     obs_a = model.beta * s_a + _log_prior(tatum, model.tatum_median_s, model.tatum_sigma)[:, None]
@@ -254,9 +270,6 @@ def tactus_observation(
         ic = np.argmax(tc, axis=1)
         best[:, w] = ta.max(axis=1) + tc[rows, ic]
         best_measure[:, w] = measure[ic]
-    log_b = (
-        model.beta * s_b + _log_prior(periods, model.tactus_median_s, model.tactus_sigma)[:, None]
-    )
     return log_b + best, s_b, best_measure
 
 
@@ -275,12 +288,7 @@ def beat_observation(
     cost); the pulse-clarity null of :mod:`beatsync.beats.tracker` decodes with it.
     """
     s_b = resonator_salience(bands, fps, starts, stops, periods, model.half_time_s, max_hz)
-    span = (np.asarray(stops) - np.asarray(starts)) / fps
-    s_b[periods[:, None] > span[None, :] / MIN_BEAT_CYCLES] = 0.0
-    log_b = (
-        model.beta * s_b + _log_prior(periods, model.tactus_median_s, model.tactus_sigma)[:, None]
-    )
-    return log_b, s_b
+    return _tactus_terms(s_b, fps, starts, stops, periods, model), s_b
 
 
 def estimate_meter(measure_at_tactus: np.ndarray, tactus: np.ndarray) -> int:
