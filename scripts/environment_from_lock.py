@@ -17,6 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: PyPI name -> conda-forge name(s), where they differ.
 CONDA_NAMES = {
     "soundfile": ["pysoundfile"],
+    "soxr": ["soxr-python"],
     "dask": ["dask", "distributed"],
 }
 #: Extras whose packages go into the conda environment.

@@ -1,3 +1,5 @@
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -159,6 +161,43 @@ def test_audio_round_trip_and_mp3(tmp_path):
     assert sr2 == sr and np.allclose(y2, y[:4410], atol=1e-4)
     y3, sr3 = io.read_audio(p, sr=22050)
     assert sr3 == 22050 and abs(y3.size - 2205) <= 1
+
+
+def test_resample_audio_equals_librosa_soxr_hq():
+    librosa = pytest.importorskip("librosa")
+    rng = np.random.default_rng(3)
+    for n, a, b in [(44100, 44100, 22050), (12345, 48000, 22050), (777, 16000, 44100.0)]:
+        y = rng.standard_normal(n).astype(np.float32)
+        out = io.resample_audio(y, a, b)
+        assert out.dtype == np.float32
+        np.testing.assert_array_equal(out, librosa.resample(y, orig_sr=a, target_sr=b))
+
+
+def test_damaged_soundfile_formats_are_refused_without_librosa(tmp_path):
+    # a broken .wav fell back to librosa/audioread: 6 s of imports (30 s with a numba
+    # compilation on a fresh installation) per process, to fail the same way
+    code = """
+import sys
+from pathlib import Path
+from beatsync import io
+from beatsync.errors import ParameterError
+d = Path(sys.argv[1])
+for name in ("junk.wav", "junk.flac", "junk.mp3"):
+    (d / name).write_bytes(b"RIFF garbage not audio" * 10)
+    try:
+        io.read_audio(d / name)
+    except ParameterError as exc:
+        print(exc)
+y = io.read_audio(io.write_audio(d / "ok.wav", [0.0, 0.5, -0.5, 0.25] * 4410, 44100), sr=22050)[0]
+print(y.size, "librosa" in sys.modules)
+"""
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    assert len(out) == 4, out
+    for line, fmt in zip(out[:3], ("WAV", "FLAC", "MP3"), strict=True):
+        assert f"as {fmt} audio" in line and "is the file complete" in line
+    assert out[3] == "8820 False"
 
 
 def test_beats_files(tmp_path):

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ParameterError
+from .io import resample_audio
 
 __all__ = ["Peer", "PEERS", "get", "available", "track", "ESSENTIA_SR"]
 
@@ -86,9 +87,7 @@ def track_librosa(y: np.ndarray, sr: float) -> np.ndarray:
 def _essentia_audio(y: np.ndarray, sr: float) -> np.ndarray:
     y = np.asarray(y, dtype=np.float32)
     if sr != ESSENTIA_SR:
-        import librosa
-
-        y = librosa.resample(y, orig_sr=sr, target_sr=ESSENTIA_SR)
+        y = resample_audio(y, sr, ESSENTIA_SR)
     return np.ascontiguousarray(y, dtype=np.float32)
 
 

@@ -38,7 +38,14 @@ from ._files import (
     write_json,
     write_jsonl,
 )
-from .audio import read_audio, read_beats, write_audio, write_beats
+from .audio import (
+    SOUNDFILE_SUFFIXES,
+    read_audio,
+    read_beats,
+    resample_audio,
+    write_audio,
+    write_beats,
+)
 from .bvh import read_bvh, write_bvh
 from .positions import (
     is_position_array,
@@ -78,6 +85,8 @@ __all__ = [
     "write_table",
     "read_audio",
     "write_audio",
+    "resample_audio",
+    "SOUNDFILE_SUFFIXES",
     "read_beats",
     "write_beats",
     "write_json",
