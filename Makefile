@@ -39,8 +39,11 @@ $(UV):
 	$(UV_DIR)/bin/python -m pip install --quiet --disable-pip-version-check "uv==$(UV_VERSION)"
 
 # --locked: refuse a uv.lock that does not match pyproject.toml (run `make lock`).
+# --compile-bytecode: every process of the tests and the study would otherwise parse
+# scipy, pandas and matplotlib from source again where bytecode is not written
+# (PYTHONDONTWRITEBYTECODE, read-only installs): 9 s instead of 3 s per import.
 $(STAMP): uv.lock pyproject.toml | $(UV)
-	$(UV) sync --locked --python $(PYTHON) $(EXTRAS)
+	$(UV) sync --locked --compile-bytecode --python $(PYTHON) $(EXTRAS)
 	@touch $(STAMP)
 
 setup: $(STAMP)
