@@ -50,6 +50,7 @@ set on the synthetic test set, and the real recordings were only scored.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -150,11 +151,9 @@ def resonator_salience(
     n_bins = power.shape[2]
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
-    omega = 2.0 * np.pi * np.arange(n_bins) / n_fft  # [rad / frame]
-    alpha = 0.5 ** (periods / half_time_s)
-    a = alpha[:, None]
-    gain = (1 - a) ** 2 / (1 - 2 * a * np.cos(np.outer(periods * fps, omega)) + a**2)
-    gamma = (1 - alpha) ** 2 / (1 - alpha**2)
+    gain, gamma = _resonator_gain(
+        np.ascontiguousarray(periods, dtype=np.float64).tobytes(), fps, n_fft, n_bins, half_time_s
+    )
     total = power.sum(axis=2)  # (window, band)
     n_win = power.shape[0]
     low = power[:, :, :n_bins].reshape(-1, n_bins)
@@ -166,6 +165,22 @@ def resonator_salience(
     span = (np.asarray(stops) - np.asarray(starts)) / fps
     r[periods[:, None] > span[None, :] / 2] = 0.0
     return r.sum(axis=2)
+
+
+@functools.lru_cache(maxsize=8)
+def _resonator_gain(
+    periods_key: bytes, fps: float, n_fft: int, n_bins: int, half_time_s: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``|H_tau(w)|^2`` per period and FFT bin, and ``gamma`` per period (cached: the
+    period grid and window length are the same for every song)."""
+    periods = np.frombuffer(periods_key, dtype=np.float64)
+    omega = 2.0 * np.pi * np.arange(n_bins) / n_fft  # [rad / frame]
+    alpha = 0.5 ** (periods / half_time_s)
+    a = alpha[:, None]
+    gain = (1 - a) ** 2 / (1 - 2 * a * np.cos(np.outer(periods * fps, omega)) + a**2)
+    gamma = (1 - alpha) ** 2 / (1 - alpha**2)
+    gain.flags.writeable = gamma.flags.writeable = False
+    return gain, gamma
 
 
 def _log_prior(periods: np.ndarray, median: float, sigma: float) -> np.ndarray:
@@ -196,6 +211,28 @@ def _log_conditional(
     top = finite.max(axis=1, keepdims=True)
     log_z = top + np.log(np.exp(finite - top).sum(axis=1, keepdims=True))
     return log_g - log_z
+
+
+@functools.lru_cache(maxsize=8)
+def _level_terms(periods_key: bytes, model: MeterModel):
+    """Tatum and measure grids and ``log P(level | tactus)`` for a tactus grid (cached).
+
+    Returns ``(tatum, measure, g_a, g_c)``: ``g_a[i, j]`` for tatum ``j`` under tactus
+    ``i`` (tatum <= tactus), ``g_c[i, k]`` for measure ``k`` (measure >= tactus).
+    """
+    periods = np.frombuffer(periods_key, dtype=np.float64)
+    tatum = _level_grid(model.min_tatum_s, float(periods.max()))
+    measure = _level_grid(float(periods.min()), model.max_measure_s)
+    with np.errstate(divide="ignore"):
+        g_a = np.log(ratio_weight(periods[:, None] / tatum[None, :], model))
+        g_c = np.log(ratio_weight(measure[None, :] / periods[:, None], model))
+    g_a[tatum[None, :] > periods[:, None] * 1.0001] = -np.inf
+    g_c[measure[None, :] < periods[:, None] * 0.9999] = -np.inf
+    g_a = _log_conditional(g_a, tatum, model.tatum_median_s, model.tatum_sigma)
+    g_c = _log_conditional(g_c, measure, model.measure_median_s, model.measure_sigma)
+    for arr in (tatum, measure, g_a, g_c):
+        arr.flags.writeable = False
+    return tatum, measure, g_a, g_c
 
 
 def _tactus_terms(
@@ -241,8 +278,9 @@ def tactus_observation(
     measure : np.ndarray [shape=(n_periods, n_windows)] [s]
         The best measure period for each tactus period and window.
     """
-    tatum = _level_grid(model.min_tatum_s, float(periods.max()))
-    measure = _level_grid(float(periods.min()), model.max_measure_s)
+    tatum, measure, g_a, g_c = _level_terms(
+        np.ascontiguousarray(periods, dtype=np.float64).tobytes(), model
+    )
     all_p = np.concatenate([periods, tatum, measure])
     sal = resonator_salience(bands, fps, starts, stops, all_p, model.half_time_s, max_hz)
     s_b = sal[: periods.size]
@@ -253,13 +291,6 @@ def tactus_observation(
     obs_c = (
         model.beta * s_c + _log_prior(measure, model.measure_median_s, model.measure_sigma)[:, None]
     )
-    with np.errstate(divide="ignore"):
-        g_a = np.log(ratio_weight(periods[:, None] / tatum[None, :], model))
-        g_c = np.log(ratio_weight(measure[None, :] / periods[:, None], model))
-    g_a[tatum[None, :] > periods[:, None] * 1.0001] = -np.inf
-    g_c[measure[None, :] < periods[:, None] * 0.9999] = -np.inf
-    g_a = _log_conditional(g_a, tatum, model.tatum_median_s, model.tatum_sigma)
-    g_c = _log_conditional(g_c, measure, model.measure_median_s, model.measure_sigma)
     n_win = s_b.shape[1]
     rows = np.arange(periods.size)
     best = np.empty((periods.size, n_win))
