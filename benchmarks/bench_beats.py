@@ -173,6 +173,36 @@ def startup_speed(repeats: int, wav: Path) -> list[dict]:
     return rows
 
 
+def real_speed_rows(repeats: int, track_beats, librosa) -> list[dict]:
+    """Steady-state seconds per audio minute on every bundled real recording, ours and librosa's."""
+    from beatsync import datasets
+
+    songs = [(name, *datasets.load_real_dev(name)[:2]) for name in datasets.REAL_DEV_ITEMS]
+    songs.append(("madmom_sample", *datasets.load_madmom_sample()[:2]))
+    for name in datasets.DANCE_PAIRS:
+        pair = datasets.load_dance_pair(name)
+        songs.append((name, pair.y, pair.sr))
+    rows = []
+    for name, y, sr in songs:
+        track_beats(y, sr)  # warm-up
+        t_psf = _median_time(lambda y=y, sr=sr: track_beats(y, sr), repeats)
+        t_lib = _median_time(lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr), repeats)
+        per_min = 60.0 / (y.size / sr)
+        rows.append(
+            {
+                "recording": name,
+                "sr [Hz]": sr,
+                "seconds": y.size / sr,
+                "psf [s per audio min]": t_psf * per_min,
+                "librosa [s per audio min]": t_lib * per_min,
+                "ratio psf/librosa": t_psf / t_lib,
+                "target": f"<= {TARGET_S_PER_MIN}",
+                "result": "PASS" if t_psf * per_min <= TARGET_S_PER_MIN else "FAIL",
+            }
+        )
+    return rows
+
+
 def accuracy_only(seeds: list[int], methods: list[str]) -> int:
     """Targets of the synthetic set per seed, and the items under F 0.95 (printed)."""
     from beatsync.study import paper_a_beats as study
@@ -236,12 +266,14 @@ def main() -> int:
             }
         )
     speed = pd.DataFrame(speed_rows)
+    real_speed = pd.DataFrame(real_speed_rows(args.repeats, track_beats, librosa))
     with tempfile.TemporaryDirectory() as tmp:
         wav = Path(tmp) / "song.wav"
         ref = beat_times(118.0, duration=PROCESS_SONG_S, start=0.4)
         io.write_audio(wav, drum_pattern(ref, sr=44100, duration=PROCESS_SONG_S, seed=1), 44100)
         startup = pd.DataFrame(startup_speed(args.repeats, wav)).fillna("")
     print(speed.to_string(index=False), file=sys.stderr)
+    print(real_speed.to_string(index=False), file=sys.stderr)
     print(startup.to_string(index=False), file=sys.stderr)
 
     # ------------------------------------------------------------------ accuracy
@@ -315,6 +347,11 @@ def main() -> int:
         "",
         _md_table(speed),
         "",
+        "## Speed: steady state on every bundled real recording (one core, median of "
+        f"{args.repeats}; 44.1 kHz files are resampled to 22.05 kHz inside the tracker)",
+        "",
+        _md_table(real_speed),
+        "",
         "## Speed: import, first call, whole process (fresh interpreters, median of "
         f"{args.repeats}, same run)",
         "",
@@ -350,7 +387,7 @@ def main() -> int:
         "and the tactus prior picks the level; the tempo-change items at 60, 120 and 180 "
         "BPM switch level at the change. The madmom sample (2.8 s) is not tapped at its "
         "level (nor by librosa or essentia here).",
-        "- Speed: `psf` analyses at 22.05 kHz (higher rates are resampled first by FFT); "
+        "- Speed: `psf` analyses at 22.05 kHz (higher rates are resampled first, by soxr); "
         "librosa analyses at the input rate. Steady-state times exclude each tracker's "
         "first call; the first-call rows show it. Absolute times depend on the machine's "
         "load (see load_average above): read the ratios.",
@@ -365,6 +402,7 @@ def main() -> int:
         "real_targets": real_targets.to_dict(orient="records"),
         "meters": meters.to_dict(orient="records"),
         "speed": speed.to_dict(orient="records"),
+        "speed_real": real_speed.to_dict(orient="records"),
         "startup": startup.to_dict(orient="records"),
         "summary_seed0": summary.to_dict(orient="records"),
         "stability": robust.to_dict(orient="records"),

@@ -374,3 +374,22 @@ def test_study_scores_and_targets_on_a_small_set():
     assert clean["result"].tolist() == ["PASS"]
     # targets of items that are not in the scores are left out, not failed
     assert not targets["target"].str.contains("hainsworth").any()
+
+
+def test_banded_tempo_decoder_equals_the_dense_viterbi():
+    # the tempo HMM decodes with a band of +-10 sigma plus the uniform jump; the path
+    # must be the dense decoder's on any observation (smooth, noisy, with jumps)
+    from beatsync.beats.tempo import period_grid, tempo_hmm, viterbi
+
+    rng = np.random.default_rng(7)
+    periods = period_grid(40, 240)
+    logp = np.log(periods)
+    trans = np.exp(-0.5 * ((logp[:, None] - logp[None, :]) / 0.02) ** 2)
+    trans /= trans.sum(axis=1, keepdims=True)
+    log_trans = np.log((1 - 1e-4) * trans + 1e-4 / periods.size)
+    for scale in (0.1, 1.0, 10.0, 100.0):
+        for _ in range(10):
+            obs = rng.normal(size=(periods.size, 40)) * scale
+            obs[rng.integers(periods.size), 20:] += 5 * scale  # a tempo change halfway
+            path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=1e-4)
+            np.testing.assert_array_equal(path, viterbi(obs, log_trans))

@@ -218,7 +218,8 @@ def _level_terms(periods_key: bytes, model: MeterModel):
     """Tatum and measure grids and ``log P(level | tactus)`` for a tactus grid (cached).
 
     Returns ``(tatum, measure, g_a, g_c)``: ``g_a[i, j]`` for tatum ``j`` under tactus
-    ``i`` (tatum <= tactus), ``g_c[i, k]`` for measure ``k`` (measure >= tactus).
+    ``i`` (tatum <= tactus), ``g_c[i, k]`` for measure ``k`` (measure >= tactus); the
+    two log terms in float32.
     """
     periods = np.frombuffer(periods_key, dtype=np.float64)
     tatum = _level_grid(model.min_tatum_s, float(periods.max()))
@@ -230,6 +231,7 @@ def _level_terms(periods_key: bytes, model: MeterModel):
     g_c[measure[None, :] < periods[:, None] * 0.9999] = -np.inf
     g_a = _log_conditional(g_a, tatum, model.tatum_median_s, model.tatum_sigma)
     g_c = _log_conditional(g_c, measure, model.measure_median_s, model.measure_sigma)
+    g_a, g_c = g_a.astype(np.float32), g_c.astype(np.float32)
     for arr in (tatum, measure, g_a, g_c):
         arr.flags.writeable = False
     return tatum, measure, g_a, g_c
@@ -287,10 +289,13 @@ def tactus_observation(
     log_b = _tactus_terms(s_b, fps, starts, stops, periods, model)
     s_a = sal[periods.size : periods.size + tatum.size]
     s_c = sal[periods.size + tatum.size :]
+    # the maximisation over tatum and measure in float32: 2.7 times faster than in
+    # float64, and its rounding (about 1e-5 of a log likelihood) decides nothing
     obs_a = model.beta * s_a + _log_prior(tatum, model.tatum_median_s, model.tatum_sigma)[:, None]
     obs_c = (
         model.beta * s_c + _log_prior(measure, model.measure_median_s, model.measure_sigma)[:, None]
     )
+    obs_a, obs_c = obs_a.astype(np.float32), obs_c.astype(np.float32)
     n_win = s_b.shape[1]
     rows = np.arange(periods.size)
     best = np.empty((periods.size, n_win))

@@ -10,11 +10,20 @@ state spaces have a few hundred states and a few hundred steps).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..units import frames_to_time, time_to_frames
 
-__all__ = ["analysis_windows", "period_grid", "tempo_hmm", "viterbi"]
+__all__ = [
+    "analysis_windows",
+    "period_grid",
+    "tempo_hmm",
+    "viterbi",
+    "viterbi_banded",
+    "BAND_SIGMAS",
+]
 
 
 def analysis_windows(n_frames: int, fps: float, win_s: float, hop_s: float):
@@ -72,6 +81,19 @@ def viterbi(
     return path
 
 
+@functools.lru_cache(maxsize=8)
+def _log_transitions(periods_key: bytes, trans_sigma: float, p_jump: float) -> np.ndarray:
+    """Log transition matrix of the tempo HMM (cached per period grid)."""
+    logp = np.log(np.frombuffer(periods_key, dtype=np.float64))
+    d = logp[:, None] - logp[None, :]
+    trans = np.exp(-0.5 * (d / trans_sigma) ** 2)
+    trans /= trans.sum(axis=1, keepdims=True)
+    trans = (1 - p_jump) * trans + p_jump / logp.size
+    log_trans = np.log(trans)
+    log_trans.flags.writeable = False
+    return log_trans
+
+
 def tempo_hmm(
     log_obs: np.ndarray,
     periods: np.ndarray,
@@ -95,9 +117,62 @@ def tempo_hmm(
     log_prior : np.ndarray, optional
         Log initial distribution over the periods.
     """
-    logp = np.log(periods)
-    d = logp[:, None] - logp[None, :]
-    trans = np.exp(-0.5 * (d / trans_sigma) ** 2)
-    trans /= trans.sum(axis=1, keepdims=True)
-    trans = (1 - p_jump) * trans + p_jump / periods.size
-    return viterbi(log_obs, np.log(trans), log_prior)
+    periods = np.ascontiguousarray(periods, dtype=np.float64)
+    log_trans = _log_transitions(periods.tobytes(), float(trans_sigma), float(p_jump))
+    steps = np.diff(np.log(periods))
+    reach = int(np.ceil(BAND_SIGMAS * trans_sigma / steps[0])) if steps.size else 0
+    uniform = steps.size > 0 and np.allclose(steps, steps[0], rtol=1e-9, atol=0.0)
+    if p_jump > 0 and uniform and 2 * reach + 1 < periods.size:
+        return viterbi_banded(log_obs, log_trans, reach, np.log(p_jump / periods.size), log_prior)
+    return viterbi(log_obs, log_trans, log_prior)
+
+
+#: Transitions further than this many ``trans_sigma`` apart are the jump probability
+#: alone (their Gaussian part, below exp(-50), is lost in rounding next to it).
+BAND_SIGMAS = 10.0
+
+
+def viterbi_banded(
+    log_obs: np.ndarray,
+    log_trans: np.ndarray,
+    reach: int,
+    log_jump: float,
+    log_init: np.ndarray | None = None,
+) -> np.ndarray:
+    """:func:`viterbi` for transitions that are a band plus a uniform jump.
+
+    ``log_trans[i, j]`` must equal ``log_jump`` (to rounding) wherever
+    ``|i - j| > reach``: the best predecessor of ``j`` is then the best inside the band,
+    or the best state overall jumping. Each step costs ``(2 reach + 1) n`` instead of
+    ``n**2``; the path is the dense decoder's (up to exact ties).
+    """
+    n_states, n_steps = log_obs.shape
+    width = 2 * reach + 1
+    offsets = np.arange(-reach, reach + 1)
+    src = np.arange(n_states)[None, :] + offsets[:, None]  # predecessor i of j, (width, n)
+    valid = (src >= 0) & (src < n_states)
+    band = np.full((width, n_states), -np.inf)
+    band[valid] = log_trans[src[valid], np.nonzero(valid)[1]]
+    src = np.clip(src, 0, n_states - 1)
+    cols = np.arange(n_states)
+    value = log_obs[:, 0] + (0.0 if log_init is None else log_init)
+    back = np.empty((n_steps, n_states), dtype=np.int64)
+    pad = np.full(n_states + 2 * reach, -np.inf)
+    for t in range(1, n_steps):
+        pad[reach : reach + n_states] = value
+        scores = np.lib.stride_tricks.sliding_window_view(pad, n_states) + band
+        k = np.argmax(scores, axis=0)
+        best = scores[k, cols]
+        i_best = src[k, cols]
+        top = int(np.argmax(value))
+        jump = value[top] + log_jump
+        use_jump = jump > best
+        best[use_jump] = jump
+        i_best[use_jump] = top
+        back[t] = i_best
+        value = best + log_obs[:, t]
+    path = np.empty(n_steps, dtype=np.int64)
+    path[-1] = int(np.argmax(value))
+    for t in range(n_steps - 1, 0, -1):
+        path[t - 1] = back[t, path[t]]
+    return path
