@@ -393,3 +393,17 @@ def test_banded_tempo_decoder_equals_the_dense_viterbi():
             obs[rng.integers(periods.size), 20:] += 5 * scale  # a tempo change halfway
             path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=1e-4)
             np.testing.assert_array_equal(path, viterbi(obs, log_trans))
+
+
+def test_front_end_blocks_equal_one_pass(monkeypatch):
+    # the front end runs in blocks of frames; the flux's frame difference must carry
+    # across block edges (a block's first frame compared with the previous block's last)
+    from beatsync.beats import onset
+
+    y = drum_pattern(beat_times(118, duration=6.0, start=0.2), sr=SR, duration=6.0, seed=3)
+    fe = onset.frontend_settings({}, SR)
+    whole = onset.compute_onsets(y.astype(np.float64), SR, fe)
+    monkeypatch.setattr(onset, "BLOCK_FRAMES", 7)
+    blocks = onset.compute_onsets(y.astype(np.float64), SR, fe)
+    np.testing.assert_allclose(blocks.bands, whole.bands, rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(blocks.onset_times, whole.onset_times, atol=1e-9)
