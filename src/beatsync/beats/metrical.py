@@ -290,7 +290,8 @@ def tactus_observation(
     s_a = sal[periods.size : periods.size + tatum.size]
     s_c = sal[periods.size + tatum.size :]
     # the maximisation over tatum and measure in float32: 2.7 times faster than in
-    # float64, and its rounding (about 1e-5 of a log likelihood) decides nothing
+    # float64; its rounding (about 1e-5 of a log likelihood) changed no score, tempo or
+    # meter of the bundled real recordings or the synthetic set
     obs_a = model.beta * s_a + _log_prior(tatum, model.tatum_median_s, model.tatum_sigma)[:, None]
     obs_c = (
         model.beta * s_c + _log_prior(measure, model.measure_median_s, model.measure_sigma)[:, None]

@@ -166,7 +166,7 @@ def _hann(n: int) -> np.ndarray:
 
 
 #: Frames per block of the front end: a block's spectra stay in cache, and no array of
-#: the whole song's spectra is allocated (1.4x faster than one pass over a 28 s song).
+#: the whole song's spectra is allocated (1.3x faster than one pass over a 28 s song).
 BLOCK_FRAMES = 256
 
 
@@ -212,7 +212,8 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
     spectral ``flux`` (mean half-wave rectified log-magnitude difference over the band's
     bins) with shape (n_bands, n_frames); ``mag`` (frames x bins, None unless
     ``keep_mag``); ``member`` the bins' band membership. Computed in blocks of
-    :data:`BLOCK_FRAMES` frames (row by row the same arithmetic as one pass).
+    :data:`BLOCK_FRAMES` frames (the arithmetic of one pass, up to the rounding of the
+    matrix products).
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
 

@@ -5,7 +5,8 @@ observation is a salience per candidate period (:mod:`beatsync.beats.metrical`
 gives the tactus salience of the metrical model); transitions are log-normal in the
 period ratio plus a small jump probability, so that an abrupt tempo change is
 followed rather than averaged away. Decoding is :func:`viterbi` (numpy, no JIT: our
-state spaces have a few hundred states and a few hundred steps).
+state spaces have a few hundred states and a few hundred steps); the tempo HMM uses
+:func:`viterbi_banded`, the same path from the +-10 sigma band and the uniform jump.
 """
 
 from __future__ import annotations
