@@ -376,22 +376,37 @@ def test_study_scores_and_targets_on_a_small_set():
     assert not targets["target"].str.contains("hainsworth").any()
 
 
-def test_banded_tempo_decoder_equals_the_dense_viterbi():
-    # the tempo HMM decodes with a band of +-10 sigma plus the uniform jump; the path
-    # must be the dense decoder's on any observation (smooth, noisy, with jumps)
+@pytest.mark.parametrize(
+    "grid, p_jump",
+    [
+        ("tracker", 1e-4),
+        ("tracker", 1e-30),  # far transitions differ from the jump by ~1e-13: wider band
+        ("tracker", 0.0),  # no jump: the dense decoder
+        ("decreasing", 1e-4),
+        ("repeated", 1e-4),
+    ],
+)
+def test_banded_tempo_decoder_equals_the_dense_viterbi(grid, p_jump):
+    # the tempo HMM decodes in the band of transitions that differ from the uniform jump;
+    # the path must be the dense decoder's on any observation (noisy, with tempo changes)
     from beatsync.beats.tempo import period_grid, tempo_hmm, viterbi
 
     rng = np.random.default_rng(7)
     periods = period_grid(40, 240)
+    if grid == "decreasing":
+        periods = periods[::-1].copy()
+    elif grid == "repeated":
+        periods = np.repeat(periods[::3], 3)
     logp = np.log(periods)
     trans = np.exp(-0.5 * ((logp[:, None] - logp[None, :]) / 0.02) ** 2)
     trans /= trans.sum(axis=1, keepdims=True)
-    log_trans = np.log((1 - 1e-4) * trans + 1e-4 / periods.size)
+    with np.errstate(divide="ignore"):
+        log_trans = np.log((1 - p_jump) * trans + p_jump / periods.size)
     for scale in (0.1, 1.0, 10.0, 100.0):
-        for _ in range(10):
+        for _ in range(5):
             obs = rng.normal(size=(periods.size, 40)) * scale
             obs[rng.integers(periods.size), 20:] += 5 * scale  # a tempo change halfway
-            path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=1e-4)
+            path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=p_jump)
             np.testing.assert_array_equal(path, viterbi(obs, log_trans))
 
 

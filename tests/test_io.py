@@ -176,6 +176,21 @@ def test_resample_audio_keeps_a_tone_and_the_length(orig, target):
     np.testing.assert_allclose(out[inner], np.sin(2 * np.pi * 440.0 * t)[inner], atol=2e-3)
 
 
+@pytest.mark.parametrize(
+    "y, orig, target, match",
+    [
+        (np.zeros((100, 2), np.float32), 44100, 22050, "mono"),
+        (np.zeros(0, np.float32), 44100, 22050, "empty"),
+        (np.array([0.0, np.nan], np.float32), 44100, 22050, "NaN"),
+        (np.zeros(100, np.float32), 0, 22050, "sample rate"),
+        (np.zeros(100, np.float32), 44100, -1, "target_sr"),
+    ],
+)
+def test_resample_audio_refuses_bad_input(y, orig, target, match):
+    with pytest.raises(ParameterError, match=match):
+        io.resample_audio(y, orig, target)
+
+
 def test_damaged_soundfile_formats_are_refused_without_librosa(tmp_path):
     # a broken .wav fell back to librosa/audioread: 6 s of imports (30 s with a numba
     # compilation on a fresh installation) per process, to fail the same way

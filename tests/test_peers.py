@@ -62,6 +62,20 @@ def test_librosa_peer_at_another_rate(song):
     assert evaluate(ref, est, min_beat_time=1.0)["F-measure"] >= 0.9
 
 
+@pytest.mark.parametrize("orig, target", [(22050, 44100), (44100, 22050), (48000, 22050.5)])
+def test_resample_audio_gives_librosa_resample_samples(orig, target):
+    # io.resample_audio (the reader and the essentia peers) replaces librosa.resample with
+    # its default soxr_hq filter: the same samples, without importing librosa
+    import librosa
+
+    from beatsync.io import resample_audio
+
+    y = np.random.default_rng(5).standard_normal(12345).astype(np.float32)
+    np.testing.assert_array_equal(
+        resample_audio(y, orig, target), librosa.resample(y, orig_sr=orig, target_sr=target)
+    )
+
+
 def test_unknown_method():
     with pytest.raises(ParameterError, match="unknown beat-tracking method 'madmom'"):
         peers.get("madmom")

@@ -102,6 +102,10 @@ class MeterModel:
     min_tatum_s: float = 0.08
     max_measure_s: float = 4.0
 
+    def __post_init__(self) -> None:
+        # a tuple, so that the model can key the cache of its constant terms
+        object.__setattr__(self, "ratio_weights", tuple(float(w) for w in self.ratio_weights))
+
 
 #: Fewest cycles of a beat period inside an analysis window for its salience to count.
 MIN_BEAT_CYCLES = 4

@@ -370,9 +370,10 @@ def onset_strength_psf(
 def _resample(y: np.ndarray, sr: float, target: float) -> np.ndarray:
     """Band-limited resampling from ``sr`` to ``target`` [Hz] (``target < sr``).
 
-    soxr's high-quality filter (:func:`beatsync.io.resample_audio`'s, in float64): 23 ms
-    for a minute of 44.1 kHz audio, against 140 ms for an ideal low-pass by FFT over the
-    whole signal; scipy.signal's import alone costs more than tracking a song.
+    soxr's high-quality filter (that of :func:`beatsync.io.resample_audio`; the output
+    keeps ``round(n * target / sr)`` samples): 23 ms for a minute of 44.1 kHz audio,
+    against 140 ms for an ideal low-pass by FFT over the whole signal; scipy.signal's
+    import alone costs more than tracking a song.
     """
     import soxr  # noqa: PLC0415
 

@@ -6,7 +6,8 @@ gives the tactus salience of the metrical model); transitions are log-normal in 
 period ratio plus a small jump probability, so that an abrupt tempo change is
 followed rather than averaged away. Decoding is :func:`viterbi` (numpy, no JIT: our
 state spaces have a few hundred states and a few hundred steps); the tempo HMM uses
-:func:`viterbi_banded`, the same path from the +-10 sigma band and the uniform jump.
+:func:`viterbi_banded`, the same path from the band of transitions that differ from
+the uniform jump probability (+-39 states of 360 on the tracker's grid).
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ __all__ = [
     "tempo_hmm",
     "viterbi",
     "viterbi_banded",
-    "BAND_SIGMAS",
 ]
 
 
@@ -83,16 +83,28 @@ def viterbi(
 
 
 @functools.lru_cache(maxsize=8)
-def _log_transitions(periods_key: bytes, trans_sigma: float, p_jump: float) -> np.ndarray:
-    """Log transition matrix of the tempo HMM (cached per period grid)."""
+def _log_transitions(
+    periods_key: bytes, trans_sigma: float, p_jump: float
+) -> tuple[np.ndarray, int | None]:
+    """Log transition matrix of the tempo HMM and its band (cached per period grid).
+
+    The band ``reach`` is the largest ``|i - j|`` whose log transition is not exactly
+    ``log(p_jump / n)``: further apart, the Gaussian part is lost in rounding next to
+    the jump probability. None when ``p_jump`` is 0 (no jump: no band).
+    """
     logp = np.log(np.frombuffer(periods_key, dtype=np.float64))
     d = logp[:, None] - logp[None, :]
     trans = np.exp(-0.5 * (d / trans_sigma) ** 2)
     trans /= trans.sum(axis=1, keepdims=True)
     trans = (1 - p_jump) * trans + p_jump / logp.size
-    log_trans = np.log(trans)
+    with np.errstate(divide="ignore"):  # p_jump 0: far transitions are impossible
+        log_trans = np.log(trans)
     log_trans.flags.writeable = False
-    return log_trans
+    if p_jump <= 0:
+        return log_trans, None
+    i, j = np.nonzero(log_trans != np.log(p_jump / logp.size))
+    reach = int(np.max(np.abs(i - j))) if i.size else 0
+    return log_trans, reach
 
 
 def tempo_hmm(
@@ -119,18 +131,10 @@ def tempo_hmm(
         Log initial distribution over the periods.
     """
     periods = np.ascontiguousarray(periods, dtype=np.float64)
-    log_trans = _log_transitions(periods.tobytes(), float(trans_sigma), float(p_jump))
-    steps = np.diff(np.log(periods))
-    reach = int(np.ceil(BAND_SIGMAS * trans_sigma / steps[0])) if steps.size else 0
-    uniform = steps.size > 0 and np.allclose(steps, steps[0], rtol=1e-9, atol=0.0)
-    if p_jump > 0 and uniform and 2 * reach + 1 < periods.size:
+    log_trans, reach = _log_transitions(periods.tobytes(), float(trans_sigma), float(p_jump))
+    if reach is not None and 2 * reach + 1 < periods.size:
         return viterbi_banded(log_obs, log_trans, reach, np.log(p_jump / periods.size), log_prior)
     return viterbi(log_obs, log_trans, log_prior)
-
-
-#: Transitions further than this many ``trans_sigma`` apart are the jump probability
-#: alone (their Gaussian part, below exp(-50), is lost in rounding next to it).
-BAND_SIGMAS = 10.0
 
 
 def viterbi_banded(
@@ -142,10 +146,11 @@ def viterbi_banded(
 ) -> np.ndarray:
     """:func:`viterbi` for transitions that are a band plus a uniform jump.
 
-    ``log_trans[i, j]`` must equal ``log_jump`` (to rounding) wherever
-    ``|i - j| > reach``: the best predecessor of ``j`` is then the best inside the band,
-    or the best state overall jumping. Each step costs ``(2 reach + 1) n`` instead of
-    ``n**2``; the path is the dense decoder's (up to exact ties).
+    ``log_trans[i, j]`` must equal ``log_jump`` exactly wherever ``|i - j| > reach``
+    (and be at least ``log_jump`` everywhere): the best predecessor of ``j`` is then the
+    best inside the band, or the best state overall jumping. Each step costs
+    ``(2 reach + 1) n`` instead of ``n**2``; the path is the dense decoder's (up to exact
+    ties).
     """
     n_states, n_steps = log_obs.shape
     width = 2 * reach + 1

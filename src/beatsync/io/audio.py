@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import warnings
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 
@@ -12,22 +13,24 @@ from ..errors import ParameterError
 from ..units import as_float, check_audio, check_finite, check_sample_rate, check_times
 from ._files import atomic_write, check_input_file
 
-#: Suffixes of the formats libsndfile reads itself (soundfile >= 0.12: MP3 too).
-SOUNDFILE_SUFFIXES = frozenset(
+#: libsndfile's format for each suffix it reads (soundfile >= 0.12 with libsndfile >= 1.1
+#: reads MP3 too): a file with one of these suffixes that libsndfile cannot read, when
+#: the installed libsndfile has the format, is damaged (no audioread fallback).
+SOUNDFILE_SUFFIXES = MappingProxyType(
     {
-        ".wav",
-        ".wave",
-        ".flac",
-        ".ogg",
-        ".oga",
-        ".mp3",
-        ".aif",
-        ".aiff",
-        ".aifc",
-        ".au",
-        ".caf",
-        ".w64",
-        ".rf64",
+        ".wav": "WAV",
+        ".wave": "WAV",
+        ".flac": "FLAC",
+        ".ogg": "OGG",
+        ".oga": "OGG",
+        ".mp3": "MP3",
+        ".aif": "AIFF",
+        ".aiff": "AIFF",
+        ".aifc": "AIFF",
+        ".au": "AU",
+        ".caf": "CAF",
+        ".w64": "W64",
+        ".rf64": "RF64",
     }
 )
 
@@ -40,7 +43,8 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     path : path-like
         WAV, FLAC, OGG, MP3, AIFF, ... (libsndfile); other formats (e.g. M4A) through
         librosa/audioread. A file with a libsndfile suffix (:data:`SOUNDFILE_SUFFIXES`)
-        that libsndfile cannot read is refused without trying audioread.
+        whose format the installed libsndfile has, but cannot read, is refused without
+        trying audioread.
     sr : int > 0 [Hz], optional
         Resample to this rate; default keeps the file's rate.
 
@@ -63,7 +67,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
         data, file_sr = sf.read(p, dtype="float32", always_2d=True)
         y = data.mean(axis=1)
     except Exception as sf_exc:
-        if p.suffix.lower() in SOUNDFILE_SUFFIXES:
+        if SOUNDFILE_SUFFIXES.get(p.suffix.lower()) in sf.available_formats():
             # libsndfile reads these formats itself: a failure is a damaged file, and
             # audioread (through librosa, seconds to import) would fail the same way
             _check_wav_header_rate(p)
@@ -91,7 +95,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
         raise ParameterError(f"audio file {str(p)!r} has no samples")
     y, _ = check_audio(y, file_sr, name=f"audio file {str(p)!r}")
     if sr is not None and sr != file_sr:
-        y = resample_audio(y, file_sr, sr)
+        y = _resample(y, file_sr, sr)
         file_sr = sr
     return y, file_sr
 
@@ -101,8 +105,19 @@ def resample_audio(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarra
 
     The same samples as ``librosa.resample(y, orig_sr=, target_sr=)`` with its default
     ``res_type="soxr_hq"``, without importing librosa (seconds, and a numba compilation
-    on a fresh installation). Trusts its input (finite mono audio, rates > 0).
+    on a fresh installation).
+
+    Raises
+    ------
+    ParameterError
+        Not 1-D, empty or non-finite samples; an implausible rate.
     """
+    y, orig = check_audio(y, orig_sr)
+    target = check_sample_rate(target_sr, name="target_sr")
+    return _resample(y, orig, target)
+
+
+def _resample(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarray:
     import soxr
 
     y = np.asarray(y, dtype=np.float32)
