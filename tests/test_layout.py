@@ -24,6 +24,7 @@ LAYER = {
     "motion": 1,
     "rotations": 1,
     "quaternions": 0,
+    "resampling": 0,
     "joints": 1,
     "segment": 2,
     "beats": 2,

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from ..resampling import resample
 from ..units import check_audio, check_positive, frames_to_time, time_to_frames
 from .filters import moving_max, moving_mean
 
@@ -367,27 +368,14 @@ def onset_strength_psf(
     return compute_onsets(y, sr, fe)
 
 
-def _resample(y: np.ndarray, sr: float, target: float) -> np.ndarray:
-    """Band-limited resampling from ``sr`` to ``target`` [Hz] (``target < sr``).
-
-    soxr's high-quality filter (that of :func:`beatsync.io.resample_audio`; the output
-    keeps ``round(n * target / sr)`` samples): 23 ms for a minute of 44.1 kHz audio,
-    against 140 ms for an ideal low-pass by FFT over the whole signal; scipy.signal's
-    import alone costs more than tracking a song.
-    """
-    import soxr  # noqa: PLC0415
-
-    n_out = int(round(y.size * target / sr))
-    out = soxr.resample(y, sr, target, quality="HQ")
-    if out.size < n_out:
-        out = np.concatenate([out, np.zeros(n_out - out.size)])
-    return out[:n_out]
-
-
 def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     """:func:`onset_strength_psf` on validated input (``y`` finite mono, not silent)."""
     if fe.analysis_sr != sr:
-        y, sr = _resample(y, sr, fe.analysis_sr), fe.analysis_sr
+        # soxr's high-quality filter (23 ms per minute of 44.1 kHz audio; an ideal low-pass
+        # by FFT over the whole signal took 140 ms), keeping round(n * ratio) samples
+        n_out = int(round(y.size * fe.analysis_sr / sr))
+        y = resample(y, sr, fe.analysis_sr, n_out).astype(np.float64)
+        sr = fe.analysis_sr
     y = y / np.max(np.abs(y))
     psf, _, fps, _, flux, _ = _phase_slope(y, sr, fe, keep_mag=False)
     n_bands, n_frames = psf.shape

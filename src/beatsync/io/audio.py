@@ -10,6 +10,7 @@ from types import MappingProxyType
 import numpy as np
 
 from ..errors import ParameterError
+from ..resampling import resample
 from ..units import as_float, check_audio, check_finite, check_sample_rate, check_times
 from ._files import atomic_write, check_input_file
 
@@ -95,7 +96,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
         raise ParameterError(f"audio file {str(p)!r} has no samples")
     y, _ = check_audio(y, file_sr, name=f"audio file {str(p)!r}")
     if sr is not None and sr != file_sr:
-        y = _resample(y, file_sr, sr)
+        y = resample(y, file_sr, sr)
         file_sr = sr
     return y, file_sr
 
@@ -114,20 +115,7 @@ def resample_audio(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarra
     """
     y, orig = check_audio(y, orig_sr)
     target = check_sample_rate(target_sr, name="target_sr")
-    return _resample(y, orig, target)
-
-
-def _resample(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarray:
-    import soxr
-
-    y = np.asarray(y, dtype=np.float32)
-    if orig_sr == target_sr:
-        return y
-    n_out = int(np.ceil(y.size * float(target_sr) / orig_sr))
-    out = np.asarray(soxr.resample(y, orig_sr, target_sr, quality="soxr_hq"), dtype=np.float32)
-    if out.size >= n_out:
-        return out[:n_out]
-    return np.concatenate([out, np.zeros(n_out - out.size, dtype=np.float32)])
+    return resample(y, orig, target)
 
 
 def _check_wav_header_rate(p: Path) -> None:
