@@ -43,9 +43,28 @@ bias (steady-state salience 3.23, 3.24 and 3.36 for 1, 2 and 3 beats of that pat
 summed over bands) at several times the cost; correcting the window bias analytically
 (dividing by each resonator's gain for a periodic input seen through the window)
 amplified the noise of the long periods on real music (meters of 5 to 8). Neither is
-used. The observation exponent ``beta``, the prior
-widths and the ratio weights are our choices (see :data:`METER_MODEL`): they were
-set on the synthetic test set, and the real recordings were only scored.
+used.
+
+Two more evaluations of the same resonators were measured and not used. The energy of
+a comb filter run over a zero-padded segment has a closed form in the segment's
+normalised autocorrelation ``rho``: ``r(tau) = (1 - alpha) sum_{d >= 1} alpha**(d-1)
+rho(d tau)``. (a) On a rectangular segment (the biased autocorrelation, each period
+searched within its grid cell) every bundled real recording keeps its level and
+meter and 3/4 at 90 BPM gets meter 3, but the synthetic set does not improve (seeds
+0-2: clean F 0.933, 0.933, 0.966; AMLt 0.961, 0.983, 0.973; tempo-change F 0.933,
+0.935, 0.957), 120 BPM items with swing or noise are tapped at 60 on every seed, and
+the madmom sample stays at 118 BPM. (b) With the unbiased autocorrelation (Hann
+segment divided by the window's own autocorrelation, lags up to half the window) no
+multiple of the beat is favoured any more: the madmom sample is tapped at its level
+(87.9 BPM, F 1.0) and the real recordings keep theirs for ``beta`` <= 5, but the
+tactus prior alone then picks between levels an octave apart, and the synthetic
+click tracks at 180 BPM are tapped at 90 (clean F 0.865-0.898). Either would also
+need the no-clear-pulse constants of :mod:`beatsync.beats.tracker` calibrated again
+(the salience scale changes).
+
+The observation exponent ``beta``, the prior widths and the ratio weights are our
+choices (see :data:`METER_MODEL`): they were set on the synthetic test set, and the
+real recordings were only scored.
 """
 
 from __future__ import annotations
