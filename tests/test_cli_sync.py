@@ -27,6 +27,7 @@ def inputs(tmp_path_factory):
     beats = beat_times(115, duration=20.0, start=0.4)
     io.write_audio(d / "song.wav", click_track(beats, sr=SR, duration=20.0), SR)
     io.write_beats(d / "song.beats", beats)
+    (d / "song_ms.beats").write_text("".join(f"{1e3 * b:.1f}\n" for b in beats))
     io.write_audio(d / "short.wav", click_track(np.array([0.05]), sr=SR, duration=0.3), SR)
     io.write_audio(d / "silence.wav", np.zeros(5 * SR, dtype=np.float32), SR)
     tone = 0.3 * np.sin(2 * np.pi * 440.0 * np.arange(5 * SR) / SR)
@@ -203,6 +204,18 @@ BAD = [
     (["{d}/salsa.bvh", "{d}/tone.wav", "-o", "{o}/x.bvh"], "no detectable beats"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--video", "{d}/song.wav"],
      "same|mp4"),
+    # beat times in milliseconds: refused (the dance would run for hours, --fill stop and
+    # --out-fps 1 only keep the old behaviour's output small)
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song_ms.beats",
+      "--fill", "stop", "--out-fps", "1"], "milliseconds"),
+    # song first, dance second: the message says the arguments look swapped
+    (["{d}/song.wav", "{d}/salsa.bvh", "-o", "{o}/x.bvh"], "swapped"),
+    # a bad video frame rate is refused before the motion is synced (named as the option)
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--video", "{o}/v.mp4", "--video-fps", "0"], "--video-fps=0"),
+    # an absurd output or video frame rate: refused before the memory fills
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--out-fps", "100000"], "out_fps.*implausibly high"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--first-beat", "500",
       "--beats", "{d}/song.beats"], "first_beat"),
 ]

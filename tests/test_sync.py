@@ -230,6 +230,9 @@ def test_no_warning_in_normal_case():
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"beats_per_period": 1.5}, "beats"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"first_beat": "x"}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"phase_offset": "x"}, "phase"),
+        # an offset of a beat or more (50 ms given as 50 s made a 1000 s dance for a 28 s song)
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"phase_offset": 50}, "one beat"),
+        (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"phase_offset": 0.5}, "first_beat"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"delta": -1.0}, "delta"),
         (np.arange(0.0, 5.5, 1.0), np.array([0.0, np.nan, 1.0]), {}, "NaN"),
         (np.arange(0.0, 5.5, 1.0), np.arange(0, 10, 0.5), {"mode": "bars"}, "mode="),

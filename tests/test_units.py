@@ -13,6 +13,7 @@ from beatsync.units import (
     check_bpm,
     check_finite,
     check_fps,
+    check_motion_fps,
     check_positive,
     check_range,
     check_sample_rate,
@@ -52,6 +53,29 @@ def test_bad_fps(fps):
 def test_bad_times(times, match):
     with pytest.raises(ParameterError, match=match):
         check_times(times)
+
+
+@pytest.mark.parametrize(
+    "times, match",
+    [
+        (np.array([2.5, 1.25]), r"time #1 \(1\.25 s\) <= time #0 \(2\.5 s\)"),
+        (np.array([-0.5, 1.0]), r"negative time -0\.5;"),
+    ],
+)
+def test_bad_times_message_shows_plain_numbers(times, match):
+    # numpy scalars in the message read as plain seconds, not as np.float64(...)
+    with pytest.raises(ParameterError, match=match) as info:
+        check_times(times, name="beat times")
+    assert "np.float64" not in str(info.value)
+
+
+@pytest.mark.parametrize("fps", [1e5, 44100])
+def test_implausibly_high_motion_fps_is_refused(fps):
+    # --out-fps 100000 made sync resample a 28 s dance to 2.8 million frames (10 GB)
+    with pytest.raises(ParameterError, match=r"out_fps=.* implausibly high.*2000 Hz"):
+        check_motion_fps(fps, name="out_fps")
+    assert check_motion_fps(2000) == 2000.0
+    assert check_fps(fps) == fps  # audio sample rates stay valid for check_fps
 
 
 def test_times_that_look_like_frames():

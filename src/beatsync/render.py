@@ -37,7 +37,14 @@ from typing import Any
 import numpy as np
 
 from .errors import BeatsyncWarning, ParameterError
-from .units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
+from .units import (
+    check_fps,
+    check_motion_fps,
+    check_positive,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 
 __all__ = [
     "beat_strip_times",
@@ -476,7 +483,7 @@ def write_video(
 
     dest = Path(path)
     parent = check_output_folder(dest)
-    fps = check_fps(motion.fps if fps is None else fps, name="video fps")
+    fps = check_motion_fps(motion.fps if fps is None else fps, name="video fps")
     w, h = (int(size[0]) // 2 * 2, int(size[1]) // 2 * 2)
     if w < 32 or h < 32:
         raise ParameterError(f"size={size!r} is too small; give (width, height) in pixels >= 32")

@@ -55,6 +55,8 @@ __all__ = [
     "MAX_BPM",
     "check_whole",
     "beat_phase",
+    "MAX_MOTION_FPS",
+    "check_motion_fps",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
@@ -343,14 +345,14 @@ def check_times(
     arr = check_finite(arr, name=name)
     if arr[0] < 0:
         raise ParameterError(
-            f"{name} has a negative time {arr[0]!r}; times are seconds from the start"
+            f"{name} has a negative time {float(arr[0])!r}; times are seconds from the start"
         )
     diffs = np.diff(arr)
     if np.any(diffs <= 0):
         i = int(np.argmax(diffs <= 0))
         raise ParameterError(
-            f"{name} must be strictly increasing, but {name}[{i + 1}]={arr[i + 1]!r} "
-            f"<= {name}[{i}]={arr[i]!r}; sort them and drop duplicates"
+            f"{name} must be strictly increasing, but time #{i + 1} ({float(arr[i + 1])!r} s) "
+            f"<= time #{i} ({float(arr[i])!r} s); sort them and drop duplicates"
         )
     if duration is not None and arr[-1] > duration + 1e-9:
         hint = ""
@@ -579,3 +581,24 @@ def check_interval(pair: Any, *, name: str, unit: str) -> tuple[float, float]:
         )
     lo, hi = pair
     return check_range(lo, hi, name=name, unit=unit)
+
+
+#: Highest motion frame rate accepted by :func:`check_motion_fps` [Hz].
+MAX_MOTION_FPS = 2000.0
+
+
+def check_motion_fps(fps: Any, *, name: str = "fps") -> float:
+    """:func:`check_fps` for the frame rate of a motion to be computed, with an upper bound.
+
+    Motion capture runs at a few hundred Hz (high-speed systems at about 2000); a motion
+    resampled to a much higher rate fills the memory (a 30 s song at 100 kHz is 3 million
+    frames), so rates above :data:`MAX_MOTION_FPS` are refused. (:func:`check_fps` itself
+    has no upper bound: it also checks audio sample rates.)
+    """
+    value = check_fps(fps, name=name)
+    if value > MAX_MOTION_FPS:
+        raise ParameterError(
+            f"{name}={fps!r} Hz is implausibly high for a motion frame rate (at most "
+            f"{MAX_MOTION_FPS:g} Hz): is it an audio sample rate, or a rate in another unit?"
+        )
+    return value

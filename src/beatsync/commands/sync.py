@@ -200,6 +200,10 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
     for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
         if inp is not None and not Path(inp).is_file():
             raise ParameterError(f"{what} file {inp!r} does not exist")
+    if args.video:
+        from ..units import check_motion_fps
+
+        check_motion_fps(args.video_fps, name="--video-fps")  # before minutes of work
     outs = Outputs(inputs=(args.motion, args.audio, args.beats))
     out = outs.add(out, option="-o/--output")
     video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
@@ -262,7 +266,13 @@ def _pipeline(
     with fb.step("finding beats"):
         t0 = time.perf_counter()
         if args.beats is not None:
-            beats = io.read_beats(args.beats)
+            from ..units import check_times
+
+            # beats after the music's end are a unit mistake (ms, frames), and would make
+            # the dance run on for hours: refused before any work
+            beats = check_times(
+                io.read_beats(args.beats), name=f"beat times in {args.beats!r}", duration=music_s
+            )
             beat_source = f"file {args.beats}"
         else:
             from ..beats import track_beats

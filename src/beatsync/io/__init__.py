@@ -158,8 +158,11 @@ def read_motion(
         return read_positions_array(p, fps=fps, key=variable, **opts)
     if suffix in (".csv", ".npy"):
         return read_table(p, fps=fps)
+    hint = ""
+    if suffix in (".wav", ".flac", ".ogg", ".mp3"):
+        hint = " (this is audio: are the arguments swapped? the motion comes first, then the music)"
     raise ParameterError(
-        f"unsupported motion file {str(p)!r}: expected one of {', '.join(MOTION_SUFFIXES)}"
+        f"unsupported motion file {str(p)!r}: expected one of {', '.join(MOTION_SUFFIXES)}{hint}"
     )
 
 

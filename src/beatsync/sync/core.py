@@ -9,7 +9,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ..units import check_fps, check_range, check_times, check_whole, frames_to_time, time_to_frames
+from ..units import (
+    check_motion_fps,
+    check_range,
+    check_times,
+    check_whole,
+    frames_to_time,
+    time_to_frames,
+)
 from .fill import LoopedClip, loop_events
 from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
 from .positions import restore_bone_lengths
@@ -269,8 +276,8 @@ def synchronize(
     mode = _choice(mode, MODES, "mode")
     land = _choice(land, LANDINGS, "land")
     fill = _choice(fill, FILLS, "fill")
-    fps = check_fps(motion.fps, name="motion.fps")
-    out_fps = fps if out_fps is None else check_fps(out_fps, name="out_fps")
+    fps = check_motion_fps(motion.fps, name="motion.fps")
+    out_fps = fps if out_fps is None else check_motion_fps(out_fps, name="out_fps")
     n_frames = int(motion.n_frames)
     if n_frames < 2:
         raise ParameterError(f"motion has {n_frames} frame(s); at least 2 are needed to resample")
@@ -315,6 +322,12 @@ def synchronize(
 
         delta = check_positive(delta, name="delta", unit="s")
     beat_period = float(np.median(np.diff(beats)))
+    if abs(phase_offset) >= beat_period:
+        raise ParameterError(
+            f"phase_offset={phase_offset:g} s is at least one beat of the music "
+            f"({beat_period:.3f} s): an offset is a fraction of a beat (milliseconds given as "
+            "seconds?); move boundaries by whole beats with first_beat (--first-beat)"
+        )
     if period_range is None and mode == "auto":
         period_range = AUTO_PERIOD_RANGE
     elif period_range is None:
