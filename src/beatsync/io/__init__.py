@@ -25,7 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
+from ..joints import fill_joint_gaps
 from ..motion import Motion
+from ..units import check_positive
 from ._files import (
     append_jsonl,
     atomic_write,
@@ -121,13 +123,14 @@ def read_motion(
     """Read any supported motion file, chosen by its suffix.
 
     ``.bvh`` (``fps`` overrides the header), ``.mat`` (MoCap Toolbox markers;
-    ``variable`` names the recording), ``.csv`` and 2-D ``.npy`` angle tables (``fps``
-    required); joint positions (:mod:`beatsync.io.positions`): ``.json``
-    (Dance-with-Melody layout, ``fps`` required), 3-D ``.npy`` ``(n_frames, n_joints,
-    3)`` (``fps`` required), ``.npz`` (``variable`` names the array; ``fps`` unless
-    stored), ``.c3d`` (its own rate; a contradicting ``fps`` is refused). For joint
-    positions, ``up`` (``"y"``/``"z"``) and ``units`` (``"m"``/``"cm"``/``"mm"``) of the
-    file are detected unless given, and gaps up to ``max_gap`` seconds are filled.
+    ``variable`` names the recording; marker gaps up to ``max_gap`` seconds are
+    filled), ``.csv`` and 2-D ``.npy`` angle tables (``fps`` required); joint
+    positions (:mod:`beatsync.io.positions`): ``.json`` (Dance-with-Melody layout,
+    ``fps`` required), 3-D ``.npy`` ``(n_frames, n_joints, 3)`` (``fps`` required),
+    ``.npz`` (``variable`` names the array; ``fps`` unless stored), ``.c3d`` (its own
+    rate; a contradicting ``fps`` is refused). For joint positions, ``up``
+    (``"y"``/``"z"``) and ``units`` (``"m"``/``"cm"``/``"mm"``) of the file are
+    detected unless given, and gaps up to ``max_gap`` seconds are filled.
     """
     p = Path(path)
     suffix = p.suffix.lower()
@@ -149,6 +152,14 @@ def read_motion(
         m = read_mocap_mat(p, variable)
         if fps is not None:
             m = m.with_values(m.values, fps=fps)
+        if not np.isfinite(m.values).all():  # marker dropouts: filled like joint positions
+            gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
+            n = m.n_frames
+            markers = [c[:-2] for c in m.channels[::3]]
+            pos = fill_joint_gaps(
+                m.values.reshape(n, -1, 3), m.fps, max_gap=gap, joint_names=markers
+            )
+            m = m.with_values(pos.reshape(n, -1))
         return m
     if suffix == ".json":
         return read_positions_json(p, fps=fps, **opts)
