@@ -74,7 +74,10 @@ def test_minimal_bvh(tmp_path):
         (GOOD.split("MOTION")[0][:80], "truncated|MOTION"),
         (GOOD.replace("0 1 0 0 0 0 0 20 0\n", ""), "declares 2 frames but has 1"),
         (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 20"), "frame line 2 has 8 values"),
-        (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 nan 0"), "NaN"),
+        (
+            GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 nan 0"),
+            r"frame 2 of 2, channel 'knee_Xrotation' is nan \(NaN",
+        ),
         (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 x 0"), "non-numeric"),
         (GOOD.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time"),
         (GOOD.replace("HIERARCHY", "HIERARCY"), "HIERARCHY"),
@@ -85,6 +88,19 @@ def test_minimal_bvh(tmp_path):
 def test_malformed_bvh(tmp_path, text, match):
     with pytest.raises(ParameterError, match=match):
         io.read_bvh(_write(tmp_path, text))
+
+
+def test_text_renamed_mp3_is_not_said_to_be_missing(tmp_path):
+    import soundfile as sf
+
+    if "MP3" not in sf.available_formats():
+        pytest.skip("this libsndfile has no MP3")
+    p = tmp_path / "notes.mp3"
+    p.write_text("not audio at all\n" * 500)
+    # libsndfile says "File does not exist or is not a regular file" of such a file
+    with pytest.raises(ParameterError, match="cannot read .* as MP3 audio") as info:
+        io.read_audio(p)
+    assert "does not exist" not in str(info.value)
 
 
 def test_missing_and_empty_files(tmp_path):

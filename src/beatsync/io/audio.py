@@ -72,9 +72,12 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
             # libsndfile reads these formats itself: a failure is a damaged file, and
             # audioread (through librosa, seconds to import) would fail the same way
             _check_wav_header_rate(p)
+            detail = _first_line(sf_exc)
+            if "does not exist" in detail:  # libsndfile's words for content it cannot decode
+                detail = "its content is not decodable audio"
             raise ParameterError(
                 f"cannot read {str(p)!r} as {p.suffix.lower()[1:].upper()} audio "
-                f"({_first_line(sf_exc)}); is the file complete and of that format?"
+                f"({detail}); is the file complete and of that format?"
             ) from None
         try:
             import librosa

@@ -327,7 +327,14 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
             values = _read_frames(lines, n_declared, len(names), p)
     except OSError as exc:
         raise ParameterError(f"cannot read BVH {str(p)!r}: {exc}") from None
-    check_finite(values, name=f"BVH {p.name} values")
+    bad = ~np.isfinite(values)
+    if bad.any():  # name the frame and channel, as the other frame errors do
+        row, col = (int(i) for i in np.argwhere(bad)[0])
+        raise ParameterError(
+            f"BVH {str(p)!r}: frame {row + 1} of {values.shape[0]}, channel {names[col]!r} is "
+            f"{float(values[row, col])!r} (NaN or infinite; {int(bad.sum())} such value(s) in "
+            "all); a motion needs finite numbers: repair or drop those frames"
+        )
     if fps is None:
         if not np.isfinite(frame_time) or frame_time <= 0:
             raise ParameterError(
