@@ -27,6 +27,7 @@ def inputs(tmp_path_factory):
     beats = beat_times(115, duration=20.0, start=0.4)
     io.write_audio(d / "song.wav", click_track(beats, sr=SR, duration=20.0), SR)
     io.write_beats(d / "song.beats", beats)
+    (d / "one.beats").write_text("1.0\n")
     (d / "song_ms.beats").write_text("".join(f"{1e3 * b:.1f}\n" for b in beats))
     io.write_audio(d / "short.wav", click_track(np.array([0.05]), sr=SR, duration=0.3), SR)
     io.write_audio(d / "silence.wav", np.zeros(5 * SR, dtype=np.float32), SR)
@@ -208,6 +209,9 @@ BAD = [
     # --out-fps 1 only keep the old behaviour's output small)
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song_ms.beats",
       "--fill", "stop", "--out-fps", "1"], "milliseconds"),
+    # a beats file with one beat: the file is named, not the music blamed
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/one.beats"],
+     "one.beats' holds 1 beat time"),
     # song first, dance second: the message says the arguments look swapped
     (["{d}/song.wav", "{d}/salsa.bvh", "-o", "{o}/x.bvh"], "swapped"),
     # a bad video frame rate is refused before the motion is synced (named as the option)

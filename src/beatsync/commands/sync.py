@@ -287,6 +287,11 @@ def _pipeline(
             if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
                 meter = (int(track.beats_per_bar), "estimated by track_beats")
             beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
+        if beats.size < 2 and args.beats is not None:
+            raise ParameterError(
+                f"the beats file {args.beats!r} holds {beats.size} beat time(s); at least two "
+                "are needed to sync a dance"
+            )
         if beats.size < 2:
             raise ParameterError(
                 f"no detectable beats in {args.audio!r} ({beats.size} found): is it silent "
