@@ -6,7 +6,8 @@ noise, abrupt tempo change halfway; 30 s items; ``min_beat_time=0``) for our tra
 (``psf``) and ``librosa.beat.beat_track`` in the same run, over several seeds; and
 every real recording with human annotations in ``data/`` (Hainsworth 001, the
 Ballroom waltz, the madmom sample) for every tracker available
-(:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed).
+(:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed),
+whole and in excerpts of 15-30 s starting every 2.5 s (:func:`excerpt_rows`).
 
 Speed, each as a ratio against librosa measured in the same run:
 
@@ -24,8 +25,8 @@ Usage::
     .venv/bin/python benchmarks/bench_beats.py --accuracy-only [--seeds 0 1 2] [--methods psf]
 
 Writes ``benchmarks/results/beats.md`` and ``benchmarks/results/beats.json``.
-``--accuracy-only`` skips every timing and the real recordings: it scores the
-synthetic set per seed (targets, and the items under F 0.95) with ``--methods``
+``--accuracy-only`` skips every timing: it scores the synthetic set per seed (targets,
+and the items under F 0.95) and the excerpts of the real recordings with ``--methods``
 (default ``psf``), prints the tables and writes nothing.
 """
 
