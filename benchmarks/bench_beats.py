@@ -6,7 +6,8 @@ noise, abrupt tempo change halfway; 30 s items; ``min_beat_time=0``) for our tra
 (``psf``) and ``librosa.beat.beat_track`` in the same run, over several seeds; and
 every real recording with human annotations in ``data/`` (Hainsworth 001, the
 Ballroom waltz, the madmom sample) for every tracker available
-(:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed).
+(:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed),
+whole and in excerpts of 15-30 s starting every 2.5 s (:func:`excerpt_rows`).
 
 Speed, each as a ratio against librosa measured in the same run:
 
@@ -24,8 +25,8 @@ Usage::
     .venv/bin/python benchmarks/bench_beats.py --accuracy-only [--seeds 0 1 2] [--methods psf]
 
 Writes ``benchmarks/results/beats.md`` and ``benchmarks/results/beats.json``.
-``--accuracy-only`` skips every timing and the real recordings: it scores the
-synthetic set per seed (targets, and the items under F 0.95) with ``--methods``
+``--accuracy-only`` skips every timing: it scores the synthetic set per seed (targets,
+and the items under F 0.95) and the excerpts of the real recordings with ``--methods``
 (default ``psf``), prints the tables and writes nothing.
 """
 
@@ -203,6 +204,55 @@ def real_speed_rows(repeats: int, track_beats, librosa) -> list[dict]:
     return rows
 
 
+EXCERPT_STEP_S = 2.5
+EXCERPT_LENGTHS_S = (15.0, 20.0, 25.0, 30.0)
+
+
+def excerpt_rows(methods: list[str]) -> list[dict]:
+    """Every tracker on excerpts of the annotated real recordings, per recording.
+
+    Excerpts of 15, 20, 25 and 30 s starting every 2.5 s (those inside the recording),
+    scored after 5 s (mir_eval's default) against the annotations inside the excerpt:
+    whether a tracker holds its level and phase on any part of a recording, not only
+    on the whole excerpt that the data set ships. Still two recordings.
+    """
+    from beatsync import datasets
+    from beatsync.evaluate.beats import evaluate_beats
+    from beatsync.peers import track
+
+    rows = []
+    for name in datasets.REAL_DEV_ITEMS:
+        y, sr, ref = datasets.load_real_dev(name)
+        dur = y.size / sr
+        cuts = [
+            (start, length)
+            for start in np.arange(0.0, dur, EXCERPT_STEP_S)
+            for length in EXCERPT_LENGTHS_S
+            if start + length <= dur
+        ]
+        for method in methods:
+            f, cml = [], []
+            for start, length in cuts:
+                seg = y[int(start * sr) : int((start + length) * sr)]
+                r = ref[(ref >= start) & (ref < start + length)] - start
+                s = evaluate_beats(r, track(method, seg, sr), min_beat_time=5.0)
+                f.append(s["F-measure"])
+                cml.append(s["Correct Metric Level Total"])
+            f = np.array(f)
+            rows.append(
+                {
+                    "recording": name,
+                    "method": method,
+                    "excerpts": len(cuts),
+                    "mean F": float(f.mean()),
+                    "lowest F": float(f.min()),
+                    "excerpts with F < 0.95": int((f < 0.95).sum()),
+                    "mean CMLt": float(np.mean(cml)),
+                }
+            )
+    return rows
+
+
 def accuracy_only(seeds: list[int], methods: list[str]) -> int:
     """Targets of the synthetic set per seed, and the items under F 0.95 (printed)."""
     from beatsync.study import paper_a_beats as study
@@ -218,6 +268,10 @@ def accuracy_only(seeds: list[int], methods: list[str]) -> int:
         print("\nitems with F < 0.95:\n")
         print(_md_table(low) if len(low) else "none")
         print()
+    import pandas as pd
+
+    print("## excerpts of the real recordings\n")
+    print(_md_table(pd.DataFrame(excerpt_rows(methods))))
     return 0
 
 
@@ -299,6 +353,7 @@ def main() -> int:
     real_targets = study.check_targets(real)
     real = real.drop(columns=["group", "seconds"])
     meters = study.meter_estimates(real_items)
+    excerpts = pd.DataFrame(excerpt_rows(study.available_methods()))
 
     # ------------------------------------------------------------------ write
     facts = _machine.machine_facts()
@@ -337,6 +392,15 @@ def main() -> int:
         _md_table(meters),
         "",
         _md_table(real_targets),
+        "",
+        "## Excerpts of the real recordings (every available tracker)",
+        "",
+        f"Excerpts of {', '.join(f'{x:g}' for x in EXCERPT_LENGTHS_S)} s starting every "
+        f"{EXCERPT_STEP_S:g} s (those inside the recording), scored after 5 s against the "
+        "annotations inside each excerpt: does a tracker hold the level and the phase on "
+        "any part of a recording? Overlapping excerpts of two recordings: a sanity check.",
+        "",
+        _md_table(excerpts),
         "",
         "## Targets on the synthetic set (seed 0)",
         "",
@@ -401,6 +465,7 @@ def main() -> int:
         "real": real.to_dict(orient="records"),
         "real_targets": real_targets.to_dict(orient="records"),
         "meters": meters.to_dict(orient="records"),
+        "excerpts": excerpts.to_dict(orient="records"),
         "speed": speed.to_dict(orient="records"),
         "speed_real": real_speed.to_dict(orient="records"),
         "startup": startup.to_dict(orient="records"),

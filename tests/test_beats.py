@@ -179,6 +179,27 @@ def test_madmom_sample_with_known_bpm():
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, start, length",
+    [
+        ("ballroom_waltz", 10.0, 15.0),
+        ("ballroom_waltz", 12.5, 15.0),
+        ("ballroom_waltz", 5.0, 25.0),
+        ("hainsworth_001", 0.0, 20.0),
+    ],
+)
+def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
+    # excerpts whose phase the bass band (onsets at every phase of the beat) pulled onto
+    # the off-beat when the bands were weighted 5:4:3:2 (F 0.00, 0.00, 0.47, 0.68)
+    y, sr, ref = datasets.load_real_dev(name)
+    y = y[int(start * sr) : int((start + length) * sr)]
+    ref = ref[(ref >= start) & (ref < start + length)] - start
+    s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=5.0)
+    assert s["F-measure"] >= 0.95
+    assert s["Correct Metric Level Total"] >= 0.90
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("name, meter", [("hainsworth_001", 4), ("ballroom_waltz", 3)])
 def test_real_recordings_at_the_annotated_level(name, meter):
     y, sr, ref = datasets.load_real_dev(name)
