@@ -443,6 +443,39 @@ def test_fill_loop_covers_a_song_longer_than_the_clip():
     assert out_step <= 1.5 * src_step
 
 
+def test_fill_loop_carries_the_travel_across_joins():
+    # the clip walks forward at 0.3 m/s: each pass goes on from where the last one
+    # ended (it jumped 1.5 m back at every join, within the 0.2 s blend)
+    m = _periodic_motion(period=1.0, duration=6.0)
+    bounds = np.arange(0.0, 5.5, 1.0)
+    beats = np.arange(0.3, 40.0, 0.5)  # 2 beats per period: the clip's own speed
+    res = synchronize(m, bounds, beats, fill="loop")
+    assert res.report["repetitions"] >= 7
+    x = res.motion.values[:, 0]
+    src_step = np.abs(np.diff(m.values[:, 0])).max()
+    assert np.diff(x).min() > -1e-9  # never walks back (held still before the first beat)
+    assert np.diff(x).max() <= 1.5 * src_step * res.report["continuous_rate_range"][1]
+    # the height and the rotations are looped as they are
+    assert np.abs(res.motion.values[:, 1] - 0.9).max() <= 0.02 + 1e-9
+
+
+def test_fill_loop_carries_the_travel_of_position_only_motion():
+    arm = _arm_positions(fps=25.0, seconds=12.0)  # swings with turns every 0.6 s
+    pos = arm.values.reshape(arm.n_frames, 3, 3).copy()
+    pos[:, :, 1] += 0.4 * arm.times[:, None]  # the whole arm moves along y (z is up)
+    m = arm.with_values(pos.reshape(arm.n_frames, -1))
+    bounds = np.arange(0.3, 11.0, 1.2)  # one period: two swings
+    beats = np.arange(0.3, 60.0, 0.6)
+    res = synchronize(m, bounds, beats, fill="loop")
+    assert res.report["repetitions"] >= 5
+    out = res.motion.values.reshape(res.motion.n_frames, 3, 3)
+    y = out[:, :, 1].mean(axis=1)
+    assert np.diff(y).min() > -1e-9  # the centroid never jumps back
+    src_step = np.abs(np.diff(pos[:, :, 1].mean(axis=1))).max()
+    assert np.diff(y).max() <= 1.5 * src_step * res.report["continuous_rate_range"][1]
+    assert np.allclose(out[:, :, 0].mean(axis=1).max(), pos[:, :, 0].mean(axis=1).max(), atol=0.05)
+
+
 def test_fill_loop_of_a_clip_longer_than_the_song_is_stop_to_the_last_beat():
     m = _periodic_motion(period=1.0, duration=6.0)
     bounds = np.arange(0.0, 5.5, 1.0)

@@ -88,8 +88,10 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
         prog="beatsync",
         description="Beat-synchronous dance animation: segment periodic motion, track "
         "music beats, make a dance follow a song, compose dances from a motion library.",
-        epilog="Exit status: 0 success, 1 some items failed, 2 usage error, 3 bad input, "
-        "4 system error (disk full, permission), 70 internal error, 130/143 interrupted.",
+        epilog="Exit status: 0 success (batch, evaluate: at least one item done; the failed "
+        "ones are listed), 1 no item done or a checksum mismatch (data), 2 usage error, "
+        "3 bad input, 4 system error (disk full, permission), 70 internal error, "
+        "130/143 interrupted.",
     )
     parser.add_argument("--version", action="version", version=f"beatsync {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

@@ -60,7 +60,7 @@ __all__ = [
 ]
 
 EXIT_OK = 0
-EXIT_FAILED_ITEMS = 1  # the command ran, but some of its items failed (batch, data)
+EXIT_FAILED_ITEMS = 1  # ran, but no item done (batch, evaluate) or a checksum failed (data)
 EXIT_USAGE = 2  # argparse: unknown option, missing argument, wrong type
 EXIT_BAD_INPUT = 3  # ParameterError: a value, file or option combination is unusable
 EXIT_OS_ERROR = 4  # the system refused: disk full, permission denied while writing

@@ -14,6 +14,16 @@ lead (``e_0 + (t - J)``) with a raised-cosine weight going 0 -> 1 across the win
 :func:`beatsync.rotations.blend_values`). Clip times outside the clip are held at its
 ends; the held part carries little weight near the window's edges. Period boundaries
 are similar poses by construction, so the blend is short and gentle.
+
+Travel is carried across joins: repetition ``r`` is moved along the floor by ``r``
+times the clip's ground travel over its span (root position at ``e_P`` minus at
+``e_0``), so a dancer who moves across the floor goes on from where the previous pass
+ended instead of jumping back to the start (a walk looped without it teleported 3.45 m
+at every join, at up to 28 m/s). The floor is the plane of the non-vertical axes: y is
+up in skeleton (BVH) motion, z in position-only motion (see :mod:`beatsync.motion`);
+the travel of position-only motion is that of the joints' centroid, and every joint is
+moved. A turn over the span is not carried on (each pass starts at the clip's
+heading), and motion without positions (angle tables) is looped as it is.
 """
 
 from __future__ import annotations
@@ -78,15 +88,67 @@ class LoopedClip:
                 w = np.where(near, 0.5 - 0.5 * np.cos(np.pi * u), w)
         return a, b, w
 
+    def repetition_index(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Repetition shown at looped times ``t``: ``(ra, rb)`` for the poses ``a``
+        and ``b`` of :meth:`source_times` (0: the clip as it is; at a join, ``rb`` is
+        the starting repetition and ``ra`` the ending one)."""
+        t = np.asarray(t, dtype=np.float64)
+        r = np.floor((t - self.last) / self.length) + 1.0
+        ra = np.clip(r, 0.0, self.repetitions - 1.0)
+        rb = ra.copy()
+        half = 0.5 * self.join
+        if half > 0 and self.repetitions > 1:
+            joins = self.last + np.arange(self.repetitions - 1) * self.length
+            k = np.clip(np.searchsorted(joins, t), 0, joins.size - 1)
+            for kk in (k, np.maximum(k - 1, 0)):
+                near = np.abs(t - joins[kk]) < half
+                ra = np.where(near, kk, ra)
+                rb = np.where(near, kk + 1.0, rb)
+        return ra, rb
+
     def sample(self, motion: object, t: np.ndarray) -> np.ndarray:
-        """Values of ``motion`` at looped times ``t`` (blended at the joins)."""
+        """Values of ``motion`` at looped times ``t`` (moved by the travel of the
+        repetitions before, blended at the joins)."""
         a, b, w = self.source_times(t)
+        ra, rb = self.repetition_index(t)
+        travel = _floor_travel(motion, self.first, self.last)
         values = sample_motion(motion, a)
+        if travel is not None:
+            values[:, travel[0]] += ra[:, None] * travel[1]
         blend = w > 0
         if blend.any():
             vb = sample_motion(motion, b[blend])
+            if travel is not None:
+                vb[:, travel[0]] += rb[blend, None] * travel[1]
             values[blend] = blend_values(motion, values[blend], vb, w[blend])
         return values
+
+
+def _floor_travel(
+    motion: object, start: float, stop: float
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Ground travel of ``motion`` from clip time ``start`` to ``stop`` [s].
+
+    Returns ``(columns, step)``: the value columns holding floor coordinates and what
+    to add to them per repetition; None for motion without positions. Skeleton motion:
+    the root's two horizontal position channels (y up); position-only motion: every
+    joint's x and y (z up), moved by the travel of the joints' centroid.
+    """
+    ends = sample_motion(motion, np.array([start, stop], dtype=np.float64))
+    if motion.is_positional:
+        n_joints = ends.shape[1] // 3
+        xy = ends.reshape(2, n_joints, 3)[:, :, :2].mean(axis=1)  # centroid on the floor
+        cols = (3 * np.arange(n_joints)[:, None] + np.arange(2)[None, :]).ravel()
+        return cols, np.tile(xy[1] - xy[0], n_joints)
+    skeleton = motion.skeleton
+    if skeleton is None:
+        return None
+    root = skeleton.joints[0].name
+    names = (f"{root}_Xposition", f"{root}_Zposition")
+    if not all(n in motion.channels for n in names):
+        return None
+    cols = np.array([motion.channels.index(n) for n in names])
+    return cols, ends[1, cols] - ends[0, cols]
 
 
 def loop_events(events: np.ndarray, n_needed: int, *, join: float) -> LoopedClip:
