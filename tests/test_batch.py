@@ -57,6 +57,21 @@ def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
     assert bad["error"].str.contains("periodic").all()
 
 
+def test_grid_mode_auto_uses_the_motion_beats_of_a_clip_that_is_not_periodic(inputs, tmp_path):
+    _, clips, songs = inputs
+    table = sync_grid(clips, songs[:1], tmp_path, processes=False, n_workers=2, fps=60.0,
+                      mode="auto")  # fmt: skip
+    assert (table["status"] == "ok").all()
+    row = table.set_index("clip")
+    assert row.loc["salsa", "mode"] == "periods" and row.loc["salsa", "note"] == ""
+    assert row.loc["pirouette", "mode"] == "beats"
+    assert "not periodic" in row.loc["pirouette", "note"]
+    assert (
+        io.read_bvh(row.loc["pirouette", "output"]).n_frames
+        == row.loc["pirouette", "output_frames"]
+    )
+
+
 def test_grid_bad_arguments(inputs, tmp_path):
     _, clips, songs = inputs
     with pytest.raises(ParameterError, match="does not exist"):
@@ -65,6 +80,8 @@ def test_grid_bad_arguments(inputs, tmp_path):
         sync_grid(clips, songs, tmp_path / "missing")
     with pytest.raises(ParameterError, match="at least one"):
         sync_grid([], songs, tmp_path)
+    with pytest.raises(ParameterError, match="mode='bars' must be one of"):
+        sync_grid(clips, songs, tmp_path, mode="bars")
 
 
 def test_batch_cli_writes_summary(inputs, scheduler, tmp_path, capsys):

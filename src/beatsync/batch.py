@@ -6,7 +6,10 @@ once, and every (clip, song) pair is synchronised from those results. By default
 local cluster (one process per core) runs it; give ``scheduler`` (an address such as
 ``"tcp://10.0.0.5:8786"``) to use an existing cluster. A pair that fails on bad
 input (a clip that is not periodic, a song without beats) records the error message
-in its row instead of stopping the study.
+in its row instead of stopping the study. ``mode`` is that of
+:func:`beatsync.sync.synchronize`: paper A's periods (default), the dancer's own motion
+beats, or ``"auto"`` (periods when the clip is periodic, else its motion beats: what
+real dancers need); the clip is segmented once either way.
 
 Data contract: every time is in seconds; every output file is written atomically
 under ``out_dir`` as ``<clip>__<song>.bvh`` (or ``.csv`` for motion without a
@@ -41,20 +44,32 @@ def prepare_clip(
     fps: float | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
+    mode: str = "periods",
 ) -> dict[str, Any]:
-    """Read a motion clip and find its periods (a task of the graph)."""
+    """Read a motion clip and find its periods (a task of the graph).
+
+    ``mode="beats"``: no segmentation (the pairs use the motion beats);
+    ``mode="auto"``: a clip that segmentation refuses (not periodic) gets no boundaries
+    and the reason in ``note``; ``mode="periods"``: the refusal is the clip's error.
+    """
     from . import io
     from .motion import segmentation_view
     from .segment import segment
 
     motion = io.read_motion(path, fps=fps)
-    seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
-    return {
-        "clip": Path(path).stem,
-        "motion": motion,
-        "boundaries": seg.boundaries,
-        "mean_period_s": seg.mean_period,
-    }
+    clip = {"clip": Path(path).stem, "motion": motion, "boundaries": None}
+    clip.update(mean_period_s=float("nan"), note="")
+    if mode == "beats":
+        return clip
+    try:
+        seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
+    except ParameterError as exc:
+        if mode == "periods":
+            raise
+        clip["note"] = f"not periodic ({exc}): its motion beats were used"
+        return clip
+    clip.update(boundaries=seg.boundaries, mean_period_s=seg.mean_period)
+    return clip
 
 
 def sync_pair(
@@ -75,7 +90,10 @@ def sync_pair(
             return row
     assert isinstance(clip, dict) and isinstance(song, dict)
     try:
-        res = synchronize(clip["motion"], clip["boundaries"], song["beats"])
+        if clip["boundaries"] is None:  # mode "beats", or "auto" on a clip that is not periodic
+            res = synchronize(clip["motion"], None, song["beats"], mode="beats")
+        else:
+            res = synchronize(clip["motion"], clip["boundaries"], song["beats"])
     except ParameterError as exc:
         row.update(status="error", error=str(exc))
         return row
@@ -93,6 +111,8 @@ def sync_pair(
     row.update(
         status="ok",
         output=str(out),
+        mode=rep.get("mode"),
+        note=clip["note"],
         tempo_bpm=float(song["tempo_bpm"]),
         mean_period_s=float(clip["mean_period_s"]),
         input_frames=rep.get("input_frames"),
@@ -131,6 +151,7 @@ def sync_grid(
     bpm: float | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
+    mode: str = "periods",
     progress: Callable[..., None] | None = None,
 ) -> Any:
     """Synchronise every clip with every song on Dask; return a table of reports.
@@ -154,14 +175,19 @@ def sync_grid(
         Frame-rate override for every clip (e.g. 60 for the CMU salsa files).
     bpm : float, optional [BPM]
         Known tempo of every song.
+    mode : {"periods", "beats", "auto"}
+        What lands on the beats: paper A's periods (a clip that is not periodic fails),
+        the clip's own motion beats, or periods when the clip is periodic and motion
+        beats otherwise (see :func:`beatsync.sync.synchronize`).
     progress : callable ``progress(done, total=None)``, optional
         Called as pairs finish (e.g. a command's progress bar).
 
     Returns
     -------
     pandas.DataFrame
-        One row per (clip, song): status, output path, tempo, frames, beats per
-        period, maximum boundary residual [ms], or the error message.
+        One row per (clip, song): status, output path, the mode used (and why, for a
+        clip that ``"auto"`` found not periodic), tempo, frames, beats per period,
+        maximum boundary residual [ms], or the error message.
 
     Raises
     ------
@@ -175,6 +201,8 @@ def sync_grid(
     from .cluster import check_cluster_options, dask_client
 
     check_cluster_options(scheduler, n_workers)
+    if mode not in ("periods", "beats", "auto"):
+        raise ParameterError(f"mode={mode!r} must be one of periods, beats, auto")
     clips = [str(c) for c in clips]
     songs = [str(s) for s in songs]
     if not clips or not songs:
@@ -213,6 +241,7 @@ def sync_grid(
                 fps=fps,
                 period_range=period_range,
                 alpha=alpha,
+                mode=mode,
                 pure=False,
             )
             for c in clips

@@ -26,6 +26,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
     add_period_range(p)
+    p.add_argument(
+        "--mode",
+        choices=("periods", "beats", "auto"),
+        default="periods",
+        help="what lands on the beats: the clip's periods (paper A; a clip that is not "
+        "periodic fails), its own motion beats, or auto: periods when the clip is "
+        "periodic, else its motion beats (real dancers)",
+    )
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument(
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
@@ -67,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
                 fps=args.fps,
                 bpm=args.bpm,
                 period_range=tuple(args.period_range),
+                mode=args.mode,
                 progress=progress,
             )
         for i in table.index[table["status"] == "ok"]:
