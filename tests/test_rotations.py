@@ -3,7 +3,7 @@ import pytest
 
 from beatsync.errors import ParameterError
 from beatsync.motion import Motion
-from beatsync.rotations import blend_values, euler_to_rotation, sample_motion
+from beatsync.rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
 
 CH = ("root_Xposition", "j_Zrotation", "j_Xrotation", "j_Yrotation")
 
@@ -99,10 +99,22 @@ def test_quaternions_match_scipy(axes):
     assert np.allclose(Rotation.from_quat(prod).as_matrix(), (ref * b).as_matrix(), atol=1e-12)
 
 
-@pytest.mark.parametrize("axes, shape", [("ZXW", (3, 3)), ("", (3, 0)), ("ZXYZ", (3, 4)),
-                                         ("ZXY", (3, 2))])
+@pytest.mark.parametrize(
+    "axes, shape", [("ZXW", (3, 3)), ("", (3, 0)), ("ZXYZ", (3, 4)), ("ZXY", (3, 2))]
+)
 def test_quat_from_euler_refuses_bad_axes_or_shapes(axes, shape):
     from beatsync.quaternions import quat_from_euler
 
     with pytest.raises(ParameterError, match="axes"):
         quat_from_euler(np.zeros(shape), axes)
+
+
+def test_euler_at_gimbal_lock_is_silent_and_exact():
+    import warnings
+
+    angles = np.array([[30.0, 90.0, 20.0], [10.0, -90.0, 45.0], [5.0, 20.0, 7.0]])
+    rot = euler_to_rotation(angles, "ZXY")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # scipy's "Gimbal lock detected" was printed per frame
+        back = rotation_to_euler(rot, "ZXY", reference=angles)
+    assert np.allclose((euler_to_rotation(back, "ZXY") * rot.inv()).magnitude(), 0.0, atol=1e-6)

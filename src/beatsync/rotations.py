@@ -12,6 +12,8 @@ Data contract: times are seconds in the source motion's timeline (frame ``i`` at
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -93,7 +95,12 @@ def rotation_to_euler(rot: Rotation, order: str, reference: np.ndarray | None = 
     ``(a + 180, 180 - b, c + 180)`` for Tait-Bryan orders), each shifted by multiples
     of 360 deg, the one closest to ``reference`` (shape ``(n, 3)``) is returned.
     """
-    e = rot.as_euler(order.upper(), degrees=True)
+    with warnings.catch_warnings():
+        # at gimbal lock (middle angle +-90 deg) scipy warns and sets the third angle to
+        # 0: the triple still gives the same rotation, which is all a BVH frame needs;
+        # the warning only cluttered the output of long runs (batch workers)
+        warnings.filterwarnings("ignore", message="Gimbal lock detected", category=UserWarning)
+        e = rot.as_euler(order.upper(), degrees=True)
     if e.ndim == 1:
         e = e[None, :]
     if reference is None:
