@@ -69,12 +69,17 @@ class LoopedClip:
 
         ``w`` is 0 away from joins (pose at clip time ``a``).
         """
+        return self._locate(t)[:3]
+
+    def _locate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(a, b, w, ra, rb)``: clip times, blend weight and repetitions at ``t``."""
         t = np.asarray(t, dtype=np.float64)
         r = np.floor((t - self.last) / self.length) + 1.0  # repetition index (0: the clip)
         r = np.clip(r, 0.0, self.repetitions - 1.0)
         a = np.where(r == 0, t, self.first + (t - self.last - (r - 1.0) * self.length))
         b = a.copy()
         w = np.zeros_like(t)
+        ra, rb = r, r.copy()
         half = 0.5 * self.join
         if half > 0 and self.repetitions > 1:
             joins = self.last + np.arange(self.repetitions - 1) * self.length
@@ -86,31 +91,14 @@ class LoopedClip:
                 b = np.where(near, self.first + d, b)
                 u = np.clip((d + half) / (2.0 * half), 0.0, 1.0)
                 w = np.where(near, 0.5 - 0.5 * np.cos(np.pi * u), w)
-        return a, b, w
-
-    def repetition_index(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Repetition shown at looped times ``t``: ``(ra, rb)`` for the poses ``a``
-        and ``b`` of :meth:`source_times` (0: the clip as it is; at a join, ``rb`` is
-        the starting repetition and ``ra`` the ending one)."""
-        t = np.asarray(t, dtype=np.float64)
-        r = np.floor((t - self.last) / self.length) + 1.0
-        ra = np.clip(r, 0.0, self.repetitions - 1.0)
-        rb = ra.copy()
-        half = 0.5 * self.join
-        if half > 0 and self.repetitions > 1:
-            joins = self.last + np.arange(self.repetitions - 1) * self.length
-            k = np.clip(np.searchsorted(joins, t), 0, joins.size - 1)
-            for kk in (k, np.maximum(k - 1, 0)):
-                near = np.abs(t - joins[kk]) < half
-                ra = np.where(near, kk, ra)
+                ra = np.where(near, kk, ra)  # join kk ends repetition kk, starts kk + 1
                 rb = np.where(near, kk + 1.0, rb)
-        return ra, rb
+        return a, b, w, ra, rb
 
     def sample(self, motion: object, t: np.ndarray) -> np.ndarray:
         """Values of ``motion`` at looped times ``t`` (moved by the travel of the
         repetitions before, blended at the joins)."""
-        a, b, w = self.source_times(t)
-        ra, rb = self.repetition_index(t)
+        a, b, w, ra, rb = self._locate(t)
         travel = _floor_travel(motion, self.first, self.last)
         values = sample_motion(motion, a)
         if travel is not None:
