@@ -49,6 +49,7 @@ __all__ = [
     "add_music_beat_options",
     "add_json_flag",
     "add_period_range",
+    "add_mode",
     "add_position_options",
     "position_options",
     "emit",
@@ -119,6 +120,19 @@ def add_music_beat_options(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=None,
         help="known tempo of the music [BPM]: the tracker only finds the phase",
+    )
+
+
+def add_mode(parser: argparse.ArgumentParser, *, default: str) -> None:
+    """The ``--mode periods|beats|auto`` option of the commands that sync a dance."""
+    parser.add_argument(
+        "--mode",
+        choices=("auto", "periods", "beats"),
+        default=default,
+        help="what lands on the beats: 'periods' (paper A: the motion's periods; a motion "
+        "that is not periodic fails), 'beats' (the dancer's own motion beats, for dances "
+        "that are not strictly periodic), or 'auto' (periods if the motion is periodic, "
+        f"else beats, with a note); default {default}",
     )
 
 

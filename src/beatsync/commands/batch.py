@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, add_period_range, emit
+from ._common import add_json_flag, add_mode, add_period_range, emit
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -26,14 +26,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
     add_period_range(p)
-    p.add_argument(
-        "--mode",
-        choices=("periods", "beats", "auto"),
-        default="periods",
-        help="what lands on the beats: the clip's periods (paper A; a clip that is not "
-        "periodic fails), its own motion beats, or auto: periods when the clip is "
-        "periodic, else its motion beats (real dancers)",
-    )
+    add_mode(p, default="periods")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument(
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"

@@ -27,6 +27,7 @@ from . import COMMAND_HELP
 from ._common import (
     Feedback,
     Outputs,
+    add_mode,
     add_music_beat_options,
     add_output_flags,
     add_position_options,
@@ -110,14 +111,7 @@ def register(subparsers: Any) -> None:
         help="put the dancer's accents (kinematic beats: minima of joint speed) "
         "on the beats instead of the period boundaries",
     )
-    p.add_argument(
-        "--mode",
-        choices=("auto", "periods", "beats"),
-        default="auto",
-        help="what lands on the beats: 'periods' (paper A: the motion's periods), 'beats' "
-        "(the dancer's own motion beats, for dances that are not strictly periodic), or "
-        "'auto' (periods if the motion is periodic, else beats, with a warning; default)",
-    )
+    add_mode(p, default="auto")
     p.add_argument(
         "--fill",
         choices=("loop", "stop"),
