@@ -75,9 +75,14 @@ def viterbi(
         scores = value[:, None] + log_trans
         back[t] = np.argmax(scores, axis=0)
         value = scores[back[t], cols] + log_obs[:, t]
-    path = np.empty(n_steps, dtype=np.int64)
+    return _backtrack(back, value)
+
+
+def _backtrack(back: np.ndarray, value: np.ndarray) -> np.ndarray:
+    """The Viterbi path from back-pointers ``(n_steps, n_states)`` and final values."""
+    path = np.empty(back.shape[0], dtype=np.int64)
     path[-1] = int(np.argmax(value))
-    for t in range(n_steps - 1, 0, -1):
+    for t in range(back.shape[0] - 1, 0, -1):
         path[t - 1] = back[t, path[t]]
     return path
 
@@ -177,8 +182,4 @@ def viterbi_banded(
         i_best[use_jump] = top
         back[t] = i_best
         value = best + log_obs[:, t]
-    path = np.empty(n_steps, dtype=np.int64)
-    path[-1] = int(np.argmax(value))
-    for t in range(n_steps - 1, 0, -1):
-        path[t - 1] = back[t, path[t]]
-    return path
+    return _backtrack(back, value)

@@ -10,7 +10,7 @@ density, window lengths and the decoder's selection bias, so one ratio threshold
 serves 2 s clips and whole songs; a fixed salience threshold could not (a 5 s noise
 reaches the salience of a 30 s real song). Its two constants
 (:data:`MIN_PULSE_CLARITY`, :data:`CLEAR_PULSE`) were set on noises and the bundled
-real recordings (numbers beside them); nothing of the beat tracking itself changed.
+real recordings (numbers beside them).
 """
 
 from __future__ import annotations
@@ -340,7 +340,6 @@ def _track_psf(
     if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
         return _empty("psf", "no onsets found in the audio (a steady sound?): no beats")
     model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
-    sigma = max(0.01 * fps, 0.5)
     accents = _accents(ons.bands, fps)
     starts, stops, centres = analysis_windows(n, fps, tempo_win_s, tempo_hop_s)
     if bpm is not None:
@@ -348,7 +347,7 @@ def _track_psf(
     else:
         periods = period_grid(min_bpm, max_bpm)
     # above this the 10-ms smoothing leaves < 1 % of the accent power
-    max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * sigma / fps)
+    max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * _accent_sigma(fps) / fps)
     log_obs, salience, measure = tactus_observation(
         accents, fps, starts, stops, periods, model, max_hz=max_hz
     )
@@ -433,9 +432,14 @@ def _warn_if_no_clear_pulse(ons, path_salience, starts, stops, periods, model, m
         )
 
 
+def _accent_sigma(fps: float) -> float:
+    """Width [frames] of the accents' Gaussian smoothing: 10 ms, at least half a frame."""
+    return max(0.01 * fps, 0.5)  # onsets a frame apart still resonate together
+
+
 def _accents(bands: np.ndarray, fps: float) -> np.ndarray:
     """Band accent signals: the onset impulses smoothed over 10 ms."""
-    sigma = max(0.01 * fps, 0.5)  # onsets a frame apart still resonate together
+    sigma = _accent_sigma(fps)
     return np.stack([gaussian_smooth(band, sigma) for band in bands])
 
 

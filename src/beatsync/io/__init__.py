@@ -154,12 +154,8 @@ def read_motion(
             m = m.with_values(m.values, fps=fps)
         if not np.isfinite(m.values).all():  # marker dropouts: filled like joint positions
             gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
-            n = m.n_frames
-            markers = [c[:-2] for c in m.channels[::3]]
-            pos = fill_joint_gaps(
-                m.values.reshape(n, -1, 3), m.fps, max_gap=gap, joint_names=markers
-            )
-            m = m.with_values(pos.reshape(n, -1))
+            pos = fill_joint_gaps(m.positions(), m.fps, max_gap=gap, joint_names=m.joint_names)
+            m = m.with_values(pos.reshape(m.n_frames, -1))
         return m
     if suffix == ".json":
         return read_positions_json(p, fps=fps, **opts)
@@ -170,7 +166,7 @@ def read_motion(
     if suffix in (".csv", ".npy"):
         return read_table(p, fps=fps)
     hint = ""
-    if suffix in (".wav", ".flac", ".ogg", ".mp3"):
+    if suffix in SOUNDFILE_SUFFIXES:
         hint = " (this is audio: are the arguments swapped? the motion comes first, then the music)"
     raise ParameterError(
         f"unsupported motion file {str(p)!r}: expected one of {', '.join(MOTION_SUFFIXES)}{hint}"
