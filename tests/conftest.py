@@ -48,3 +48,18 @@ def chain_motion(rng: np.random.Generator) -> Motion:
     values[:, 9:12] = 30 * np.sin(2 * np.pi * t + 1)[:, None] * np.array([0.1, 1.0, 0.3])
     values += rng.normal(0, 0.01, values.shape)
     return Motion(values, 30.0, sk.channel_names(), sk, "chain")
+
+
+# An existing in-process cluster reached over TCP: with the default inproc transport a
+# client on another event-loop thread shares inproc's non-thread-safe queues with the
+# scheduler's loop, and under load its connection can fail (seen once in a full run).
+_LOCAL_TCP = {"protocol": "tcp://", "host": "127.0.0.1", "dashboard_address": ":0"}
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """An existing cluster of 2 workers (threads here: no start-up or compilation per run)."""
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, processes=False, **_LOCAL_TCP) as lc:
+        yield lc.scheduler_address

@@ -33,15 +33,6 @@ def inputs(tmp_path_factory):
     return d, [d / "salsa.bvh", d / "pirouette.bvh"], songs
 
 
-@pytest.fixture(scope="module")
-def scheduler():
-    """An existing cluster (threads of this process: no start-up or compilation per worker)."""
-    from dask.distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, processes=False, dashboard_address=":0") as lc:
-        yield lc.scheduler_address
-
-
 def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
     _, clips, songs = inputs
     table = sync_grid(clips, songs, tmp_path, processes=False, n_workers=2, fps=60.0)

@@ -53,15 +53,6 @@ def dataset(tmp_path_factory):
     return audio, notes
 
 
-@pytest.fixture(scope="module")
-def scheduler():
-    """An existing cluster of 2 workers (threads here: no start-up or compilation per run)."""
-    from dask.distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, processes=False, dashboard_address=":0") as lc:
-        yield lc.scheduler_address
-
-
 def _argv(dataset, out, *extra):
     audio, notes = dataset
     return [

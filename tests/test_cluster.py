@@ -71,7 +71,9 @@ def test_local_cluster_runs_and_shuts_down():
 def test_existing_scheduler_by_address():
     from dask.distributed import LocalCluster
 
-    with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as lc:
+    # TCP, not inproc: the client's loop thread and the scheduler's share no queue
+    tcp = {"protocol": "tcp://", "host": "127.0.0.1"}
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=":0", **tcp) as lc:
         with cluster.dask_client(scheduler=lc.scheduler_address) as client:
             assert client.submit(max, [4, 1]).result() == 4
         assert client.status == "closed"

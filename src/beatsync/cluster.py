@@ -184,9 +184,11 @@ def _connect(address: str, timeout: float) -> Any:
             "expected e.g. tcp://10.0.0.5:8786"
         ) from None
     except Exception as exc:  # refused, timed out, or something else answering there
-        reason = "no answer" if isinstance(exc, (OSError, TimeoutError)) else type(exc).__name__
+        if isinstance(exc, (OSError, TimeoutError)):
+            reason = f"within {timeout:g} s (no answer)"
+        else:  # failed at once, not a time-out: say how
+            reason = f"({type(exc).__name__}: {exc})" if str(exc) else f"({type(exc).__name__})"
         raise ParameterError(
-            f"could not connect to the Dask scheduler at {address!r} within {timeout:g} s "
-            f"({reason}); is `dask scheduler` running there and reachable? "
-            "Omit --scheduler to run on a local cluster"
+            f"could not connect to the Dask scheduler at {address!r} {reason}; is `dask "
+            "scheduler` running there and reachable? Omit --scheduler to run on a local cluster"
         ) from None
