@@ -57,3 +57,4 @@ def test_sync_table_and_views():
 def test_make_songs_bad_source():
     with pytest.raises(ParameterError, match="beat_source"):
         study.make_songs([96.0, 132.0], beat_source="guess")
+
