@@ -7,7 +7,8 @@ noise, abrupt tempo change halfway; 30 s items; ``min_beat_time=0``) for our tra
 every real recording with human annotations in ``data/`` (Hainsworth 001, the
 Ballroom waltz, the madmom sample) for every tracker available
 (:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed),
-whole and in excerpts of 15-30 s starting every 2.5 s (:func:`excerpt_rows`).
+whole, in excerpts of 15-30 s starting every 2.5 s (:func:`excerpt_rows`) and in
+short clips of 3-10 s starting every 1 s (:func:`short_rows`).
 
 Speed, each as a ratio against librosa measured in the same run:
 
@@ -206,17 +207,31 @@ def real_speed_rows(repeats: int, track_beats, librosa) -> list[dict]:
 
 EXCERPT_STEP_S = 2.5
 EXCERPT_LENGTHS_S = (15.0, 20.0, 25.0, 30.0)
+#: Short clips: lengths [s], step [s]; scored from 0 s (a clip has no 5 s to spare).
+SHORT_LENGTHS_S = (3.0, 5.0, 7.0, 10.0)
+SHORT_STEP_S = 1.0
 
 
-def excerpt_rows(methods: list[str]) -> list[dict]:
+def excerpt_rows(
+    methods: list[str],
+    lengths: tuple[float, ...] = EXCERPT_LENGTHS_S,
+    step: float = EXCERPT_STEP_S,
+    min_beat_time: float = 5.0,
+    per_length: bool = False,
+) -> list[dict]:
     """Every tracker on excerpts of the annotated real recordings, per recording.
 
-    Excerpts of 15, 20, 25 and 30 s starting every 2.5 s (those inside the recording),
-    scored after 5 s (mir_eval's default) against the annotations inside the excerpt:
-    whether a tracker holds its level and phase on any part of a recording, not only
-    on the whole excerpt that the data set ships. Still two recordings.
+    Excerpts of each of ``lengths`` starting every ``step`` seconds (those inside the
+    recording), scored after ``min_beat_time`` (mir_eval's default 5 s) against the
+    annotations inside the excerpt: whether a tracker holds its level and phase on any
+    part of a recording, not only on the whole excerpt that the data set ships. Still
+    two recordings. ``per_length``: one row per excerpt length, with the share of
+    excerpts on which our tracker warned (no clear pulse).
     """
+    import warnings
+
     from beatsync import datasets
+    from beatsync.errors import BeatsyncWarning
     from beatsync.evaluate.beats import evaluate_beats
     from beatsync.peers import track
 
@@ -226,31 +241,47 @@ def excerpt_rows(methods: list[str]) -> list[dict]:
         dur = y.size / sr
         cuts = [
             (start, length)
-            for start in np.arange(0.0, dur, EXCERPT_STEP_S)
-            for length in EXCERPT_LENGTHS_S
+            for start in np.arange(0.0, dur, step)
+            for length in lengths
             if start + length <= dur
         ]
-        for method in methods:
-            f, cml = [], []
-            for start, length in cuts:
-                seg = y[int(start * sr) : int((start + length) * sr)]
-                r = ref[(ref >= start) & (ref < start + length)] - start
-                s = evaluate_beats(r, track(method, seg, sr), min_beat_time=5.0)
-                f.append(s["F-measure"])
-                cml.append(s["Correct Metric Level Total"])
-            f = np.array(f)
-            rows.append(
-                {
-                    "recording": name,
+        groups = (
+            [(L, [c for c in cuts if c[1] == L]) for L in lengths] if per_length else [(None, cuts)]
+        )
+        for length, group in groups:
+            for method in methods:
+                f, cml, warned = [], [], 0
+                for start, cut in group:
+                    seg = y[int(start * sr) : int((start + cut) * sr)]
+                    r = ref[(ref >= start) & (ref < start + cut)] - start
+                    with warnings.catch_warnings(record=True) as caught:
+                        warnings.simplefilter("always", BeatsyncWarning)
+                        est = track(method, seg, sr)
+                    warned += any(issubclass(w.category, BeatsyncWarning) for w in caught)
+                    s = evaluate_beats(r, est, min_beat_time=min_beat_time)
+                    f.append(s["F-measure"])
+                    cml.append(s["Correct Metric Level Total"])
+                f = np.array(f)
+                row = {"recording": name}
+                if per_length:
+                    row["clip [s]"] = length
+                row |= {
                     "method": method,
-                    "excerpts": len(cuts),
+                    "excerpts": len(group),
                     "mean F": float(f.mean()),
                     "lowest F": float(f.min()),
                     "excerpts with F < 0.95": int((f < 0.95).sum()),
                     "mean CMLt": float(np.mean(cml)),
                 }
-            )
+                if per_length:
+                    row["warned"] = f"{warned}/{len(group)}" if method == "psf" else ""
+                rows.append(row)
     return rows
+
+
+def short_rows(methods: list[str]) -> list[dict]:
+    """:func:`excerpt_rows` on short clips (:data:`SHORT_LENGTHS_S`), one row per length."""
+    return excerpt_rows(methods, SHORT_LENGTHS_S, SHORT_STEP_S, min_beat_time=0.0, per_length=True)
 
 
 def accuracy_only(seeds: list[int], methods: list[str]) -> int:
@@ -272,6 +303,8 @@ def accuracy_only(seeds: list[int], methods: list[str]) -> int:
 
     print("## excerpts of the real recordings\n")
     print(_md_table(pd.DataFrame(excerpt_rows(methods))))
+    print("\n## short clips of the real recordings\n")
+    print(_md_table(pd.DataFrame(short_rows(methods))))
     return 0
 
 
@@ -354,6 +387,7 @@ def main() -> int:
     real = real.drop(columns=["group", "seconds"])
     meters = study.meter_estimates(real_items)
     excerpts = pd.DataFrame(excerpt_rows(study.available_methods()))
+    short = pd.DataFrame(short_rows(study.available_methods()))
 
     # ------------------------------------------------------------------ write
     facts = _machine.machine_facts()
@@ -401,6 +435,16 @@ def main() -> int:
         "any part of a recording? Overlapping excerpts of two recordings: a sanity check.",
         "",
         _md_table(excerpts),
+        "",
+        "## Short clips of the real recordings (every available tracker)",
+        "",
+        f"Clips of {', '.join(f'{x:g}' for x in SHORT_LENGTHS_S)} s starting every "
+        f"{SHORT_STEP_S:g} s, scored from 0 s: how long a clip a tracker needs. Clips "
+        "shorter than the tempo window (8 s) are one analysis window for our tracker, "
+        "with no tempo path to smooth over. `warned`: clips on which our tracker warned "
+        "of no clear pulse.",
+        "",
+        _md_table(short),
         "",
         "## Targets on the synthetic set (seed 0)",
         "",
@@ -466,6 +510,7 @@ def main() -> int:
         "real_targets": real_targets.to_dict(orient="records"),
         "meters": meters.to_dict(orient="records"),
         "excerpts": excerpts.to_dict(orient="records"),
+        "short_clips": short.to_dict(orient="records"),
         "speed": speed.to_dict(orient="records"),
         "speed_real": real_speed.to_dict(orient="records"),
         "startup": startup.to_dict(orient="records"),
