@@ -71,9 +71,9 @@ At 180 BPM, the labelled level minus the half-note level is -0.24 (``beta * s``
 averaged over windows). At 90 BPM, the labelled level minus the eighth-note level is
 -0.03. Every evaluation above shares this, because the kick and the snare fall in
 different bands and each band on its own repeats every two beats. So with a wider
-tactus prior (sigma 0.45 or 0.6 instead of 0.3) the 90 BPM pattern is tapped at 180
-on every seed, and the 180 BPM pattern is still tapped at 90 on two of the three
-seeds. Nothing else we measured helped:
+tactus prior (sigma 0.45 or 0.6 instead of 0.3) the clean 90 BPM pattern is tapped
+at 180 on every seed (seeds 0-2), and the 180 BPM pattern with drift or noise is
+still tapped at 90. Nothing else we measured helped:
 
 - The band sum added as a fifth band changed no level. The band sum alone tapped
   180 BPM clicks at 90.
