@@ -490,11 +490,13 @@ def main() -> int:
         "on 84 noises of 2-30 s (ratios 0.36-1.97) and the seven bundled real recordings "
         "(3.22-12.5), never on the synthetic set.",
         "- Known gaps: the drum pattern is tapped at 90 BPM at 180 BPM (and at 120 BPM at "
-        "60 BPM on some seeds and with drift): the per-window resonator salience falls "
-        "with the period for a periodic pattern, so the evidence prefers the faster pulse "
-        "and the tactus prior picks the level; the tempo-change items at 60, 120 and 180 "
-        "BPM switch level at the change. The madmom sample (2.8 s) is not tapped at its "
-        "level (nor by librosa or essentia here).",
+        "60 BPM on some seeds and with drift), and the tempo-change items at 60, 120 and "
+        "180 BPM switch level at the change. The pattern at 90 and at 180 BPM is the same "
+        "pattern scaled, and our salience does not peak at the labelled level of either "
+        "(labelled minus half-note level -0.24 at 180 BPM, labelled minus eighth-note "
+        "level -0.03 at 90 BPM), so no single tactus prior taps both at their level (the "
+        "`beatsync.beats.metrical` docstring lists what was measured). The madmom sample "
+        "(2.8 s) is not tapped at its level (nor by librosa or essentia here).",
         "- Speed: `psf` analyses at 22.05 kHz (higher rates are resampled first, by soxr); "
         "librosa analyses at the input rate. Steady-state times exclude each tracker's "
         "first call; the first-call rows show it. Absolute times depend on the machine's "
