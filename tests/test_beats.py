@@ -15,6 +15,7 @@ from beatsync.beats import (
     phase_slope,
     track_beats,
 )
+from beatsync.beats.phase import band_phase_weights
 from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.evaluate.beats import evaluate_beats
 from beatsync.synth.audio import (
@@ -197,6 +198,41 @@ def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
     s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=5.0)
     assert s["F-measure"] >= 0.95
     assert s["Correct Metric Level Total"] >= 0.90
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, start, length",
+    [
+        ("hainsworth_001", 13.0, 7.0),
+        ("hainsworth_001", 10.0, 10.0),
+        ("hainsworth_001", 13.0, 10.0),
+        ("ballroom_waltz", 18.0, 7.0),
+        ("ballroom_waltz", 20.0, 10.0),
+    ],
+)
+def test_real_short_clips_on_the_beat_not_the_off_beat(name, start, length):
+    # short clips that the bass band's random phases put on the off-beat when the
+    # bands had equal weights in the phase observation (F 0.00 each)
+    y, sr, ref = datasets.load_real_dev(name)
+    y = y[int(start * sr) : int((start + length) * sr)]
+    ref = ref[(ref >= start) & (ref < start + length)] - start
+    s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=0.0)
+    assert s["F-measure"] >= 0.95
+
+
+def test_band_phase_weights_favour_the_band_locked_to_the_beat():
+    n = 1000  # frames at 100 fps
+    cycles = np.arange(n) / 50.0  # 120 BPM
+    rng = np.random.default_rng(0)
+    bands = np.zeros((3, n))
+    bands[0, rng.integers(0, n, 400)] = 5.0  # loud, at every phase
+    bands[1, ::50] = 1.0  # quiet, on every beat
+    bands[2, 25::50] = 1.0  # quiet, on every off-beat
+    w = band_phase_weights(bands, cycles)
+    assert w.sum() == pytest.approx(1.0)
+    assert w[1] == pytest.approx(w[2]) and w[1] > 5 * w[0]
+    assert np.allclose(band_phase_weights(np.zeros((4, n)), cycles), 0.25)
 
 
 @pytest.mark.slow
