@@ -283,8 +283,11 @@ def test_short_noise_warns_no_clear_pulse(seconds):
     # one or a few tempo windows: the salience of noise is high, but no higher than
     # that of the same onsets in random order
     y = np.random.default_rng(1).standard_normal(seconds * SR)
-    with pytest.warns(BeatsyncWarning, match="no clear pulse.*random order"):
+    with pytest.warns(BeatsyncWarning, match="no clear pulse.*random order") as rec:
         track_beats(y, SR)
+    # a clip shorter than the tempo window is told so
+    short = any("shorter than the 8 s tempo window" in str(w.message) for w in rec)
+    assert short == (seconds < 8)
 
 
 def test_pulse_clarity_null_is_reproducible_and_low_on_clicks():
