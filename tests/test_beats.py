@@ -183,27 +183,14 @@ def test_madmom_sample_with_known_bpm():
 @pytest.mark.parametrize(
     "name, start, length",
     [
+        # long excerpts that the bass band (onsets at every phase of the beat) pulled onto
+        # the off-beat when the bands were weighted 5:4:3:2 (F 0.00, 0.00, 0.47, 0.68)
         ("ballroom_waltz", 10.0, 15.0),
         ("ballroom_waltz", 12.5, 15.0),
         ("ballroom_waltz", 5.0, 25.0),
         ("hainsworth_001", 0.0, 20.0),
-    ],
-)
-def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
-    # excerpts whose phase the bass band (onsets at every phase of the beat) pulled onto
-    # the off-beat when the bands were weighted 5:4:3:2 (F 0.00, 0.00, 0.47, 0.68)
-    y, sr, ref = datasets.load_real_dev(name)
-    y = y[int(start * sr) : int((start + length) * sr)]
-    ref = ref[(ref >= start) & (ref < start + length)] - start
-    s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=5.0)
-    assert s["F-measure"] >= 0.95
-    assert s["Correct Metric Level Total"] >= 0.90
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize(
-    "name, start, length",
-    [
+        # short clips that its random phases still put on the off-beat when the bands had
+        # equal weights (F 0.00 each)
         ("hainsworth_001", 13.0, 7.0),
         ("hainsworth_001", 10.0, 10.0),
         ("hainsworth_001", 13.0, 10.0),
@@ -211,14 +198,14 @@ def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
         ("ballroom_waltz", 20.0, 10.0),
     ],
 )
-def test_real_short_clips_on_the_beat_not_the_off_beat(name, start, length):
-    # short clips that the bass band's random phases put on the off-beat when the
-    # bands had equal weights in the phase observation (F 0.00 each)
+def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
     y, sr, ref = datasets.load_real_dev(name)
     y = y[int(start * sr) : int((start + length) * sr)]
     ref = ref[(ref >= start) & (ref < start + length)] - start
-    s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=0.0)
+    # mir_eval's default skips the first 5 s, which a 7-10 s clip cannot spare
+    s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=5.0 if length > 10 else 0.0)
     assert s["F-measure"] >= 0.95
+    assert s["Correct Metric Level Total"] >= 0.90
 
 
 def test_band_phase_weights_favour_the_band_locked_to_the_beat():
