@@ -8,7 +8,8 @@ every real recording with human annotations in ``data/`` (Hainsworth 001, the
 Ballroom waltz, the madmom sample) for every tracker available
 (:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed),
 whole, in excerpts of 15-30 s starting every 2.5 s (:func:`excerpt_rows`) and in
-short clips of 3-10 s starting every 1 s (:func:`short_rows`).
+short clips of 3-10 s starting every 1 s (:func:`short_rows`); our meter estimate on
+the synthetic meter patterns at 60-160 BPM (:func:`meter_rows`).
 
 Speed, each as a ratio against librosa measured in the same run:
 
@@ -284,6 +285,44 @@ def short_rows(methods: list[str]) -> list[dict]:
     return excerpt_rows(methods, SHORT_LENGTHS_S, SHORT_STEP_S, min_beat_time=0.0, per_length=True)
 
 
+#: Synthetic meters: tempi [bpm] and seeds of :func:`meter_rows`.
+METER_TEMPI = (60.0, 70.0, 90.0, 100.0, 120.0, 140.0, 160.0)
+METER_SEEDS = (1, 3)
+
+
+def meter_rows() -> list[dict]:
+    """Our meter estimate on the synthetic meter patterns, per meter.
+
+    :func:`beatsync.synth.audio.meter_pattern` (2/4, 3/4, 6/8) at every tempo of
+    :data:`METER_TEMPI`, 20 s, seeds :data:`METER_SEEDS`: how often ``beats_per_bar`` is
+    the meter's, and the misses as ``bpm:estimate``. The test suite covers four of these
+    items; this table is the whole grid.
+    """
+    from beatsync.beats import track_beats
+    from beatsync.synth.audio import METERS, beat_times, meter_pattern
+
+    rows = []
+    for meter, (per_bar, _) in METERS.items():
+        misses, n = [], 0
+        for bpm in METER_TEMPI:
+            for seed in METER_SEEDS:
+                ref = beat_times(bpm, duration=20.0, start=0.4)
+                bt = track_beats(meter_pattern(ref, meter=meter, duration=20.0, seed=seed), 22050)
+                n += 1
+                if bt.beats_per_bar != per_bar:
+                    misses.append(f"{bpm:g}:{bt.beats_per_bar}")
+        rows.append(
+            {
+                "meter": meter,
+                "beats per bar": per_bar,
+                "items": n,
+                "right": n - len(misses),
+                "misses (bpm:estimate)": " ".join(misses),
+            }
+        )
+    return rows
+
+
 def accuracy_only(seeds: list[int], methods: list[str]) -> int:
     """Targets of the synthetic set per seed, and the items under F 0.95 (printed)."""
     from beatsync.study import paper_a_beats as study
@@ -305,6 +344,9 @@ def accuracy_only(seeds: list[int], methods: list[str]) -> int:
     print(_md_table(pd.DataFrame(excerpt_rows(methods))))
     print("\n## short clips of the real recordings\n")
     print(_md_table(pd.DataFrame(short_rows(methods))))
+    if "psf" in methods:
+        print("\n## meter of the synthetic meter patterns (psf)\n")
+        print(_md_table(pd.DataFrame(meter_rows())))
     return 0
 
 
@@ -386,6 +428,7 @@ def main() -> int:
     real_targets = study.check_targets(real)
     real = real.drop(columns=["group", "seconds"])
     meters = study.meter_estimates(real_items)
+    synth_meters = pd.DataFrame(meter_rows())
     excerpts = pd.DataFrame(excerpt_rows(study.available_methods()))
     short = pd.DataFrame(short_rows(study.available_methods()))
 
@@ -424,6 +467,14 @@ def main() -> int:
         "Our meter estimate (beats per bar; Hainsworth 001 is in 4/4, the waltz in 3/4):",
         "",
         _md_table(meters),
+        "",
+        "Our meter estimate on the synthetic meter patterns (kick on each downbeat, snare "
+        "on the other beats, hi-hat eighths; 2/4, 3/4, 6/8 at "
+        f"{', '.join(f'{x:g}' for x in METER_TEMPI)} BPM, 20 s, seeds "
+        f"{', '.join(map(str, METER_SEEDS))}; any other beats per bar is a miss, also when "
+        "the tempo was tracked at another level):",
+        "",
+        _md_table(synth_meters),
         "",
         _md_table(real_targets),
         "",
@@ -511,6 +562,7 @@ def main() -> int:
         "real": real.to_dict(orient="records"),
         "real_targets": real_targets.to_dict(orient="records"),
         "meters": meters.to_dict(orient="records"),
+        "synthetic_meters": synth_meters.to_dict(orient="records"),
         "excerpts": excerpts.to_dict(orient="records"),
         "short_clips": short.to_dict(orient="records"),
         "speed": speed.to_dict(orient="records"),
