@@ -92,8 +92,8 @@ still tapped at 90. Nothing else we measured helped:
 - Goto's (2001) drum-pattern cue was added to the tactus observation: the beat is the
   interval between a bass drum and a snare drum that alternate. We scored it as the
   low band and a higher band both concentrated at twice the period, in antiphase.
-  On our phase-slope onsets the low band is too dense to show the kick (the score
-  was 0.05 at most). With weight 100, the cue fixed the 60 BPM pattern but not the
+  On our phase-slope onsets the low band is too dense to show the kick (the score,
+  averaged over windows, was 0.05 at most). With weight 100, the cue fixed the 60 BPM pattern but not the
   180 BPM one. With weight 300, it tapped DANCE_R_3 at 190.
 
 The observation exponent ``beta``, the prior widths and the ratio weights are our
