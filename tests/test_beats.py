@@ -220,6 +220,14 @@ def test_band_phase_weights_favour_the_band_locked_to_the_beat():
     assert w.sum() == pytest.approx(1.0)
     assert w[1] == pytest.approx(w[2]) and w[1] > 5 * w[0]
     assert np.allclose(band_phase_weights(np.zeros((4, n)), cycles), 0.25)
+    # a band that slips by half a beat halfway: over the whole signal its phases cancel,
+    # window by window they do not
+    slip = np.zeros((2, n))
+    slip[0, np.r_[0:500:50, 525:1000:50]] = 1.0
+    slip[1, rng.integers(0, n, 40)] = 1.0
+    assert band_phase_weights(slip, cycles)[0] < 0.3
+    w = band_phase_weights(slip, cycles, [0, 500], [500, 1000])
+    assert w[0] > 0.7
 
 
 @pytest.mark.slow

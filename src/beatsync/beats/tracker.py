@@ -440,7 +440,7 @@ def _warn_if_no_clear_pulse(
             # brown noise of those lengths, and 3.5-4.2 at 7 s (the short-clip table of
             # benchmarks/bench_beats.py counts the warnings)
             why = (
-                f"the audio is only {duration:.1f} s long, shorter than the {tempo_win_s:g} s "
+                f"the audio is only {duration:.2f} s long, shorter than the {tempo_win_s:g} s "
                 "tempo window: give a longer excerpt if you can (or it is noise or free "
                 "rhythm);"
             )
