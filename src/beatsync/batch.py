@@ -57,8 +57,13 @@ def prepare_clip(
     from .segment import segment
 
     motion = io.read_motion(path, fps=fps)
-    clip = {"clip": Path(path).stem, "motion": motion, "boundaries": None}
-    clip.update(mean_period_s=float("nan"), note="")
+    clip = {
+        "clip": Path(path).stem,
+        "motion": motion,
+        "boundaries": None,
+        "mean_period_s": float("nan"),
+        "note": "",
+    }
     if mode == "beats":
         return clip
     try:
@@ -199,10 +204,11 @@ def sync_grid(
     import pandas as pd
 
     from .cluster import check_cluster_options, dask_client
+    from .sync import MODES
 
     check_cluster_options(scheduler, n_workers)
-    if mode not in ("periods", "beats", "auto"):
-        raise ParameterError(f"mode={mode!r} must be one of periods, beats, auto")
+    if mode not in MODES:
+        raise ParameterError(f"mode={mode!r} must be one of {', '.join(MODES)}")
     clips = [str(c) for c in clips]
     songs = [str(s) for s in songs]
     if not clips or not songs:

@@ -267,6 +267,11 @@ def _pipeline(
             beats = check_times(
                 io.read_beats(args.beats), name=f"beat times in {args.beats!r}", duration=music_s
             )
+            if beats.size < 2:
+                raise ParameterError(
+                    f"the beats file {args.beats!r} holds {beats.size} beat time(s); at least "
+                    "two are needed to sync a dance"
+                )
             beat_source = f"file {args.beats}"
         else:
             from ..beats import track_beats
@@ -281,16 +286,11 @@ def _pipeline(
             if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
                 meter = (int(track.beats_per_bar), "estimated by track_beats")
             beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
-        if beats.size < 2 and args.beats is not None:
-            raise ParameterError(
-                f"the beats file {args.beats!r} holds {beats.size} beat time(s); at least two "
-                "are needed to sync a dance"
-            )
-        if beats.size < 2:
-            raise ParameterError(
-                f"no detectable beats in {args.audio!r} ({beats.size} found): is it silent "
-                "or without rhythm? give --bpm or --beats FILE"
-            )
+            if beats.size < 2:
+                raise ParameterError(
+                    f"no detectable beats in {args.audio!r} ({beats.size} found): is it silent "
+                    "or without rhythm? give --bpm or --beats FILE"
+                )
         timings["beats_s"] = time.perf_counter() - t0
 
     with fb.step("synchronising motion"):
