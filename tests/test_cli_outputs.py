@@ -175,6 +175,25 @@ def test_output_same_as_input_is_refused(argv, option, inputs, tmp_path, capsys)
     assert not any(outdir.iterdir())
 
 
+@pytest.mark.parametrize(
+    "argv, victim",
+    [
+        # --out where --click was meant: the beat times as text would replace a sound file
+        (["beats", "{song}", "--out", "{o}/mix.wav"], "mix.wav"),
+        (["segment", "{clip}", "--out", "{o}/dance.bvh"], "dance.bvh"),
+    ],
+)
+def test_text_output_named_like_a_media_file_is_refused(argv, victim, inputs, tmp_path, capsys):
+    outdir = tmp_path / "o"
+    outdir.mkdir()
+    target = outdir / victim
+    target.write_bytes(b"precious")
+    argv = [a.format(o=outdir, **inputs) for a in argv]
+    code, _, err = _run(argv, capsys)
+    _assert_refused(code, err, "as text", "--out")
+    assert target.read_bytes() == b"precious"
+
+
 def test_two_options_naming_one_file_are_refused(inputs, tmp_path, capsys):
     out = tmp_path / "same.json"
     argv = ["sync", str(inputs["clip"]), str(inputs["song"]), "-o", str(tmp_path / "a.bvh")]

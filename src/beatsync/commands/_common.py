@@ -183,13 +183,16 @@ def check_output(
     option: str = "output",
     inputs: Iterable[str | os.PathLike[str] | None] = (),
     suffixes: Iterable[str] | None = None,
+    text: str | None = None,
 ) -> Path:
     """Refuse an output path that cannot be written whole; return it as a ``Path``.
 
-    Refused, in this order: a wrong suffix (if ``suffixes`` are given), an existing
-    folder, an existing file that is not a regular file (a device, a pipe), a read-only
-    file, the same file as one of ``inputs`` (also through links), a missing or
-    unwritable folder. Nothing is touched on disk.
+    Refused, in this order: a wrong suffix (if ``suffixes`` are given), the suffix of an
+    audio, video or binary motion file for a text output (``text`` says what the file
+    holds, e.g. ``"beat times"``: writing it would replace such a file with text), an
+    existing folder, an existing file that is not a regular file (a device, a pipe), a
+    read-only file, the same file as one of ``inputs`` (also through links), a missing
+    or unwritable folder. Nothing is touched on disk.
     """
     p = Path(path)
     name = f"{option} {str(path)!r}"
@@ -197,6 +200,12 @@ def check_output(
         allowed = tuple(s.lower() for s in suffixes)
         if p.suffix.lower() not in allowed:
             raise ParameterError(f"{name} must end in {' or '.join(allowed)}")
+    if text is not None and p.suffix.lower() in _media_suffixes():
+        raise ParameterError(
+            f"{name} ends in {p.suffix}, the suffix of an audio, video or motion file, but "
+            f"{option} writes {text} as text: a mistaken option or argument? choose a text "
+            "file name (e.g. .txt)"
+        )
     if p.is_dir():
         example = p / ("output" + (p.suffix or next(iter(suffixes or ()), "")))
         raise ParameterError(
@@ -280,6 +289,15 @@ def _mkdtemp(folder: Path) -> Path:
     return Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=folder))
 
 
+def _media_suffixes() -> frozenset[str]:
+    """Suffixes of the audio, video and binary motion files beatsync reads or writes."""
+    from ..io import AUDIO_SUFFIXES, SOUNDFILE_SUFFIXES
+
+    return frozenset(
+        {*AUDIO_SUFFIXES, *SOUNDFILE_SUFFIXES, ".mp4", ".bvh", ".mat", ".npy", ".npz", ".c3d"}
+    )
+
+
 class Outputs:
     """Every output file of one command: checked up front, written all-or-nothing.
 
@@ -332,9 +350,10 @@ class Outputs:
         *,
         option: str = "output",
         suffixes: Iterable[str] | None = None,
+        text: str | None = None,
     ) -> Path:
         """Declare an output file and check it now (see :func:`check_output`)."""
-        p = check_output(path, option=option, inputs=self._inputs, suffixes=suffixes)
+        p = check_output(path, option=option, inputs=self._inputs, suffixes=suffixes, text=text)
         key = p.resolve()
         if key in self._declared:
             other = self._declared[key][1]

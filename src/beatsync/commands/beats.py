@@ -82,7 +82,9 @@ def run(args: Any) -> int:
         )
     fb = feedback(args)
     with Outputs(inputs=[args.audio]) as outs:  # both files are written, or neither
-        out = outs.add(args.out, option="--out") if args.out is not None else None
+        out = (
+            outs.add(args.out, option="--out", text="beat times") if args.out is not None else None
+        )
         click = (
             outs.add(args.click, option="--click", suffixes=(".wav", ".flac"))
             if args.click is not None

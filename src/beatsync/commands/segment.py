@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         period_range = period_range_from_beat(60.0 / check_bpm(args.bpm, name="--bpm"))
     fb = feedback(args)
     outs = Outputs(inputs=[args.motion])
-    out = outs.add(args.out, option="--out") if args.out else None
+    out = outs.add(args.out, option="--out", text="a CSV table of boundaries") if args.out else None
     with fb.step("reading motion"):
         motion = io.read_motion(
             args.motion, fps=args.fps, variable=args.variable, **position_options(args)
