@@ -90,3 +90,41 @@ def test_local_workers_keep_glibc_default_malloc():
     with cluster.dask_client(n_workers=1, processes=True) as client:
         (env,) = client.run(environ).values()
     assert env == (None, "1")
+
+
+class _FlakyHandshake:
+    """A stand-in for ``distributed.Client`` whose first ``fail`` connections trip the
+    handshake assertion, as when a broadcast is batched with "stream-start"."""
+
+    def __init__(self, fail):
+        self.fail, self.calls = fail, []
+
+    def __call__(self, address, timeout):
+        self.calls.append(timeout)
+        if len(self.calls) <= self.fail:
+            raise AssertionError
+        return ("client", address)
+
+
+def test_connection_handshake_race_is_retried():
+    """CI once failed: a shared test scheduler's broadcast arrived with "stream-start"
+    and the client's bare `assert len(msg) == 1` ended the batch run."""
+    flaky = _FlakyHandshake(fail=2)
+    got = cluster._client_with_handshake_retries(flaky, "tcp://127.0.0.1:1", 5.0)
+    assert got == ("client", "tcp://127.0.0.1:1") and len(flaky.calls) == 3
+    assert all(0.5 <= t <= 5.0 for t in flaky.calls)
+
+
+def test_connection_handshake_failing_every_time_is_reported(monkeypatch):
+    flaky = _FlakyHandshake(fail=99)
+    with pytest.raises(AssertionError):
+        cluster._client_with_handshake_retries(flaky, "tcp://127.0.0.1:1", 5.0)
+    assert len(flaky.calls) == cluster.HANDSHAKE_ATTEMPTS
+
+    import dask.distributed
+
+    monkeypatch.setattr(dask.distributed, "Client", _FlakyHandshake(fail=99))
+    with pytest.raises(
+        ParameterError, match=r"could not connect .*AssertionError: its reply to 3 connections"
+    ):
+        cluster._connect("tcp://127.0.0.1:1", 1.0)

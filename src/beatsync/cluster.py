@@ -168,6 +168,33 @@ def _glibc_default_malloc() -> Any:
     return dask.config.set({key: env})
 
 
+#: Connection attempts when the scheduler's first reply is not the lone "stream-start".
+HANDSHAKE_ATTEMPTS = 3
+
+
+def _client_with_handshake_retries(client_cls: Any, address: str, timeout: float) -> Any:
+    """``Client(address)``, tried again when the connection handshake trips an assertion.
+
+    The scheduler batches its messages to a client every 2 ms; a message broadcast to
+    all clients in that window (another client's cancelled keys, say) arrives together
+    with the "stream-start" reply, and ``distributed``'s client then fails
+    ``assert len(msg) == 1`` with no message. That is a race on a busy shared
+    scheduler, not a bad address: a fresh connection succeeds. Other errors, and the
+    last failed attempt, go to the caller.
+    """
+    import time
+
+    deadline = time.monotonic() + timeout
+    attempt = 1
+    while True:
+        try:
+            return client_cls(address, timeout=max(deadline - time.monotonic(), 0.5))
+        except AssertionError:
+            if attempt >= HANDSHAKE_ATTEMPTS or time.monotonic() >= deadline:
+                raise
+            attempt += 1
+
+
 def _connect(address: str, timeout: float) -> Any:
     from dask.distributed import Client
     from distributed.comm import parse_address
@@ -177,7 +204,7 @@ def _connect(address: str, timeout: float) -> Any:
         # an unknown scheme is refused here, not inside the client's connection retries
         # (which, on a busy machine, can time out before they report the scheme)
         get_backend(parse_address(address)[0])
-        return Client(address, timeout=timeout)
+        return _client_with_handshake_retries(Client, address, timeout)
     except ValueError as exc:  # malformed address: unknown scheme, no port
         raise ParameterError(
             f"--scheduler {address!r} is not a Dask scheduler address ({exc}); "
@@ -186,6 +213,12 @@ def _connect(address: str, timeout: float) -> Any:
     except Exception as exc:  # refused, timed out, or something else answering there
         if isinstance(exc, (OSError, TimeoutError)):
             reason = f"within {timeout:g} s (no answer)"
+        elif isinstance(exc, AssertionError) and not str(exc):
+            reason = (
+                f"(AssertionError: its reply to {HANDSHAKE_ATTEMPTS} connections was not "
+                "the handshake a Dask client expects; is it a Dask scheduler of the same "
+                "version, and not overloaded?)"
+            )
         else:  # failed at once, not a time-out: say how
             reason = f"({type(exc).__name__}: {exc})" if str(exc) else f"({type(exc).__name__})"
         raise ParameterError(
