@@ -9,7 +9,10 @@ Ballroom waltz, the madmom sample) for every tracker available
 (:func:`beatsync.study.paper_a_beats.available_methods`: essentia's when installed),
 whole, in excerpts of 15-30 s starting every 2.5 s (:func:`excerpt_rows`) and in
 short clips of 3-10 s starting every 1 s (:func:`short_rows`); our meter estimate on
-the synthetic meter patterns at 60-160 BPM (:func:`meter_rows`).
+the synthetic meter patterns at 60-160 BPM (:func:`meter_rows`); and, for the four
+unannotated songs of the dance pairs, excerpts scored against our own beats of the
+whole song (:func:`dance_song_rows`: consistency, and whether the warning marks the
+excerpts that disagree).
 
 Speed, each as a ratio against librosa measured in the same run:
 
@@ -289,6 +292,73 @@ def short_rows(methods: list[str]) -> list[dict]:
     return excerpt_rows(methods, SHORT_LENGTHS_S, SHORT_STEP_S, min_beat_time=0.0, per_length=True)
 
 
+#: Excerpt lengths [s] and step [s] of :func:`dance_song_rows`.
+DANCE_EXCERPT_LENGTHS_S = (10.0, 15.0, 20.0)
+DANCE_EXCERPT_STEP_S = 2.5
+#: Agreement F under which an excerpt of a dance song counts as disagreeing.
+DANCE_AGREE_F = 0.9
+
+
+def dance_song_rows() -> list[dict]:
+    """Our tracker on the songs of the dance pairs: excerpts against the whole song.
+
+    The four songs that real dancers danced to have no beat annotations. The beats of
+    each whole song stand in as the reference for excerpts of
+    :data:`DANCE_EXCERPT_LENGTHS_S` starting every :data:`DANCE_EXCERPT_STEP_S` s
+    (scored after 5 s, as :func:`excerpt_rows`): a measure of consistency, not of
+    accuracy. The columns say how many excerpts disagree (F < :data:`DANCE_AGREE_F`),
+    how many of those the tracker warned of no clear pulse, and how many agreeing
+    excerpts it warned of anyway: whether the warning marks the excerpts that go wrong.
+    """
+    import warnings
+
+    from beatsync import datasets
+    from beatsync.beats import track_beats
+    from beatsync.errors import BeatsyncWarning
+    from beatsync.evaluate.beats import evaluate_beats
+
+    def tracked(y, sr):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            bt = track_beats(y, sr)
+        warned = any(
+            issubclass(w.category, BeatsyncWarning) and "no clear pulse" in str(w.message)
+            for w in caught
+        )
+        return bt, warned
+
+    rows = []
+    for name in datasets.DANCE_PAIRS:
+        pair = datasets.load_dance_pair(name)
+        y, sr = pair.y, pair.sr
+        whole, whole_warned = tracked(y, sr)
+        dur = y.size / sr
+        f, warned = [], []
+        for length in DANCE_EXCERPT_LENGTHS_S:
+            for start in np.arange(0.0, dur - length + 1e-9, DANCE_EXCERPT_STEP_S):
+                seg = y[int(start * sr) : int((start + length) * sr)]
+                bt, w = tracked(seg, sr)
+                ref = whole.beats[(whole.beats >= start) & (whole.beats < start + length)]
+                f.append(evaluate_beats(ref - start, bt.beats, min_beat_time=5.0)["F-measure"])
+                warned.append(w)
+        f, warned = np.array(f), np.array(warned)
+        bad = f < DANCE_AGREE_F
+        rows.append(
+            {
+                "song": f"{name} ({pair.style})",
+                "whole: tempo [bpm]": whole.tempo,
+                "whole: beats per bar": whole.beats_per_bar,
+                "whole: warned": "yes" if whole_warned else "no",
+                "excerpts": f.size,
+                "mean F against the whole": float(f.mean()),
+                f"disagreeing (F < {DANCE_AGREE_F:g})": int(bad.sum()),
+                "disagreeing, warned": int((bad & warned).sum()),
+                "agreeing, warned": int((~bad & warned).sum()),
+            }
+        )
+    return rows
+
+
 #: Synthetic meters: tempi [bpm] and seeds of :func:`meter_rows`.
 METER_TEMPI = (60.0, 70.0, 90.0, 100.0, 120.0, 140.0, 160.0)
 METER_SEEDS = (1, 3)
@@ -348,6 +418,9 @@ def accuracy_only(seeds: list[int], methods: list[str]) -> int:
     print(_md_table(pd.DataFrame(excerpt_rows(methods))))
     print("\n## short clips of the real recordings\n")
     print(_md_table(pd.DataFrame(short_rows(methods))))
+    if "psf" in methods:
+        print("\n## the dancers' songs: excerpts against the whole song (psf)\n")
+        print(_md_table(pd.DataFrame(dance_song_rows())))
     if "psf" in methods:
         print("\n## meter of the synthetic meter patterns (psf)\n")
         print(_md_table(pd.DataFrame(meter_rows())))
@@ -435,6 +508,7 @@ def main() -> int:
     synth_meters = pd.DataFrame(meter_rows())
     excerpts = pd.DataFrame(excerpt_rows(study.available_methods()))
     short = pd.DataFrame(short_rows(study.available_methods()))
+    dance_songs = pd.DataFrame(dance_song_rows())
 
     # ------------------------------------------------------------------ write
     facts = _machine.machine_facts()
@@ -500,6 +574,16 @@ def main() -> int:
         "of no clear pulse.",
         "",
         _md_table(short),
+        "",
+        "## The dancers' songs: excerpts against the whole song (psf)",
+        "",
+        "The four songs of the dance pairs (cha-cha, rumba, two waltzes) have no beat "
+        "annotations. Our beats of each whole song stand in as the reference for excerpts "
+        f"of {', '.join(f'{x:g}' for x in DANCE_EXCERPT_LENGTHS_S)} s starting every "
+        f"{DANCE_EXCERPT_STEP_S:g} s, scored after 5 s: consistency, not accuracy. "
+        "`warned`: excerpts on which our tracker warned of no clear pulse.",
+        "",
+        _md_table(dance_songs),
         "",
         "## Targets on the synthetic set (seed 0)",
         "",
@@ -569,6 +653,7 @@ def main() -> int:
         "synthetic_meters": synth_meters.to_dict(orient="records"),
         "excerpts": excerpts.to_dict(orient="records"),
         "short_clips": short.to_dict(orient="records"),
+        "dance_songs": dance_songs.to_dict(orient="records"),
         "speed": speed.to_dict(orient="records"),
         "speed_real": real_speed.to_dict(orient="records"),
         "startup": startup.to_dict(orient="records"),
