@@ -95,6 +95,11 @@ still tapped at 90. Nothing else we measured helped:
   level by 9-25 (log observation summed over ten windows): 120 BPM over 60 by 22,
   80 over 160 by 25, 135 over 67.5 by 9. Nor would keeping the meter help: the best
   measure is two beats on both sides of the decoded 120 -> 80 BPM switch.
+- A narrower ratio model (``ratio_sigma`` 0.15 instead of the paper's 0.3, so that a
+  tactus of three tatums counts against one of two or four) changed nothing on the
+  synthetic set or the madmom sample (119.8 BPM), lifted the 5 s clips of
+  Hainsworth 001 from mean F 0.654 to 0.751, and lowered those of the waltz
+  (5 s: 0.911 to 0.905; 7 s: 0.967 to 0.960). Mixed, and seen on two recordings only.
 - Goto's (2001) drum-pattern cue was added to the tactus observation: the beat is the
   interval between a bass drum and a snare drum that alternate. We scored it as the
   low band and a higher band both concentrated at twice the period, in antiphase.
