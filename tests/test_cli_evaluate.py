@@ -217,7 +217,8 @@ def test_missing_folder(dataset, tmp_path):
     [
         (1000.0, 0, "looks like milliseconds"),
         (100.0, 0, "looks like frame indices"),
-        (44100.0, 0, "looks like not beat times"),
+        (44100.0, 0, "looks like sample indices"),
+        (10.0, 0, "looks like frame indices"),  # 10 frames/s: once taken for seconds
     ],
 )
 def test_annotation_not_in_seconds(dataset, tmp_path, scale, decimals, match):

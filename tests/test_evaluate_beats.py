@@ -87,7 +87,11 @@ def test_bad_input_raises(ref, est, mbt):
         (np.round(REF * 86.13), "looks like frame indices"),  # librosa frames (hop 512)
         (REF * 1000, "looks like milliseconds"),
         (REF * 1000 + 0.25, "looks like milliseconds"),
-        (REF * 100000, "looks like not beat times"),
+        (REF * 100000, "looks like sample indices"),
+        (np.round(REF * 22050), "looks like sample indices"),
+        # frames at 10 frames/s: 5 apart at 120 BPM, once read as beats 5 s apart
+        (np.round(REF * 10), "looks like frame indices"),
+        (REF * 7.3, "looks like something slower than any beat"),
         (np.array([50000.0, 60000.0]), "milliseconds or frame indices"),
     ],
 )

@@ -28,7 +28,7 @@ import mir_eval
 import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
-from ..units import check_positive, check_times
+from ..units import MIN_BPM, check_positive, check_times
 
 __all__ = [
     "validate",
@@ -53,8 +53,10 @@ __all__ = [
     "MAX_BEAT_INTERVAL",
 ]
 
-#: Beat sequences whose median interval exceeds this [s] are refused (not seconds).
-MAX_BEAT_INTERVAL = 10.0
+#: Beat sequences whose median interval exceeds this [s] are refused (not seconds):
+#: 3 s, the beat period at :data:`beatsync.units.MIN_BPM` (20 BPM), the slowest
+#: tempo the tracker considers.
+MAX_BEAT_INTERVAL = 60.0 / MIN_BPM
 
 #: Keys of the dict returned by :func:`evaluate`.
 METRICS = (
@@ -95,10 +97,12 @@ def diagnose_times(times: np.ndarray) -> str | None:
     Returns
     -------
     str or None
-        ``None`` if the values are plausible beat times in seconds; otherwise a
-        phrase naming what they look like: ``"frame indices"`` (integers at most 150
-        apart: 40 BPM and faster at 100 frames/s), ``"milliseconds"`` (150-3000 apart:
-        20-400 BPM in ms), or ``"not beat times"``.
+        ``None`` if the values are plausible beat times in seconds (a median spacing
+        of at most :data:`MAX_BEAT_INTERVAL`); otherwise a phrase naming what they look
+        like: ``"frame indices"`` (integers less than 150 apart: 40 BPM and faster at
+        100 frames/s), ``"milliseconds"`` (150-3000 apart: 20-400 BPM in ms),
+        ``"sample indices"`` (integers more than 3000 apart), or, for anything else,
+        ``"something slower than any beat (bars? a wrong unit?)"``.
     """
     if times.size == 0:
         return None
@@ -108,11 +112,15 @@ def diagnose_times(times: np.ndarray) -> str | None:
     if step <= MAX_BEAT_INTERVAL and times[-1] <= mir_eval.beat.MAX_TIME:
         return None
     integers = bool(np.all(times == np.round(times)))
+    if step <= MAX_BEAT_INTERVAL and not integers:
+        return f"a recording longer than mir_eval's {mir_eval.beat.MAX_TIME:g} s"
     if integers and step < 150.0:
         return "frame indices"
     if 150.0 <= step <= 3000.0:
         return "milliseconds"
-    return "not beat times"
+    if integers:
+        return "sample indices"
+    return "something slower than any beat (bars? a wrong unit?)"
 
 
 def validate(reference: Any, estimated: Any) -> tuple[np.ndarray, np.ndarray]:
