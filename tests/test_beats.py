@@ -435,6 +435,27 @@ def test_study_scores_and_targets_on_a_small_set():
     assert not targets["target"].str.contains("hainsworth").any()
 
 
+def test_frontend_sweep_lists_the_items_of_a_small_set():
+    """The sweep's mean of three real recordings moved with the 2.8 s sample alone; a
+    small set now shows each item's F beside the mean."""
+    from beatsync.study import paper_a_beats as study
+
+    few = make_beat_test_set(duration=8.0, bpms=[90, 150], kinds=["click"], groups=["clean"])
+    many = make_beat_test_set(duration=6.0, bpms=[60, 80, 100, 120, 140, 160], kinds=["click"],
+                              groups=["clean"])  # fmt: skip
+    sweep = study.frontend_sweep(
+        {"few": few, "many": many}, {"win_s": [0.023], "hop_s": [0.0058]}, min_beat_time=0.0
+    )
+    row = sweep.set_index("set")
+    assert bool(row.loc["few", "default"])
+    listed = row.loc["few", "F per item"].split(", ")
+    assert [x.split()[0] for x in listed] == ["click_90_clean", "click_150_clean"]
+    assert np.mean([float(x.split()[1]) for x in listed]) == pytest.approx(
+        row.loc["few", "F"], abs=1e-3
+    )
+    assert row.loc["many", "F per item"] == ""  # more than SWEEP_ITEMS_LISTED items
+
+
 @pytest.mark.parametrize(
     "grid, p_jump",
     [

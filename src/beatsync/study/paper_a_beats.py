@@ -43,6 +43,7 @@ __all__ = [
     "check_targets",
     "tempo_change_figure",
     "frontend_sweep",
+    "SWEEP_ITEMS_LISTED",
 ]
 
 #: Column names of the study tables.
@@ -207,6 +208,10 @@ def tempo_change_figure(items: Sequence[BeatTestItem], max_items: int = 4):
     return fig
 
 
+#: Item sets of :func:`frontend_sweep` up to this size get the F of each item.
+SWEEP_ITEMS_LISTED = 5
+
+
 def frontend_sweep(
     item_sets: dict[str, Sequence[BeatTestItem]],
     grid: dict[str, Sequence[Any]],
@@ -227,7 +232,9 @@ def frontend_sweep(
     -------
     pandas.DataFrame
         One row per combination and item set: the parameters, whether they are the
-        defaults, mean F, CMLt and AMLt.
+        defaults, mean F, CMLt and AMLt, and for sets of at most
+        :data:`SWEEP_ITEMS_LISTED` items the F of each item (``"F per item"``: a mean
+        of three recordings can move with one of them).
     """
     keys = list(grid)
     rows = []
@@ -246,5 +253,10 @@ def frontend_sweep(
             }
             row.update({"set": set_name, "default": default})
             row.update({m: float(sc[m].mean()) for m in ("F", "CMLt", "AMLt")})
+            row["F per item"] = (
+                ", ".join(f"{r.item} {r.F:.3f}" for r in sc.itertuples())
+                if len(items) <= SWEEP_ITEMS_LISTED
+                else ""
+            )
             rows.append(row)
     return pd.DataFrame(rows)
