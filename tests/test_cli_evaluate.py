@@ -121,7 +121,17 @@ def test_rerun_skips_finished_tracks_and_force_reruns(dataset, scheduler, tmp_pa
     assert len(TrackLog(out / "tracks.jsonl").rows()) == 6  # --force replaced the old rows
 
 
-def test_resume_after_interrupted_run(dataset, scheduler, tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize(
+    "cluster",
+    ["scheduler", pytest.param("two local workers", marks=pytest.mark.slow)],
+)
+def test_resume_after_interrupted_run(dataset, cluster, request, tmp_path, capsys, monkeypatch):
+    """Ctrl-C after three tracks, on an existing cluster and on a local cluster of two
+    worker processes (whose shutdown must not lose the rows already written)."""
+    if cluster == "scheduler":
+        where = ["--scheduler", request.getfixturevalue("scheduler")]
+    else:
+        where = ["--workers", "2"]
     out = tmp_path / "results"
     real_append = TrackLog.append
     calls = []
@@ -133,7 +143,7 @@ def test_resume_after_interrupted_run(dataset, scheduler, tmp_path, capsys, monk
             raise KeyboardInterrupt  # Ctrl-C while the other tracks are in flight
 
     monkeypatch.setattr(TrackLog, "append", append_then_interrupt)
-    code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
+    code, _, err = _run(_argv(dataset, out, *where), capsys)
     assert code == 130
     assert "interrupted by SIGINT; the finished tracks are recorded in" in err
     assert "run the same command again" in err
@@ -144,7 +154,7 @@ def test_resume_after_interrupted_run(dataset, scheduler, tmp_path, capsys, monk
     with open(out / "tracks.jsonl", "a") as fh:
         fh.write('{"key": "rock/drums_96", "meth')
     monkeypatch.setattr(TrackLog, "append", real_append)
-    code, stdout, err = _run(_argv(dataset, out, "--scheduler", scheduler, "--json"), capsys)
+    code, stdout, err = _run(_argv(dataset, out, *where, "--json"), capsys)
     assert code == 0, err
     res = json.loads(stdout)
     ok_before = sum(r["status"] == "ok" for r in done)
