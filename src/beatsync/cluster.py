@@ -7,8 +7,9 @@ before starting anything, gives up on an unreachable scheduler after
 ``timeout`` seconds with a :class:`~beatsync.errors.ParameterError` (not a hang, not
 a traceback), connects again when a busy scheduler's handshake reply came batched with
 another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and
-the local cluster on the way out, also on Ctrl-C. Local workers run with glibc's default memory-allocator settings (Dask's
-``MALLOC_TRIM_THRESHOLD_`` makes our work about 1.8x slower).
+the local cluster on the way out, also on Ctrl-C. Local workers run with glibc's
+default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
+about 1.8x slower).
 
 Workers of an existing cluster must see the same file paths as the client (a shared
 file system) and have beatsync installed.
