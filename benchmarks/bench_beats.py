@@ -216,10 +216,20 @@ SHORT_LENGTHS_S = (3.0, 5.0, 7.0, 10.0)
 SHORT_STEP_S = 1.0
 
 
-def _tempo(beats: np.ndarray) -> float:
-    """Tempo [bpm] of a beat sequence: 60 over its median interval (NaN under 2 beats)."""
-    beats = np.asarray(beats, dtype=np.float64)
-    return 60.0 / float(np.median(np.diff(beats))) if beats.size > 1 else float("nan")
+def _with_pulse_warning(fn, *args):
+    """``fn(*args)``, and whether it warned of no clear pulse (a ``BeatsyncWarning``)."""
+    import warnings
+
+    from beatsync.errors import BeatsyncWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BeatsyncWarning)
+        out = fn(*args)
+    warned = any(
+        issubclass(w.category, BeatsyncWarning) and "no clear pulse" in str(w.message)
+        for w in caught
+    )
+    return out, warned
 
 
 def _tempo_range(tempi: np.ndarray) -> str:
@@ -247,11 +257,8 @@ def excerpt_rows(
     two recordings. ``per_length``: one row per excerpt length, with the share of
     excerpts on which our tracker warned (no clear pulse).
     """
-    import warnings
-
     from beatsync import datasets
-    from beatsync.errors import BeatsyncWarning
-    from beatsync.evaluate.beats import evaluate_beats
+    from beatsync.evaluate.beats import evaluate_beats, median_tempo
     from beatsync.peers import track
 
     rows = []
@@ -273,18 +280,12 @@ def excerpt_rows(
                 for start, cut in group:
                     seg = y[int(start * sr) : int((start + cut) * sr)]
                     r = ref[(ref >= start) & (ref < start + cut)] - start
-                    with warnings.catch_warnings(record=True) as caught:
-                        warnings.simplefilter("always", BeatsyncWarning)
-                        est = track(method, seg, sr)
-                    warned += any(
-                        issubclass(w.category, BeatsyncWarning)
-                        and "no clear pulse" in str(w.message)
-                        for w in caught
-                    )
+                    est, w = _with_pulse_warning(track, method, seg, sr)
+                    warned += w
                     s = evaluate_beats(r, est, min_beat_time=min_beat_time)
                     f.append(s["F-measure"])
                     cml.append(s["Correct Metric Level Total"])
-                    tempi.append(_tempo(est))
+                    tempi.append(median_tempo(est))
                 f = np.array(f)
                 row = {"recording": name}
                 if per_length:
@@ -329,38 +330,25 @@ def dance_song_rows() -> list[dict]:
     many agreeing clips it warned of anyway: whether the warning marks the clips that
     go wrong.
     """
-    import warnings
-
     from beatsync import datasets
     from beatsync.beats import track_beats
-    from beatsync.errors import BeatsyncWarning
-    from beatsync.evaluate.beats import evaluate_beats
-
-    def tracked(y, sr):
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", BeatsyncWarning)
-            bt = track_beats(y, sr)
-        warned = any(
-            issubclass(w.category, BeatsyncWarning) and "no clear pulse" in str(w.message)
-            for w in caught
-        )
-        return bt, warned
+    from beatsync.evaluate.beats import evaluate_beats, median_tempo
 
     rows = []
     for name in datasets.DANCE_PAIRS:
         pair = datasets.load_dance_pair(name)
         y, sr = pair.y, pair.sr
-        whole, whole_warned = tracked(y, sr)
+        whole, whole_warned = _with_pulse_warning(track_beats, y, sr)
         dur = y.size / sr
         f, warned, tempi = [], [], []
         for length in DANCE_EXCERPT_LENGTHS_S:
             for start in np.arange(0.0, dur - length + 1e-9, DANCE_EXCERPT_STEP_S):
                 seg = y[int(start * sr) : int((start + length) * sr)]
-                bt, w = tracked(seg, sr)
+                bt, w = _with_pulse_warning(track_beats, seg, sr)
                 ref = whole.beats[(whole.beats >= start) & (whole.beats < start + length)]
                 f.append(evaluate_beats(ref - start, bt.beats, min_beat_time=5.0)["F-measure"])
                 warned.append(w)
-                tempi.append(_tempo(bt.beats))
+                tempi.append(median_tempo(bt.beats))
         f, warned = np.array(f), np.array(warned)
         bad = f < DANCE_AGREE_F
         rows.append(
@@ -395,6 +383,7 @@ def meter_rows() -> list[dict]:
     level). The test suite covers four of these items; this table is the whole grid.
     """
     from beatsync.beats import track_beats
+    from beatsync.evaluate.beats import octave_relation
     from beatsync.synth.audio import METERS, beat_times, meter_pattern
 
     rows = []
@@ -407,7 +396,7 @@ def meter_rows() -> list[dict]:
                 n += 1
                 if bt.beats_per_bar != per_bar:
                     misses.append(f"{bpm:g}:{bt.beats_per_bar}@{bt.tempo:.0f}")
-                if abs(np.log(bt.tempo / bpm)) > np.log(1.08):
+                if octave_relation(bt.tempo, bpm) != "correct":  # off by more than 8 %
                     off_level.append(f"{bpm:g}@{bt.tempo:.0f}")
         rows.append(
             {
