@@ -122,4 +122,6 @@ def test_noise_warns_on_stderr(tmp_path, capsys):
     assert main(["beats", str(path), "--json"]) == 0
     captured = capsys.readouterr()
     assert "beatsync beats: warning: no clear pulse" in captured.err
+    # the way out is named: a known tempo
+    assert "give it with bpm= (--bpm)" in captured.err
     assert json.loads(captured.out)["warnings"]

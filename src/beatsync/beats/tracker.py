@@ -264,7 +264,8 @@ def track_beats(
         If no onsets are found (e.g. a steady tone): returns no beats. If the pulse
         is unclear (e.g. noise: the salience along the tempo path is less than
         ``MIN_PULSE_CLARITY`` times that of the same onsets in random order, see
-        :func:`pulse_clarity_null`): returns the beats found.
+        :func:`pulse_clarity_null`): returns the beats found, and names the way out
+        (a known ``bpm``, with which only the phase is tracked).
 
     Examples
     --------
@@ -447,7 +448,8 @@ def _warn_if_no_clear_pulse(
         warnings.warn(
             f"no clear pulse in the audio (pulse clarity {clarity:.2f}, less than "
             f"{MIN_PULSE_CLARITY} times the {null:.2f} of the same onsets in random order): "
-            f"{why} the beats may be meaningless",
+            f"{why} the beats may be meaningless or at another metrical level; if you "
+            "know the tempo, give it with bpm= (--bpm) and only the phase is tracked",
             BeatsyncWarning,
             stacklevel=4,
         )
