@@ -107,6 +107,24 @@ still tapped at 90. Nothing else we measured helped:
   averaged over windows, was 0.05 at most). With weight 100, the cue fixed the 60 BPM
   pattern but not the 180 BPM one. With weight 300, it tapped DANCE_R_3 at 190.
 
+Why 10-20 s clips of the Dance-with-Melody waltzes are tapped at 4/3 of the beat
+(measured on their clips; ``dance_song_rows`` in ``benchmarks/bench_beats.py``). The
+measure is found right, about 2.07 s: three beats at 87 BPM, or four at 116 BPM. Both
+readings are consistent metrical trees, and a balance of small terms decides. On the
+first 20 s of DANCE_W_10, summed over its 13 windows:
+
+- the salience favours 87 BPM by 2.9, and the tatum term by 2.0;
+- the tactus prior favours 116 BPM by 3.4, and the measure term by 4.0. About 3 of
+  the 4.0 is the normalisation of ``P(measure | tactus)``, which is larger for a
+  shorter tactus.
+
+Searching only 60-100 BPM moves most of DANCE_W_10's disagreeing clips to 98-102 BPM,
+the edge of the range, not to 87: the salience near the beat is flat on them. Most of
+DANCE_W_5's disagreeing clips are at the right tempo (84-86 BPM) on another phase.
+A known tempo puts the first 20 s of DANCE_W_10 back on the whole excerpt's beats
+(F 0.27 -> 1.0 with ``bpm=87``). The no-clear-pulse warning of
+:mod:`beatsync.beats.tracker` names that way out.
+
 The observation exponent ``beta``, the prior widths and the ratio weights are our
 choices (see :data:`METER_MODEL`): they were set on the synthetic test set, and the
 real recordings were only scored.
