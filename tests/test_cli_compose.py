@@ -191,6 +191,8 @@ def _odd_clip(path):
         ("missing_clip", "does not exist"),
         ("tempo_neg", "--tempo-weight"),
         ("not_bvh_out", "must end in .bvh"),
+        ("range_with_beats", "--min-bpm bounds the tempo"),
+        ("range_reversed", "--min-bpm 150 must be smaller than --max-bpm 100"),
     ],
 )
 def test_bad_inputs_write_nothing(workdir, capsys, case, message):
@@ -218,6 +220,10 @@ def test_bad_inputs_write_nothing(workdir, capsys, case, message):
         lib.append(str(workdir / "nope.bvh"))
     elif case == "tempo_neg":
         extra += ["--tempo-weight", "-1"]
+    elif case == "range_with_beats":
+        extra += ["--min-bpm", "60"]
+    elif case == "range_reversed":
+        extra = ["--min-bpm", "150", "--max-bpm", "100"]
     before = _outputs(workdir)
     out = workdir / ("dance.csv" if case == "not_bvh_out" else "dance.bvh")
     argv = [

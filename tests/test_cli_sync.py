@@ -137,6 +137,23 @@ def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     assert io.read_bvh(out).fps == 30.0
 
 
+def test_sync_tempo_range_steers_the_metrical_level(inputs, tmp_path, capsys):
+    # the song is a click track at 115 BPM; a range of 40-80 BPM takes every other click
+    d, _, _ = inputs
+    runs = {}
+    for name, extra in (("default", []), ("range", ["--min-bpm", "40", "--max-bpm", "80"])):
+        out = tmp_path / f"{name}.bvh"
+        code, stdout, err = _run(
+            ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--json", *extra],
+            capsys,
+        )
+        assert code == 0, err
+        runs[name] = json.loads(stdout)
+    assert runs["default"]["n_music_beats"] == pytest.approx(38, abs=2)
+    assert runs["range"]["n_music_beats"] == pytest.approx(19, abs=1)
+    assert runs["range"]["beats_source"] == "track_beats(method='psf', min_bpm=40, max_bpm=80)"
+
+
 def test_sync_align_accents(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.bvh"
@@ -183,6 +200,16 @@ BAD = [
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
       "--bpm", "120"], "conflict"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{d}/salsa.bvh"], "same"),
+    # a tempo range is checked before any work, named as the options, and conflicts with a
+    # fixed tempo or given beats
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--bpm", "115", "--max-bpm", "80"],
+     "--max-bpm bounds the tempo.*--bpm.*one or the other"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--min-bpm", "60", "--max-bpm", "80"], "--min-bpm and --max-bpm bound.*--beats"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--min-bpm", "300"],
+     "--min-bpm 300 must be smaller than --max-bpm 240 \\(the other bound is its default"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--max-bpm", "1"],
+     "--max-bpm=1.0 is outside the plausible range"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--align-accents", "--phase-offset",
       "0.1"], "phase"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),

@@ -95,6 +95,15 @@ def test_quiet_music_is_not_silence():
         track_music_beats(y * 0.1, 22050)
 
 
+def test_tempo_range_reaches_the_tracker():
+    # a drum song at 120 BPM; searched at 50-70 BPM, every other beat is taken
+    song = drum_song(12.0, bpm=120, sr=22050, seed=0)
+    est = track_music_beats(song.y, song.sr, min_bpm=50, max_bpm=70)
+    assert np.median(np.diff(est)) == pytest.approx(1.0, rel=0.03)
+    with pytest.raises(ParameterError, match="min_bpm"):
+        track_music_beats(song.y, song.sr, min_bpm=5)
+
+
 @pytest.mark.parametrize("bpm", [0.0, 2.0, 1200.0])
 def test_bpm_checked_like_the_tracker(bpm):
     y = np.random.default_rng(0).normal(size=4 * SR)

@@ -73,7 +73,13 @@ def music_intensity(y: Any, sr: float, beats: Any, *, amin: float = 1e-5) -> np.
 
 
 def track_music_beats(
-    y: Any, sr: float, *, bpm: float | None = None, method: str = "psf"
+    y: Any,
+    sr: float,
+    *,
+    bpm: float | None = None,
+    method: str = "psf",
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
 ) -> np.ndarray:
     """Music beat times [s] from :func:`beatsync.beats.track_beats`.
 
@@ -85,6 +91,8 @@ def track_music_beats(
     bpm : float, optional [bpm]
         Known tempo (20-400 BPM, :func:`beatsync.units.check_bpm`).
     method : {"psf", "librosa"}
+    min_bpm, max_bpm : float, optional [bpm]
+        Tempo range searched (default: :func:`beatsync.beats.track_beats`'s).
 
     Returns
     -------
@@ -103,6 +111,9 @@ def track_music_beats(
     kwargs: dict[str, Any] = {"method": method}
     if bpm is not None:
         kwargs["bpm"] = bpm
+    for name, value in (("min_bpm", min_bpm), ("max_bpm", max_bpm)):
+        if value is not None:
+            kwargs[name] = value
     beats = np.asarray(track_beats(y, int(round(sr)), **kwargs).beats, dtype=np.float64)
     if beats.size < 2:
         raise ParameterError(

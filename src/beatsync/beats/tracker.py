@@ -49,6 +49,8 @@ __all__ = [
     "SILENCE_PEAK",
     "MIN_SANE_BPM",
     "MAX_SANE_BPM",
+    "DEFAULT_MIN_BPM",
+    "DEFAULT_MAX_BPM",
     "BeatTrack",
     "track_beats",
     "beat_tempo",
@@ -60,6 +62,9 @@ __all__ = [
     "pulse_clarity_null",
 ]
 
+#: Tempo range [bpm] that :func:`track_beats` searches unless told otherwise.
+DEFAULT_MIN_BPM = 40.0
+DEFAULT_MAX_BPM = 240.0
 #: The plausible tempo range [bpm] (:data:`beatsync.units.MIN_BPM`, ``MAX_BPM``).
 MIN_SANE_BPM = MIN_BPM
 MAX_SANE_BPM = MAX_BPM
@@ -208,8 +213,8 @@ def track_beats(
     *,
     method: str = "psf",
     bpm: float | None = None,
-    min_bpm: float = 40.0,
-    max_bpm: float = 240.0,
+    min_bpm: float = DEFAULT_MIN_BPM,
+    max_bpm: float = DEFAULT_MAX_BPM,
     prior_period_s: float = METER_MODEL.tactus_median_s,
     prior_sigma: float = METER_MODEL.tactus_sigma,
     tempo_win_s: float = 8.0,

@@ -15,7 +15,7 @@ from typing import Any
 
 from ..errors import BeatsyncWarning, ParameterError
 from . import COMMAND_HELP
-from ._common import Outputs, add_output_flags, emit, feedback
+from ._common import Outputs, add_output_flags, add_tempo_range, emit, feedback, tempo_options
 
 __all__ = ["register", "run"]
 
@@ -45,12 +45,7 @@ def register(subparsers: Any) -> None:
         default=None,
         help="known tempo [BPM]: skip tempo estimation, only find the phase",
     )
-    p.add_argument(
-        "--min-bpm", type=float, default=40.0, help="slowest tempo considered [BPM] (default 40)"
-    )
-    p.add_argument(
-        "--max-bpm", type=float, default=240.0, help="fastest tempo considered [BPM] (default 240)"
-    )
+    add_tempo_range(p)
     p.add_argument(
         "--out",
         default=None,
@@ -71,15 +66,9 @@ def run(args: Any) -> int:
     # imported here, not at module level: building the parser must stay cheap
     from .. import io
     from ..beats import mix_clicks, track_beats
-    from ..units import check_bpm
 
     # cheap checks first, so that nothing is read or written on bad options
-    if args.bpm is not None:
-        check_bpm(args.bpm, name="--bpm")
-    if not args.min_bpm < args.max_bpm:
-        raise ParameterError(
-            f"--min-bpm {args.min_bpm:g} must be smaller than --max-bpm {args.max_bpm:g}"
-        )
+    tempo = tempo_options(args)
     fb = feedback(args)
     with Outputs(inputs=[args.audio]) as outs:  # both files are written, or neither
         out = (
@@ -94,9 +83,7 @@ def run(args: Any) -> int:
             y, sr = io.read_audio(args.audio)
         with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
             warnings.simplefilter("always", BeatsyncWarning)
-            track = track_beats(
-                y, sr, method=args.method, bpm=args.bpm, min_bpm=args.min_bpm, max_bpm=args.max_bpm
-            )
+            track = track_beats(y, sr, method=args.method, **tempo)
         notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
         for note in notes:
             fb.warn(note)

@@ -24,7 +24,14 @@ import numpy as np
 
 from ..errors import BeatsyncWarning, ParameterError
 from . import COMMAND_HELP
-from ._common import Outputs, add_music_beat_options, add_output_flags, emit, feedback
+from ._common import (
+    Outputs,
+    add_music_beat_options,
+    add_output_flags,
+    emit,
+    feedback,
+    tempo_options,
+)
 
 __all__ = ["register", "run"]
 
@@ -175,6 +182,7 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     th = check_th(args.th, name="--th")
     if args.beats is not None and args.bpm is not None:
         raise ParameterError("--beats and --bpm conflict: give beat times or a tempo, not both")
+    tempo_options(args)  # a bad tempo or range, before any work
     if not Path(audio).is_file():
         raise ParameterError(f"audio file {audio!r} does not exist")
     if args.beats is not None and not Path(args.beats).is_file():
@@ -241,7 +249,7 @@ def run(args: argparse.Namespace) -> int:
     if beats is None:
         with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
             warnings.simplefilter("always", BeatsyncWarning)
-            beats = track_music_beats(y, sr, bpm=args.bpm)
+            beats = track_music_beats(y, sr, **tempo_options(args))
         notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
         for note in notes:
             fb.warn(note)

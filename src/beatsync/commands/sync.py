@@ -34,6 +34,7 @@ from ._common import (
     emit,
     feedback,
     position_options,
+    tempo_options,
 )
 
 __all__ = ["register", "run"]
@@ -185,6 +186,7 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
             "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
             "not both"
         )
+    tempo_options(args)  # a bad tempo or range, before any work
     out = Path(args.output)
     if out.suffix.lower() not in _MOTION_OUT:
         raise ParameterError(
@@ -281,11 +283,15 @@ def _pipeline(
                     f"the music ({music_s:.2f} s) is shorter than {MIN_MUSIC_S:g} s: too short "
                     "to find beats in; use a longer song"
                 )
-            track = track_beats(y, sr, bpm=args.bpm)
+            tempo = tempo_options(args)
+            track = track_beats(y, sr, **tempo)
             beats = np.asarray(track.beats, dtype=np.float64)
             if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
                 meter = (int(track.beats_per_bar), "estimated by track_beats")
-            beat_source = "track_beats(method='psf'" + (f", bpm={args.bpm})" if args.bpm else ")")
+            given = {k: v for k, v in vars(args).items() if k in ("bpm", "min_bpm", "max_bpm")}
+            beat_source = "track_beats(method='psf'" + "".join(
+                f", {k}={v:g}" for k, v in given.items() if v is not None
+            ) + ")"
             if beats.size < 2:
                 raise ParameterError(
                     f"no detectable beats in {args.audio!r} ({beats.size} found): is it silent "
