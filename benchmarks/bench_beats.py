@@ -216,15 +216,15 @@ SHORT_LENGTHS_S = (3.0, 5.0, 7.0, 10.0)
 SHORT_STEP_S = 1.0
 
 
-def _with_pulse_warning(fn, *args):
-    """``fn(*args)``, and whether it warned of no clear pulse (a ``BeatsyncWarning``)."""
+def _with_pulse_warning(fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``, and whether it warned of no clear pulse (a ``BeatsyncWarning``)."""
     import warnings
 
     from beatsync.errors import BeatsyncWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", BeatsyncWarning)
-        out = fn(*args)
+        out = fn(*args, **kwargs)
     warned = any(
         issubclass(w.category, BeatsyncWarning) and "no clear pulse" in str(w.message)
         for w in caught
@@ -315,6 +315,9 @@ DANCE_EXCERPT_LENGTHS_S = (10.0, 15.0, 20.0)
 DANCE_EXCERPT_STEP_S = 2.5
 #: Agreement F under which an excerpt of a dance song counts as disagreeing.
 DANCE_AGREE_F = 0.9
+#: Half-width of the tempo range a user gives (``min_bpm``/``max_bpm``), relative to
+#: the tempo: :func:`dance_song_rows` and :func:`madmom_rows`.
+KNOWN_RANGE = 0.15
 
 
 def dance_song_rows() -> list[dict]:
@@ -328,7 +331,10 @@ def dance_song_rows() -> list[dict]:
     accuracy. The columns say how many clips disagree (F < :data:`DANCE_AGREE_F`) and
     at what tempo, how many of those the tracker warned of no clear pulse, and how
     many agreeing clips it warned of anyway: whether the warning marks the clips that
-    go wrong.
+    go wrong. The last two columns say what a user who knows the tempo can do about
+    the disagreeing clips: how many agree when given the 28 s excerpt's tempo
+    (``bpm=``, ``--bpm``), and when given only a range of +-:data:`KNOWN_RANGE` around
+    it (``min_bpm=``/``max_bpm=``), with the tempi those are tapped at.
     """
     from beatsync import datasets
     from beatsync.beats import track_beats
@@ -340,15 +346,23 @@ def dance_song_rows() -> list[dict]:
         y, sr = pair.y, pair.sr
         whole, whole_warned = _with_pulse_warning(track_beats, y, sr)
         dur = y.size / sr
-        f, warned, tempi = [], [], []
+        f, warned, tempi, known_bpm, known_range, range_tempi = [], [], [], 0, 0, []
+        lo, hi = whole.tempo * (1 - KNOWN_RANGE), whole.tempo * (1 + KNOWN_RANGE)
         for length in DANCE_EXCERPT_LENGTHS_S:
             for start in np.arange(0.0, dur - length + 1e-9, DANCE_EXCERPT_STEP_S):
                 seg = y[int(start * sr) : int((start + length) * sr)]
                 bt, w = _with_pulse_warning(track_beats, seg, sr)
                 ref = whole.beats[(whole.beats >= start) & (whole.beats < start + length)]
-                f.append(evaluate_beats(ref - start, bt.beats, min_beat_time=5.0)["F-measure"])
+                ref = ref - start
+                f.append(evaluate_beats(ref, bt.beats, min_beat_time=5.0)["F-measure"])
                 warned.append(w)
                 tempi.append(median_tempo(bt.beats))
+                if f[-1] < DANCE_AGREE_F:
+                    told, _ = _with_pulse_warning(track_beats, seg, sr, bpm=round(whole.tempo))
+                    known_bpm += _agrees(ref, told.beats)
+                    told, _ = _with_pulse_warning(track_beats, seg, sr, min_bpm=lo, max_bpm=hi)
+                    known_range += _agrees(ref, told.beats)
+                    range_tempi.append(median_tempo(told.beats))
         f, warned = np.array(f), np.array(warned)
         bad = f < DANCE_AGREE_F
         rows.append(
@@ -363,6 +377,55 @@ def dance_song_rows() -> list[dict]:
                 "their tempo [bpm]": _tempo_range(np.array(tempi)[bad]),
                 "disagreeing, warned": int((bad & warned).sum()),
                 "agreeing, warned": int((~bad & warned).sum()),
+                "disagreeing, agree given the tempo": f"{known_bpm} of {int(bad.sum())}",
+                f"disagreeing, agree given +-{KNOWN_RANGE:.0%} (tapped at [bpm])": (
+                    f"{known_range} of {int(bad.sum())}"
+                    + (f" ({_tempo_range(np.array(range_tempi))})" if range_tempi else "")
+                ),
+            }
+        )
+    return rows
+
+
+def _agrees(ref: np.ndarray, beats: np.ndarray) -> bool:
+    """Whether ``beats`` agree with ``ref`` (F >= :data:`DANCE_AGREE_F`, scored after 5 s)."""
+    from beatsync.evaluate.beats import evaluate_beats
+
+    return evaluate_beats(ref, beats, min_beat_time=5.0)["F-measure"] >= DANCE_AGREE_F
+
+
+def madmom_rows() -> list[dict]:
+    """The madmom sample (2.8 s) told nothing, its annotated tempo, or a range around it.
+
+    ``bpm=`` the median tempo of its annotated beats, rounded; the range +-
+    :data:`KNOWN_RANGE` around that tempo. Scored from 0 s, like the per-item table.
+    """
+    from beatsync import datasets
+    from beatsync.beats import track_beats
+    from beatsync.evaluate.beats import evaluate_beats, median_tempo
+
+    y, sr, ref = datasets.load_madmom_sample()[:3]
+    tempo = median_tempo(ref)
+    told = {
+        "nothing": {},
+        f"bpm={round(tempo)}": {"bpm": round(tempo)},
+        f"min_bpm={tempo * (1 - KNOWN_RANGE):.0f}, max_bpm={tempo * (1 + KNOWN_RANGE):.0f}": {
+            "min_bpm": tempo * (1 - KNOWN_RANGE),
+            "max_bpm": tempo * (1 + KNOWN_RANGE),
+        },
+    }
+    rows = []
+    for what, kwargs in told.items():
+        bt, warned = _with_pulse_warning(track_beats, y, sr, **kwargs)
+        s = evaluate_beats(ref, bt.beats, min_beat_time=0.0)
+        rows.append(
+            {
+                "told": what,
+                "tempo [bpm]": bt.tempo,
+                "beats": bt.beats.size,
+                "F": s["F-measure"],
+                "CMLt": s["Correct Metric Level Total"],
+                "warned": "yes" if warned else "no",
             }
         )
     return rows
@@ -436,6 +499,8 @@ def accuracy_only(seeds: list[int], methods: list[str]) -> int:
     if "psf" in methods:
         print("\n## the dancers' songs: clips against the bundled 28 s (psf)\n")
         print(_md_table(pd.DataFrame(dance_song_rows())))
+        print("\n## the madmom sample: told nothing, its tempo, or a range (psf)\n")
+        print(_md_table(pd.DataFrame(madmom_rows())))
     if "psf" in methods:
         print("\n## meter of the synthetic meter patterns (psf)\n")
         print(_md_table(pd.DataFrame(meter_rows())))
@@ -524,6 +589,7 @@ def main() -> int:
     excerpts = pd.DataFrame(excerpt_rows(study.available_methods()))
     short = pd.DataFrame(short_rows(study.available_methods()))
     dance_songs = pd.DataFrame(dance_song_rows())
+    madmom = pd.DataFrame(madmom_rows())
 
     # ------------------------------------------------------------------ write
     facts = _machine.machine_facts()
@@ -597,9 +663,19 @@ def main() -> int:
         "204-245 s) stand in as the reference for clips "
         f"of {', '.join(f'{x:g}' for x in DANCE_EXCERPT_LENGTHS_S)} s starting every "
         f"{DANCE_EXCERPT_STEP_S:g} s, scored after 5 s: consistency, not accuracy. "
-        "`warned`: clips on which our tracker warned of no clear pulse.",
+        "`warned`: clips on which our tracker warned of no clear pulse. The last two "
+        "columns: the disagreeing clips tracked again, given the 28 s excerpt's tempo "
+        f"(`--bpm`), or a range of +-{KNOWN_RANGE:.0%} around it (`--min-bpm`/`--max-bpm`).",
         "",
         _md_table(dance_songs),
+        "",
+        "## The madmom sample: told nothing, its tempo, or a range (psf)",
+        "",
+        "What a user who knows the tempo can do about the one real recording tapped at "
+        "another level: `bpm=` its annotated tempo, or a range of "
+        f"+-{KNOWN_RANGE:.0%} around it. Scored from 0 s.",
+        "",
+        _md_table(madmom),
         "",
         "## Targets on the synthetic set (seed 0)",
         "",
