@@ -100,6 +100,14 @@ still tapped at 90. Nothing else we measured helped:
   synthetic set or the madmom sample (119.8 BPM), lifted the 5 s clips of
   Hainsworth 001 from mean F 0.654 to 0.751, and lowered those of the waltz
   (5 s: 0.911 to 0.905; 7 s: 0.967 to 0.960). Mixed, and seen on two recordings only.
+- The decoded level was checked against the levels at 3/4 and 4/3 of it, each decoded
+  again within +-4 % of that tempo with its beats placed, and the beat sequence whose
+  beats fall on the strongest accents (mean accent at the beats over the mean accent)
+  was kept. Hainsworth 001's clips rose (3 s: mean F 0.416 to 0.788; 5 s: 0.654 to
+  0.893), but the waltz's fell (5 s: 0.911 to 0.721; 10 s: 0.992 to 0.852; its 15-30 s
+  excerpts: 0.993 to 0.940): a slower sequence that keeps to the downbeats scores
+  higher. With 2/3 and 3/2 of the level as well (+-8 %), the waltz's excerpts fell to
+  0.832. The synthetic set did not change. Not used.
 - Goto's (2001) drum-pattern cue was added to the tactus observation: the beat is the
   interval between a bass drum and a snare drum that alternate. We scored it as the
   low band and a higher band both concentrated at twice the period, in antiphase.
