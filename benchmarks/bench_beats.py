@@ -365,6 +365,7 @@ def dance_song_rows() -> list[dict]:
                     range_tempi.append(median_tempo(told.beats))
         f, warned = np.array(f), np.array(warned)
         bad = f < DANCE_AGREE_F
+        span = f"{KNOWN_RANGE:.0%}"
         rows.append(
             {
                 "song": f"{name} ({pair.style})",
@@ -378,10 +379,8 @@ def dance_song_rows() -> list[dict]:
                 "disagreeing, warned": int((bad & warned).sum()),
                 "agreeing, warned": int((~bad & warned).sum()),
                 "disagreeing, agree given the tempo": f"{known_bpm} of {int(bad.sum())}",
-                f"disagreeing, agree given +-{KNOWN_RANGE:.0%} (tapped at [bpm])": (
-                    f"{known_range} of {int(bad.sum())}"
-                    + (f" ({_tempo_range(np.array(range_tempi))})" if range_tempi else "")
-                ),
+                f"disagreeing, agree given +-{span}": f"{known_range} of {int(bad.sum())}",
+                f"given +-{span}: tapped at [bpm]": _tempo_range(np.array(range_tempi)),
             }
         )
     return rows

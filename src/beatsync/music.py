@@ -109,9 +109,7 @@ def track_music_beats(
     if bpm is not None:
         bpm = check_bpm(bpm)
     kwargs: dict[str, Any] = {"method": method}
-    if bpm is not None:
-        kwargs["bpm"] = bpm
-    for name, value in (("min_bpm", min_bpm), ("max_bpm", max_bpm)):
+    for name, value in (("bpm", bpm), ("min_bpm", min_bpm), ("max_bpm", max_bpm)):
         if value is not None:
             kwargs[name] = value
     beats = np.asarray(track_beats(y, int(round(sr)), **kwargs).beats, dtype=np.float64)

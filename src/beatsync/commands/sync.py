@@ -288,9 +288,9 @@ def _pipeline(
             beats = np.asarray(track.beats, dtype=np.float64)
             if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
                 meter = (int(track.beats_per_bar), "estimated by track_beats")
-            given = {k: v for k, v in vars(args).items() if k in ("bpm", "min_bpm", "max_bpm")}
+            told = ((k, getattr(args, k)) for k in ("bpm", "min_bpm", "max_bpm"))
             beat_source = "track_beats(method='psf'" + "".join(
-                f", {k}={v:g}" for k, v in given.items() if v is not None
+                f", {k}={v:g}" for k, v in told if v is not None
             ) + ")"
             if beats.size < 2:
                 raise ParameterError(
