@@ -108,6 +108,12 @@ still tapped at 90. Nothing else we measured helped:
   excerpts: 0.993 to 0.940): a slower sequence that keeps to the downbeats scores
   higher. With 2/3 and 3/2 of the level as well (+-8 %), the waltz's excerpts fell to
   0.832. The synthetic set did not change. Not used.
+- A contrast of the folded accent was measured as evidence that could peak at the
+  beat (per window and period: the band-sum accent folded over the period, the most
+  that one phase exceeds the phase half a period later, over the mean accent). On the
+  synthetic drums it peaks at half the beat, where the empty sixteenth counts as a
+  weak off-beat, and of the seven bundled real recordings it peaks at the beat only
+  on DANCE_C_4 (elsewhere at 1/2, 3/4 or 3/2 of it). Not used.
 - Goto's (2001) drum-pattern cue was added to the tactus observation: the beat is the
   interval between a bass drum and a snare drum that alternate. We scored it as the
   low band and a higher band both concentrated at twice the period, in antiphase.
