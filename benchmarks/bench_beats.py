@@ -331,7 +331,7 @@ def dance_song_rows() -> list[dict]:
     accuracy. The columns say how many clips disagree (F < :data:`DANCE_AGREE_F`) and
     at what tempo, how many of those the tracker warned of no clear pulse, and how
     many agreeing clips it warned of anyway: whether the warning marks the clips that
-    go wrong. The last two columns say what a user who knows the tempo can do about
+    go wrong. The last three columns say what a user who knows the tempo can do about
     the disagreeing clips: how many agree when given the 28 s excerpt's tempo
     (``bpm=``, ``--bpm``), and when given only a range of +-:data:`KNOWN_RANGE` around
     it (``min_bpm=``/``max_bpm=``), with the tempi those are tapped at.
@@ -662,7 +662,7 @@ def main() -> int:
         "204-245 s) stand in as the reference for clips "
         f"of {', '.join(f'{x:g}' for x in DANCE_EXCERPT_LENGTHS_S)} s starting every "
         f"{DANCE_EXCERPT_STEP_S:g} s, scored after 5 s: consistency, not accuracy. "
-        "`warned`: clips on which our tracker warned of no clear pulse. The last two "
+        "`warned`: clips on which our tracker warned of no clear pulse. The last three "
         "columns: the disagreeing clips tracked again, given the 28 s excerpt's tempo "
         f"(`--bpm`), or a range of +-{KNOWN_RANGE:.0%} around it (`--min-bpm`/`--max-bpm`).",
         "",

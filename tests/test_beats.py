@@ -314,8 +314,9 @@ def _no_pulse_warnings(y, sr, **kwargs):
 
 def test_no_pulse_warning_advice_works_on_a_real_clip():
     # the first 20 s of the waltz DANCE_W_10 (soft onsets) are tapped at about 110 BPM,
-    # 4/3 of the 87 BPM that the whole 28 s excerpt gets; the warning says so and names
-    # the way out, a known tempo, which puts the beats back on those of the excerpt
+    # against the 87 BPM of the whole 28 s excerpt; the warning says the level may be
+    # wrong and names the way out, a known tempo, which puts the beats back on those of
+    # the excerpt
     pair = datasets.load_dance_pair("DANCE_W_10")
     whole = track_beats(pair.y, pair.sr)
     ref = whole.beats[whole.beats < 20.0]
@@ -325,7 +326,7 @@ def test_no_pulse_warning_advice_works_on_a_real_clip():
     assert _score(ref, guessed.beats)["F-measure"] < 0.5
     known, msgs = _no_pulse_warnings(clip, pair.sr, bpm=round(whole.tempo))
     assert msgs == []
-    assert _score(ref, known.beats)["F-measure"] == 1.0
+    assert _score(ref, known.beats)["F-measure"] >= 0.95  # 1.0 here
 
 
 @pytest.mark.slow

@@ -42,6 +42,18 @@ def test_json_out_and_click(song, tmp_path, capsys):
     assert sr == SR and y.size == 10 * SR
 
 
+def test_tempo_range_help_states_the_trackers_defaults(capsys):
+    # the option help is written without importing the tracker (start-up stays light)
+    from beatsync.beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
+
+    for command in ("beats", "sync", "compose"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        assert f"(default {DEFAULT_MIN_BPM:g})" in text
+        assert f"(default {DEFAULT_MAX_BPM:g})" in text
+
+
 def test_librosa_and_bpm_options(song, capsys):
     path, ref = song
     assert main(["beats", str(path), "--method", "librosa", "--json"]) == 0

@@ -121,11 +121,13 @@ still tapped at 90. Nothing else we measured helped:
   averaged over windows, was 0.05 at most). With weight 100, the cue fixed the 60 BPM
   pattern but not the 180 BPM one. With weight 300, it tapped DANCE_R_3 at 190.
 
-Why 10-20 s clips of the Dance-with-Melody waltzes are tapped at 4/3 of the beat
-(measured on their clips; ``dance_song_rows`` in ``benchmarks/bench_beats.py``). The
-measure is found right, about 2.07 s: three beats at 87 BPM, or four at 116 BPM. Both
-readings are consistent metrical trees, and a balance of small terms decides. On the
-first 20 s of DANCE_W_10, summed over its 13 windows:
+Why 10-20 s clips of the waltz DANCE_W_10 are tapped faster than its beat (the
+disagreeing ones at 85-116 BPM, median 107, against 87 BPM for the 28 s excerpt;
+``dance_song_rows`` in ``benchmarks/bench_beats.py``). Its first 20 s are tapped at
+110 BPM. Their terms were compared at 87 BPM and at 4/3 of it, 116 BPM, in a scratch
+decomposition of :func:`tactus_observation`. The measure is found right for both,
+about 2.07 s: three beats at 87 BPM, or four at 116 BPM. Both readings are consistent
+metrical trees, and a balance of small terms decides. Summed over the 13 windows:
 
 - the salience favours 87 BPM by 2.9, and the tatum term by 2.0;
 - the tactus prior favours 116 BPM by 3.4, and the measure term by 4.0. About 3 of

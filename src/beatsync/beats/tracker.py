@@ -479,7 +479,7 @@ def _track_librosa(y, sr, *, bpm, min_bpm, max_bpm) -> BeatTrack:
     kwargs: dict[str, Any] = {}
     if bpm is not None:
         kwargs["bpm"] = bpm
-    elif (min_bpm, max_bpm) != (40.0, 240.0):
+    elif (min_bpm, max_bpm) != (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
         # a user-narrowed range: flat prior inside it (else librosa's log-normal prior)
         kwargs["prior"] = scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
     tempo, beats = librosa.beat.beat_track(

@@ -55,12 +55,17 @@ def tempo_options(args: argparse.Namespace) -> dict[str, float]:
     Raises
     ------
     ParameterError
-        A tempo outside 20-400 BPM, ``--min-bpm`` not below ``--max-bpm``, or a range
-        given with ``--bpm`` or ``--beats`` (the tempo is then not searched).
+        ``--beats`` with ``--bpm``, a range given with either (the tempo is then not
+        searched), a tempo outside 20-400 BPM, or ``--min-bpm`` not below ``--max-bpm``.
     """
     from ..beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM  # noqa: PLC0415 (numpy)
     from ..units import check_bpm  # noqa: PLC0415
 
+    if getattr(args, "beats", None) is not None and args.bpm is not None:
+        raise ParameterError(
+            "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
+            "not both"
+        )
     bounds = {"--min-bpm": args.min_bpm, "--max-bpm": args.max_bpm}
     given = [name for name, value in bounds.items() if value is not None]
     fixed = "--bpm" if args.bpm is not None else None

@@ -1,11 +1,11 @@
 """``beatsync compose``: compose a dance for a song from a motion library (paper B).
 
 Reads the library's BVH clips (one skeleton), builds their weighted motion graph (or
-loads it from the on-disk cache), finds the music's beats (tracker, a beats file or a
-known BPM) and its level per beat interval, searches the best path by dynamic
-programming, synthesizes the dance (every motion beat on a music beat, blended
-transitions) and writes it as BVH, optionally a video with the music and a JSON
-report (path, number of transitions, graph-build and search times).
+loads it from the on-disk cache), finds the music's beats (tracker, optionally within a
+tempo range; a beats file; or a known BPM) and its level per beat interval, searches the
+best path by dynamic programming, synthesizes the dance (every motion beat on a music
+beat, blended transitions) and writes it as BVH, optionally a video with the music and a
+JSON report (path, number of transitions, graph-build and search times).
 
 Graph cache (on by default, :mod:`beatsync.graph.cache`): built graphs are stored in
 ``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else in
@@ -174,9 +174,7 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     from ..graph.build import check_th
 
     th = check_th(args.th, name="--th")
-    if args.beats is not None and args.bpm is not None:
-        raise ParameterError("--beats and --bpm conflict: give beat times or a tempo, not both")
-    tempo_options(args)  # a bad tempo or range, before any work
+    tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
     if not Path(audio).is_file():
         raise ParameterError(f"audio file {audio!r} does not exist")
     if args.beats is not None and not Path(args.beats).is_file():

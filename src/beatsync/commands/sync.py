@@ -1,15 +1,16 @@
 """``beatsync sync``: make a dance follow a song (paper A, section 5, and real dances).
 
 Reads a motion file (BVH; MoCap Toolbox ``.mat``; joint positions as Dance-with-Melody
-``.json``, ``.npy``/``.npz`` or C3D; CSV/NPY angle tables) and a song, finds the
-music's beats (:func:`beatsync.beats.track_beats` with its meter estimate, or a beats
-file / a known BPM) and calls :func:`beatsync.sync.synchronize` with ``boundaries=None``:
-it finds the motion's periods (``--mode periods``, paper A), or warps the dancer's own
-motion beats (``--mode beats``), or tries periods and falls back to beats with a
-warning (``--mode auto``, default), and with ``--fill loop`` (default) repeats whole
-periods with blended joins until the dance reaches the song's last beat. Writes the
-motion (BVH with the input skeleton; joint positions in the input's layout; or CSV),
-optionally a video with the music that lasts as long as the song, and the report.
+``.json``, ``.npy``/``.npz`` or C3D; CSV/NPY angle tables) and a song, finds the music's
+beats (:func:`beatsync.beats.track_beats` with its meter estimate, optionally within a
+tempo range, or a beats file / a known BPM) and calls :func:`beatsync.sync.synchronize`
+with ``boundaries=None``: it finds the motion's periods (``--mode periods``, paper A),
+or warps the dancer's own motion beats (``--mode beats``), or tries periods and falls
+back to beats with a warning (``--mode auto``, default), and with ``--fill loop``
+(default) repeats whole periods with blended joins until the dance reaches the song's
+last beat. Writes the motion (BVH with the input skeleton; joint positions in the
+input's layout; or CSV), optionally a video with the music that lasts as long as the
+song, and the report.
 """
 
 from __future__ import annotations
@@ -180,12 +181,7 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
             f"--period-range {args.period_range[0]:g} {args.period_range[1]:g} must be "
             "LO HI with 0 < LO < HI [s]"
         )
-    if args.beats is not None and args.bpm is not None:
-        raise ParameterError(
-            "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
-            "not both"
-        )
-    tempo_options(args)  # a bad tempo or range, before any work
+    tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
     out = Path(args.output)
     if out.suffix.lower() not in _MOTION_OUT:
         raise ParameterError(
@@ -288,9 +284,11 @@ def _pipeline(
             if args.beats_per_bar is None and getattr(track, "beats_per_bar", 0) > 0:
                 meter = (int(track.beats_per_bar), "estimated by track_beats")
             told = ((k, getattr(args, k)) for k in ("bpm", "min_bpm", "max_bpm"))
-            beat_source = "track_beats(method='psf'" + "".join(
-                f", {k}={v:g}" for k, v in told if v is not None
-            ) + ")"
+            beat_source = (
+                "track_beats(method='psf'"
+                + "".join(f", {k}={v:g}" for k, v in told if v is not None)
+                + ")"
+            )
             if beats.size < 2:
                 raise ParameterError(
                     f"no detectable beats in {args.audio!r} ({beats.size} found): is it silent "
