@@ -63,6 +63,15 @@ def test_grid_mode_auto_uses_the_motion_beats_of_a_clip_that_is_not_periodic(inp
     )
 
 
+def test_grid_tempo_range_reaches_every_song(inputs, tmp_path):
+    # click tracks at 100 and 125 BPM, searched at 40-70 BPM: every other click
+    _, clips, songs = inputs
+    table = sync_grid(clips[:1], songs, tmp_path, processes=False, n_workers=1, fps=60.0,
+                      min_bpm=40, max_bpm=70)  # fmt: skip
+    assert (table["status"] == "ok").all()
+    np.testing.assert_allclose(sorted(table["tempo_bpm"]), [50.0, 62.5], rtol=0.03)
+
+
 def test_grid_bad_arguments(inputs, tmp_path):
     _, clips, songs = inputs
     with pytest.raises(ParameterError, match="does not exist"):
@@ -151,6 +160,9 @@ def _batch_args(inputs, out, *extra):
         (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "give one or the other"),
         (["--scheduler", "tcp://127.0.0.1:9"], "could not connect to the Dask scheduler"),
         (["--scheduler", "nonsense"], "not a Dask scheduler address"),
+        # the tempo options are checked before the cluster starts
+        (["--bpm", "100", "--max-bpm", "80"], "--max-bpm bounds the tempo.*one or the other"),
+        (["--min-bpm", "90", "--max-bpm", "60"], "--min-bpm 90 must be smaller"),
     ],
 )
 def test_batch_bad_cluster_options_fail_fast(inputs, tmp_path, monkeypatch, extra, match):

@@ -46,7 +46,7 @@ def test_tempo_range_help_states_the_trackers_defaults(capsys):
     # the option help is written without importing the tracker (start-up stays light)
     from beatsync.beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
 
-    for command in ("beats", "sync", "compose"):
+    for command in ("beats", "sync", "compose", "batch"):
         with pytest.raises(SystemExit):
             main([command, "--help"])
         text = " ".join(capsys.readouterr().out.split())

@@ -28,13 +28,20 @@ from .errors import ParameterError
 __all__ = ["sync_grid", "prepare_song", "prepare_clip", "sync_pair"]
 
 
-def prepare_song(path: str, *, bpm: float | None = None) -> dict[str, Any]:
-    """Read a song and track its beats (a task of the graph)."""
+def prepare_song(
+    path: str,
+    *,
+    bpm: float | None = None,
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
+) -> dict[str, Any]:
+    """Read a song and track its beats (a task of the graph); the range only if given."""
     from . import io
     from .beats import track_beats
 
     y, sr = io.read_audio(path)
-    track = track_beats(y, sr, bpm=bpm)
+    told = {"min_bpm": min_bpm, "max_bpm": max_bpm}
+    track = track_beats(y, sr, bpm=bpm, **{k: v for k, v in told.items() if v is not None})
     return {"song": Path(path).stem, "beats": track.beats, "tempo_bpm": track.tempo}
 
 
@@ -154,6 +161,8 @@ def sync_grid(
     processes: bool = True,
     fps: float | None = None,
     bpm: float | None = None,
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
     mode: str = "periods",
@@ -180,6 +189,8 @@ def sync_grid(
         Frame-rate override for every clip (e.g. 60 for the CMU salsa files).
     bpm : float, optional [BPM]
         Known tempo of every song.
+    min_bpm, max_bpm : float, optional [BPM]
+        Tempo range searched in every song (default: :func:`beatsync.beats.track_beats`'s).
     mode : {"periods", "beats", "auto"}
         What lands on the beats: paper A's periods (a clip that is not periodic fails),
         the clip's own motion beats, or periods when the clip is periodic and motion
@@ -239,7 +250,12 @@ def sync_grid(
                     )
 
     with dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes) as client:
-        song_f = {s: client.submit(_guard(prepare_song), s, bpm=bpm, pure=False) for s in songs}
+        song_f = {
+            s: client.submit(
+                _guard(prepare_song), s, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm, pure=False
+            )
+            for s in songs
+        }
         clip_f = {
             c: client.submit(
                 _guard(prepare_clip),

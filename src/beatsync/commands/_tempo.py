@@ -1,5 +1,5 @@
 """The music options of the commands that track beats: a known beat list or tempo, and
-the tempo range searched (``beats``, ``sync``, ``compose``).
+the tempo range searched (``beats``, ``sync``, ``compose``, ``batch``).
 
 Like :mod:`._common`, it imports nothing heavy at import time.
 """

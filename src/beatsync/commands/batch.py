@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import add_json_flag, add_mode, add_period_range, emit
+from ._tempo import add_tempo_range, tempo_options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -25,6 +26,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--fps", type=float, default=None, help="frame-rate override for every clip [Hz]"
     )
     p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
+    add_tempo_range(p)
     add_period_range(p)
     add_mode(p, default="periods")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
@@ -45,6 +47,7 @@ def run(args: argparse.Namespace) -> int:
     from ..io import check_input_file
     from ._common import Outputs, check_output, feedback
 
+    tempo = tempo_options(args)  # before any work
     workers = check_cluster_options(args.scheduler, args.workers)
     inputs = [check_input_file(p, "clip") for p in args.clips]
     inputs += [check_input_file(p, "song") for p in args.songs]
@@ -66,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
                 scheduler=args.scheduler,
                 n_workers=workers,
                 fps=args.fps,
-                bpm=args.bpm,
+                **tempo,
                 period_range=tuple(args.period_range),
                 mode=args.mode,
                 progress=progress,
