@@ -141,6 +141,14 @@ with ``bpm=87``), and none of DANCE_W_5's 11, most of which are at its tempo on 
 phase (``dance_song_rows``). The no-clear-pulse warning of
 :mod:`beatsync.beats.tracker` names a known tempo as the way out.
 
+The whole songs show the same (``benchmarks/whole_dance_songs.py``, on the songs of
+the development machine's shared data, which are not bundled). The cha-cha and the
+rumba keep their excerpt's tempo in every window. Of the waltzes' windows, only 93 of
+197 (DANCE_W_5) and 56 of 239 (DANCE_W_10) do; 51 and 129 are at 4/3 of it, and
+DANCE_W_10 gets 4 beats per bar. Both warn. Forced to one tempo (``time_varying=False``),
+DANCE_W_5 gets 85.3 BPM and 3 beats per bar, but DANCE_W_10 gets 120.3 BPM and 4: even
+summed over its 245 s, the evidence of DANCE_W_10 favours the faster level.
+
 The observation exponent ``beta``, the prior widths and the ratio weights are our
 choices (see :data:`METER_MODEL`): they were set on the synthetic test set, and the
 real recordings were only scored.

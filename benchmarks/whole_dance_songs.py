@@ -1,0 +1,79 @@
+"""Our tracker on the whole songs that the Dance-with-Melody dancers danced to.
+
+The project bundles 28 s excerpts of the four songs (``data/motion/dance_with_melody``);
+the whole songs (204-245 s, MP3) are in the shared data folder of the development
+machine and are not redistributed. This script tracks each whole song and compares its
+tempo path with our tempo of the bundled excerpt: how many tempo windows are within
+8 % of that tempo, and how many are at 4/3 or 3/4 of it (another metrical level). The
+songs have no annotations, so this measures consistency, not accuracy.
+
+Usage::
+
+    .venv/bin/python benchmarks/whole_dance_songs.py [--shared ../shared/data]
+
+Not part of ``run_all.py``: a clone without the shared folder cannot run it. On
+2026-11-28: the cha-cha and the rumba keep the excerpt's tempo in every window (199
+and 238 windows); the waltzes DANCE_W_5 and DANCE_W_10 in 93 of 197 and 56 of 239
+windows, with 51 and 129 at 4/3 of it, and both warn of no clear pulse.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+#: Relative tempo tolerance of "the same tempo" (as ``evaluate.beats.octave_relation``).
+TOLERANCE = 0.08
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument(
+        "--shared",
+        default=str(Path(__file__).resolve().parents[2] / "shared" / "data"),
+        help="the shared data folder (holds motion/dance_with_melody/NAME/audio.mp3)",
+    )
+    args = ap.parse_args()
+    root = Path(args.shared) / "motion" / "dance_with_melody"
+    if not root.is_dir():
+        print(f"{root} does not exist: the whole songs are not on this machine", file=sys.stderr)
+        return 2
+
+    from beatsync import datasets, io
+    from beatsync.beats import track_beats
+    from beatsync.errors import BeatsyncWarning
+
+    print(
+        "| song | seconds | excerpt: tempo / beats per bar | whole song: median tempo / "
+        "beats per bar | windows within 8 % of the excerpt's tempo | at 4/3 of it | "
+        "at 3/4 of it | warned |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    for name in datasets.DANCE_PAIRS:
+        pair = datasets.load_dance_pair(name)
+        excerpt = track_beats(pair.y, pair.sr)
+        y, sr = io.read_audio(root / name / "audio.mp3")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            song = track_beats(y, sr)
+        warned = any("no clear pulse" in str(w.message) for w in caught)
+        ratio = np.asarray(song.tempo_curve) / excerpt.tempo
+
+        def near(r: float, ratio=ratio) -> int:
+            return int(np.sum(np.abs(np.log(ratio / r)) < np.log(1 + TOLERANCE)))
+
+        print(
+            f"| {name} ({pair.style}) | {y.size / sr:.0f} | {excerpt.tempo:.1f} / "
+            f"{excerpt.beats_per_bar} | {song.tempo:.1f} / {song.beats_per_bar} | "
+            f"{near(1.0)} of {ratio.size} | {near(4 / 3)} | {near(3 / 4)} | "
+            f"{'yes' if warned else 'no'} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
