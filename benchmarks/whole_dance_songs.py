@@ -4,8 +4,9 @@ The project bundles 28 s excerpts of the four songs (``data/motion/dance_with_me
 the whole songs (204-245 s, MP3) are in the shared data folder of the development
 machine and are not redistributed. This script tracks each whole song and compares its
 tempo path with our tempo of the bundled excerpt: how many tempo windows are within
-8 % of that tempo, and how many are at 4/3 or 3/4 of it (another metrical level). The
-songs have no annotations, so this measures consistency, not accuracy.
+8 % of that tempo, how many are at 4/3 or 3/4 of it or at twice or half of it
+(another metrical level), and the tempo of the others. The songs have no annotations,
+so this measures consistency, not accuracy.
 
 Usage::
 
@@ -50,9 +51,9 @@ def main() -> int:
     print(
         "| song | seconds | excerpt: tempo / beats per bar | whole song: median tempo / "
         "beats per bar | windows within 8 % of the excerpt's tempo | at 4/3 of it | "
-        "at 3/4 of it | warned |"
+        "at 3/4 of it | at 2 or 1/2 times it | the others [bpm] | warned |"
     )
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for name in datasets.DANCE_PAIRS:
         pair = datasets.load_dance_pair(name)
         excerpt = track_beats(pair.y, pair.sr)
@@ -63,13 +64,18 @@ def main() -> int:
         warned = any("no clear pulse" in str(w.message) for w in caught)
         ratio = np.asarray(song.tempo_curve) / excerpt.tempo
 
-        def near(r: float, ratio=ratio) -> int:
-            return int(np.sum(np.abs(np.log(ratio / r)) < np.log(1 + TOLERANCE)))
+        def near(r: float, ratio=ratio) -> np.ndarray:
+            return np.abs(np.log(ratio / r)) < np.log(1 + TOLERANCE)
+
+        levels = {r: near(r) for r in (1.0, 4 / 3, 3 / 4, 2.0, 0.5)}
+        others = np.asarray(song.tempo_curve)[~np.any(list(levels.values()), axis=0)]
+        spread = f"{others.min():.0f}-{others.max():.0f} ({others.size})" if others.size else ""
 
         print(
             f"| {name} ({pair.style}) | {y.size / sr:.0f} | {excerpt.tempo:.1f} / "
             f"{excerpt.beats_per_bar} | {song.tempo:.1f} / {song.beats_per_bar} | "
-            f"{near(1.0)} of {ratio.size} | {near(4 / 3)} | {near(3 / 4)} | "
+            f"{levels[1.0].sum()} of {ratio.size} | {levels[4 / 3].sum()} | "
+            f"{levels[3 / 4].sum()} | {levels[2.0].sum() + levels[0.5].sum()} | {spread} | "
             f"{'yes' if warned else 'no'} |"
         )
     return 0

@@ -196,6 +196,12 @@ def test_madmom_sample_with_known_bpm():
         ("hainsworth_001", 13.0, 10.0),
         ("ballroom_waltz", 18.0, 7.0),
         ("ballroom_waltz", 20.0, 10.0),
+        # clips tapped at 4/3 of the beat (about 132 BPM, a "beat" of three sixteenths,
+        # F 0.21-0.31) while a beat of three tatums weighed as much as one of two or four
+        ("hainsworth_001", 2.0, 5.0),
+        ("hainsworth_001", 10.0, 5.0),
+        ("hainsworth_001", 47.0, 7.0),
+        ("hainsworth_001", 46.0, 10.0),
     ],
 )
 def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
