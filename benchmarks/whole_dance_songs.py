@@ -14,8 +14,10 @@ Usage::
 
 Not part of ``run_all.py``: a clone without the shared folder cannot run it. On
 2026-11-28: the cha-cha and the rumba keep the excerpt's tempo in every window (199
-and 238 windows); the waltzes DANCE_W_5 and DANCE_W_10 in 93 of 197 and 56 of 239
-windows, with 51 and 129 at 4/3 of it, and both warn of no clear pulse.
+and 238 windows); the waltzes DANCE_W_5 and DANCE_W_10 in 189 of 197 and 147 of 239
+windows, none at 4/3 of it (the other 92 of DANCE_W_10 at 95-106 BPM; it warns of no
+clear pulse). With a beat of three tatums weighed as one of two or four (before
+``MeterModel.tatum_ratio_weights``): 93 and 56 windows, with 51 and 129 at 4/3.
 """
 
 from __future__ import annotations

@@ -123,11 +123,12 @@ still tapped at 90. Nothing else we measured helped:
   averaged over windows, was 0.05 at most). With weight 100, the cue fixed the 60 BPM
   pattern but not the 180 BPM one. With weight 300, it tapped DANCE_R_3 at 190.
 
-Why 10-20 s clips of the waltz DANCE_W_10 are tapped faster than its beat (the
-disagreeing ones at 85-116 BPM, median 107, against 87 BPM for the 28 s excerpt;
-``dance_song_rows`` in ``benchmarks/bench_beats.py``). Its first 20 s are tapped at
-110 BPM. Their terms were compared at 87 BPM and at 4/3 of it, 116 BPM, in a scratch
-decomposition of :func:`tactus_observation`. The measure is found right for both,
+Why 10-20 s clips of the waltz DANCE_W_10 were tapped faster than its beat, measured
+before :attr:`MeterModel.tatum_ratio_weights` weighed a beat of three tatums half (the
+disagreeing clips at 85-116 BPM, median 107, against 87 BPM for the 28 s excerpt;
+``dance_song_rows`` in ``benchmarks/bench_beats.py``). Its first 20 s were tapped at
+110 BPM (now 87.5). Their terms were compared at 87 BPM and at 4/3 of it, 116 BPM, in a
+scratch decomposition of :func:`tactus_observation`. The measure is found right for both,
 about 2.07 s: three beats at 87 BPM, or four at 116 BPM. Both readings are consistent
 metrical trees, and a balance of small terms decides. Summed over the 13 windows:
 
@@ -136,20 +137,22 @@ metrical trees, and a balance of small terms decides. Summed over the 13 windows
   the 4.0 is the normalisation of ``P(measure | tactus)``, which is larger for a
   shorter tactus.
 
-Given a range of +-15 % around the excerpt's tempo, 1 of DANCE_W_10's 9 disagreeing
-clips agrees; they are tapped at 85-102 BPM (median 91): the salience near the beat is
-flat on them. Given the tempo itself, 4 of the 9 agree (the first 20 s: F 0.27 -> 1.0
-with ``bpm=87``), and none of DANCE_W_5's 11, most of which are at its tempo on another
-phase (``dance_song_rows``). The no-clear-pulse warning of
+The ratio term is where the two readings differ: the faster one is a beat of three
+tatums. With that weighed half, DANCE_W_10 still has 9 disagreeing clips (median 105
+BPM). Given a range of +-15 % around the excerpt's tempo, 1 of them agrees (tapped at
+80-102 BPM, median 90): the salience near the beat is flat on them. Given the tempo
+itself, 4 of the 9 agree, and none of DANCE_W_5's 11, most of which are at its tempo on
+another phase (``dance_song_rows``). The no-clear-pulse warning of
 :mod:`beatsync.beats.tracker` names a known tempo as the way out.
 
-The whole songs show the same (``benchmarks/whole_dance_songs.py``, on the songs of
-the development machine's shared data, which are not bundled). The cha-cha and the
-rumba keep their excerpt's tempo in every window. Of the waltzes' windows, only 93 of
-197 (DANCE_W_5) and 56 of 239 (DANCE_W_10) do; 51 and 129 are at 4/3 of it, and
-DANCE_W_10 gets 4 beats per bar. Both warn. Forced to one tempo (``time_varying=False``),
-DANCE_W_5 gets 85.3 BPM and 3 beats per bar, but DANCE_W_10 gets 120.3 BPM and 4: even
-summed over its 245 s, the evidence of DANCE_W_10 favours the faster level.
+The whole songs (``benchmarks/whole_dance_songs.py``, on the songs of the development
+machine's shared data, which are not bundled) showed it most. The cha-cha and the rumba
+keep their excerpt's tempo in every window. With equal tatum-ratio weights, only 93 of
+197 windows of DANCE_W_5 and 56 of 239 of DANCE_W_10 did, 51 and 129 were at 4/3 of
+it, and DANCE_W_10 got 4 beats per bar; forced to one tempo (``time_varying=False``),
+DANCE_W_10 got 120.3 BPM. With ``w_3 = 0.5``: 189 of 197 and 147 of 239, none at 4/3,
+3 beats per bar for both; DANCE_W_10's other 92 windows are at 95-106 BPM and it still
+warns of no clear pulse.
 
 The observation exponent ``beta``, the prior widths and the ratio weights are our
 choices (see :data:`METER_MODEL`): they were set on the synthetic test set, and the
@@ -196,10 +199,12 @@ class MeterModel:
         their beat (a "beat" of three sixteenths, four to the bar) in 51 of 197 and 129
         of 239 tempo windows; with ``w_3`` at 0.2, 0.5 or 0.7, in none, and at 0.8 in 95
         of DANCE_W_10's (``benchmarks/whole_dance_songs.py``). Chosen on those two
-        songs; every score of the synthetic set, of the annotated recordings and their
-        excerpts stayed the same, and Hainsworth 001's 3-10 s clips rose. The synthetic
-        6/8 pattern at 140 BPM is now tapped at its beat rather than at half of it, but
-        with 4 beats per bar rather than 2.
+        songs. The scores of the annotated recordings and their excerpts stayed the
+        same, and Hainsworth 001's 3-10 s clips rose (5 s: mean F 0.654 to 0.789; 12
+        clips moved from 132 to 100 BPM, none the other way). On the synthetic set the
+        180 BPM click track with noise (seed 0) is now tapped at 90 BPM, and the 6/8
+        pattern at 140 BPM at its beat rather than at half of it, but with 4 beats per
+        bar rather than 2; every other synthetic score stayed the same.
     ratio_sigma : float
         Width of each Gaussian of the ratio model.
     beta : float
