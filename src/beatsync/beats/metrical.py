@@ -201,10 +201,13 @@ class MeterModel:
         of DANCE_W_10's (``benchmarks/whole_dance_songs.py``). Chosen on those two
         songs. The scores of the annotated recordings and their excerpts stayed the
         same, and Hainsworth 001's 3-10 s clips rose (5 s: mean F 0.654 to 0.789; 12
-        clips moved from 132 to 100 BPM, none the other way). On the synthetic set the
-        180 BPM click track with noise (seed 0) is now tapped at 90 BPM, and the 6/8
-        pattern at 140 BPM at its beat rather than at half of it, but with 4 beats per
-        bar rather than 2; every other synthetic score stayed the same.
+        clips moved from 132 to 100 BPM, none the other way). Of the 168 synthetic items
+        of the 30 s set (seeds 0-2) and the 20 s front-end sweep set, 4 moved to another
+        level and none the other way, all at the edges of the tempo range: the 180 BPM
+        click track with noise (30 s, seed 0; and 20 s) and the 180 BPM drums with noise
+        (20 s) to 90 BPM, the clean 60 BPM drums (20 s) to 120 BPM. The 6/8 pattern at
+        140 BPM is tapped at its beat rather than at half of it, but with 4 beats per bar
+        rather than 2.
     ratio_sigma : float
         Width of each Gaussian of the ratio model.
     beta : float
