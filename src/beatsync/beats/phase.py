@@ -28,9 +28,11 @@ phases (0.25). The bands above 1 kHz have 0.34-0.51 there.
   off-beat.
 - **With concentration weights**, on clips of 5, 7 and 10 s starting every second, mean
   F went from 0.633, 0.888 and 0.941 to 0.654, 0.948 and 0.984 on Hainsworth 001, and
-  from 0.736, 0.833 and 0.940 to 0.911, 0.967 and 0.992 on the waltz. The 15-30 s
-  excerpts scored 0.998 and 0.993 (lowest 0.970 and 0.952), and both whole recordings
-  scored F 1.000. The synthetic set (seeds 0-2) is unchanged to within 0.002.
+  from 0.736, 0.833 and 0.940 to 0.911, 0.967 and 0.992 on the waltz (the tatum ratio
+  weight of :class:`beatsync.beats.metrical.MeterModel` later lifted Hainsworth 001's
+  to 0.789, 0.957 and 0.999). The 15-30 s excerpts scored 0.998 and 0.993 (lowest
+  0.970 and 0.952), and both whole recordings scored F 1.000. The synthetic set
+  (seeds 0-2) is unchanged to within 0.002.
 - **Variants measured and not used.** One concentration over the whole signal scored
   the same clips but the whole waltz at F 0.971, with one beat 95 ms off. Squared
   concentrations were about the same. Subtracting the resultant expected from random
