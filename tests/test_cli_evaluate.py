@@ -258,6 +258,11 @@ def test_output_folder_is_a_file(dataset, tmp_path):
         (["--scheduler", "tcp://127.0.0.1:9"], "could not connect to the Dask scheduler"),
         (["--scheduler", "not-an-address"], "not a Dask scheduler address"),
         (["--min-beat-time", "-5"], "min-beat-time=-5.0 must be a finite number >= 0"),
+        (["--min-bpm", "120", "--max-bpm", "90"], "--min-bpm 120 must be smaller than --max-bpm"),
+        (["--max-bpm", "30"], r"\(40 is psf's default --min-bpm\)"),
+        (["--min-bpm", "0.5"], "outside the plausible range 20-400 BPM"),
+        (["--method", "essentia-degara", "--min-bpm", "30"], "whole number of BPM from 40"),
+        (["--method", "essentia-degara", "--min-bpm", "90", "--max-bpm", "100"], "at least 20"),
     ],
 )
 def test_bad_options(dataset, tmp_path, monkeypatch, extra, match):
@@ -283,6 +288,50 @@ def test_results_scored_otherwise_are_not_mixed(dataset, scheduler, tmp_path, ca
     assert code == 0, err
     extra = ["--min-beat-time", "5", "--scheduler", scheduler]
     _refused(_bad(tmp_path, dataset, extra=extra), "scored with min_beat_time=0 s, not 5 s")
+
+
+def test_tempo_range_reaches_the_tracker_and_is_recorded(dataset, scheduler, tmp_path, capsys):
+    # the real madmom sample (88 BPM) alone, told nothing and told 75-101 BPM
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    audio.mkdir(), notes.mkdir()
+    shutil.copy(dataset[0] / "sample.wav", audio)
+    shutil.copy(dataset[1] / "sample.beats", notes)
+    base = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    base += ["--scheduler", scheduler, "--json"]
+    told = ["--min-bpm", "75", "--max-bpm", "101"]
+    code, stdout, err = _run([*base, "--out", str(tmp_path / "told"), *told], capsys)
+    assert code == 0, err
+    res = json.loads(stdout)
+    assert (res["min_bpm"], res["max_bpm"]) == (75.0, 101.0)
+    (row,) = TrackLog(tmp_path / "told" / "tracks.jsonl").rows()
+    assert (row["min_bpm"], row["max_bpm"]) == (75.0, 101.0)
+    assert row["F-measure"] >= 0.95 and row["octave"] == "correct"
+    code, stdout, err = _run([*base, "--out", str(tmp_path / "default")], capsys)
+    (row,) = TrackLog(tmp_path / "default" / "tracks.jsonl").rows()
+    assert (row["min_bpm"], row["max_bpm"]) == (None, None)
+    # results of one range are never mixed with another's in the same folder
+    code, _, err = _run([*base, "--out", str(tmp_path / "default"), *told], capsys)
+    assert code == 3
+    assert "tracked with the default tempo range, not min_bpm=75 and max_bpm=101" in err
+    code, stdout, err = _run([*base, "--out", str(tmp_path / "default"), *told, "--force"], capsys)
+    assert code == 0, err
+    (row,) = TrackLog(tmp_path / "default" / "tracks.jsonl").rows()
+    assert row["min_bpm"] == 75.0
+
+
+def test_tempo_range_help_states_each_methods_defaults_and_limits(capsys):
+    from beatsync.beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
+    from beatsync.peers import ESSENTIA_TEMPO
+
+    with pytest.raises(SystemExit):
+        main(["evaluate", "beats", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    (lo_lo, lo_hi), (hi_lo, hi_hi) = ESSENTIA_TEMPO["min"], ESSENTIA_TEMPO["max"]
+    assert ESSENTIA_TEMPO["default"][0] == DEFAULT_MIN_BPM
+    assert f"(default: the method's own, {DEFAULT_MIN_BPM:g})" in text
+    assert f"{DEFAULT_MAX_BPM:g} for psf and librosa, {ESSENTIA_TEMPO['default'][1]}" in text
+    assert f"whole BPM from {lo_lo} to {lo_hi}" in text
+    assert f"whole BPM from {hi_lo} to {hi_hi}" in text
 
 
 def test_exit_code_and_message_on_bad_input(dataset, tmp_path, capsys):

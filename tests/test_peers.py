@@ -53,6 +53,77 @@ def test_every_method_tracks_a_drum_pattern(song, name):
     assert evaluate(ref, est, min_beat_time=1.0)["F-measure"] >= 0.9, name
 
 
+_METHODS = [
+    "psf",
+    "librosa",
+    pytest.param(
+        "essentia-degara",
+        marks=pytest.mark.skipif(not HAS_ESSENTIA, reason="optional essentia not installed"),
+    ),
+    pytest.param(
+        "essentia-multifeature",
+        marks=pytest.mark.skipif(not HAS_ESSENTIA, reason="optional essentia not installed"),
+    ),
+]
+
+
+@pytest.mark.parametrize("name", _METHODS)
+def test_every_method_searches_the_tempo_range_given(song, name):
+    # the 120 BPM pattern, told to look between 45 and 75 BPM: its half tempo, on the
+    # kicks or on the snares
+    y, ref = song
+    est = peers.track(name, y, SR, min_bpm=45, max_bpm=75)
+    assert 55 <= 60.0 / np.median(np.diff(est)) <= 65, name
+    f = max(evaluate(r, est, min_beat_time=1.0)["F-measure"] for r in (ref[::2], ref[1::2]))
+    assert f >= 0.9, name
+
+
+@pytest.mark.parametrize("name", _METHODS)
+def test_a_range_puts_every_method_on_the_real_samples_beat(name):
+    # the madmom sample (2.8 s, 88 BPM) is tapped at another level by every method told
+    # nothing here; a range around its tempo puts each on its 4 annotated beats
+    from beatsync import datasets
+
+    y, sr, ref = datasets.load_madmom_sample()
+    est = peers.track(name, y, sr, min_bpm=75, max_bpm=101)
+    assert evaluate(ref, est, min_beat_time=0.0)["F-measure"] >= 0.85, name
+
+
+@pytest.mark.parametrize(
+    "name, lo, hi, match",
+    [
+        ("psf", 120, 90, "min_bpm 120 must be smaller than max_bpm 90$"),
+        ("psf", None, 30, r"min_bpm 40 must be smaller than max_bpm 30 \(40 is psf's default"),
+        ("librosa", 500, None, "outside the plausible range 20-400 BPM"),
+        ("essentia-degara", 30, None, "whole number of BPM from 40 to 180"),
+        ("essentia-degara", 75.5, None, "whole number of BPM from 40 to 180"),
+        ("essentia-multifeature", None, 260, "whole number of BPM from 60 to 250"),
+        ("essentia-degara", 100, 110, "at least 20 BPM below max_bpm 110"),
+        ("essentia-degara", 190, None, "from 40 to 180"),
+    ],
+)
+def test_tempo_range_a_method_does_not_take_is_refused(name, lo, hi, match):
+    with pytest.raises(ParameterError, match=match):
+        peers.check_tempo_range(name, lo, hi)
+
+
+@pytest.mark.skipif(not HAS_ESSENTIA, reason="optional essentia not installed")
+def test_essentia_tempo_limits_are_essentias_own():
+    es = peers._essentia()
+    for algo in (es.BeatTrackerDegara, es.BeatTrackerMultiFeature):
+        params = {p["name"]: p for p in algo().getStruct()["parameters"]}
+        assert params["minTempo"]["range"] == "[{},{}]".format(*peers.ESSENTIA_TEMPO["min"])
+        assert params["maxTempo"]["range"] == "[{},{}]".format(*peers.ESSENTIA_TEMPO["max"])
+        default = (params["minTempo"]["default"], params["maxTempo"]["default"])
+        assert tuple(int(v) for v in default) == peers.ESSENTIA_TEMPO["default"]
+
+
+def test_tempo_range_defaults_stay_each_methods_own():
+    assert peers.check_tempo_range("psf") == {}
+    assert peers.check_tempo_range("essentia-degara", 60) == {"min_bpm": 60.0}
+    assert peers.check_tempo_range("librosa", None, 100.0) == {"max_bpm": 100.0}
+
+
 def test_librosa_peer_at_another_rate(song):
     import librosa
 

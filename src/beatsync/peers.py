@@ -1,8 +1,10 @@
 """The beat trackers a user would pick instead of ours, behind one signature.
 
-Every method is a function ``track(y, sr) -> beats``: mono audio ``y`` (float, finite)
-at ``sr`` [Hz] in, beat times [s] out (1-D ``float64``, strictly increasing), each
-with its published default settings. :data:`PEERS` names them:
+Every method is a function ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``:
+mono audio ``y`` (float, finite) at ``sr`` [Hz] in, beat times [s] out (1-D
+``float64``, strictly increasing), each with its published default settings. A tempo
+range narrows the tempi searched; a bound not given keeps the method's own default
+(:func:`check_tempo_range` says what each method accepts). :data:`PEERS` names them:
 
 - ``"psf"``: ours, :func:`beatsync.beats.track_beats` (phase-slope onsets and a
   tempo/phase HMM; paper A, section 4).
@@ -31,10 +33,24 @@ import numpy as np
 from .errors import ParameterError
 from .io import resample_audio
 
-__all__ = ["Peer", "PEERS", "get", "available", "track", "ESSENTIA_SR"]
+__all__ = [
+    "Peer",
+    "PEERS",
+    "get",
+    "available",
+    "track",
+    "check_tempo_range",
+    "ESSENTIA_SR",
+    "ESSENTIA_TEMPO",
+]
 
 #: Sample rate the essentia beat trackers are built for [Hz].
 ESSENTIA_SR = 44100
+
+#: essentia's beat trackers' tempo range parameters [BPM]: whole numbers, ``minTempo``
+#: in 40-180 (default 40), ``maxTempo`` in 60-250 (default 208), ``maxTempo`` at least
+#: 20 above ``minTempo``.
+ESSENTIA_TEMPO = {"min": (40, 180), "max": (60, 250), "default": (40, 208), "span": 20}
 
 
 @dataclass(frozen=True)
@@ -47,14 +63,14 @@ class Peer:
         Registry key (``--method`` of ``beatsync evaluate beats``).
     description : str
         One line: the algorithm and its reference.
-    track : callable ``(y, sr) -> beats [s]``
+    track : callable ``(y, sr, *, min_bpm=None, max_bpm=None) -> beats [s]``
     requires : str or None
         The optional package it needs (``None``: always available).
     """
 
     name: str
     description: str
-    track: Callable[[np.ndarray, float], np.ndarray]
+    track: Callable[..., np.ndarray]
     requires: str | None = None
 
     @property
@@ -67,19 +83,39 @@ def _as_beats(times: object) -> np.ndarray:
     return np.unique(np.asarray(times, dtype=np.float64).ravel())
 
 
-def track_psf(y: np.ndarray, sr: float) -> np.ndarray:
+def _given(min_bpm: float | None, max_bpm: float | None) -> dict[str, float]:
+    bounds = {"min_bpm": min_bpm, "max_bpm": max_bpm}
+    return {k: float(v) for k, v in bounds.items() if v is not None}
+
+
+def track_psf(
+    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+) -> np.ndarray:
     """Our tracker, :func:`beatsync.beats.track_beats` with its defaults."""
     from .beats import track_beats
 
-    return _as_beats(track_beats(y, sr).beats)
+    return _as_beats(track_beats(y, sr, **_given(min_bpm, max_bpm)).beats)
 
 
-def track_librosa(y: np.ndarray, sr: float) -> np.ndarray:
-    """:func:`librosa.beat.beat_track` with its defaults (hop 512), times in seconds."""
+def track_librosa(
+    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+) -> np.ndarray:
+    """:func:`librosa.beat.beat_track` with its defaults (hop 512), times in seconds.
+
+    With a tempo range, a flat tempo prior inside it replaces librosa's log-normal one
+    (as ``track_beats(method="librosa", min_bpm=, max_bpm=)``).
+    """
     import librosa
 
+    kwargs = {}
+    if min_bpm is not None or max_bpm is not None:
+        from .beats.tracker import librosa_tempo_prior
+
+        prior = librosa_tempo_prior(**_given(min_bpm, max_bpm))
+        if prior is not None:
+            kwargs["prior"] = prior
     _, beats = librosa.beat.beat_track(
-        y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=512, units="time"
+        y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=512, units="time", **kwargs
     )
     return _as_beats(beats)
 
@@ -101,16 +137,27 @@ def _essentia():
     return es
 
 
-def track_essentia_degara(y: np.ndarray, sr: float) -> np.ndarray:
+def _essentia_tempo(min_bpm: float | None, max_bpm: float | None) -> dict[str, int]:
+    params = {"minTempo": min_bpm, "maxTempo": max_bpm}
+    return {k: int(round(v)) for k, v in params.items() if v is not None}
+
+
+def track_essentia_degara(
+    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+) -> np.ndarray:
     """essentia ``BeatTrackerDegara`` with its defaults (at 44.1 kHz)."""
     es = _essentia()
-    return _as_beats(es.BeatTrackerDegara()(_essentia_audio(y, sr)))
+    algo = es.BeatTrackerDegara(**_essentia_tempo(min_bpm, max_bpm))
+    return _as_beats(algo(_essentia_audio(y, sr)))
 
 
-def track_essentia_multifeature(y: np.ndarray, sr: float) -> np.ndarray:
+def track_essentia_multifeature(
+    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+) -> np.ndarray:
     """essentia ``BeatTrackerMultiFeature`` with its defaults (at 44.1 kHz)."""
     es = _essentia()
-    ticks, _confidence = es.BeatTrackerMultiFeature()(_essentia_audio(y, sr))
+    algo = es.BeatTrackerMultiFeature(**_essentia_tempo(min_bpm, max_bpm))
+    ticks, _confidence = algo(_essentia_audio(y, sr))
     return _as_beats(ticks)
 
 
@@ -161,19 +208,109 @@ def get(name: str) -> Peer:
     return peer
 
 
-def track(name: str, y: np.ndarray, sr: float) -> np.ndarray:
-    """Run the method ``name`` on ``y`` at ``sr`` [Hz]; return beat times [s].
+def check_tempo_range(
+    name: str,
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
+    *,
+    names: tuple[str, str] = ("min_bpm", "max_bpm"),
+) -> dict[str, float]:
+    """The tempo range [BPM] that method ``name`` will search, checked; ``{}`` if none.
+
+    A bound not given keeps the method's default: 40 and 240 BPM for ``psf`` and
+    ``librosa`` (within 20-400 BPM, as :func:`beatsync.beats.track_beats`), and
+    essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers,
+    ``min_bpm`` in 40-180 and ``max_bpm`` in 60-250, at least 20 apart).
+
+    Parameters
+    ----------
+    names : (str, str)
+        How the two bounds are named in the errors (e.g. the options ``--min-bpm``).
+
+    Returns
+    -------
+    dict
+        The bounds given, as floats (``min_bpm``, ``max_bpm``), for :func:`track`.
 
     Raises
     ------
     ParameterError
-        Unknown or unavailable method (:func:`get`); empty, silent or non-finite audio
-        or ``sr <= 0`` (checked here for every method, as ours does).
+        An unknown method, or a bound that is not a number, out of the method's range,
+        not whole for essentia, or a range that is empty (or, for essentia, narrower
+        than 20 BPM); the message names the option and the default it was set against.
+    """
+    from .units import check_bpm
+
+    peer = PEERS.get(name)
+    if peer is None:
+        get(name)  # raises: unknown method
+    given = {
+        key: check_bpm(value, name=label)
+        for key, label, value in zip(("min_bpm", "max_bpm"), names, (min_bpm, max_bpm), strict=True)
+        if value is not None
+    }
+    if not given:
+        return {}
+    if peer.requires == "essentia":
+        lo_lo, lo_hi = ESSENTIA_TEMPO["min"]
+        hi_lo, hi_hi = ESSENTIA_TEMPO["max"]
+        span = ESSENTIA_TEMPO["span"]
+        defaults = dict(zip(("min_bpm", "max_bpm"), ESSENTIA_TEMPO["default"], strict=True))
+        limits = {"min_bpm": (lo_lo, lo_hi), "max_bpm": (hi_lo, hi_hi)}
+    else:
+        from .beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
+
+        span = 0
+        defaults = {"min_bpm": DEFAULT_MIN_BPM, "max_bpm": DEFAULT_MAX_BPM}
+        limits = {}
+    label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
+    for key, value in given.items():
+        if key in limits:
+            a, b = limits[key]
+            if value != round(value) or not a <= value <= b:
+                raise ParameterError(
+                    f"{label[key]} {value:g}: {name} takes a whole number of BPM from {a} to "
+                    f"{b} (essentia's range)"
+                )
+    lo = given.get("min_bpm", defaults["min_bpm"])
+    hi = given.get("max_bpm", defaults["max_bpm"])
+    if not (hi - lo >= span if span else lo < hi):
+        what = f"at least {span} BPM below" if span else "smaller than"
+        other = ""
+        if len(given) == 1:
+            key = "max_bpm" if "min_bpm" in given else "min_bpm"
+            other = f" ({defaults[key]:g} is {name}'s default {label[key]})"
+        raise ParameterError(
+            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}{other}"
+        )
+    return given
+
+
+def track(
+    name: str,
+    y: np.ndarray,
+    sr: float,
+    *,
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
+) -> np.ndarray:
+    """Run the method ``name`` on ``y`` at ``sr`` [Hz]; return beat times [s].
+
+    ``min_bpm``/``max_bpm`` narrow the tempo range searched (:func:`check_tempo_range`);
+    a bound not given keeps the method's default.
+
+    Raises
+    ------
+    ParameterError
+        Unknown or unavailable method (:func:`get`); a tempo range the method does not
+        accept; empty, silent or non-finite audio or ``sr <= 0`` (checked here for
+        every method, as ours does).
     """
     from .beats import check_audio
 
     peer = get(name)
+    tempo = check_tempo_range(name, min_bpm, max_bpm)
     y, sr = check_audio(y, sr)
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=FutureWarning)
-        return peer.track(y, sr)
+        return peer.track(y, sr, **tempo)

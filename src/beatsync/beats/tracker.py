@@ -471,17 +471,28 @@ def _accents(bands: np.ndarray, fps: float) -> np.ndarray:
     return np.stack([gaussian_smooth(band, sigma) for band in bands])
 
 
+def librosa_tempo_prior(min_bpm: float = DEFAULT_MIN_BPM, max_bpm: float = DEFAULT_MAX_BPM):
+    """The tempo prior given to :func:`librosa.beat.beat_track` for a tempo range [BPM].
+
+    ``None`` (librosa's own log-normal prior) for the default range; a flat prior
+    inside a range the user narrowed (``scipy.stats.uniform``).
+    """
+    if (min_bpm, max_bpm) == (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
+        return None
+    import scipy.stats  # noqa: PLC0415
+
+    return scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
+
+
 def _track_librosa(y, sr, *, bpm, min_bpm, max_bpm) -> BeatTrack:
     import librosa  # noqa: PLC0415 (heavy; only for the comparison method)
-    import scipy.stats  # noqa: PLC0415
 
     hop = 512
     kwargs: dict[str, Any] = {}
     if bpm is not None:
         kwargs["bpm"] = bpm
-    elif (min_bpm, max_bpm) != (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
-        # a user-narrowed range: flat prior inside it (else librosa's log-normal prior)
-        kwargs["prior"] = scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
+    elif (prior := librosa_tempo_prior(min_bpm, max_bpm)) is not None:
+        kwargs["prior"] = prior
     tempo, beats = librosa.beat.beat_track(
         y=y.astype(np.float32), sr=sr, hop_length=hop, units="time", **kwargs
     )

@@ -55,6 +55,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=0.0,
         help="beats before this time are not scored [s] (default 0; MIREX uses 5)",
     )
+    b.add_argument(
+        "--min-bpm",
+        type=float,
+        default=None,
+        help="slowest tempo the tracker searches on every track [BPM] (default: the "
+        "method's own, 40); essentia's trackers take whole BPM from 40 to 180",
+    )
+    b.add_argument(
+        "--max-bpm",
+        type=float,
+        default=None,
+        help="fastest tempo the tracker searches [BPM] (default: the method's own, 240 for "
+        "psf and librosa, 208 for essentia's, which take whole BPM from 60 to 250)",
+    )
     b.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     b.add_argument(
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
@@ -78,6 +92,9 @@ def run_beats(args: argparse.Namespace) -> int:
     # cheapest first: options, then the output folder, then the inputs
     workers = check_cluster_options(args.scheduler, args.workers)
     mbt = check_positive(args.min_beat_time, name="--min-beat-time", unit="s", allow_zero=True)
+    tempo = peers.check_tempo_range(
+        args.method, args.min_bpm, args.max_bpm, names=("--min-bpm", "--max-bpm")
+    )
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out {args.out!r} is a file; give a folder for the results")
@@ -101,6 +118,7 @@ def run_beats(args: argparse.Namespace) -> int:
                 method=args.method,
                 min_beat_time=mbt,
                 force=args.force,
+                **tempo,
                 scheduler=args.scheduler,
                 n_workers=workers,
                 progress=progress,
@@ -111,6 +129,8 @@ def run_beats(args: argparse.Namespace) -> int:
     failed = t[t["status"] != "ok"]
     result = {
         "method": args.method,
+        "min_bpm": tempo.get("min_bpm"),
+        "max_bpm": tempo.get("max_bpm"),
         "tracks": len(t),
         "scored_now": run.scored,
         "skipped": run.skipped,
@@ -128,8 +148,9 @@ def run_beats(args: argparse.Namespace) -> int:
     for _, row in failed.iterrows():
         lines.append(f"failed: {row['key']}: {row['error']}")
     skipped = f", {run.skipped} already scored (--force re-runs them)" if run.skipped else ""
+    searched = "".join(f", {k}={v:g}" for k, v in tempo.items())
     lines.append(
-        f"{len(t) - len(failed)}/{len(t)} tracks scored with {args.method} "
+        f"{len(t) - len(failed)}/{len(t)} tracks scored with {args.method}{searched} "
         f"({run.scored} run now{skipped}); results in {run.files['summary'].parent}"
     )
     emit(result, "\n".join(lines), args)

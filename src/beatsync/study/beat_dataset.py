@@ -182,6 +182,8 @@ def evaluate_track(
     min_beat_time: float,
     name: str,
     group: str = ".",
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
 ) -> dict[str, Any]:
     """Track one audio file and score it; a failure becomes the row's ``error``.
 
@@ -201,11 +203,14 @@ def evaluate_track(
         The track's key (:attr:`Track.key`), recorded as ``key``.
     group : str
         The track's folder (:attr:`Track.group`).
+    min_bpm, max_bpm : float, optional [BPM]
+        The tempo range searched (:func:`beatsync.peers.check_tempo_range`); ``None``:
+        the method's default.
 
     Returns
     -------
     dict
-        ``key, group, audio, method, min_beat_time, status`` (``"ok"`` or
+        ``key, group, audio, method, min_beat_time, min_bpm, max_bpm, status`` (``"ok"`` or
         ``"error"``), ``error``, ``warning`` (the tracker's or scorer's warnings),
         ``n_ref, n_est, tempo_ref, tempo_est, octave``, every metric of
         :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking
@@ -217,6 +222,8 @@ def evaluate_track(
         "audio": str(audio),
         "method": method,
         "min_beat_time": float(min_beat_time),
+        "min_bpm": min_bpm,
+        "max_bpm": max_bpm,
         "status": "error",
         "error": "",
         "warning": "",
@@ -227,7 +234,7 @@ def evaluate_track(
             warnings.simplefilter("ignore")
             warnings.simplefilter("always", BeatsyncWarning)
             y, sr = io.read_audio(audio)
-            est = peers.track(method, y, sr)
+            est = peers.track(method, y, sr, min_bpm=min_bpm, max_bpm=max_bpm)
             seconds = time.perf_counter() - t0
             scores = evaluate(reference, est, min_beat_time=min_beat_time)
     except ParameterError as exc:
@@ -362,6 +369,8 @@ def evaluate_dataset(
     *,
     method: str = "psf",
     min_beat_time: float = 0.0,
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
     force: bool = False,
     scheduler: str | None = None,
     n_workers: int | None = None,
@@ -381,6 +390,10 @@ def evaluate_dataset(
         A name of :data:`beatsync.peers.PEERS`.
     min_beat_time : float >= 0 [s]
         Beats before this time are not scored (mir_eval/MIREX use 5 s; 0 scores all).
+    min_bpm, max_bpm : float, optional [BPM]
+        The tempo range the method searches on every track; a bound not given keeps the
+        method's default (:func:`beatsync.peers.check_tempo_range`). Recorded in each
+        row.
     force : bool
         Re-run tracks already recorded for ``method`` (default: skip those scored).
         Tracks recorded with an error are always re-run.
@@ -395,7 +408,8 @@ def evaluate_dataset(
     ParameterError
         An unknown or unavailable method; an annotation that is not beat times in
         seconds; an output folder that is a file; results in ``out_dir`` recorded
-        with another ``min_beat_time`` (without ``force``); a bad worker count or an
+        with another ``min_beat_time`` or tempo range (without ``force``); a tempo range
+        the method does not accept; a bad worker count or an
         unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
     """
     from ..cluster import check_cluster_options, dask_client
@@ -403,6 +417,8 @@ def evaluate_dataset(
 
     peers.get(method)
     mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
+    tempo = peers.check_tempo_range(method, min_bpm, max_bpm)
+    bpm_range = (tempo.get("min_bpm"), tempo.get("max_bpm"))
     check_cluster_options(scheduler, n_workers)
     if not tracks:
         raise ParameterError("no tracks to evaluate; see find_tracks")
@@ -420,6 +436,14 @@ def evaluate_dataset(
                 f"{str(log.path)!r} holds {method} results scored with min_beat_time="
                 f"{other[0]:g} s, not {mbt:g} s; use --force to re-run them or another --out"
             )
+        ranges = {(r.get("min_bpm"), r.get("max_bpm")) for r in previous.values()}
+        other_range = sorted(ranges - {bpm_range}, key=str)
+        if other_range:
+            raise ParameterError(
+                f"{str(log.path)!r} holds {method} results tracked with "
+                f"{_range_text(other_range[0])}, not {_range_text(bpm_range)}; use --force "
+                "to re-run them or another --out"
+            )
     done = set() if force else {k for k, r in previous.items() if r.get("status") == "ok"}
     todo = [t for t in tracks if t.key not in done]
     with contextlib.ExitStack() as stack:
@@ -431,7 +455,7 @@ def evaluate_dataset(
         if force and previous:
             log.rewrite([r for r in log.rows() if r["method"] != method])
         if todo:
-            _run(client, todo, refs, log, method=method, mbt=mbt, progress=progress)
+            _run(client, todo, refs, log, method=method, mbt=mbt, tempo=tempo, progress=progress)
     latest = log.latest()
     mine = [latest[(method, k)] for k in keys if (method, k) in latest]
     files = {"log": log.path, "tracks": out / "tracks.csv", "summary": out / "summary.csv"}
@@ -441,7 +465,14 @@ def evaluate_dataset(
     return DatasetRun(_table(mine), summary, len(todo), len(tracks) - len(todo), files)
 
 
-def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
+def _range_text(bounds: tuple[float | None, float | None]) -> str:
+    """``(None, None)`` -> "the default tempo range"; ``(60, None)`` -> "min_bpm=60"."""
+    names = ("min_bpm", "max_bpm")
+    given = [f"{k}={v:g}" for k, v in zip(names, bounds, strict=True) if v is not None]
+    return " and ".join(given) if given else "the default tempo range"
+
+
+def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
     from dask.distributed import as_completed
 
     futures = {
@@ -453,6 +484,7 @@ def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
             min_beat_time=mbt,
             name=t.key,
             group=t.group,
+            **tempo,
             key=f"evaluate-{method}-{t.key}-{uuid.uuid4().hex}",
         ): t
         for t in todo
@@ -471,6 +503,8 @@ def _run(client, todo, refs, log, *, method, mbt, progress) -> None:
                     "audio": str(t.audio),
                     "method": method,
                     "min_beat_time": mbt,
+                    "min_bpm": tempo.get("min_bpm"),
+                    "max_bpm": tempo.get("max_bpm"),
                     "status": "error",
                     "error": f"{type(exc).__name__}: {exc}",
                     "warning": "",
