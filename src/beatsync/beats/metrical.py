@@ -167,7 +167,8 @@ salience at 88 BPM is below the noise level (``s`` = -0.03 against 0.14 at 120 B
 Correcting the extra window bias of a clip shorter than the tempo window (scaling
 ``s`` by the salience a periodic accent train gets in an 8 s window over that in the
 clip's) would multiply both by 3-4 and cannot lift a negative salience; not used.
-Given a tempo range around its tempo (75-101 BPM), ours and every peer tap its beats.
+Given a tempo range around its tempo (75-101 BPM), ours and librosa tap its beats (F
+0.40 and 0.44 to 1.0), essentia's two trackers most of them (0.55 to 0.86).
 
 The observation exponent ``beta``, the prior widths and the ratio weights are our
 choices (see :data:`METER_MODEL`): they were set on the synthetic test set, except the
