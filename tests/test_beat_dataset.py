@@ -105,6 +105,21 @@ def test_evaluate_track_records_failures_instead_of_raising(tmp_path):
     assert row["status"] == "error" and "0.500 s long" in row["error"]
 
 
+def test_evaluate_track_records_the_tempo_range_as_checked(tmp_path):
+    ref = beat_times(120, duration=6.0, start=0.3)
+    good = io.write_audio(tmp_path / "good.wav", click_track(ref, sr=SR, duration=6.0), SR)
+
+    def row(**tempo):
+        return evaluate_track(str(good), ref, method="psf", min_beat_time=0.0, name="g", **tempo)
+
+    told = row(min_bpm=40, max_bpm="75")  # the default min_bpm is the same as none
+    assert told["status"] == "ok" and (told["min_bpm"], told["max_bpm"]) == (None, 75.0)
+    assert 55 <= told["tempo_est"] <= 65  # the half tempo, inside the range
+    bad = row(min_bpm=120, max_bpm=90)
+    assert bad["status"] == "error"
+    assert "min_bpm 120 must be smaller than max_bpm 90" in bad["error"]
+
+
 def test_track_log_appends_and_skips_a_torn_line(tmp_path):
     log = TrackLog(tmp_path / "tracks.jsonl")
     assert log.rows() == []
@@ -139,3 +154,19 @@ def test_summarize_dataset_per_folder_and_all():
     assert pd.isna(s.loc["all", "Goto"])  # a metric no row has
     one_folder = summarize_dataset([dict(r, group=".") for r in rows])
     assert list(one_folder["group"]) == ["all"]
+
+
+def test_summary_states_the_settings_the_rows_were_scored_with():
+    rows = [
+        {"key": "g/a", "group": "g", "method": "psf", "status": "ok", "min_beat_time": 5.0,
+         "min_bpm": 75.0, "max_bpm": None},
+        {"key": "h/b", "group": "h", "method": "psf", "status": "ok", "min_beat_time": 5.0,
+         "min_bpm": None, "max_bpm": None},
+        {"key": "h/c", "group": "h", "method": "librosa", "status": "ok"},  # an old log
+    ]  # fmt: skip
+    s = summarize_dataset(rows).set_index(["method", "group"])
+    assert s.loc[("psf", "g"), ["min_beat_time", "min_bpm"]].tolist() == [5.0, 75.0]
+    assert pd.isna(s.loc[("psf", "g"), "max_bpm"]) and pd.isna(s.loc[("psf", "h"), "min_bpm"])
+    assert s.loc[("psf", "all"), "min_beat_time"] == 5.0
+    assert pd.isna(s.loc[("psf", "all"), "min_bpm"])  # the rows differ: not one range
+    assert s.loc[("librosa", "all"), ["min_beat_time", "min_bpm", "max_bpm"]].isna().all()

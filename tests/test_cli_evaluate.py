@@ -259,7 +259,8 @@ def test_output_folder_is_a_file(dataset, tmp_path):
         (["--scheduler", "not-an-address"], "not a Dask scheduler address"),
         (["--min-beat-time", "-5"], "min-beat-time=-5.0 must be a finite number >= 0"),
         (["--min-bpm", "120", "--max-bpm", "90"], "--min-bpm 120 must be smaller than --max-bpm"),
-        (["--max-bpm", "30"], r"\(40 is psf's default --min-bpm\)"),
+        (["--max-bpm", "30"], "--max-bpm 30 is below psf's default --min-bpm 40: give --min-bpm"),
+        (["--method", "librosa", "--min-bpm", "330", "--max-bpm", "400"], "above 320 BPM"),
         (["--min-bpm", "0.5"], "outside the plausible range 20-400 BPM"),
         (["--method", "essentia-degara", "--min-bpm", "30"], "whole number of BPM from 40"),
         (["--method", "essentia-degara", "--min-bpm", "90", "--max-bpm", "100"], "at least 20"),
@@ -307,14 +308,27 @@ def test_tempo_range_reaches_the_tracker_and_is_recorded(dataset, scheduler, tmp
     assert (row["min_bpm"], row["max_bpm"]) == (75.0, 101.0)
     assert row["F-measure"] >= 0.95 and row["octave"] == "correct"
     code, stdout, err = _run([*base, "--out", str(tmp_path / "default")], capsys)
+    assert code == 0, err
     (row,) = TrackLog(tmp_path / "default" / "tracks.jsonl").rows()
     assert (row["min_bpm"], row["max_bpm"]) == (None, None)
+    # the default bounds given are the same search, and a log written before rows held
+    # the range was tracked with the default: the folder resumes (nothing re-run)
+    log = TrackLog(tmp_path / "default" / "tracks.jsonl")
+    old = [{k: v for k, v in r.items() if k not in ("min_bpm", "max_bpm")} for r in log.rows()]
+    log.rewrite(old)
+    default = ["--min-bpm", "40", "--max-bpm", "240"]
+    for again in ([], default):
+        code, stdout, err = _run([*base, "--out", str(tmp_path / "default"), *again], capsys)
+        assert code == 0, err
+        assert json.loads(stdout)["skipped"] == 1 and json.loads(stdout)["min_bpm"] is None
     # results of one range are never mixed with another's in the same folder
     code, _, err = _run([*base, "--out", str(tmp_path / "default"), *told], capsys)
     assert code == 3
-    assert "tracked with the default tempo range, not min_bpm=75 and max_bpm=101" in err
-    code, stdout, err = _run([*base, "--out", str(tmp_path / "default"), *told, "--force"], capsys)
+    assert "tracked with the default tempo range, not --min-bpm 75 and --max-bpm 101" in err
+    text = [a for a in base if a != "--json"]  # the summary line names the options
+    code, stdout, err = _run([*text, "--out", str(tmp_path / "default"), *told, "--force"], capsys)
     assert code == 0, err
+    assert "1/1 tracks scored with psf, --min-bpm 75, --max-bpm 101 (1 run now)" in stdout
     (row,) = TrackLog(tmp_path / "default" / "tracks.jsonl").rows()
     assert row["min_bpm"] == 75.0
 
@@ -328,9 +342,11 @@ def test_tempo_range_help_states_each_methods_defaults_and_limits(capsys):
     text = " ".join(capsys.readouterr().out.split())
     (lo_lo, lo_hi), (hi_lo, hi_hi) = ESSENTIA_TEMPO["min"], ESSENTIA_TEMPO["max"]
     assert ESSENTIA_TEMPO["default"][0] == DEFAULT_MIN_BPM
-    assert f"(default: the method's own, {DEFAULT_MIN_BPM:g})" in text
-    assert f"{DEFAULT_MAX_BPM:g} for psf and librosa, {ESSENTIA_TEMPO['default'][1]}" in text
-    assert f"whole BPM from {lo_lo} to {lo_hi}" in text
+    assert f"(default {DEFAULT_MIN_BPM:g})" in text
+    max_default = ESSENTIA_TEMPO["default"][1]
+    assert f"(default {DEFAULT_MAX_BPM:g} for psf and librosa, {max_default}" in text
+    assert f"whole BPM from {lo_lo} to {lo_hi}, at least {ESSENTIA_TEMPO['span']} below" in text
+    assert "librosa searches a flat tempo prior inside the range" in text
     assert f"whole BPM from {hi_lo} to {hi_hi}" in text
 
 

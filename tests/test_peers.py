@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from beatsync import peers
+from beatsync.beats import track_beats
 from beatsync.errors import ParameterError
 from beatsync.evaluate.beats import evaluate
 from beatsync.synth.audio import beat_times, drum_pattern
@@ -81,7 +82,8 @@ def test_every_method_searches_the_tempo_range_given(song, name):
 @pytest.mark.parametrize("name", _METHODS)
 def test_a_range_puts_every_method_on_the_real_samples_beat(name):
     # the madmom sample (2.8 s, 88 BPM) is tapped at another level by every method told
-    # nothing here; a range around its tempo puts each on its 4 annotated beats
+    # nothing here; a range around its tempo puts ours and librosa on its 4 annotated
+    # beats and essentia's two on 3 of them (F 0.857)
     from beatsync import datasets
 
     y, sr, ref = datasets.load_madmom_sample()
@@ -89,14 +91,62 @@ def test_a_range_puts_every_method_on_the_real_samples_beat(name):
     assert evaluate(ref, est, min_beat_time=0.0)["F-measure"] >= 0.85, name
 
 
+@pytest.fixture(scope="module")
+def song80():
+    ref = beat_times(80, duration=12.0, start=0.37)
+    return drum_pattern(ref, sr=SR, duration=12.0)
+
+
+@pytest.mark.parametrize("name", _METHODS)
+def test_one_bound_alone_moves_every_method(song80, name):
+    # an 80 BPM pattern: librosa taps it at 160 BPM told nothing, the others at 80; a
+    # single bound across the other level moves each (the other bound stays the default)
+    def bpm(**tempo):
+        return 60.0 / np.median(np.diff(peers.track(name, song80, SR, **tempo)))
+
+    if name == "librosa":
+        assert 155 <= bpm() <= 165 and 77 <= bpm(max_bpm=100) <= 83
+    else:
+        assert 77 <= bpm() <= 83 and 155 <= bpm(min_bpm=110) <= 165
+
+
+def test_librosa_range_without_a_tempo_step_is_refused(song):
+    # librosa's tempo is one lag of its onset autocorrelation: at 22.05 kHz and hop 512
+    # the steps near 190 BPM are 184.6 and 198.8, so 185-198 holds none; unchecked it
+    # returned a single beat at an infinite tempo
+    from beatsync.beats.tracker import librosa_tempo_steps
+
+    steps = librosa_tempo_steps(SR)
+    assert not np.any((steps >= 185) & (steps <= 198))
+    y, _ = song
+    with pytest.raises(ParameterError, match=r"185-198 BPM holds none .* 184\.6 and 198\.8 BPM"):
+        peers.track("librosa", y, SR, min_bpm=185, max_bpm=198)
+    with pytest.raises(ParameterError, match="holds none"):
+        track_beats(y, SR, method="librosa", min_bpm=185, max_bpm=198)
+    est = peers.track("librosa", y, SR, min_bpm=180, max_bpm=200)  # holds two steps
+    assert 180 <= 60.0 / np.median(np.diff(est)) <= 200
+
+
+def test_tempo_range_bounds_equal_to_the_default_are_none():
+    # the same search as no bound, so a folder scored without it resumes with it
+    assert peers.check_tempo_range("librosa", 40, 240) == {}
+    assert peers.check_tempo_range("psf", 40.0, 200) == {"max_bpm": 200.0}
+    assert peers.check_tempo_range("essentia-degara", 40, 208) == {}
+    narrowest = peers.check_tempo_range("essentia-degara", 100, 120)  # exactly 20 apart
+    assert narrowest == {"min_bpm": 100.0, "max_bpm": 120.0}
+
+
 @pytest.mark.parametrize(
     "name, lo, hi, match",
     [
         ("psf", 120, 90, "min_bpm 120 must be smaller than max_bpm 90$"),
-        ("psf", None, 30, r"min_bpm 40 must be smaller than max_bpm 30 \(40 is psf's default"),
+        ("psf", None, 30, "max_bpm 30; max_bpm 30 is below psf's default min_bpm 40: give min"),
+        ("librosa", 300, None, "min_bpm 300 is above librosa's default max_bpm 240: give max_bpm"),
+        ("librosa", 330, 400, "librosa's beat tracker does not search above 320 BPM"),
+        ("psf", float("nan"), None, "not a finite number"),
         ("librosa", 500, None, "outside the plausible range 20-400 BPM"),
-        ("essentia-degara", 30, None, "whole number of BPM from 40 to 180"),
-        ("essentia-degara", 75.5, None, "whole number of BPM from 40 to 180"),
+        ("essentia-degara", 30, None, "from 40 to 180 .*; to search outside them, use psf"),
+        ("essentia-degara", 75.5, None, "whole number of BPM from 40 to 180 .*; round it to 76"),
         ("essentia-multifeature", None, 260, "whole number of BPM from 60 to 250"),
         ("essentia-degara", 100, 110, "at least 20 BPM below max_bpm 110"),
         ("essentia-degara", 190, None, "from 40 to 180"),

@@ -207,7 +207,9 @@ def test_check_sample_rate_accepts():
         (0.5, r"bpm=0.5 is outside the plausible range 20-400 BPM \(did you give a beat period"),
         (2.0, "beats per second"),
         (1000, "sub-beats"),
-        (np.nan, "outside"),
+        (np.nan, r"bpm=nan is not a finite number; give a tempo in BPM from 20 to 400"),
+        (np.inf, "not a finite number"),
+        ("inf", "not a finite number"),
         ("x", r"not a number \[bpm\]"),
     ],
 )

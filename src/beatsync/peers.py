@@ -3,8 +3,10 @@
 Every method is a function ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``:
 mono audio ``y`` (float, finite) at ``sr`` [Hz] in, beat times [s] out (1-D
 ``float64``, strictly increasing), each with its published default settings. A tempo
-range narrows the tempi searched; a bound not given keeps the method's own default
-(:func:`check_tempo_range` says what each method accepts). :data:`PEERS` names them:
+range narrows the tempi searched; a bound not given keeps the method's default
+(:func:`check_tempo_range` says what each method accepts; librosa given a range
+searches a flat tempo prior inside it instead of its own log-normal one around 120
+BPM). :data:`PEERS` names them:
 
 - ``"psf"``: ours, :func:`beatsync.beats.track_beats` (phase-slope onsets and a
   tempo/phase HMM; paper A, section 4).
@@ -107,15 +109,15 @@ def track_librosa(
     """
     import librosa
 
+    from .beats.tracker import LIBROSA_HOP, librosa_tempo_prior
+
     kwargs = {}
     if min_bpm is not None or max_bpm is not None:
-        from .beats.tracker import librosa_tempo_prior
-
-        prior = librosa_tempo_prior(**_given(min_bpm, max_bpm))
+        prior = librosa_tempo_prior(**_given(min_bpm, max_bpm), sr=sr)
         if prior is not None:
             kwargs["prior"] = prior
     _, beats = librosa.beat.beat_track(
-        y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=512, units="time", **kwargs
+        y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
     )
     return _as_beats(beats)
 
@@ -218,7 +220,10 @@ def check_tempo_range(
     """The tempo range [BPM] that method ``name`` will search, checked; ``{}`` if none.
 
     A bound not given keeps the method's default: 40 and 240 BPM for ``psf`` and
-    ``librosa`` (within 20-400 BPM, as :func:`beatsync.beats.track_beats`), and
+    ``librosa`` (within 20-400 BPM, as :func:`beatsync.beats.track_beats`; librosa
+    given either bound searches a flat prior from ``min_bpm`` to ``max_bpm`` instead of
+    its own log-normal one, and refuses at tracking time a range holding none of its
+    tempo steps, :func:`beatsync.beats.tracker.librosa_tempo_prior`), and
     essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers,
     ``min_bpm`` in 40-180 and ``max_bpm`` in 60-250, at least 20 apart).
 
@@ -230,15 +235,18 @@ def check_tempo_range(
     Returns
     -------
     dict
-        The bounds given, as floats (``min_bpm``, ``max_bpm``), for :func:`track`.
+        The bounds given, as floats (``min_bpm``, ``max_bpm``), for :func:`track`; a
+        bound equal to the method's default is left out (the same search as none).
 
     Raises
     ------
     ParameterError
         An unknown method, or a bound that is not a number, out of the method's range,
-        not whole for essentia, or a range that is empty (or, for essentia, narrower
+        not whole for essentia, a ``min_bpm`` of 320 or more for librosa (it does not
+        search above 320 BPM), or a range that is empty (or, for essentia, narrower
         than 20 BPM); the message names the option and the default it was set against.
     """
+    from .beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM, LIBROSA_MAX_TEMPO
     from .units import check_bpm
 
     peer = PEERS.get(name)
@@ -258,8 +266,6 @@ def check_tempo_range(
         defaults = dict(zip(("min_bpm", "max_bpm"), ESSENTIA_TEMPO["default"], strict=True))
         limits = {"min_bpm": (lo_lo, lo_hi), "max_bpm": (hi_lo, hi_hi)}
     else:
-        from .beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
-
         span = 0
         defaults = {"min_bpm": DEFAULT_MIN_BPM, "max_bpm": DEFAULT_MAX_BPM}
         limits = {}
@@ -268,22 +274,45 @@ def check_tempo_range(
         if key in limits:
             a, b = limits[key]
             if value != round(value) or not a <= value <= b:
+                hint = (
+                    f"round it to {round(value)}"
+                    if a <= value <= b
+                    else "to search outside them, use psf or librosa"
+                )
                 raise ParameterError(
                     f"{label[key]} {value:g}: {name} takes a whole number of BPM from {a} to "
-                    f"{b} (essentia's range)"
+                    f"{b} (essentia's limits); {hint}"
                 )
+    if name == "librosa" and given.get("min_bpm", 0.0) >= LIBROSA_MAX_TEMPO:
+        raise ParameterError(
+            f"{label['min_bpm']} {given['min_bpm']:g}: librosa's beat tracker does not search "
+            f"above {LIBROSA_MAX_TEMPO:g} BPM; give a lower {label['min_bpm']} (or track the "
+            "half tempo)"
+        )
     lo = given.get("min_bpm", defaults["min_bpm"])
     hi = given.get("max_bpm", defaults["max_bpm"])
     if not (hi - lo >= span if span else lo < hi):
         what = f"at least {span} BPM below" if span else "smaller than"
-        other = ""
-        if len(given) == 1:
-            key = "max_bpm" if "min_bpm" in given else "min_bpm"
-            other = f" ({defaults[key]:g} is {name}'s default {label[key]})"
         raise ParameterError(
-            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}{other}"
+            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}"
+            f"{_one_bound_hint(given, label, defaults, name)}"
         )
-    return given
+    # a bound equal to the method's default is the same search as no bound: record it
+    # as not given, so that a folder scored without it resumes with it and vice versa
+    return {k: v for k, v in given.items() if v != defaults[k]}
+
+
+def _one_bound_hint(given, label, defaults, name) -> str:
+    """The likely mistake when only one bound was given and it crosses the other default."""
+    if len(given) != 1:
+        return ""
+    (key,) = given
+    other = "max_bpm" if key == "min_bpm" else "min_bpm"
+    side = "below" if key == "max_bpm" else "above"
+    return (
+        f"; {label[key]} {given[key]:g} is {side} {name}'s default {label[other]} "
+        f"{defaults[other]:g}: give {label[other]} too"
+    )
 
 
 def track(

@@ -469,9 +469,14 @@ def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
     120.0
     """
     v = as_float(bpm, name=name, unit="bpm", allow_nonfinite=True, text=True)
-    if not np.isfinite(v) or not MIN_BPM <= v <= MAX_BPM:
+    if not np.isfinite(v):
+        raise ParameterError(
+            f"{name}={bpm!r} is not a finite number; give a tempo in BPM from "
+            f"{MIN_BPM:g} to {MAX_BPM:g}"
+        )
+    if not MIN_BPM <= v <= MAX_BPM:
         hint = "did you give a beat period in seconds, or beats per second?"
-        if np.isfinite(v) and v > MAX_BPM:
+        if v > MAX_BPM:
             hint = "did you give a rate of sub-beats, or a tempo in another unit?"
         raise ParameterError(
             f"{name}={bpm!r} is outside the plausible range {MIN_BPM:g}-{MAX_BPM:g} BPM "

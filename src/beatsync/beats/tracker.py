@@ -471,14 +471,66 @@ def _accents(bands: np.ndarray, fps: float) -> np.ndarray:
     return np.stack([gaussian_smooth(band, sigma) for band in bands])
 
 
-def librosa_tempo_prior(min_bpm: float = DEFAULT_MIN_BPM, max_bpm: float = DEFAULT_MAX_BPM):
+#: librosa's beat tracker does not search above this tempo [BPM] (``beat_track``'s
+#: ``max_tempo``).
+LIBROSA_MAX_TEMPO = 320.0
+
+#: Hop [samples] of the onset envelope when librosa tracks beats here (its default).
+LIBROSA_HOP = 512
+
+
+def librosa_tempo_steps(sr: float, hop: int = LIBROSA_HOP) -> np.ndarray:
+    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], in ascending order.
+
+    Its tempo is a lag of the 8 s onset autocorrelation: ``60 sr / (hop lag)`` BPM for
+    every whole lag (:func:`librosa.tempo_frequencies`), up to 320 BPM. At 22.05 kHz the
+    steps near 190 BPM are 13.5 BPM apart (184.6, 198.8).
+    """
+    win = int(np.floor(8.0 * sr / hop))  # librosa.time_to_frames(ac_size=8, sr, hop)
+    lags = np.arange(1, win)
+    bpms = 60.0 * sr / (hop * lags)
+    return np.sort(bpms[bpms < LIBROSA_MAX_TEMPO])
+
+
+def librosa_tempo_prior(
+    min_bpm: float = DEFAULT_MIN_BPM,
+    max_bpm: float = DEFAULT_MAX_BPM,
+    *,
+    sr: float | None = None,
+    hop: int = LIBROSA_HOP,
+):
     """The tempo prior given to :func:`librosa.beat.beat_track` for a tempo range [BPM].
 
     ``None`` (librosa's own log-normal prior) for the default range; a flat prior
     inside a range the user narrowed (``scipy.stats.uniform``).
+
+    Raises
+    ------
+    ParameterError
+        A range that holds none of the tempi librosa can choose at ``sr``
+        (:func:`librosa_tempo_steps`; checked when ``sr`` is given), e.g. 185-198 BPM at
+        22.05 kHz or anything above 320 BPM: librosa would return a single beat at an
+        infinite tempo. The message names the nearest tempi it can choose.
     """
     if (min_bpm, max_bpm) == (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
         return None
+    if min_bpm >= LIBROSA_MAX_TEMPO:
+        raise ParameterError(
+            f"min_bpm {min_bpm:g}: librosa's beat tracker does not search above "
+            f"{LIBROSA_MAX_TEMPO:g} BPM; give a lower min_bpm (or track the half tempo)"
+        )
+    if sr is not None:
+        steps = librosa_tempo_steps(sr, hop)
+        if not np.any((steps >= min_bpm) & (steps <= max_bpm)):
+            below = steps[steps < min_bpm]
+            above = steps[steps > max_bpm]
+            near = [f"{v:.1f}" for v in (below[-1:].tolist() + above[:1].tolist())]
+            raise ParameterError(
+                f"tempo range {min_bpm:g}-{max_bpm:g} BPM holds none of the tempi librosa "
+                f"can choose at {sr:g} Hz (one lag of its onset autocorrelation, "
+                f"hop {hop}); the nearest are {' and '.join(near)} BPM: widen the range "
+                "to include one"
+            )
     import scipy.stats  # noqa: PLC0415
 
     return scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
@@ -487,11 +539,11 @@ def librosa_tempo_prior(min_bpm: float = DEFAULT_MIN_BPM, max_bpm: float = DEFAU
 def _track_librosa(y, sr, *, bpm, min_bpm, max_bpm) -> BeatTrack:
     import librosa  # noqa: PLC0415 (heavy; only for the comparison method)
 
-    hop = 512
+    hop = LIBROSA_HOP
     kwargs: dict[str, Any] = {}
     if bpm is not None:
         kwargs["bpm"] = bpm
-    elif (prior := librosa_tempo_prior(min_bpm, max_bpm)) is not None:
+    elif (prior := librosa_tempo_prior(min_bpm, max_bpm, sr=sr, hop=hop)) is not None:
         kwargs["prior"] = prior
     tempo, beats = librosa.beat.beat_track(
         y=y.astype(np.float32), sr=sr, hop_length=hop, units="time", **kwargs

@@ -59,15 +59,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--min-bpm",
         type=float,
         default=None,
-        help="slowest tempo the tracker searches on every track [BPM] (default: the "
-        "method's own, 40); essentia's trackers take whole BPM from 40 to 180",
+        help="slowest tempo the tracker searches on every track [BPM] (default 40); "
+        "essentia's trackers take whole BPM from 40 to 180, at least 20 below --max-bpm. "
+        "With either bound, librosa searches a flat tempo prior inside the range instead "
+        "of its own log-normal prior around 120 BPM",
     )
     b.add_argument(
         "--max-bpm",
         type=float,
         default=None,
-        help="fastest tempo the tracker searches [BPM] (default: the method's own, 240 for "
-        "psf and librosa, 208 for essentia's, which take whole BPM from 60 to 250)",
+        help="fastest tempo the tracker searches [BPM] (default 240 for psf and librosa, "
+        "208 for essentia's, which take whole BPM from 60 to 250)",
     )
     b.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     b.add_argument(
@@ -148,7 +150,7 @@ def run_beats(args: argparse.Namespace) -> int:
     for _, row in failed.iterrows():
         lines.append(f"failed: {row['key']}: {row['error']}")
     skipped = f", {run.skipped} already scored (--force re-runs them)" if run.skipped else ""
-    searched = "".join(f", {k}={v:g}" for k, v in tempo.items())
+    searched = "".join(f", --{k.replace('_', '-')} {v:g}" for k, v in tempo.items())
     lines.append(
         f"{len(t) - len(failed)}/{len(t)} tracks scored with {args.method}{searched} "
         f"({run.scored} run now{skipped}); results in {run.files['summary'].parent}"

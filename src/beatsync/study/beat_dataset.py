@@ -205,7 +205,8 @@ def evaluate_track(
         The track's folder (:attr:`Track.group`).
     min_bpm, max_bpm : float, optional [BPM]
         The tempo range searched (:func:`beatsync.peers.check_tempo_range`); ``None``:
-        the method's default.
+        the method's default. Recorded as checked (a bound equal to the default as
+        ``None``); a range the method refuses is the row's ``error``.
 
     Returns
     -------
@@ -230,11 +231,13 @@ def evaluate_track(
     }
     t0 = time.perf_counter()
     try:
+        tempo = peers.check_tempo_range(method, min_bpm, max_bpm)
+        row.update(min_bpm=tempo.get("min_bpm"), max_bpm=tempo.get("max_bpm"))
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("ignore")
             warnings.simplefilter("always", BeatsyncWarning)
             y, sr = io.read_audio(audio)
-            est = peers.track(method, y, sr, min_bpm=min_bpm, max_bpm=max_bpm)
+            est = peers.track(method, y, sr, **tempo)
             seconds = time.perf_counter() - t0
             scores = evaluate(reference, est, min_beat_time=min_beat_time)
     except ParameterError as exc:
@@ -288,15 +291,30 @@ class TrackLog:
 SUMMARY_METRICS = METRICS
 
 
+#: The settings a row records besides the method: one value per method in a folder.
+SETTINGS = ("min_beat_time", "min_bpm", "max_bpm")
+
+
+def _setting(rows: pd.DataFrame, key: str) -> float:
+    """The one value of ``key`` in ``rows`` (NaN if none, absent or they differ)."""
+    if key not in rows:
+        return float("nan")
+    values = {None if v is None or v != v else float(v) for v in rows[key]}
+    one = values.pop() if len(values) == 1 else None
+    return float("nan") if one is None else one
+
+
 def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
     """Means per method and folder (and over all folders) of a dataset run's rows.
 
     Returns
     -------
     pandas.DataFrame
-        Columns ``method, group`` (``"all"`` for every folder together), ``tracks``,
-        ``failed``, the mean of every metric over the scored tracks, ``octave
-        errors`` and ``other tempo`` (counts).
+        Columns ``method, group`` (``"all"`` for every folder together), the settings
+        the rows were scored with (``min_beat_time``, ``min_bpm``, ``max_bpm``: empty
+        for the default range, or if the rows differ), ``tracks``, ``failed``, the mean
+        of every metric over the scored tracks, ``octave errors`` and ``other tempo``
+        (counts).
     """
     table = pd.DataFrame(list(rows))
     if table.empty:
@@ -309,6 +327,7 @@ def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
             rec: dict[str, Any] = {
                 "method": method,
                 "group": group,
+                **{key: _setting(sub, key) for key in SETTINGS},
                 "tracks": len(sub),
                 "failed": int((sub["status"] != "ok").sum()),
             }
@@ -466,9 +485,9 @@ def evaluate_dataset(
 
 
 def _range_text(bounds: tuple[float | None, float | None]) -> str:
-    """``(None, None)`` -> "the default tempo range"; ``(60, None)`` -> "min_bpm=60"."""
-    names = ("min_bpm", "max_bpm")
-    given = [f"{k}={v:g}" for k, v in zip(names, bounds, strict=True) if v is not None]
+    """``(None, None)`` -> "the default tempo range"; ``(60, None)`` -> "--min-bpm 60"."""
+    names = ("--min-bpm", "--max-bpm")
+    given = [f"{k} {v:g}" for k, v in zip(names, bounds, strict=True) if v is not None]
     return " and ".join(given) if given else "the default tempo range"
 
 
