@@ -181,9 +181,8 @@ does not hold: with the band accents at the beats, the Ballroom waltz and DANCE_
 come out duple; with log-mel energies per beat, the Ballroom waltz and DANCE_W_10 do,
 and the lag-3 autocorrelation is within 0.2 of the larger of lags 2 and 4 on all six
 real items with a known meter, against about 1.4 on the synthetic ones (a scratch
-measurement). The metrical model names the meter of all six real
-items with a known meter (Hainsworth 001, the cha-cha and the rumba 4; the three
-waltzes 3).
+measurement). The metrical model names the meter of all six (Hainsworth 001, the
+cha-cha and the rumba 4; the three waltzes 3).
 
 The observation exponent ``beta``, the prior widths and the ratio weights are our
 choices (see :data:`METER_MODEL`): they were set on the synthetic test set, except the
