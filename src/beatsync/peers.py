@@ -4,9 +4,11 @@ Every method is a function ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beat
 mono audio ``y`` (float, finite) at ``sr`` [Hz] in, beat times [s] out (1-D
 ``float64``, strictly increasing), each with its published default settings. A tempo
 range narrows the tempi searched; a bound not given keeps the method's default
-(:func:`check_tempo_range` says what each method accepts; librosa given a range
-searches a flat tempo prior inside it instead of its own log-normal one around 120
-BPM). :data:`PEERS` names them:
+(:func:`check_tempo_range` says what each method accepts; librosa given a bound
+other than its default searches a flat tempo prior inside the range instead of its own
+log-normal one around 120 BPM, but only its tempo estimate keeps to the range, not
+the beats it then picks; essentia's trackers take the range as a preference, not a
+limit; :func:`track` warns when the beats fall outside it). :data:`PEERS` names them:
 
 - ``"psf"``: ours, :func:`beatsync.beats.track_beats` (phase-slope onsets and a
   tempo/phase HMM; paper A, section 4).
@@ -221,9 +223,10 @@ def check_tempo_range(
 
     A bound not given keeps the method's default: 40 and 240 BPM for ``psf`` and
     ``librosa`` (within 20-400 BPM, as :func:`beatsync.beats.track_beats`; librosa
-    given either bound searches a flat prior from ``min_bpm`` to ``max_bpm`` instead of
-    its own log-normal one, and refuses at tracking time a range holding none of its
-    tempo steps, :func:`beatsync.beats.tracker.librosa_tempo_prior`), and
+    given a bound other than its default searches a flat prior from ``min_bpm`` to
+    ``max_bpm`` instead of its own log-normal one, and refuses at tracking time a range
+    holding none of its tempo steps, :func:`beatsync.beats.tracker.librosa_tempo_prior`),
+    and
     essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers,
     ``min_bpm`` in 40-180 and ``max_bpm`` in 60-250, at least 20 apart).
 
@@ -246,7 +249,7 @@ def check_tempo_range(
         search above 320 BPM), or a range that is empty (or, for essentia, narrower
         than 20 BPM); the message names the option and the default it was set against.
     """
-    from .beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM, LIBROSA_MAX_TEMPO
+    from .beats.tracker import LIBROSA_MAX_TEMPO
     from .units import check_bpm
 
     peer = PEERS.get(name)
@@ -259,15 +262,12 @@ def check_tempo_range(
     }
     if not given:
         return {}
+    defaults = _default_range(peer)
     if peer.requires == "essentia":
-        lo_lo, lo_hi = ESSENTIA_TEMPO["min"]
-        hi_lo, hi_hi = ESSENTIA_TEMPO["max"]
         span = ESSENTIA_TEMPO["span"]
-        defaults = dict(zip(("min_bpm", "max_bpm"), ESSENTIA_TEMPO["default"], strict=True))
-        limits = {"min_bpm": (lo_lo, lo_hi), "max_bpm": (hi_lo, hi_hi)}
+        limits = {"min_bpm": ESSENTIA_TEMPO["min"], "max_bpm": ESSENTIA_TEMPO["max"]}
     else:
         span = 0
-        defaults = {"min_bpm": DEFAULT_MIN_BPM, "max_bpm": DEFAULT_MAX_BPM}
         limits = {}
     label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
     for key, value in given.items():
@@ -276,7 +276,7 @@ def check_tempo_range(
             if value != round(value) or not a <= value <= b:
                 hint = (
                     f"round it to {round(value)}"
-                    if a <= value <= b
+                    if a <= round(value) <= b
                     else "to search outside them, use psf or librosa"
                 )
                 raise ParameterError(
@@ -300,6 +300,47 @@ def check_tempo_range(
     # a bound equal to the method's default is the same search as no bound: record it
     # as not given, so that a folder scored without it resumes with it and vice versa
     return {k: v for k, v in given.items() if v != defaults[k]}
+
+
+def _default_range(peer: Peer) -> dict[str, float]:
+    """The tempo range [BPM] ``peer`` searches when given no bound."""
+    if peer.requires == "essentia":
+        return dict(zip(("min_bpm", "max_bpm"), ESSENTIA_TEMPO["default"], strict=True))
+    from .beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
+
+    return {"min_bpm": DEFAULT_MIN_BPM, "max_bpm": DEFAULT_MAX_BPM}
+
+
+#: How far [fraction] the tracked median tempo may lie outside a given range before
+#: :func:`track` warns (beat times are quantised to frames; a slow drift moves the median).
+OUT_OF_RANGE_TOLERANCE = 0.05
+
+
+def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) -> None:
+    """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it."""
+    from .errors import BeatsyncWarning
+
+    if not tempo or beats.size < 3:
+        return
+    bounds = {**_default_range(PEERS[name]), **tempo}
+    lo, hi = bounds["min_bpm"], bounds["max_bpm"]
+    bpm = 60.0 / float(np.median(np.diff(beats)))
+    tol = OUT_OF_RANGE_TOLERANCE
+    if lo / (1 + tol) <= bpm <= hi * (1 + tol):
+        return
+    if PEERS[name].requires == "essentia":
+        why = "essentia's trackers take the range as a preference, not a limit"
+    elif name == "librosa":
+        why = "librosa's range bounds its tempo estimate, not the beats it then picks"
+    else:
+        why = "the music's pulse lies outside it"
+    alt = "" if name == "psf" else " (psf keeps to the range)"
+    warnings.warn(
+        f"{name} tapped a median tempo of {bpm:.0f} BPM, outside the range it was given "
+        f"({lo:g}-{hi:g} BPM): {why}; check the beats{alt}",
+        BeatsyncWarning,
+        stacklevel=3,
+    )
 
 
 def _one_bound_hint(given, label, defaults, name) -> str:
@@ -328,6 +369,15 @@ def track(
     ``min_bpm``/``max_bpm`` narrow the tempo range searched (:func:`check_tempo_range`);
     a bound not given keeps the method's default.
 
+    Warns
+    -----
+    BeatsyncWarning
+        Given a range, the beats' median tempo lies more than
+        :data:`OUT_OF_RANGE_TOLERANCE` outside it: only ours keeps to the range; librosa's
+        bounds its tempo estimate, not the beats it then picks, and essentia's trackers
+        take it as a preference (an 80 BPM pattern given 180-250 BPM: librosa taps 161,
+        essentia's 126 and 112).
+
     Raises
     ------
     ParameterError
@@ -342,4 +392,6 @@ def track(
     y, sr = check_audio(y, sr)
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=FutureWarning)
-        return peer.track(y, sr, **tempo)
+        beats = peer.track(y, sr, **tempo)
+    _warn_out_of_range(name, beats, tempo)
+    return beats
