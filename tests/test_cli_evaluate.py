@@ -312,15 +312,18 @@ def test_tempo_range_reaches_the_tracker_and_is_recorded(dataset, scheduler, tmp
     (row,) = TrackLog(tmp_path / "default" / "tracks.jsonl").rows()
     assert (row["min_bpm"], row["max_bpm"]) == (None, None)
     # the default bounds given are the same search, and a log written before rows held
-    # the range was tracked with the default: the folder resumes (nothing re-run)
+    # the range (no keys), or before a default bound was recorded as none (40 and 240),
+    # was tracked with the default: the folder resumes (nothing re-run)
     log = TrackLog(tmp_path / "default" / "tracks.jsonl")
-    old = [{k: v for k, v in r.items() if k not in ("min_bpm", "max_bpm")} for r in log.rows()]
-    log.rewrite(old)
+    (row,) = log.rows()
+    no_keys = {k: v for k, v in row.items() if k not in ("min_bpm", "max_bpm")}
     default = ["--min-bpm", "40", "--max-bpm", "240"]
-    for again in ([], default):
-        code, stdout, err = _run([*base, "--out", str(tmp_path / "default"), *again], capsys)
-        assert code == 0, err
-        assert json.loads(stdout)["skipped"] == 1 and json.loads(stdout)["min_bpm"] is None
+    for stored in (no_keys, {**row, "min_bpm": 40.0, "max_bpm": 240.0}):
+        log.rewrite([stored])
+        for again in ([], default):
+            code, stdout, err = _run([*base, "--out", str(tmp_path / "default"), *again], capsys)
+            assert code == 0, err
+            assert json.loads(stdout)["skipped"] == 1 and json.loads(stdout)["min_bpm"] is None
     # results of one range are never mixed with another's in the same folder
     code, _, err = _run([*base, "--out", str(tmp_path / "default"), *told], capsys)
     assert code == 3
@@ -331,6 +334,44 @@ def test_tempo_range_reaches_the_tracker_and_is_recorded(dataset, scheduler, tmp
     assert "1/1 tracks scored with psf, --min-bpm 75, --max-bpm 101 (1 run now)" in stdout
     (row,) = TrackLog(tmp_path / "default" / "tracks.jsonl").rows()
     assert row["min_bpm"] == 75.0
+
+
+def test_failed_rows_do_not_bind_a_resume(dataset, scheduler, tmp_path, capsys):
+    # a track that failed under one range is re-run under another: only scored rows
+    # hold a folder to their settings
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    audio.mkdir(), notes.mkdir()
+    shutil.copy(dataset[0] / "sample.wav", audio)
+    shutil.copy(dataset[1] / "sample.beats", notes)
+    out = tmp_path / "out"
+    out.mkdir()
+    failed = {"key": "sample", "group": ".", "audio": str(audio / "sample.wav")}
+    failed |= {"method": "psf", "min_beat_time": 5.0, "min_bpm": 185.0, "max_bpm": 198.0}
+    TrackLog(out / "tracks.jsonl").rewrite([{**failed, "status": "error", "error": "boom"}])
+    argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    argv += ["--scheduler", scheduler, "--json", "--out", str(out)]
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    assert json.loads(stdout)["scored_now"] == 1
+    (row,) = TrackLog(out / "tracks.jsonl").latest().values()
+    assert row["status"] == "ok" and (row["min_bpm"], row["min_beat_time"]) == (None, 0.0)
+
+
+def test_librosa_range_without_a_tempo_step_is_refused_before_any_track(dataset, tmp_path, capsys):
+    # at 44.1 kHz (the madmom sample) and hop 512, librosa's tempi near 188 BPM are
+    # 184.6 and 191.4: 185-191 holds none; refused up front, not once per track
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    audio.mkdir(), notes.mkdir()
+    shutil.copy(dataset[0] / "sample.wav", audio)
+    shutil.copy(dataset[1] / "sample.beats", notes)
+    out = tmp_path / "out"
+    argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    argv += ["--method", "librosa", "--min-bpm", "185", "--max-bpm", "191", "--out", str(out)]
+    code, _, err = _run(argv, capsys)
+    assert code == 3
+    assert "'sample' (and any other track at 44100 Hz): tempo range 185-191 BPM holds none" in err
+    assert "the nearest are 184.6 and 191.4 BPM" in err and "nothing was run" in err
+    assert "Traceback" not in err and not out.exists()
 
 
 def test_tempo_range_help_states_each_methods_defaults_and_limits(capsys):
@@ -347,6 +388,7 @@ def test_tempo_range_help_states_each_methods_defaults_and_limits(capsys):
     assert f"(default {DEFAULT_MAX_BPM:g} for psf and librosa, {max_default}" in text
     assert f"whole BPM from {lo_lo} to {lo_hi}, at least {ESSENTIA_TEMPO['span']} below" in text
     assert "librosa searches a flat tempo prior inside the range" in text
+    assert "Only psf keeps its beats inside the range" in text
     assert f"whole BPM from {hi_lo} to {hi_hi}" in text
 
 

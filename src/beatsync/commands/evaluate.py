@@ -61,8 +61,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=None,
         help="slowest tempo the tracker searches on every track [BPM] (default 40); "
         "essentia's trackers take whole BPM from 40 to 180, at least 20 below --max-bpm. "
-        "With either bound, librosa searches a flat tempo prior inside the range instead "
-        "of its own log-normal prior around 120 BPM",
+        "With a bound other than the default, librosa searches a flat tempo prior inside "
+        "the range instead of its own log-normal prior around 120 BPM. Only psf keeps its "
+        "beats inside the range (librosa's bounds its tempo estimate, essentia's is a "
+        "preference): a row warns when the beats fall outside it",
     )
     b.add_argument(
         "--max-bpm",

@@ -296,10 +296,16 @@ SETTINGS = ("min_beat_time", "min_bpm", "max_bpm")
 
 
 def _setting(rows: pd.DataFrame, key: str) -> float:
-    """The one value of ``key`` in ``rows`` (NaN if none, absent or they differ)."""
+    """The one value of ``key`` in ``rows`` (NaN if none, absent, not a number (a
+    refused bound, recorded as given) or they differ)."""
     if key not in rows:
         return float("nan")
-    values = {None if v is None or v != v else float(v) for v in rows[key]}
+    values = set()
+    for v in rows[key]:
+        try:
+            values.add(None if v is None or v != v else float(v))
+        except (TypeError, ValueError):
+            return float("nan")
     one = values.pop() if len(values) == 1 else None
     return float("nan") if one is None else one
 
@@ -426,8 +432,9 @@ def evaluate_dataset(
     ------
     ParameterError
         An unknown or unavailable method; an annotation that is not beat times in
-        seconds; an output folder that is a file; results in ``out_dir`` recorded
-        with another ``min_beat_time`` or tempo range (without ``force``); a tempo range
+        seconds; an output folder that is a file; results in ``out_dir`` scored
+        with another ``min_beat_time`` or tempo range (without ``force``; failed rows
+        do not count, they are re-run); a tempo range
         the method does not accept; a bad worker count or an
         unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
     """
@@ -449,13 +456,15 @@ def evaluate_dataset(
     log = TrackLog(out / "tracks.jsonl")
     previous = {k: r for (m, k), r in log.latest().items() if m == method}
     if not force:
-        other = sorted({r["min_beat_time"] for r in previous.values()} - {mbt})
+        # only scored rows bind a resume: failed ones are re-run with today's settings
+        scored = [r for r in previous.values() if r.get("status") == "ok"]
+        other = sorted({r["min_beat_time"] for r in scored} - {mbt})
         if other:
             raise ParameterError(
                 f"{str(log.path)!r} holds {method} results scored with min_beat_time="
                 f"{other[0]:g} s, not {mbt:g} s; use --force to re-run them or another --out"
             )
-        ranges = {(r.get("min_bpm"), r.get("max_bpm")) for r in previous.values()}
+        ranges = {_recorded_range(method, r) for r in scored}
         other_range = sorted(ranges - {bpm_range}, key=str)
         if other_range:
             raise ParameterError(
@@ -465,6 +474,8 @@ def evaluate_dataset(
             )
     done = set() if force else {k for k, r in previous.items() if r.get("status") == "ok"}
     todo = [t for t in tracks if t.key not in done]
+    if method == "librosa" and tempo:
+        _check_librosa_rates(todo, tempo)
     with contextlib.ExitStack() as stack:
         if todo:  # connect first: an unreachable scheduler changes nothing on disk
             client = stack.enter_context(
@@ -482,6 +493,45 @@ def evaluate_dataset(
     io.write_csv(files["tracks"], _table(list(latest.values())))
     io.write_csv(files["summary"], summary)
     return DatasetRun(_table(mine), summary, len(todo), len(tracks) - len(todo), files)
+
+
+def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> None:
+    """Refuse, before any work, a tempo range librosa cannot search at a track's rate.
+
+    librosa's tempi are lags of an onset autocorrelation, so which exist depends on the
+    sample rate (:func:`beatsync.beats.tracker.librosa_tempo_prior`); a file the client
+    cannot open (e.g. a path valid only on the workers) is left to its task.
+    """
+    import soundfile as sf
+
+    from ..beats.tracker import librosa_tempo_prior
+
+    first: dict[float, str] = {}
+    for t in tracks:
+        try:
+            rate = float(sf.info(str(t.audio)).samplerate)
+        except Exception:  # unreadable here: the track's own row records why
+            continue
+        first.setdefault(rate, t.key)
+    for rate, key in sorted(first.items()):
+        try:
+            librosa_tempo_prior(**tempo, sr=rate)
+        except ParameterError as exc:
+            raise ParameterError(
+                f"{key!r} (and any other track at {rate:g} Hz): {exc}; nothing was run"
+            ) from None
+
+
+def _recorded_range(method: str, row: dict[str, Any]) -> tuple[float | None, float | None]:
+    """The tempo range a stored row was tracked with, as :func:`check_tempo_range` would
+    record it today (a bound equal to the default as ``None``: rows written before that
+    rule resume)."""
+    bounds = (row.get("min_bpm"), row.get("max_bpm"))
+    try:
+        tempo = peers.check_tempo_range(method, *bounds)
+    except ParameterError:
+        return bounds
+    return (tempo.get("min_bpm"), tempo.get("max_bpm"))
 
 
 def _range_text(bounds: tuple[float | None, float | None]) -> str:
