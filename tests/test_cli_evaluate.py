@@ -288,7 +288,8 @@ def test_results_scored_otherwise_are_not_mixed(dataset, scheduler, tmp_path, ca
     code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
     assert code == 0, err
     extra = ["--min-beat-time", "5", "--scheduler", scheduler]
-    _refused(_bad(tmp_path, dataset, extra=extra), "scored with min_beat_time=0 s, not 5 s")
+    expected = "scored with --min-beat-time 0 s, not 5 s; use --force"
+    _refused(_bad(tmp_path, dataset, extra=extra), expected)
 
 
 def test_tempo_range_reaches_the_tracker_and_is_recorded(dataset, scheduler, tmp_path, capsys):

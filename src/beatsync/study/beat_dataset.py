@@ -461,7 +461,7 @@ def evaluate_dataset(
         other = sorted({r["min_beat_time"] for r in scored} - {mbt})
         if other:
             raise ParameterError(
-                f"{str(log.path)!r} holds {method} results scored with min_beat_time="
+                f"{str(log.path)!r} holds {method} results scored with --min-beat-time "
                 f"{other[0]:g} s, not {mbt:g} s; use --force to re-run them or another --out"
             )
         ranges = {_recorded_range(method, r) for r in scored}
