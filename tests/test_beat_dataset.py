@@ -118,11 +118,14 @@ def test_evaluate_track_records_the_tempo_range_as_checked(tmp_path):
     bad = row(min_bpm=120, max_bpm=90)
     assert bad["status"] == "error"
     assert "min_bpm 120 must be smaller than max_bpm 90" in bad["error"]
-    # a bound that is not a number is recorded as given; the summary still builds
-    nan = row(min_bpm="abc")
+    # a bound that is not a number is recorded as given; the summary still builds, and
+    # states the settings of the scored rows (failed ones are re-run with others)
+    nan = row(min_bpm="abc", max_bpm=90)
     assert nan["status"] == "error" and "min_bpm" in nan["error"]
     s = summarize_dataset([nan, told]).set_index(["method", "group"])
-    assert pd.isna(s.loc[("psf", "all"), "min_bpm"]) and s.loc[("psf", "all"), "failed"] == 1
+    assert s.loc[("psf", "all"), "max_bpm"] == 75.0 and s.loc[("psf", "all"), "failed"] == 1
+    s = summarize_dataset([nan]).set_index(["method", "group"])
+    assert pd.isna(s.loc[("psf", "all"), "min_bpm"]) and s.loc[("psf", "all"), "max_bpm"] == 90
 
 
 def test_track_log_appends_and_skips_a_torn_line(tmp_path):

@@ -358,21 +358,59 @@ def test_failed_rows_do_not_bind_a_resume(dataset, scheduler, tmp_path, capsys):
     assert row["status"] == "ok" and (row["min_bpm"], row["min_beat_time"]) == (None, 0.0)
 
 
+def test_tracks_tapped_outside_the_range_are_counted(scheduler, tmp_path, capsys):
+    # librosa's range bounds its tempo estimate, not its beats: an 80 BPM pattern given
+    # 180-250 BPM is tapped at 161; the row warns and the command counts it
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    audio.mkdir(), notes.mkdir()
+    ref = beat_times(80, duration=12.0, start=0.37)
+    io.write_audio(audio / "drums_80.wav", drum_pattern(ref, sr=SR, duration=12.0), SR)
+    io.write_beats(notes / "drums_80.beats", ref)
+    argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    argv += ["--method", "librosa", "--scheduler", scheduler, "--out", str(tmp_path / "o")]
+    code, stdout, err = _run([*argv, "--min-bpm", "180", "--max-bpm", "250"], capsys)
+    assert code == 0, err
+    text = " ".join(stdout.split())
+    assert (
+        "1 track(s) tapped outside the tempo range given (only psf keeps to it; the "
+        "warning column of tracks.csv says which)" in text
+    )
+    table = pd.read_csv(tmp_path / "o" / "tracks.csv")
+    assert "librosa tapped a median tempo of 161 BPM, outside the range" in table["warning"][0]
+    code, stdout, err = _run([*argv, "--force", "--json", "--max-bpm", "100"], capsys)
+    assert code == 0, err
+    assert json.loads(stdout)["outside_range"] == []
+
+
 def test_librosa_range_without_a_tempo_step_is_refused_before_any_track(dataset, tmp_path, capsys):
-    # at 44.1 kHz (the madmom sample) and hop 512, librosa's tempi near 188 BPM are
-    # 184.6 and 191.4: 185-191 holds none; refused up front, not once per track
+    # librosa's tempi near 188 BPM are 184.6 and 191.4 at 44.1 kHz (the madmom sample)
+    # and 184.6 and 198.8 at 22.05 kHz, hop 512: 185-191 holds none at either rate;
+    # refused up front, every rate named, not once per track
     audio, notes = tmp_path / "audio", tmp_path / "notes"
     audio.mkdir(), notes.mkdir()
     shutil.copy(dataset[0] / "sample.wav", audio)
     shutil.copy(dataset[1] / "sample.beats", notes)
+    shutil.copy(dataset[0] / "rock" / "drums_96.wav", audio)
+    shutil.copy(dataset[1] / "drums_96.beats", notes)
+    # a file at an implausible rate is left to its own row, not blamed for the range
+    import soundfile as sf
+
+    sf.write(audio / "tiny.wav", np.zeros(400, dtype=np.float32), 100)
+    io.write_beats(notes / "tiny.beats", np.arange(0.5, 4.0, 0.5))
     out = tmp_path / "out"
     argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
-    argv += ["--method", "librosa", "--min-bpm", "185", "--max-bpm", "191", "--out", str(out)]
-    code, _, err = _run(argv, capsys)
+    argv += ["--method", "librosa", "--out", str(out), "--workers", "1"]
+    code, _, err = _run([*argv, "--min-bpm", "185", "--max-bpm", "191"], capsys)
     assert code == 3
-    assert "'sample' (and any other track at 44100 Hz): tempo range 185-191 BPM holds none" in err
+    assert "'drums_96' (and any other track at 22050 Hz): tempo range 185-191 BPM holds" in err
+    assert "the nearest are 184.6 and 198.8 BPM" in err
+    assert "'sample' (and any other track at 44100 Hz): tempo range 185-191 BPM holds" in err
     assert "the nearest are 184.6 and 191.4 BPM" in err and "nothing was run" in err
-    assert "Traceback" not in err and not out.exists()
+    assert "tiny" not in err and "Traceback" not in err and not out.exists()
+    code, stdout, err = _run([*argv, "--min-bpm", "180", "--max-bpm", "200", "--json"], capsys)
+    assert code == 0, err
+    res = json.loads(stdout)
+    assert [f["key"] for f in res["failed"]] == ["tiny"] and res["scored_now"] == 3
 
 
 def test_tempo_range_help_states_each_methods_defaults_and_limits(capsys):

@@ -75,7 +75,7 @@ def test_a_range_puts_every_method_on_the_real_samples_beat(name):
 
     y, sr, ref = datasets.load_madmom_sample()
     est = peers.track(name, y, sr, min_bpm=75, max_bpm=101)
-    assert evaluate(ref, est, min_beat_time=0.0)["F-measure"] >= 0.8, name
+    assert evaluate(ref, est, min_beat_time=0.0)["F-measure"] >= 0.85, name
 
 
 @pytest.fixture(scope="module")
@@ -100,8 +100,10 @@ def test_one_bound_alone_moves_every_method(song80, name):
 @pytest.mark.parametrize("name", _METHODS)
 def test_beats_outside_the_range_given_warn(song80, name):
     # told 180-250 BPM, the 80 BPM pattern is tapped at 240 by ours (three beats per
-    # beat, inside the range) and at 161, 126 and 112 by librosa and essentia's two:
-    # their ranges bound a tempo estimate or are a preference, not a limit on the beats
+    # beat, inside the range) and at 161 by librosa (its range bounds a tempo estimate,
+    # not the beats); essentia's two take the range as a preference and answer 80-162
+    # BPM, different from one call to the next, so for them the test checks only that
+    # the warning matches where their beats are
     from beatsync.errors import BeatsyncWarning
 
     with warnings.catch_warnings(record=True) as caught:
@@ -109,10 +111,14 @@ def test_beats_outside_the_range_given_warn(song80, name):
         est = peers.track(name, song80, SR, min_bpm=180, max_bpm=250)
     outside = [w for w in caught if issubclass(w.category, BeatsyncWarning)]
     bpm = 60.0 / np.median(np.diff(est))
+    inside = 180 / 1.05 <= bpm <= 250 * 1.05
     if name == "psf":
-        assert 180 <= bpm <= 250 and not outside
+        assert 180 <= bpm <= 250, bpm
+    if name == "librosa":
+        assert 155 <= bpm <= 165, bpm
+    if inside:
+        assert not outside, name
     else:
-        assert not 180 / 1.05 <= bpm <= 250 * 1.05, bpm
         assert len(outside) == 1, name
         assert (
             f"{name} tapped a median tempo of {bpm:.0f} BPM, outside the range it was "
@@ -140,6 +146,28 @@ def test_librosa_range_without_a_tempo_step_is_refused(song):
         track_beats(y, SR, method="librosa", min_bpm=185, max_bpm=198)
     est = peers.track("librosa", y, SR, min_bpm=180, max_bpm=200)  # holds two steps
     assert 180 <= 60.0 / np.median(np.diff(est)) <= 200
+    from beatsync.beats.tracker import LIBROSA_MAX_TEMPO, librosa_tempo_prior
+
+    top = steps[steps <= LIBROSA_MAX_TEMPO][-1]  # above the fastest step: one neighbour
+    with pytest.raises(ParameterError, match=rf"the nearest is {top:.1f} BPM: widen"):
+        librosa_tempo_prior(top + 0.5, LIBROSA_MAX_TEMPO - 0.1, sr=SR)
+    with pytest.raises(ParameterError, match="it has none at this sample rate$"):
+        librosa_tempo_prior(60, 100, sr=100)  # no tempo step at all
+
+
+def test_out_of_range_warning_for_ours_names_skipped_beats():
+    # ours decodes only tempi inside the range, so a median outside it means beats
+    # were skipped or doubled; the advice to use psf is for the other methods
+    from beatsync.errors import BeatsyncWarning
+
+    with pytest.warns(
+        BeatsyncWarning, match="some beats were skipped or doubled; check the beats$"
+    ):
+        peers._warn_out_of_range("psf", np.arange(0.0, 10.0, 0.5), {"min_bpm": 180.0})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        peers._warn_out_of_range("psf", np.arange(0.0, 10.0, 0.5), {})  # no range given
+        peers._warn_out_of_range("psf", np.array([0.0, 0.5]), {"min_bpm": 180.0})  # 2 beats
 
 
 def test_tempo_range_bounds_equal_to_the_default_are_none():

@@ -315,6 +315,9 @@ def _default_range(peer: Peer) -> dict[str, float]:
 #: :func:`track` warns (beat times are quantised to frames; a slow drift moves the median).
 OUT_OF_RANGE_TOLERANCE = 0.05
 
+#: The words of that warning that say which track it concerns (a command counts them).
+OUT_OF_RANGE_TEXT = "outside the range it was given"
+
 
 def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) -> None:
     """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it."""
@@ -332,11 +335,11 @@ def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) ->
         why = "essentia's trackers take the range as a preference, not a limit"
     elif name == "librosa":
         why = "librosa's range bounds its tempo estimate, not the beats it then picks"
-    else:
-        why = "the music's pulse lies outside it"
+    else:  # ours decodes only tempi inside the range: beats are missing or doubled
+        why = "some beats were skipped or doubled"
     alt = "" if name == "psf" else " (psf keeps to the range)"
     warnings.warn(
-        f"{name} tapped a median tempo of {bpm:.0f} BPM, outside the range it was given "
+        f"{name} tapped a median tempo of {bpm:.0f} BPM, {OUT_OF_RANGE_TEXT} "
         f"({lo:g}-{hi:g} BPM): {why}; check the beats{alt}",
         BeatsyncWarning,
         stacklevel=3,
@@ -375,8 +378,10 @@ def track(
         Given a range, the beats' median tempo lies more than
         :data:`OUT_OF_RANGE_TOLERANCE` outside it: only ours keeps to the range; librosa's
         bounds its tempo estimate, not the beats it then picks, and essentia's trackers
-        take it as a preference (an 80 BPM pattern given 180-250 BPM: librosa taps 161,
-        essentia's 126 and 112).
+        take it as a preference. An 80 BPM pattern given 180-250 BPM is tapped at 161 by
+        librosa, and at 80-162 by essentia's two, different from one call to the next in
+        the same process (the instability of MTG/essentia issue 1097; with their default
+        range, or given 75-101 BPM on the madmom sample, they repeat).
 
     Raises
     ------

@@ -525,11 +525,16 @@ def librosa_tempo_prior(
             below = steps[steps < min_bpm]
             above = steps[steps > max_bpm]
             near = [f"{v:.1f}" for v in (below[-1:].tolist() + above[:1].tolist())]
+            verb = "is" if len(near) == 1 else "are"
+            nearest = (
+                f"the nearest {verb} {' and '.join(near)} BPM: widen the range to include one"
+                if near
+                else "it has none at this sample rate"
+            )
             raise ParameterError(
                 f"tempo range {min_bpm:g}-{max_bpm:g} BPM holds none of the tempi librosa "
                 f"can choose at {sr:g} Hz (one lag of its onset autocorrelation, "
-                f"hop {hop}); the nearest are {' and '.join(near)} BPM: widen the range "
-                "to include one"
+                f"hop {hop}); {nearest}"
             )
     import scipy.stats  # noqa: PLC0415
 

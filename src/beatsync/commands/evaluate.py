@@ -64,7 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "With a bound other than the default, librosa searches a flat tempo prior inside "
         "the range instead of its own log-normal prior around 120 BPM. Only psf keeps its "
         "beats inside the range (librosa's bounds its tempo estimate, essentia's is a "
-        "preference): a row warns when the beats fall outside it",
+        "preference): the command counts the tracks whose beats fall outside it",
     )
     b.add_argument(
         "--max-bpm",
@@ -84,6 +84,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run_beats(args: argparse.Namespace) -> int:
     from pathlib import Path
+
+    import pandas as pd
 
     from .. import peers
     from ..cluster import check_cluster_options
@@ -131,6 +133,8 @@ def run_beats(args: argparse.Namespace) -> int:
         return _interrupted(exc, out / "tracks.jsonl", args)
     t = run.tracks
     failed = t[t["status"] != "ok"]
+    warned = t["warning"].fillna("").astype(str) if "warning" in t else pd.Series("", t.index)
+    outside = t[(t["status"] == "ok") & warned.str.contains(peers.OUT_OF_RANGE_TEXT)]
     result = {
         "method": args.method,
         "min_bpm": tempo.get("min_bpm"),
@@ -139,6 +143,7 @@ def run_beats(args: argparse.Namespace) -> int:
         "scored_now": run.scored,
         "skipped": run.skipped,
         "failed": failed[["key", "error"]].to_dict("records"),
+        "outside_range": outside["key"].tolist(),
         "unmatched": [str(p) for p in found.unmatched],
         "summary": run.summary.to_dict("records"),
         "files": {k: str(v) for k, v in run.files.items()},
@@ -151,6 +156,11 @@ def run_beats(args: argparse.Namespace) -> int:
     lines = [shown.to_string(index=False, float_format=lambda x: f"{x:.3f}"), ""]
     for _, row in failed.iterrows():
         lines.append(f"failed: {row['key']}: {row['error']}")
+    if len(outside):
+        lines.append(
+            f"{len(outside)} track(s) tapped outside the tempo range given (only psf keeps "
+            f"to it; the warning column of {run.files['tracks'].name} says which)"
+        )
     skipped = f", {run.skipped} already scored (--force re-runs them)" if run.skipped else ""
     searched = "".join(f", --{k.replace('_', '-')} {v:g}" for k, v in tempo.items())
     lines.append(

@@ -317,8 +317,9 @@ def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
     -------
     pandas.DataFrame
         Columns ``method, group`` (``"all"`` for every folder together), the settings
-        the rows were scored with (``min_beat_time``, ``min_bpm``, ``max_bpm``: empty
-        for the default range, or if the rows differ), ``tracks``, ``failed``, the mean
+        the scored rows were scored with (``min_beat_time``, ``min_bpm``, ``max_bpm``:
+        empty for the default range, or if the rows differ; those of the failed rows if
+        none scored), ``tracks``, ``failed``, the mean
         of every metric over the scored tracks, ``octave errors`` and ``other tempo``
         (counts).
     """
@@ -333,7 +334,8 @@ def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
             rec: dict[str, Any] = {
                 "method": method,
                 "group": group,
-                **{key: _setting(sub, key) for key in SETTINGS},
+                # the scored rows' settings (failed rows are re-run with today's)
+                **{key: _setting(ok if len(ok) else sub, key) for key in SETTINGS},
                 "tracks": len(sub),
                 "failed": int((sub["status"] != "ok").sum()),
             }
@@ -499,27 +501,30 @@ def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> No
     """Refuse, before any work, a tempo range librosa cannot search at a track's rate.
 
     librosa's tempi are lags of an onset autocorrelation, so which exist depends on the
-    sample rate (:func:`beatsync.beats.tracker.librosa_tempo_prior`); a file the client
-    cannot open (e.g. a path valid only on the workers) is left to its task.
+    sample rate (:func:`beatsync.beats.tracker.librosa_tempo_prior`). A file the client
+    cannot open (e.g. a path valid only on the workers) or with an implausible rate is
+    left to its task, which records why it fails.
     """
     import soundfile as sf
 
     from ..beats.tracker import librosa_tempo_prior
+    from ..units import check_sample_rate
 
     first: dict[float, str] = {}
     for t in tracks:
         try:
-            rate = float(sf.info(str(t.audio)).samplerate)
-        except Exception:  # unreadable here: the track's own row records why
+            rate = check_sample_rate(sf.info(str(t.audio)).samplerate)
+        except Exception:  # unreadable or implausible here: the track's own row says why
             continue
         first.setdefault(rate, t.key)
+    refused = []
     for rate, key in sorted(first.items()):
         try:
             librosa_tempo_prior(**tempo, sr=rate)
         except ParameterError as exc:
-            raise ParameterError(
-                f"{key!r} (and any other track at {rate:g} Hz): {exc}; nothing was run"
-            ) from None
+            refused.append(f"{key!r} (and any other track at {rate:g} Hz): {exc}")
+    if refused:
+        raise ParameterError("; ".join(refused) + "; nothing was run")
 
 
 def _recorded_range(method: str, row: dict[str, Any]) -> tuple[float | None, float | None]:
