@@ -226,8 +226,7 @@ def check_tempo_range(
     given a bound other than its default searches a flat prior from ``min_bpm`` to
     ``max_bpm`` instead of its own log-normal one, and refuses at tracking time a range
     holding none of its tempo steps, :func:`beatsync.beats.tracker.librosa_tempo_prior`),
-    and
-    essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers,
+    and essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers,
     ``min_bpm`` in 40-180 and ``max_bpm`` in 60-250, at least 20 apart).
 
     Parameters

@@ -319,9 +319,8 @@ def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
         Columns ``method, group`` (``"all"`` for every folder together), the settings
         the scored rows were scored with (``min_beat_time``, ``min_bpm``, ``max_bpm``:
         empty for the default range, or if the rows differ; those of the failed rows if
-        none scored), ``tracks``, ``failed``, the mean
-        of every metric over the scored tracks, ``octave errors`` and ``other tempo``
-        (counts).
+        none scored), ``tracks``, ``failed``, the mean of every metric over the scored
+        tracks, ``octave errors`` and ``other tempo`` (counts).
     """
     table = pd.DataFrame(list(rows))
     if table.empty:
@@ -434,11 +433,11 @@ def evaluate_dataset(
     ------
     ParameterError
         An unknown or unavailable method; an annotation that is not beat times in
-        seconds; an output folder that is a file; results in ``out_dir`` scored
-        with another ``min_beat_time`` or tempo range (without ``force``; failed rows
-        do not count, they are re-run); a tempo range
-        the method does not accept; a bad worker count or an
-        unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
+        seconds; an output folder that is a file; results in ``out_dir`` scored with
+        another ``min_beat_time`` or tempo range (without ``force``; failed rows do not
+        count, they are re-run); a tempo range the method does not accept (for librosa,
+        one holding none of its tempi at a track's sample rate); a bad worker count or
+        an unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
     """
     from ..cluster import check_cluster_options, dask_client
     from ..units import check_positive
