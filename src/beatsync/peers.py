@@ -379,8 +379,9 @@ def track(
         bounds its tempo estimate, not the beats it then picks, and essentia's trackers
         take it as a preference. An 80 BPM pattern given 180-250 BPM is tapped at 161 by
         librosa, and at 80-162 by essentia's two, different from one call to the next in
-        the same process (the instability of MTG/essentia issue 1097; with their default
-        range, or given 75-101 BPM on the madmom sample, they repeat).
+        the same process (inside essentia; a similar instability is reported upstream as
+        MTG/essentia issue 1097). With their default range on the bundled real
+        recordings, or given 75-101 BPM on the madmom sample, they repeat.
 
     Raises
     ------
