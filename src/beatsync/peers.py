@@ -320,13 +320,14 @@ OUT_OF_RANGE_TEXT = "outside the range it was given"
 
 def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) -> None:
     """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it."""
-    from .errors import BeatsyncWarning
-
     if not tempo or beats.size < 3:
         return
+    from .errors import BeatsyncWarning
+    from .evaluate.beats import median_tempo
+
     bounds = {**_default_range(PEERS[name]), **tempo}
     lo, hi = bounds["min_bpm"], bounds["max_bpm"]
-    bpm = 60.0 / float(np.median(np.diff(beats)))
+    bpm = median_tempo(beats)
     tol = OUT_OF_RANGE_TOLERANCE
     if lo / (1 + tol) <= bpm <= hi * (1 + tol):
         return

@@ -465,7 +465,8 @@ def evaluate_dataset(
                 f"{str(log.path)!r} holds {method} results scored with --min-beat-time "
                 f"{other[0]:g} s, not {mbt:g} s; use --force to re-run them or another --out"
             )
-        ranges = {_recorded_range(method, r) for r in scored}
+        stored = {(r.get("min_bpm"), r.get("max_bpm")) for r in scored}
+        ranges = {_recorded_range(method, bounds) for bounds in stored}
         other_range = sorted(ranges - {bpm_range}, key=str)
         if other_range:
             raise ParameterError(
@@ -526,11 +527,10 @@ def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> No
         raise ParameterError("; ".join(refused) + "; nothing was run")
 
 
-def _recorded_range(method: str, row: dict[str, Any]) -> tuple[float | None, float | None]:
-    """The tempo range a stored row was tracked with, as :func:`check_tempo_range` would
-    record it today (a bound equal to the default as ``None``: rows written before that
-    rule resume)."""
-    bounds = (row.get("min_bpm"), row.get("max_bpm"))
+def _recorded_range(method: str, bounds: tuple[Any, Any]) -> tuple[float | None, float | None]:
+    """A stored row's tempo range ``bounds``, as :func:`check_tempo_range` would record
+    it today (a bound equal to the default as ``None``: rows written before that rule
+    resume)."""
     try:
         tempo = peers.check_tempo_range(method, *bounds)
     except ParameterError:
