@@ -234,6 +234,37 @@ print(y.size, "librosa" in sys.modules)
     assert out[3] == "8820 False"
 
 
+@pytest.mark.parametrize("fmt, suffix", [("WAV", ".wav"), ("MP3", ".mp3")])
+def test_a_file_cut_short_is_refused_naming_both_lengths(tmp_path, fmt, suffix):
+    # libsndfile read what was left of a truncated WAV (it trims the length to the bytes
+    # present) or MP3 without a word: 2 s of a 15 s song analysed as the whole song
+    import soundfile as sf
+
+    if fmt not in sf.available_formats():
+        pytest.skip(f"this libsndfile does not write {fmt}")
+    sr = 22050
+    t = np.arange(15 * sr) / sr
+    y = (0.3 * np.sin(2 * np.pi * 440.0 * t) * (np.sin(2 * np.pi * 2 * t) > 0)).astype(np.float32)
+    whole = tmp_path / f"whole{suffix}"
+    sf.write(whole, y, sr, format=fmt)
+    assert io.read_audio(whole)[0].size == pytest.approx(y.size, rel=0.01)
+    cut = tmp_path / f"cut{suffix}"
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 4])
+    with pytest.raises(ParameterError, match=r"is cut short: its header announces 15\.0"):
+        io.read_audio(cut)
+
+
+def test_a_streamed_wav_with_no_data_size_is_read(tmp_path):
+    # writers that cannot seek leave the data size at 0xFFFFFFFF: not a truncation
+    path = io.write_audio(tmp_path / "s.wav", np.zeros(4410, np.float32) + 0.1, 22050)
+    raw = bytearray(path.read_bytes())
+    at = raw.index(b"data")
+    raw[at + 4 : at + 8] = b"\xff\xff\xff\xff"
+    path.write_bytes(bytes(raw))
+    y, sr = io.read_audio(path)
+    assert sr == 22050 and y.size == 4410
+
+
 def test_beats_files(tmp_path):
     y, sr, beats = datasets.load_madmom_sample()
     np.testing.assert_allclose(beats, [0.0913, 0.7997, 1.4806, 2.1478])

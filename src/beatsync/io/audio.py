@@ -57,7 +57,8 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     Raises
     ------
     ParameterError
-        Missing, empty or unreadable file; no samples; NaN/inf samples.
+        Missing, empty or unreadable file; a file cut short (fewer samples than its
+        header announces); no samples; NaN/inf samples.
     """
     import soundfile as sf
 
@@ -65,7 +66,9 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     if sr is not None:
         sr = _integral_rate(sr, name="sr")
     try:
-        data, file_sr = sf.read(p, dtype="float32", always_2d=True)
+        with sf.SoundFile(p) as f:
+            announced, file_sr = f.frames, f.samplerate
+            data = f.read(dtype="float32", always_2d=True)
         y = data.mean(axis=1)
     except Exception as sf_exc:
         if SOUNDFILE_SUFFIXES.get(p.suffix.lower()) in sf.available_formats():
@@ -90,6 +93,8 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
                 f"cannot read {str(p)!r} as audio ({type(exc).__name__}); "
                 "is it a WAV/FLAC/OGG/MP3 file?"
             ) from None
+    else:
+        _check_complete(p, announced, y.size, file_sr)
     y = np.asarray(y, dtype=np.float32)
     try:
         file_sr = _integral_rate(file_sr, name="sample rate")
@@ -119,6 +124,70 @@ def resample_audio(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarra
     y, orig = check_audio(y, orig_sr)
     target = check_sample_rate(target_sr, name="target_sr")
     return resample(y, orig, target)
+
+
+#: A file that holds fewer samples than its header announces is refused when it lacks
+#: more than this fraction of them and at least :data:`SHORT_FILE_MIN_S`: an MP3's
+#: announced length (its Xing header) may be an estimate off by a frame or two.
+SHORT_FILE_FRACTION = 0.01
+SHORT_FILE_MIN_S = 0.1
+
+
+def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
+    """Refuse a file cut short: fewer samples than its header announces.
+
+    libsndfile reads what is there without a word: it trims a WAV's length to the bytes
+    present, and decodes an MP3 until its data ends. The WAV's own ``data`` chunk size
+    (:func:`_wav_announced_frames`) and libsndfile's announced frame count for other
+    formats are compared with the samples read.
+    """
+    wav = _wav_announced_frames(p)
+    if wav is not None:
+        announced = max(announced, wav)
+    missing = announced - n_read
+    if rate <= 0 or missing <= 0:
+        return
+    if missing > SHORT_FILE_FRACTION * announced and missing >= SHORT_FILE_MIN_S * rate:
+        raise ParameterError(
+            f"audio file {str(p)!r} is cut short: its header announces "
+            f"{announced / rate:.3f} s ({announced} samples at {rate:g} Hz) but it holds "
+            f"{n_read / rate:.3f} s; an interrupted copy or download? Copy the file again"
+        )
+
+
+def _wav_announced_frames(p: Path) -> int | None:
+    """Frames announced by a RIFF WAVE file's ``data`` chunk, or None (another format,
+    an unknown size, or a header this walk does not understand)."""
+    import struct
+
+    try:
+        with open(p, "rb") as f:
+            head = f.read(12)
+            if len(head) < 12 or head[:4] != b"RIFF" or head[8:12] != b"WAVE":
+                return None
+            block_align = None
+            for _ in range(64):  # chunks before the data: fmt, fact, LIST, ...
+                chunk = f.read(8)
+                if len(chunk) < 8:
+                    return None
+                cid, size = chunk[:4], struct.unpack("<I", chunk[4:])[0]
+                if cid == b"fmt ":
+                    fmt = f.read(size)
+                    if len(fmt) < 14:
+                        return None
+                    block_align = struct.unpack("<H", fmt[12:14])[0]
+                    if size % 2:
+                        f.seek(1, os.SEEK_CUR)
+                    continue
+                if cid == b"data":
+                    # 0 and 0xFFFFFFFF: a writer that could not seek back to fill it in
+                    if not block_align or size in (0, 0xFFFFFFFF):
+                        return None
+                    return size // block_align
+                f.seek(size + size % 2, os.SEEK_CUR)
+    except OSError:
+        return None
+    return None
 
 
 def _check_wav_header_rate(p: Path) -> None:
