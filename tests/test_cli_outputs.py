@@ -122,6 +122,28 @@ def test_output_that_is_a_folder_is_refused(case, inputs, tmp_path, capsys):
     assert _listing(tmp_path) == before
 
 
+@pytest.mark.parametrize("exists", [False, True])
+@pytest.mark.parametrize("case", sorted(OUTPUT_OPTIONS))
+def test_output_ending_in_a_slash_is_refused(case, exists, inputs, tmp_path, capsys):
+    # "out/" names a folder; Path() dropped the slash and wrote (or replaced) a file "out"
+    template, option = OUTPUT_OPTIONS[case]
+    assert template[-1].startswith("{out}")
+    outdir = tmp_path / "o"
+    outdir.mkdir()
+    target = outdir / "taken"
+    victim = Path(str(target) + Path(template[-1]).suffix)
+    if exists:
+        victim.write_text("keep me\n")
+    before = _listing(tmp_path)
+    argv = _argv(template, inputs, target, outdir)
+    argv[-1] += "/"
+    code, _, err = _run(argv, capsys)
+    _assert_refused(code, err, "which names a folder", option)
+    assert _listing(tmp_path) == before
+    if exists:
+        assert victim.read_text() == "keep me\n"
+
+
 @pytest.mark.parametrize("case", sorted(OUTPUT_OPTIONS))
 def test_read_only_output_is_refused_and_kept(case, inputs, tmp_path, capsys):
     template, option = OUTPUT_OPTIONS[case]

@@ -175,10 +175,22 @@ def check_output(
     holds, e.g. ``"beat times"``: writing it would replace such a file with text), an
     existing folder, an existing file that is not a regular file (a device, a pipe), a
     read-only file, the same file as one of ``inputs`` (also through links), a missing
-    or unwritable folder. Nothing is touched on disk.
+    or unwritable folder; an empty name, and a name ending in a path separator (a
+    folder's name; ``Path`` would drop the separator and write a file). Nothing is
+    touched on disk.
     """
+    raw = os.fspath(path)
     p = Path(path)
     name = f"{option} {str(path)!r}"
+    if not raw:
+        raise ParameterError(f"{option} is an empty name; give a file name")
+    seps = tuple(x for x in (os.sep, os.altsep) if x)
+    if raw.endswith(seps) and not p.is_dir():
+        # Path() drops the slash: "out/" would be written as a file named "out"
+        raise ParameterError(
+            f"{name} ends in {raw[-1]!r}, which names a folder, but {option} is a file: "
+            f"drop the {raw[-1]!r} or add a file name (e.g. {str(p / 'output')!r})"
+        )
     if suffixes is not None:
         allowed = tuple(s.lower() for s in suffixes)
         if p.suffix.lower() not in allowed:

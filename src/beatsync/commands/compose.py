@@ -184,7 +184,7 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     if out.suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
     outs = Outputs(inputs=(audio, args.beats, *files))
-    outs.add(out, option="-o/--output")
+    outs.add(args.output, option="-o/--output")
     video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
     report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
     return {

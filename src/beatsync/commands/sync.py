@@ -196,7 +196,7 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
 
         check_motion_fps(args.video_fps, name="--video-fps")  # before minutes of work
     outs = Outputs(inputs=(args.motion, args.audio, args.beats))
-    out = outs.add(out, option="-o/--output")
+    out = outs.add(args.output, option="-o/--output")
     video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
     report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
     return outs, out, video, report
