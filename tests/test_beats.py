@@ -112,6 +112,28 @@ def test_frontend_parameters_accepted():
     assert _score(ref, bt.beats)["F-measure"] >= 0.95
 
 
+@pytest.mark.parametrize(
+    "edges, match",
+    [
+        # band edges for another rate: no onsets, and a warning that blamed "a steady sound"
+        ((20000, 30000), r"band 1 \(20000-30000 Hz\) .* above 11025 Hz"),
+        ((0, 100, 100.5, 4000), r"band 2 \(100-100\.5 Hz\) .* narrower than one FFT bin"),
+    ],
+)
+def test_band_edges_that_hold_no_frequency_are_refused(edges, match):
+    y = click_track(beat_times(120, duration=5.0, start=0.3), sr=SR, duration=5.0)
+    with pytest.raises(ParameterError, match=match):
+        track_beats(y, SR, band_edges_hz=edges)
+
+
+def test_default_band_edges_still_track_low_rate_audio():
+    # the default top band (4-22 kHz) holds nothing at 4 kHz: not the user's mistake
+    sr = 4000
+    ref = beat_times(120, duration=10.0, start=0.3)
+    bt = track_beats(click_track(ref, sr=sr, duration=10.0), sr)
+    assert bt.tempo == pytest.approx(120, rel=0.05)
+
+
 def test_librosa_method_scores_on_clean_clicks():
     ref = beat_times(120, duration=10.0, start=0.3)
     bt = track_beats(click_track(ref, sr=SR, duration=10.0), SR, method="librosa")
@@ -153,8 +175,10 @@ def test_beat_tempo_known_answer():
 
 
 def test_check_audio_silence_threshold_and_allow_silent():
-    quiet = np.full(100, 5e-7)  # above the silence threshold (1e-7)
+    quiet = 5e-7 * (-1.0) ** np.arange(100)  # above the silence threshold (1e-7)
     assert check_audio(quiet, SR)[0].dtype == np.float64
+    with pytest.raises(ParameterError, match="constant at 5e-07"):  # a DC offset: no sound
+        check_audio(np.full(100, 5e-7), SR)
     with pytest.raises(ParameterError, match="silent"):
         check_audio(np.full(100, 5e-8), SR)
     y, sr = check_audio(np.zeros(100), SR, allow_silent=True)

@@ -207,6 +207,8 @@ def test_check_sample_rate_accepts():
         (0.5, r"bpm=0.5 is outside the plausible range 20-400 BPM \(did you give a beat period"),
         (2.0, "beats per second"),
         (1000, "sub-beats"),
+        (0, r"bpm=0 .* \(a tempo is a positive number of beats per minute\)"),
+        (-5, "a tempo is a positive number"),
         (np.nan, r"bpm=nan is not a finite number; give a tempo in BPM from 20 to 400"),
         (np.inf, "not a finite number"),
         ("inf", "not a finite number"),
@@ -252,6 +254,8 @@ _Y = np.full(2205, 0.1, dtype=np.float32)
         (["a"] * 5, 22050, {}, "strings"),
         (_Y, 22050, {"min_duration": 1.0}, r"only 0.100 s long \(2205 samples at sr=22050"),
         (_Y * 0, 22050, {"silence_peak": 1e-7}, "all silent"),
+        (_Y, 22050, {"silence_peak": 1e-7}, r"constant at 0\.1 \(a DC offset"),
+        (_Y - 0.3, 22050, {"silence_peak": 1e-7}, r"constant at -0\.2"),
     ],
 )
 def test_check_audio_refuses(y, sr, kwargs, match):

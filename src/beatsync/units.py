@@ -478,6 +478,8 @@ def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
         hint = "did you give a beat period in seconds, or beats per second?"
         if v > MAX_BPM:
             hint = "did you give a rate of sub-beats, or a tempo in another unit?"
+        elif v <= 0:
+            hint = "a tempo is a positive number of beats per minute"
         raise ParameterError(
             f"{name}={bpm!r} is outside the plausible range {MIN_BPM:g}-{MAX_BPM:g} BPM "
             f"({hint})"
@@ -509,13 +511,14 @@ def check_audio(
     min_duration : float, optional [s]
         Refuse audio shorter than this (the message gives the length).
     silence_peak : float, optional
-        Refuse audio whose peak magnitude is below this (all silent).
+        Refuse audio whose peak magnitude is below this (all silent), or that departs
+        from its mean by less than this (constant: a DC offset and no sound).
 
     Raises
     ------
     ParameterError
         Not 1-D (the message says how to mix down), empty, NaN/inf samples, a bad
-        sample rate, too short, or silent.
+        sample rate, too short, silent or constant.
     """
     sr_f = check_sample_rate(sr)
     arr = as_float_array(y, name=f"{name} (audio samples)", dtype=None)
@@ -540,10 +543,18 @@ def check_audio(
                 f"Hz); at least {min_duration:.3g} s is needed (give a longer excerpt, or "
                 "check the sample rate)"
             )
-    if silence_peak is not None and not float(np.max(np.abs(arr))) >= silence_peak:
-        raise ParameterError(
-            f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
-        )
+    if silence_peak is not None:
+        peak = float(np.max(np.abs(arr)))
+        if not peak >= silence_peak:
+            raise ParameterError(
+                f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
+            )
+        level = float(np.mean(arr))
+        if not float(np.max(np.abs(arr - level))) >= silence_peak:
+            raise ParameterError(
+                f"the audio is constant at {level:.6g} (a DC offset, no sound; it varies by "
+                f"less than {silence_peak:g}): check the file and the recording chain"
+            )
     return arr, sr_f
 
 

@@ -107,7 +107,9 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     ------
     ParameterError
         Unknown key, non-positive window or hop, a hop over half the window, an FFT
-        shorter than the window, or band edges that do not increase.
+        shorter than the window, band edges that do not increase, or given band edges
+        with a band that holds no FFT bin at the analysis rate (above its Nyquist
+        frequency, or too narrow).
     """
     unknown = set(params) - set(FRONTEND_DEFAULTS)
     if unknown:
@@ -135,6 +137,21 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     if edges.ndim != 1 or edges.size < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
         raise ParameterError(
             f"band_edges_hz={p['band_edges_hz']!r} must be increasing frequencies [Hz]"
+        )
+    band = _bin_bands(np.fft.rfftfreq(n_fft, d=1.0 / sr), edges)
+    empty = np.flatnonzero(np.bincount(band[band >= 0], minlength=edges.size - 1) == 0)
+    # the default top band (4-22 kHz) is empty below 8 kHz: only edges a user gave count
+    if empty.size and "band_edges_hz" in params:
+        k = int(empty[0])
+        why = (
+            f"it lies above {sr / 2:g} Hz, the highest frequency at the analysis rate "
+            f"{sr:g} Hz (edges meant for another sample rate?)"
+            if edges[k] >= sr / 2
+            else f"it is narrower than one FFT bin ({sr / n_fft:.3g} Hz)"
+        )
+        raise ParameterError(
+            f"band_edges_hz={p['band_edges_hz']!r}: band {k + 1} ({edges[k]:g}-"
+            f"{edges[k + 1]:g} Hz) holds no frequency of the analysis: {why}"
         )
     flux_norm_s = check_positive(p["flux_norm_s"], name="flux_norm_s", unit="s", allow_zero=True)
     return FrontEnd(sr, win, hop, n_fft, tuple(float(e) for e in edges), flux_norm_s)

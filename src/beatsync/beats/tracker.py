@@ -266,7 +266,9 @@ def track_beats(
     Warns
     -----
     BeatsyncWarning
-        If no onsets are found (e.g. a steady tone): returns no beats. If the pulse
+        If no onsets are found (no attack in any band): returns no beats. (A steady
+        tone does have onsets and gets beats without a warning: a known limit, see
+        :mod:`beatsync.beats.onset`.) If the pulse
         is unclear (e.g. noise: the salience along the tempo path is less than
         ``MIN_PULSE_CLARITY`` times that of the same onsets in random order, see
         :func:`pulse_clarity_null`): returns the beats found, and names the way out
@@ -344,7 +346,7 @@ def _track_psf(
     fps = ons.fps
     n = ons.envelope.size
     if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
-        return _empty("psf", "no onsets found in the audio (a steady sound?): no beats")
+        return _empty("psf", "no onsets found in the audio (no attack in any band): no beats")
     model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
     accents = _accents(ons.bands, fps)
     starts, stops, centres = analysis_windows(n, fps, tempo_win_s, tempo_hop_s)

@@ -90,7 +90,8 @@ def run(args: Any) -> int:
             fb.warn(note)
         if track.beats.size == 0:
             raise ParameterError(
-                f"no beats found in {args.audio!r} (no onsets: a steady tone or near silence?); "
+                f"no beats found in {args.audio!r} (no onsets: no attack in any band, e.g. near "
+                "silence?); "
                 "nothing written"
             )
         written = []
