@@ -105,6 +105,15 @@ def test_known_bpm_override_and_range():
     assert bt2.tempo == pytest.approx(90, rel=0.03)
 
 
+@pytest.mark.parametrize("method", ["psf", "librosa"])
+def test_a_tempo_with_a_range_is_refused(method):
+    # the range was ignored, even when the tempo lay outside it (the CLI refused it)
+    y = click_track(beat_times(120, duration=5.0, start=0.3), sr=SR, duration=5.0)
+    with pytest.raises(ParameterError, match=r"bpm=120 fixes the tempo, and .*\(130, 200\)"):
+        track_beats(y, SR, method=method, bpm=120, min_bpm=130, max_bpm=200)
+    assert track_beats(y, SR, method=method, bpm=120, min_bpm=40, max_bpm=240).beats.size
+
+
 def test_frontend_parameters_accepted():
     ref = beat_times(120, duration=10.0, start=0.3)
     y = click_track(ref, sr=SR, duration=10.0)

@@ -260,7 +260,8 @@ def track_beats(
         Empty, silent or non-finite audio; audio too short for a pulse (shorter
         than 1.5 s, or than two beat periods of a given ``bpm``, see
         :func:`check_duration`); ``sr <= 0``; ``min_bpm >= max_bpm``; a ``bpm``,
-        ``min_bpm`` or ``max_bpm`` outside 20-400; unknown method or front-end
+        ``min_bpm`` or ``max_bpm`` outside 20-400; a ``bpm`` with a range other
+        than the default (the range would be ignored); unknown method or front-end
         parameter.
 
     Warns
@@ -289,6 +290,11 @@ def track_beats(
     check_bpm(max_bpm, name="max_bpm")
     if bpm is not None:
         bpm = check_bpm(bpm)
+        if (min_bpm, max_bpm) != (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
+            raise ParameterError(
+                f"bpm={bpm:g} fixes the tempo, and (min_bpm, max_bpm)=({min_bpm:g}, "
+                f"{max_bpm:g}) bounds a tempo search that bpm skips: give one or the other"
+            )
     check_duration(y.size, sr, bpm=bpm)
     if method == "librosa":
         if frontend_params:
