@@ -1,5 +1,6 @@
 """The one Dask set-up: worker counts, scheduler addresses, timeouts, shutdown."""
 
+import contextlib
 import time
 
 import pytest
@@ -17,6 +18,10 @@ from beatsync.errors import ParameterError
         ("two", "not a number of workers"),
         (True, "whole number of workers"),
         ([2], "whole number of workers"),
+        (float("inf"), "whole number of workers"),
+        # a typo such as 10**12 started workers until the command hung
+        (10**12, r"more worker processes than a local cluster here can start \(at most"),
+        ("99999999999999999999999", "more worker processes"),
     ],
 )
 def test_bad_worker_counts(n, match):
@@ -59,6 +64,42 @@ def test_unreachable_scheduler_fails_fast_and_clearly(monkeypatch, address, matc
     with pytest.raises(ParameterError, match=match), cluster.dask_client(scheduler=address):
         pass  # pragma: no cover
     assert time.perf_counter() - t0 < 10.0
+
+
+@pytest.mark.parametrize("reply", [None, b"HTTP/1.0 400 Bad Request\r\n\r\n", b""])
+def test_a_listener_that_is_not_dask_is_refused_fast(monkeypatch, reply):
+    # the dashboard's HTTP port given for the scheduler's: the client waited forever for
+    # a handshake; an HTTP answer was read as a frame of exabytes (a MemoryError)
+    import socket
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def serve():
+        with contextlib.suppress(OSError):
+            conn, _ = server.accept()
+            held.append(conn)
+            if reply is not None:
+                conn.sendall(reply)
+                if not reply:
+                    conn.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(ParameterError, match=r"^--scheduler '[^']*' is not a Dask scheduler: "):
+            with cluster.dask_client(scheduler=address):
+                pass  # pragma: no cover
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+    assert time.perf_counter() - t0 < 5.0
 
 
 def test_local_cluster_runs_and_shuts_down():

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import os
 from collections.abc import Iterator
 from typing import Any
@@ -42,13 +43,24 @@ def default_workers() -> int:
     return os.cpu_count() or 1
 
 
+#: Local worker processes allowed per core (each is a Python process of ~100 MB; a count
+#: of 10**12, a typo, started workers until the command hung).
+LOCAL_WORKERS_PER_CORE = 16
+
+
+def max_local_workers() -> int:
+    """The largest ``--workers`` a local cluster accepts: 16 per core, at least 64."""
+    return max(LOCAL_WORKERS_PER_CORE * default_workers(), 64)
+
+
 def check_workers(n_workers: Any, *, name: str = "--workers") -> int | None:
     """Check a local cluster's worker count: ``None`` (default) or a whole number >= 1.
 
     Raises
     ------
     ParameterError
-        Zero, negative, fractional or non-numeric counts.
+        Zero, negative, fractional or non-numeric counts, and counts above
+        :func:`max_local_workers`.
     """
     if n_workers is None:
         return None
@@ -58,10 +70,16 @@ def check_workers(n_workers: Any, *, name: str = "--workers") -> int | None:
         value = float(n_workers)
     except ValueError:
         raise ParameterError(f"{name}={n_workers!r} is not a number of workers") from None
-    if value != int(value) or value < 1:
+    if not math.isfinite(value) or value != int(value) or value < 1:
         raise ParameterError(
             f"{name}={n_workers!r} must be a whole number of workers >= 1 "
             f"(this machine has {default_workers()} cores; omit it for one worker per core)"
+        )
+    if value > max_local_workers():
+        raise ParameterError(
+            f"{name}={n_workers!r} is more worker processes than a local cluster here can "
+            f"start (at most {max_local_workers()} on its {default_workers()} cores); a typo? "
+            "For a larger cluster, start one and give its address with --scheduler"
         )
     return int(value)
 
@@ -197,6 +215,62 @@ def _client_with_handshake_retries(client_cls: Any, address: str, timeout: float
             attempt += 1
 
 
+#: A Dask frame header (a little-endian count of bytes) larger than this is not Dask's.
+_MAX_FIRST_FRAME = 2**32
+
+
+def _probe_tcp(address: str, location: str, timeout: float) -> None:
+    """Refuse a TCP address where something listens that does not speak Dask.
+
+    A Dask scheduler writes its handshake as soon as a connection opens; the client
+    then reads it with no time limit of its own, so a server that waits for a request
+    (the dashboard's HTTP port, 8787, given for the scheduler's 8786) held the command
+    forever, and one that answered with text was read as a frame of exabytes. Only a
+    silent or non-Dask answer is refused here; a refused connection or no route is
+    left to the client (its own message and retries).
+    """
+    import socket
+    import struct
+    import time
+
+    from distributed.comm.addressing import parse_host_port
+
+    try:
+        host, port = parse_host_port(location)
+    except ValueError:
+        return  # the client says what is wrong with it
+    t0 = time.monotonic()
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except OSError:
+        return
+    with sock:
+        sock.settimeout(max(timeout - (time.monotonic() - t0), 0.5))
+        try:
+            first = sock.recv(16)
+        except OSError:
+            first = None
+    hint = (
+        "; a Dask scheduler listens on 8786 by default (8787 is its dashboard)"
+        if port == 8787 or (first or b"").startswith(b"HTTP")
+        else ""
+    )
+    if first is None:
+        why = f"something listens there but sent nothing within {timeout:g} s"
+    elif first.startswith(b"HTTP"):
+        why = "an HTTP server answers there"
+    elif len(first) >= 8 and struct.unpack("<Q", first[:8])[0] > _MAX_FIRST_FRAME:
+        why = f"something answers there that does not speak Dask (it began {first[:8]!r})"
+    elif not first:
+        why = "something listens there but closed the connection at once"
+    else:
+        return
+    raise ParameterError(
+        f"--scheduler {address!r} is not a Dask scheduler: {why}{hint}. Give the address "
+        "`dask scheduler` prints, or omit --scheduler to run on a local cluster"
+    )
+
+
 def _connect(address: str, timeout: float) -> Any:
     from dask.distributed import Client
     from distributed.comm import parse_address
@@ -205,8 +279,13 @@ def _connect(address: str, timeout: float) -> Any:
     try:
         # an unknown scheme is refused here, not inside the client's connection retries
         # (which, on a busy machine, can time out before they report the scheme)
-        get_backend(parse_address(address)[0])
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme == "tcp":
+            _probe_tcp(address, location, timeout)
         return _client_with_handshake_retries(Client, address, timeout)
+    except ParameterError:
+        raise
     except ValueError as exc:  # malformed address: unknown scheme, no port
         raise ParameterError(
             f"--scheduler {address!r} is not a Dask scheduler address ({exc}); "
