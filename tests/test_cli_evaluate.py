@@ -121,6 +121,84 @@ def test_rerun_skips_finished_tracks_and_force_reruns(dataset, scheduler, tmp_pa
     assert len(TrackLog(out / "tracks.jsonl").rows()) == 6  # --force replaced the old rows
 
 
+def _copy_dataset(dataset, tmp_path):
+    audio, notes = tmp_path / "audio", tmp_path / "annotations"
+    shutil.copytree(dataset[0], audio)
+    shutil.copytree(dataset[1], notes)
+    return audio, notes
+
+
+def test_resume_reruns_a_track_whose_audio_or_annotation_changed(
+    dataset, scheduler, tmp_path, capsys
+):
+    # a resume kept a row scored on another file or against an edited annotation
+    ds = _copy_dataset(dataset, tmp_path)
+    out = tmp_path / "results"
+    where = ["--scheduler", scheduler, "--json"]
+    assert _run(_argv(ds, out, *where), capsys)[0] == 0
+    before = {r["key"]: r for r in TrackLog(out / "tracks.jsonl").latest().values()}
+    shifted = io.read_beats(ds[1] / "drums_96.beats") + 0.25  # the annotation edited
+    io.write_beats(ds[1] / "drums_96.beats", shifted)
+    ref = beat_times(150, duration=8.0, start=0.3)  # another song under the same name
+    io.write_audio(ds[0] / "rock" / "drums_132.wav", click_track(ref, sr=SR, duration=6.0), SR)
+    code, stdout, err = _run(_argv(ds, out, *where), capsys)
+    assert code == 0, err
+    res = json.loads(stdout)
+    assert res["changed"] == 2 and res["scored_now"] == 4 and res["skipped"] == 2
+    after = {r["key"]: r for r in TrackLog(out / "tracks.jsonl").latest().values()}
+    assert after["rock/drums_96"]["F-measure"] < before["rock/drums_96"]["F-measure"]
+    assert after["rock/drums_132"]["audio_seconds"] == pytest.approx(6.0)
+    assert after["clicks/click_110"] == before["clicks/click_110"]
+    code, stdout, _ = _run(_argv(ds, out, *where[:2]), capsys)
+    assert "2 scored before and run again" not in stdout and "4 already scored" in stdout
+
+
+def test_force_on_some_tracks_keeps_the_others(dataset, scheduler, tmp_path, capsys):
+    # --force dropped every row of the method, also of tracks outside the run
+    ds = _copy_dataset(dataset, tmp_path)
+    out = tmp_path / "results"
+    assert _run(_argv(ds, out, "--scheduler", scheduler), capsys)[0] == 0
+    before = TrackLog(out / "tracks.jsonl").latest()
+    sub = tmp_path / "sub"
+    (sub / "rock").mkdir(parents=True)
+    shutil.copy(ds[0] / "rock" / "drums_96.wav", sub / "rock")
+    argv = ["evaluate", "beats", "--audio", str(sub), "--annotations", str(ds[1])]
+    code, _, err = _run([*argv, "--out", str(out), "--scheduler", scheduler, "--force"], capsys)
+    assert code == 0, err
+    after = TrackLog(out / "tracks.jsonl").latest()
+    assert set(after) == set(before)  # the same key, rock/drums_96, re-run
+    assert after[("psf", "rock/drums_96")]["audio"] == str(sub / "rock" / "drums_96.wav")
+    assert len(TrackLog(out / "tracks.jsonl").rows()) == len(after)  # compacted
+    table = pd.read_csv(out / "tracks.csv")
+    assert len(table) == len(after)
+    # with other settings, rows of tracks outside the run would bind every resume: dropped
+    extra = ["--scheduler", scheduler, "--force", "--min-beat-time", "1"]
+    assert _run([*argv, "--out", str(out), *extra], capsys)[0] == 0
+    assert set(TrackLog(out / "tracks.jsonl").latest()) == {("psf", "rock/drums_96")}
+
+
+def test_interrupted_force_keeps_the_earlier_rows(
+    dataset, scheduler, tmp_path, capsys, monkeypatch
+):
+    # --force rewrote the record before any work: Ctrl-C then lost every earlier row
+    out = tmp_path / "results"
+    where = ["--scheduler", scheduler]
+    assert _run(_argv(dataset, out, *where), capsys)[0] == 0
+    before = TrackLog(out / "tracks.jsonl").latest()
+    real_append = TrackLog.append
+
+    def append_then_interrupt(self, row):
+        real_append(self, row)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(TrackLog, "append", append_then_interrupt)
+    code, _, err = _run(_argv(dataset, out, *where, "--force"), capsys)
+    assert code == 130, err
+    after = TrackLog(out / "tracks.jsonl").latest()
+    assert set(after) == set(before)
+    assert len(TrackLog(out / "tracks.jsonl").rows()) == len(before) + 1
+
+
 @pytest.mark.parametrize(
     "cluster",
     ["scheduler", pytest.param("two local workers", marks=pytest.mark.slow)],

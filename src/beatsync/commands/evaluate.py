@@ -77,7 +77,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     b.add_argument(
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
     )
-    b.add_argument("--force", action="store_true", help="re-run tracks already scored")
+    b.add_argument(
+        "--force",
+        action="store_true",
+        help="re-run the tracks of this run although already scored (rows of other tracks "
+        "in --out are kept; a track whose audio or annotation changed is always re-run)",
+    )
     add_output_flags(b)
     b.set_defaults(func=run_beats)
 
@@ -142,6 +147,7 @@ def run_beats(args: argparse.Namespace) -> int:
         "tracks": len(t),
         "scored_now": run.scored,
         "skipped": run.skipped,
+        "changed": run.changed,
         "failed": failed[["key", "error"]].to_dict("records"),
         "outside_range": outside["key"].tolist(),
         "unmatched": [str(p) for p in found.unmatched],
@@ -162,6 +168,11 @@ def run_beats(args: argparse.Namespace) -> int:
             f"to it; the warning column of {run.files['tracks'].name} says which)"
         )
     skipped = f", {run.skipped} already scored (--force re-runs them)" if run.skipped else ""
+    if run.changed:
+        skipped += (
+            f", {run.changed} scored before and run again: their audio file or annotation "
+            "changed since"
+        )
     searched = "".join(f", --{k.replace('_', '-')} {v:g}" for k, v in tempo.items())
     lines.append(
         f"{len(t) - len(failed)}/{len(t)} tracks scored with {args.method}{searched} "

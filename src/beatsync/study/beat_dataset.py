@@ -17,6 +17,7 @@ Methods are named as in :data:`beatsync.peers.PEERS` (``psf`` is ours); scores a
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import time
 import uuid
@@ -211,8 +212,10 @@ def evaluate_track(
     Returns
     -------
     dict
-        ``key, group, audio, method, min_beat_time, min_bpm, max_bpm, status`` (``"ok"`` or
-        ``"error"``), ``error``, ``warning`` (the tracker's or scorer's warnings),
+        ``key, group, audio, audio_bytes`` (its size, None if unreadable),
+        ``reference_digest`` (:func:`reference_digest`), ``method, min_beat_time,
+        min_bpm, max_bpm, status`` (``"ok"`` or ``"error"``), ``error``, ``warning``
+        (the tracker's or scorer's warnings),
         ``n_ref, n_est, tempo_ref, tempo_est, octave``, every metric of
         :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking
         time), ``audio_seconds`` and ``beats`` (the estimated times).
@@ -221,6 +224,8 @@ def evaluate_track(
         "key": name,
         "group": group,
         "audio": str(audio),
+        "audio_bytes": _audio_bytes(audio),
+        "reference_digest": reference_digest(reference),
         "method": method,
         "min_beat_time": float(min_beat_time),
         "min_bpm": min_bpm,
@@ -362,6 +367,9 @@ class DatasetRun:
         :func:`summarize_dataset` of every method recorded in the output folder.
     scored, skipped : int
         Tracks run now, and tracks already recorded by an earlier run.
+    changed : int
+        Tracks run now although scored before: their audio file (path or size) or
+        annotation changed since.
     files : dict of str -> Path
         ``log`` (``tracks.jsonl``), ``tracks`` (CSV) and ``summary`` (CSV).
     """
@@ -371,6 +379,7 @@ class DatasetRun:
     scored: int
     skipped: int
     files: dict[str, Path]
+    changed: int = 0
 
 
 def _table(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
@@ -421,8 +430,12 @@ def evaluate_dataset(
         method's default (:func:`beatsync.peers.check_tempo_range`). Recorded in each
         row.
     force : bool
-        Re-run tracks already recorded for ``method`` (default: skip those scored).
-        Tracks recorded with an error are always re-run.
+        Re-run these tracks although recorded for ``method`` (default: skip those
+        scored). The new rows are appended; once the run completes, the record keeps
+        the latest row of every track, and drops rows of this method for tracks outside
+        this run that were scored with other settings. Tracks recorded with an error,
+        and tracks whose audio file (path or size) or annotation changed since they were
+        scored, are always re-run.
     scheduler, n_workers, processes
         See :func:`beatsync.cluster.dask_client`. Workers of an existing cluster must
         see the audio files at the same paths.
@@ -474,7 +487,17 @@ def evaluate_dataset(
                 f"{_range_text(other_range[0])}, not {_range_text(bpm_range)}; use --force "
                 "to re-run them or another --out"
             )
-    done = set() if force else {k for k, r in previous.items() if r.get("status") == "ok"}
+    done = set()
+    changed = 0
+    if not force:
+        for t in tracks:
+            row = previous.get(t.key)
+            if row is None or row.get("status") != "ok":
+                continue
+            if _same_inputs(row, t, refs[t.key]):
+                done.add(t.key)
+            else:
+                changed += 1
     todo = [t for t in tracks if t.key not in done]
     if method == "librosa" and tempo:
         _check_librosa_rates(todo, tempo)
@@ -484,17 +507,58 @@ def evaluate_dataset(
                 dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes)
             )
         out.mkdir(exist_ok=True)
-        if force and previous:
-            log.rewrite([r for r in log.rows() if r["method"] != method])
         if todo:
             _run(client, todo, refs, log, method=method, mbt=mbt, tempo=tempo, progress=progress)
+    if force and previous:
+        # appended, not replaced up front: an interrupted --force keeps the earlier rows
+        # of the tracks it did not reach, and tracks outside this run keep theirs unless
+        # they were scored with other settings (those would bind every later resume)
+        mine_now = (mbt, *bpm_range)
+        log.rewrite(
+            [
+                r
+                for (m, k), r in log.latest().items()
+                if m != method or k in refs or _row_settings(method, r) == mine_now
+            ]
+        )
     latest = log.latest()
     mine = [latest[(method, k)] for k in keys if (method, k) in latest]
     files = {"log": log.path, "tracks": out / "tracks.csv", "summary": out / "summary.csv"}
     summary = summarize_dataset(list(latest.values()))
     io.write_csv(files["tracks"], _table(list(latest.values())))
     io.write_csv(files["summary"], summary)
-    return DatasetRun(_table(mine), summary, len(todo), len(tracks) - len(todo), files)
+    return DatasetRun(_table(mine), summary, len(todo), len(tracks) - len(todo), files, changed)
+
+
+def reference_digest(reference: np.ndarray) -> str:
+    """A short digest of an annotation's beat times (a row records the one it was scored
+    against; a resume re-runs a track whose annotation changed since)."""
+    data = np.ascontiguousarray(np.asarray(reference, dtype=np.float64)).tobytes()
+    return hashlib.sha256(data).hexdigest()[:16]
+
+
+def _audio_bytes(path: str | os.PathLike[str]) -> int | None:
+    try:
+        return os.stat(path).st_size
+    except OSError:
+        return None
+
+
+def _same_inputs(row: dict[str, Any], track: Track, reference: np.ndarray) -> bool:
+    """Was ``row`` scored on this track's audio file and annotation? Rows written before
+    the digest and size were recorded are taken as they are."""
+    if row.get("audio") not in (None, str(track.audio)):
+        return False
+    size = row.get("audio_bytes")
+    if size is not None and size != _audio_bytes(track.audio):
+        return False
+    digest = row.get("reference_digest")
+    return digest is None or digest == reference_digest(reference)
+
+
+def _row_settings(method: str, row: dict[str, Any]) -> tuple[Any, ...]:
+    bounds = _recorded_range(method, (row.get("min_bpm"), row.get("max_bpm")))
+    return (row.get("min_beat_time"), *bounds)
 
 
 def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> None:
@@ -574,6 +638,8 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
                     "key": t.key,
                     "group": t.group,
                     "audio": str(t.audio),
+                    "audio_bytes": _audio_bytes(t.audio),
+                    "reference_digest": reference_digest(refs[t.key]),
                     "method": method,
                     "min_beat_time": mbt,
                     "min_bpm": tempo.get("min_bpm"),
