@@ -307,6 +307,7 @@ def test_missing_folder(dataset, tmp_path):
         (100.0, 0, "looks like frame indices"),
         (44100.0, 0, "looks like sample indices"),
         (10.0, 0, "looks like frame indices"),  # 10 frames/s: once taken for seconds
+        (1 / 60, 6, r"\(5760 BPM read as seconds, .*\): minutes"),  # once scored F 0
     ],
 )
 def test_annotation_not_in_seconds(dataset, tmp_path, scale, decimals, match):
@@ -318,6 +319,54 @@ def test_annotation_not_in_seconds(dataset, tmp_path, scale, decimals, match):
     )
     _refused(_bad(tmp_path, dataset, notes=notes), f"drums_96.beats' is not beat times.*{match}")
     assert not (tmp_path / "results").exists()  # refused before anything is written
+
+
+def test_results_files_of_someone_else_are_not_replaced(dataset, tmp_path):
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "summary.csv").write_text("mine\n")
+    _refused(_bad(tmp_path, dataset, out=out), r"holds summary.csv but no tracks.jsonl")
+    assert (out / "summary.csv").read_text() == "mine\n"
+    assert sorted(p.name for p in out.iterdir()) == ["summary.csv"]
+
+
+def test_annotation_of_another_recording_and_empty_references(dataset, scheduler, tmp_path, capsys):
+    # annotations past the audio's end, or none left after --min-beat-time, scored 0
+    # in the means with nothing said on the terminal
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    audio.mkdir()
+    notes.mkdir()
+    for name in ("drums_96", "drums_132"):
+        shutil.copy(dataset[0] / "rock" / f"{name}.wav", audio)
+        shutil.copy(dataset[1] / f"{name}.beats", notes)
+    io.write_beats(notes / "drums_132.beats", np.arange(100.0, 112.0, 0.5))
+    argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    where = ["--out", str(tmp_path / "r"), "--scheduler", scheduler]
+    code, stdout, err = _run([*argv, *where], capsys)
+    assert code == 0, err
+    assert "failed: drums_132: no annotated beat falls inside the audio: the first is at 100" in (
+        stdout
+    )
+    (audio / "drums_132.wav").unlink()  # one track: the thread workers share warnings
+    where = ["--out", str(tmp_path / "r2"), "--scheduler", scheduler, "--json"]
+    code, stdout, err = _run([*argv, *where, "--min-beat-time", "7.9"], capsys)
+    res = json.loads(stdout)
+    assert res["no_reference_beats"] == ["drums_96"], res
+    code, stdout, err = _run([*argv, *where[:-1], "--min-beat-time", "7.9"], capsys)
+    assert "1 track(s) have no annotated beat after --min-beat-time 7.9 s" in stdout
+
+
+def test_interrupt_before_any_track_finished_says_so(dataset, scheduler, tmp_path, capsys,
+                                                      monkeypatch):  # fmt: skip
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(beat_dataset, "_run", interrupt)
+    out = tmp_path / "results"
+    code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
+    assert code == 130
+    assert "before any track finished: nothing was recorded" in err
+    assert not out.exists()
 
 
 def test_output_folder_is_a_file(dataset, tmp_path):

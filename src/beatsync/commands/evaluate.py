@@ -95,6 +95,7 @@ def run_beats(args: argparse.Namespace) -> int:
     from .. import peers
     from ..cluster import check_cluster_options
     from ..errors import ParameterError
+    from ..evaluate.beats import EMPTY_REFERENCE_TEXT
     from ..study.beat_dataset import RESULT_FILES, evaluate_dataset, find_tracks
     from ..units import check_positive
     from ._common import check_output, feedback
@@ -112,6 +113,14 @@ def run_beats(args: argparse.Namespace) -> int:
     if out.is_dir():  # the files it will hold must be writable files
         for name in RESULT_FILES:
             check_output(out / name, option="--out")
+        foreign = [n for n in RESULT_FILES[1:] if (out / n).exists()]
+        if foreign and not (out / RESULT_FILES[0]).exists():
+            # results are rebuilt from tracks.jsonl: without it these are not ours
+            raise ParameterError(
+                f"--out {args.out!r} holds {' and '.join(foreign)} but no {RESULT_FILES[0]}: "
+                "files that evaluate beats did not write, which it would replace; choose "
+                "another folder, or remove them"
+            )
     peers.get(args.method)
     found = find_tracks(args.audio, args.annotations)
     if found.unmatched:
@@ -140,6 +149,7 @@ def run_beats(args: argparse.Namespace) -> int:
     failed = t[t["status"] != "ok"]
     warned = t["warning"].fillna("").astype(str) if "warning" in t else pd.Series("", t.index)
     outside = t[(t["status"] == "ok") & warned.str.contains(peers.OUT_OF_RANGE_TEXT)]
+    empty_ref = t[(t["status"] == "ok") & warned.str.contains(EMPTY_REFERENCE_TEXT)]
     result = {
         "method": args.method,
         "min_bpm": tempo.get("min_bpm"),
@@ -150,6 +160,7 @@ def run_beats(args: argparse.Namespace) -> int:
         "changed": run.changed,
         "failed": failed[["key", "error"]].to_dict("records"),
         "outside_range": outside["key"].tolist(),
+        "no_reference_beats": empty_ref["key"].tolist(),
         "unmatched": [str(p) for p in found.unmatched],
         "summary": run.summary.to_dict("records"),
         "files": {k: str(v) for k, v in run.files.items()},
@@ -162,6 +173,13 @@ def run_beats(args: argparse.Namespace) -> int:
     lines = [shown.to_string(index=False, float_format=lambda x: f"{x:.3f}"), ""]
     for _, row in failed.iterrows():
         lines.append(f"failed: {row['key']}: {row['error']}")
+    if len(empty_ref):
+        lines.append(
+            f"{len(empty_ref)} track(s) have no annotated beat after --min-beat-time "
+            f"{mbt:g} s and score 0 in the means: "
+            f"{', '.join(empty_ref['key'].astype(str).tolist()[:SHOWN])}"
+            + (" ..." if len(empty_ref) > SHOWN else "")
+        )
     if len(outside):
         lines.append(
             f"{len(outside)} track(s) tapped outside the tempo range given (only psf keeps "
@@ -188,10 +206,18 @@ def _interrupted(exc: KeyboardInterrupt, log: object, args: argparse.Namespace) 
     import signal
 
     signum = int(getattr(exc, "signum", signal.SIGINT))
-    msg = (
-        f"interrupted by {signal.Signals(signum).name}; the finished tracks are recorded in "
-        f"{str(log)!r}: run the same command again to score the others"
-    )
+    from pathlib import Path
+
+    if Path(str(log)).is_file():
+        msg = (
+            f"interrupted by {signal.Signals(signum).name}; the finished tracks are recorded "
+            f"in {str(log)!r}: run the same command again to score the others"
+        )
+    else:
+        msg = (
+            f"interrupted by {signal.Signals(signum).name} before any track finished: "
+            "nothing was recorded"
+        )
     if args.json:
         obj = {"error": msg, "kind": "interrupted", "command": "evaluate",
                "exit_code": 128 + signum}  # fmt: skip

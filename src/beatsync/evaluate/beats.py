@@ -31,6 +31,7 @@ from ..errors import BeatsyncWarning, ParameterError
 from ..units import MIN_BPM, check_positive, check_times
 
 __all__ = [
+    "EMPTY_REFERENCE_TEXT",
     "validate",
     "diagnose_times",
     "not_seconds_detail",
@@ -121,6 +122,10 @@ def diagnose_times(times: np.ndarray) -> str | None:
     if integers:
         return "sample indices"
     return "something slower than any beat (bars? a wrong unit?)"
+
+
+#: The start of the warning :func:`evaluate` gives when no reference beat is left to score.
+EMPTY_REFERENCE_TEXT = "the reference beats are empty"
 
 
 def validate(reference: Any, estimated: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -234,9 +239,9 @@ def evaluate(
     ref = mir_eval.beat.trim_beats(ref, min_beat_time=mbt)
     est = mir_eval.beat.trim_beats(est, min_beat_time=mbt)
     if ref.size == 0 or est.size == 0:
-        which = "reference" if ref.size == 0 else "estimated"
+        which = EMPTY_REFERENCE_TEXT if ref.size == 0 else "the estimated beats are empty"
         warnings.warn(
-            f"the {which} beats are empty after min_beat_time={mbt:g} s: every score is 0",
+            f"{which} after min_beat_time={mbt:g} s: every score is 0",
             BeatsyncWarning,
             stacklevel=2,
         )

@@ -40,6 +40,7 @@ from ..evaluate.beats import (
     not_seconds_detail,
     tempo_octave,
 )
+from ..units import MAX_BPM
 
 __all__ = [
     "Track",
@@ -163,8 +164,9 @@ def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
     Raises
     ------
     ParameterError
-        Unreadable, empty, unsorted, non-numeric (:func:`beatsync.io.read_beats`), or
-        values that look like frame indices or milliseconds (the message says which).
+        Unreadable, empty, unsorted, non-numeric (:func:`beatsync.io.read_beats`),
+        values that look like frame indices or milliseconds (the message says which),
+        or times closer than a beat at 400 BPM (minutes, or onsets).
     """
     times = io.read_beats(path)
     detail = not_seconds_detail(times)
@@ -172,6 +174,14 @@ def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
         raise ParameterError(
             f"annotation {str(path)!r} is not beat times in seconds: it ends at {detail}"
         )
+    if times.size >= 3:
+        step = float(np.median(np.diff(times)))
+        if step < 60.0 / MAX_BPM:
+            raise ParameterError(
+                f"annotation {str(path)!r} is not beat times in seconds: its times are a "
+                f"median {step:.4g} apart ({60.0 / step:.0f} BPM read as seconds, faster "
+                f"than any beat, over {MAX_BPM:g} BPM): minutes, or onsets rather than beats?"
+            )
     return times
 
 
@@ -242,6 +252,12 @@ def evaluate_track(
             warnings.simplefilter("ignore")
             warnings.simplefilter("always", BeatsyncWarning)
             y, sr = io.read_audio(audio)
+            if reference.size and reference[0] >= y.size / sr:
+                raise ParameterError(
+                    f"no annotated beat falls inside the audio: the first is at "
+                    f"{reference[0]:.3f} s and the audio ends at {y.size / sr:.3f} s; the "
+                    "annotation of another recording?"
+                )
             est = peers.track(method, y, sr, **tempo)
             seconds = time.perf_counter() - t0
             scores = evaluate(reference, est, min_beat_time=min_beat_time)
@@ -501,14 +517,23 @@ def evaluate_dataset(
     todo = [t for t in tracks if t.key not in done]
     if method == "librosa" and tempo:
         _check_librosa_rates(todo, tempo)
-    with contextlib.ExitStack() as stack:
-        if todo:  # connect first: an unreachable scheduler changes nothing on disk
-            client = stack.enter_context(
-                dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes)
-            )
-        out.mkdir(exist_ok=True)
-        if todo:
-            _run(client, todo, refs, log, method=method, mbt=mbt, tempo=tempo, progress=progress)
+    created = not out.exists()
+    try:
+        with contextlib.ExitStack() as stack:
+            if todo:  # connect first: an unreachable scheduler changes nothing on disk
+                client = stack.enter_context(
+                    dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes)
+                )
+            out.mkdir(exist_ok=True)
+            if todo:
+                _run(
+                    client, todo, refs, log, method=method, mbt=mbt, tempo=tempo,
+                    progress=progress,
+                )  # fmt: skip
+    except BaseException:
+        if created and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()  # interrupted before any track finished: no empty folder left
+        raise
     if force and previous:
         # appended, not replaced up front: an interrupted --force keeps the earlier rows
         # of the tracks it did not reach, and tracks outside this run keep theirs unless
