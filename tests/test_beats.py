@@ -372,6 +372,18 @@ def test_short_noise_warns_no_clear_pulse(seconds):
     assert short == (seconds < 8)
 
 
+def test_noise_whose_ratio_passes_warns_by_its_low_salience():
+    # a 2 s white noise (seed 5 of the calibration, benchmarks/calibrate_pulse_clarity.py)
+    # whose path salience is 3.32 times its null, above MIN_PULSE_CLARITY: it warns by
+    # its salience (0.054, below MIN_PATH_SALIENCE)
+    x = np.random.default_rng(5).standard_normal(2 * SR)
+    y = (0.5 * x / np.abs(x).max()).astype(np.float32)
+    with pytest.warns(
+        BeatsyncWarning, match=r"no clear pulse in the audio \(pulse clarity 0\.05: below 0\.08\)"
+    ):
+        track_beats(y, SR)
+
+
 def test_pulse_clarity_null_is_reproducible_and_low_on_clicks():
     from beatsync.beats.metrical import METER_MODEL
     from beatsync.beats.onset import compute_onsets, frontend_settings

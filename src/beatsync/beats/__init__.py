@@ -30,6 +30,7 @@ from .onset import FRONTEND_DEFAULTS, FrontEnd, OnsetSignal, onset_strength_psf,
 from .tracker import (
     MAX_SANE_BPM,
     MIN_DURATION_S,
+    MIN_PATH_SALIENCE,
     MIN_PULSE_CLARITY,
     MIN_SANE_BPM,
     SILENCE_PEAK,
@@ -58,5 +59,6 @@ __all__ = [
     "MAX_SANE_BPM",
     "MIN_DURATION_S",
     "SILENCE_PEAK",
+    "MIN_PATH_SALIENCE",
     "MIN_PULSE_CLARITY",
 ]

@@ -33,6 +33,15 @@ bands).
 The paper's comb filters run on integer lags sample by sample; we take their
 steady-state energy per 8-s window.
 
+The spectrum of each window is zero-padded so that every resonator pass band (about
+0.074 Hz wide) spans :data:`BINS_PER_PASS_BAND` bins (:func:`resonator_fft_size`).
+Before, padded only to a power of two (0.084 Hz bins for 8 s windows), the salience
+was jagged over the period grid; every measurement below that does not say otherwise
+was made with that coarser sampling, and the fine sampling changed the synthetic set
+little (it fixed the 180 BPM click track with drift on every seed) while it lifted
+the short clips of the real recordings and put the madmom sample at its level (see
+below and ``benchmarks/RESULTS.md``).
+
 Known limit of the per-window evaluation (measured, not yet fixed): the Hann-windowed
 8-s segment smears each spectral line over more than a resonator's pass band, so a
 perfectly periodic pattern gets a salience that falls with the period (per band about
@@ -160,15 +169,13 @@ warns of no clear pulse. The peers do not settle those windows either: on 30 s c
 101); on 200-230 s essentia gives 86 and ours alone 121 (a scratch check, median beat
 intervals).
 
-The madmom sample (2.8 s, 88 BPM, 4 annotated beats) is tapped at 120 BPM. Its
-strongest accents include a sequence every 0.5 s (0.62, 1.13, 1.61, 2.15 and 2.61 s,
-a pulse of three sixteenths in a syncopated pattern), and in a single 2.8 s window the
-salience at 88 BPM is below the noise level (``s`` = -0.03 against 0.14 at 120 BPM).
-Correcting the extra window bias of a clip shorter than the tempo window (scaling
-``s`` by the salience a periodic accent train gets in an 8 s window over that in the
-clip's) would multiply both by 3-4 and cannot lift a negative salience; not used.
-Given a tempo range around its tempo (75-101 BPM), ours and librosa tap its beats (F
-0.40 and 0.44 to 1.0), essentia's two trackers most of them (0.55 to 0.86).
+The madmom sample (2.8 s, 88 BPM, 4 annotated beats) was tapped at 120 BPM, a pulse of
+three sixteenths, until the resonators' spectrum was sampled finely enough
+(:func:`resonator_fft_size`): with 0.34 Hz bins for a 2.8 s clip (n_fft 512 at 172
+frames/s) its salience at 88 BPM came out below the noise level (``s`` = -0.03 against
+0.14 at 120 BPM), which no correction of the window bias could lift. It is now tapped
+at 87.9 BPM (F 1.0) told nothing; neither librosa nor essentia's two trackers tap it at
+its level (117 and 175 BPM).
 
 The meter of the synthetic 3/4 pattern at 60-90 BPM is found as 1 or 2 beats (the
 measure term sees the bar through the same window bias). A beat-synchronous meter

@@ -7,10 +7,10 @@ The no-clear-pulse warning compares the resonator salience along the decoded tem
 path with a null: the same band onsets in random (seeded) order, observed and decoded
 the same way (:func:`pulse_clarity_null`). The null carries the audio's onset
 density, window lengths and the decoder's selection bias, so one ratio threshold
-serves 2 s clips and whole songs; a fixed salience threshold could not (a 5 s noise
-reaches the salience of a 30 s real song). Its two constants
-(:data:`MIN_PULSE_CLARITY`, :data:`CLEAR_PULSE`) were set on noises and the bundled
-real recordings (numbers beside them).
+serves 2 s clips and whole songs; a fixed salience threshold alone could not (a 5 s
+noise reaches the salience of the quietest real song). Its constants
+(:data:`MIN_PULSE_CLARITY`, :data:`MIN_PATH_SALIENCE`, :data:`CLEAR_PULSE`) were set on
+noises and the bundled real recordings (numbers beside them).
 """
 
 from __future__ import annotations
@@ -58,6 +58,7 @@ __all__ = [
     "check_duration",
     "MIN_DURATION_S",
     "MIN_PULSE_CLARITY",
+    "MIN_PATH_SALIENCE",
     "CLEAR_PULSE",
     "pulse_clarity_null",
 ]
@@ -77,15 +78,23 @@ MIN_DURATION_S = 1.5
 #: (:func:`beatsync.beats.metrical.resonator_salience`) along the decoded tempo path.
 #: Unless it reaches :data:`CLEAR_PULSE`, it is compared with the same measure on the
 #: audio's own onsets in random order (:func:`pulse_clarity_null`, the null); below
-#: ``MIN_PULSE_CLARITY`` times the null a warning says the beats may be meaningless.
-#: Calibrated on 84 noises (white, 10 seeds, and brown, 2 seeds, at 2, 3, 5, 7, 10, 15
-#: and 30 s: ratios 0.36-1.97) and the seven bundled real recordings (Hainsworth 001,
-#: the Ballroom waltz, the madmom sample and the four Dance-with-Melody songs: ratios
-#: 3.22-12.5, the lowest the waltz DANCE_W_10); 2.5 is about their geometric middle.
-#: The synthetic set (path salience above 0.9) and the madmom sample (0.79) need no null.
-MIN_PULSE_CLARITY = 2.5
-#: Path salience above which the pulse is clear without the null (noises of 2 s
-#: reached 0.61, of 3-30 s at most 0.48).
+#: ``MIN_PULSE_CLARITY`` times the null, or below :data:`MIN_PATH_SALIENCE`, a warning
+#: says the beats may be meaningless. Calibrated on 84 noises (white, 10 seeds, and
+#: brown, 2 seeds, at 2, 3, 5, 7, 10, 15 and 30 s) and the seven bundled real recordings
+#: (Hainsworth 001, the Ballroom waltz, the madmom sample and the four Dance-with-Melody
+#: songs; ``benchmarks/calibrate_pulse_clarity.py``). Since the resonators' spectrum is
+#: sampled at 3 bins per pass band
+#: (:func:`beatsync.beats.metrical.resonator_fft_size`): noises 0.00-2.53, but one 2 s
+#: white noise 3.32; real recordings 3.33 (the madmom sample) to 22.4; 2.9 is the
+#: geometric middle of 2.53 and 3.33. (With the coarser sampling before: noises
+#: 0.36-1.97, real 3.22-12.5, threshold 2.5.)
+MIN_PULSE_CLARITY = 2.9
+#: Path salience below which the pulse is unclear whatever the null says: the noises'
+#: that pass the ratio (one 2 s white noise) is 0.054, the real recordings' 0.11
+#: (DANCE_W_10) to 0.67; 0.08 is about their geometric middle.
+MIN_PATH_SALIENCE = 0.08
+#: Path salience above which the pulse is clear without the null (noises reached 0.13,
+#: real recordings 0.11-0.67; with the coarser sampling before, noises of 2 s 0.61).
 CLEAR_PULSE = 0.7
 #: Seconds of shuffled onsets the null is averaged over, and the most draws.
 NULL_AUDIO_S = 15.0
@@ -272,7 +281,8 @@ def track_beats(
         :mod:`beatsync.beats.onset`.) If the pulse
         is unclear (e.g. noise: the salience along the tempo path is less than
         ``MIN_PULSE_CLARITY`` times that of the same onsets in random order, see
-        :func:`pulse_clarity_null`): returns the beats found, and names the way out
+        :func:`pulse_clarity_null`, or below ``MIN_PATH_SALIENCE``): returns the
+        beats found, and names the way out
         (a known ``bpm``, with which only the phase is tracked).
 
     Examples
@@ -446,21 +456,25 @@ def _warn_if_no_clear_pulse(
     if clarity >= CLEAR_PULSE:
         return
     null = pulse_clarity_null(ons, starts, stops, periods, model, max_hz)
-    if clarity < MIN_PULSE_CLARITY * null:
+    if clarity < MIN_PULSE_CLARITY * null or clarity < MIN_PATH_SALIENCE:
         why = "noise, free rhythm or too short?"
         if duration < tempo_win_s:
-            # measured on clips of the two annotated real recordings: their median
-            # ratio to the null was 1.2-1.6 at 3-5 s, inside the 0.46-1.65 of white and
-            # brown noise of those lengths, and 3.5-4.2 at 7 s (the short-clip table of
-            # benchmarks/bench_beats.py counts the warnings)
+            # clips shorter than the tempo window warn more often than whole songs
+            # (the short-clip table of benchmarks/bench_beats.py counts the warnings)
             why = (
                 f"the audio is only {duration:.2f} s long, shorter than the {tempo_win_s:g} s "
                 "tempo window: give a longer excerpt if you can (or it is noise or free "
                 "rhythm);"
             )
         warnings.warn(
-            f"no clear pulse in the audio (pulse clarity {clarity:.2f}, less than "
-            f"{MIN_PULSE_CLARITY} times the {null:.2f} of the same onsets in random order): "
+            f"no clear pulse in the audio (pulse clarity {clarity:.2f}: "
+            + (
+                f"less than {MIN_PULSE_CLARITY} times the {null:.2f} of the same onsets in "
+                "random order"
+                if clarity < MIN_PULSE_CLARITY * null
+                else f"below {MIN_PATH_SALIENCE}"
+            )
+            + f"): "
             f"{why} the beats may be meaningless or at another metrical level; if you "
             "know the tempo, give it with bpm= (--bpm) and only the phase is tracked",
             BeatsyncWarning,
