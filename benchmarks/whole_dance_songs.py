@@ -13,11 +13,14 @@ Usage::
     .venv/bin/python benchmarks/whole_dance_songs.py [--shared ../shared/data]
 
 Not part of ``run_all.py``: a clone without the shared folder cannot run it. On
-2026-11-28: the cha-cha and the rumba keep the excerpt's tempo in every window (199
-and 238 windows); the waltzes DANCE_W_5 and DANCE_W_10 in 189 of 197 and 147 of 239
-windows, none at 4/3 of it (the other 92 of DANCE_W_10 at 95-106 BPM; it warns of no
-clear pulse). With a beat of three tatums weighed as one of two or four (before
-``MeterModel.tatum_ratio_weights``): 93 and 56 windows, with 51 and 129 at 4/3.
+2026-11-29, with the resonators' spectrum sampled at 3 bins per pass band
+(``metrical.resonator_fft_size``): the cha-cha and the rumba keep the excerpt's tempo
+in every window (199 and 238 windows); the waltzes DANCE_W_5 and DANCE_W_10 in 175 of
+197 and 187 of 239 windows (DANCE_W_5's other 22 at 91-95 BPM; DANCE_W_10's 16 at 4/3
+of it and 36 at 94-107 BPM); both warn of no clear pulse. On 2026-11-28, with the
+coarser sampling: 189 of 197 and 147 of 239, none at 4/3 (DANCE_W_10's other 92 at
+95-106 BPM; only it warned). With a beat of three tatums weighed as one of two or four
+(before ``MeterModel.tatum_ratio_weights``): 93 and 56 windows, with 51 and 129 at 4/3.
 """
 
 from __future__ import annotations

@@ -331,7 +331,7 @@ def test_808_loop_tempo():
     "sidelobes interfere with a phase that turns by 2f per second; seen at the frame rate "
     "(172 Hz) that ripple has the alias frequency of 880 Hz, about 18.6 Hz, and the phase "
     "slope crosses zero about 37 times a second. That onset train is periodic, so its "
-    "sub-harmonics resonate as a clear pulse: 5 beats in 3 s, 24 in 10 s, and no warning "
+    "sub-harmonics resonate as a clear pulse: 5 beats in 3 s, 27 in 10 s, and no warning "
     "(the gates measured against it: beatsync.beats.onset)",
 )
 @pytest.mark.parametrize("seconds, fade_s", [(3, 1.5), (10, 0.01)])
