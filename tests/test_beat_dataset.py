@@ -43,8 +43,24 @@ def test_pairing_prefers_same_relative_path_then_unique_stem(tmp_path):
         "g2/z": ("g2", "z.beats"),  # flat annotations: the only z.beats
         "w": (".", "w.beats"),
     }
-    # no annotation; and w.wav beside w.flac: one key, the second file is listed
-    assert sorted(p.name for p in found.unmatched) == ["lonely.wav", "w.wav"]
+    # no annotation; and w.wav beside w.flac: one key, the second file is listed apart
+    assert [p.name for p in found.unmatched] == ["lonely.wav"]
+    assert [p.name for p in found.duplicates] == ["w.wav"]
+    assert found.shared == {}
+
+
+def test_one_flat_annotation_is_not_shared_by_two_recordings(tmp_path):
+    # a/x.wav and b/x.wav were both scored against the flat x.beats (F 0.16 for the one
+    # it did not belong to, without a word)
+    a, b = tmp_path / "audio", tmp_path / "notes"
+    for rel in ("a/x.wav", "b/x.wav", "a/y.wav"):
+        _touch_audio(a / rel)
+    b.mkdir()
+    for name in ("x.beats", "y.beats"):
+        (b / name).write_text("0.5\n1.0\n")
+    found = find_tracks(a, b)
+    assert [t.key for t in found.tracks] == ["a/y"]
+    assert found.shared == {b / "x.beats": [a / "a" / "x.wav", a / "b" / "x.wav"]}
 
 
 def test_ambiguous_stem_is_unmatched(tmp_path):

@@ -321,6 +321,27 @@ def test_annotation_not_in_seconds(dataset, tmp_path, scale, decimals, match):
     assert not (tmp_path / "results").exists()  # refused before anything is written
 
 
+def test_an_annotation_shared_by_name_is_not_used(dataset, scheduler, tmp_path, capsys):
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    for sub in ("a", "b"):
+        (audio / sub).mkdir(parents=True)
+        shutil.copy(dataset[0] / "rock" / "drums_96.wav", audio / sub / "drums_96.wav")
+    shutil.copy(dataset[0] / "rock" / "drums_132.wav", audio / "a")
+    shutil.copy(dataset[0] / "rock" / "drums_132.wav", audio / "a" / "drums_132.flac")
+    notes.mkdir()
+    for name in ("drums_96", "drums_132"):
+        shutil.copy(dataset[1] / f"{name}.beats", notes)
+    argv = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    argv += ["--out", str(tmp_path / "r"), "--scheduler", scheduler, "--json"]
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    res = json.loads(stdout)
+    assert res["tracks"] == 1 and res["duplicates"] == [str(audio / "a" / "drums_132.wav")]
+    assert list(res["shared_annotations"]) == [str(notes / "drums_96.beats")]
+    assert "is the only one of its name, and 2 audio files would use it" in err
+    assert "another file of the same name with another suffix is scored instead" in err
+
+
 def test_results_files_of_someone_else_are_not_replaced(dataset, tmp_path):
     out = tmp_path / "results"
     out.mkdir()

@@ -130,6 +130,21 @@ def run_beats(args: argparse.Namespace) -> int:
             f"{len(names)} audio file(s) without an annotation (NAME.beats) are skipped: "
             f"{', '.join(names[:SHOWN])}{more}"
         )
+    for note, users in list(found.shared.items())[:SHOWN]:
+        fb.warn(
+            f"annotation {str(note)!r} is the only one of its name, and {len(users)} audio "
+            f"files would use it ({', '.join(str(p) for p in users[:SHOWN])}): they are "
+            "skipped; put each annotation at its audio file's relative path"
+        )
+    if len(found.shared) > SHOWN:
+        fb.warn(f"... and {len(found.shared) - SHOWN} more annotations shared by name")
+    if found.duplicates:
+        names = [str(p) for p in found.duplicates]
+        more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
+        fb.warn(
+            f"{len(names)} audio file(s) skipped: another file of the same name with "
+            f"another suffix is scored instead: {', '.join(names[:SHOWN])}{more}"
+        )
     try:
         with fb.step(f"evaluate {args.method}") as progress:
             run = evaluate_dataset(
@@ -162,6 +177,8 @@ def run_beats(args: argparse.Namespace) -> int:
         "outside_range": outside["key"].tolist(),
         "no_reference_beats": empty_ref["key"].tolist(),
         "unmatched": [str(p) for p in found.unmatched],
+        "shared_annotations": {str(k): [str(p) for p in v] for k, v in found.shared.items()},
+        "duplicates": [str(p) for p in found.duplicates],
         "summary": run.summary.to_dict("records"),
         "files": {k: str(v) for k, v in run.files.items()},
     }

@@ -85,10 +85,26 @@ class Track:
 
 @dataclass(frozen=True)
 class TrackList:
-    """Output of :func:`find_tracks`: the pairs, and the audio files left without one."""
+    """Output of :func:`find_tracks`: the pairs, and the audio files left without one.
+
+    Attributes
+    ----------
+    tracks : list of Track
+    unmatched : list of Path
+        Audio files with no annotation of their name.
+    shared : dict of Path -> list of Path
+        Annotations found by name only (a flat folder) that more than one audio file
+        would use (``a/x.wav`` and ``b/x.wav`` for ``x.beats``): those audio files are
+        skipped, as the annotation fits one recording at most.
+    duplicates : list of Path
+        Audio files skipped because a file of the same path and name with another
+        suffix was taken (``x.wav`` beside ``x.flac``: the first in sorted order).
+    """
 
     tracks: list[Track]
     unmatched: list[Path] = field(default_factory=list)
+    shared: dict[Path, list[Path]] = field(default_factory=dict)
+    duplicates: list[Path] = field(default_factory=list)
 
 
 def _folder(path: str | os.PathLike[str], what: str) -> Path:
@@ -114,7 +130,8 @@ def find_tracks(
     ------
     ParameterError
         A folder that is missing or a file; no audio file; no annotation file; no
-        audio file with an annotation.
+        audio file with an annotation (of its own: one that several audio files would
+        share by name does not count, see :class:`TrackList`).
     """
     a_dir = _folder(audio_dir, "audio")
     b_dir = _folder(annotation_dir, "annotation")
@@ -135,27 +152,36 @@ def find_tracks(
     by_stem: dict[str, list[Path]] = {}
     for p in notes:
         by_stem.setdefault(p.stem, []).append(p)
-    tracks, unmatched = [], []
+    tracks, unmatched, duplicates = [], [], []
+    by_name: dict[Path, list[Path]] = {}  # annotations found by name only, and their users
     seen: set[str] = set()
     for p in audio:
         rel = p.relative_to(a_dir)
         key = rel.with_suffix("").as_posix()
+        if key in seen:  # x.wav beside x.flac
+            duplicates.append(p)
+            continue
         note = by_rel.get(key)
         if note is None and len(by_stem.get(p.stem, [])) == 1:
             note = by_stem[p.stem][0]
-        if note is None or key in seen:  # no annotation, or x.wav beside x.flac
+            by_name.setdefault(note, []).append(p)
+        if note is None:
             unmatched.append(p)
             continue
         seen.add(key)
         group = rel.parent.as_posix()
         tracks.append(Track(key, group, p, note))
+    shared = {note: users for note, users in by_name.items() if len(users) > 1}
+    if shared:
+        taken = {p for users in shared.values() for p in users}
+        tracks = [t for t in tracks if t.audio not in taken]
     if not tracks:
         raise ParameterError(
             f"none of the {len(audio)} audio files under {str(a_dir)!r} has an annotation "
             f"of the same name ({ANNOTATION_SUFFIX}) under {str(b_dir)!r}, e.g. "
             f"{audio[0].stem}{ANNOTATION_SUFFIX}"
         )
-    return TrackList(tracks, unmatched)
+    return TrackList(tracks, unmatched, shared, duplicates)
 
 
 def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
