@@ -388,14 +388,18 @@ def track(
     ------
     ParameterError
         Unknown or unavailable method (:func:`get`); a tempo range the method does not
-        accept; empty, silent or non-finite audio or ``sr <= 0`` (checked here for
-        every method, as ours does).
+        accept; empty, silent, constant or non-finite audio, ``sr <= 0``, or audio
+        shorter than 1.5 s (:func:`beatsync.beats.tracker.check_duration`; librosa
+        returned one beat for 0.5 s, essentia's none): checked here for every method,
+        as ours does.
     """
     from .beats import check_audio
+    from .beats.tracker import check_duration
 
     peer = get(name)
     tempo = check_tempo_range(name, min_bpm, max_bpm)
     y, sr = check_audio(y, sr)
+    check_duration(y.size, sr)
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=FutureWarning)
         beats = peer.track(y, sr, **tempo)

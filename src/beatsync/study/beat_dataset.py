@@ -1,8 +1,9 @@
 """Beat trackers run and scored over a dataset of audio files, on Dask.
 
-``beatsync evaluate beats`` calls this module. :func:`find_tracks` pairs every audio
-file with the annotation of the same stem (``.beats``: one time [s] per line, an
-optional second column such as the beat in the bar is ignored);
+``beatsync evaluate beats`` calls this module. :func:`find_tracks`
+(:mod:`beatsync.study.beat_tracks`, re-exported here) pairs every audio file with the
+annotation of the same stem (``.beats``: one time [s] per line, an optional second
+column such as the beat in the bar is ignored);
 :func:`evaluate_dataset` tracks and scores every pair on Dask
 (:func:`beatsync.cluster.dask_client`) and records one row per track as soon as it
 finishes in ``OUT/tracks.jsonl`` (append-only: a crash or Ctrl-C loses at most the
@@ -23,7 +24,7 @@ import time
 import uuid
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -37,10 +38,9 @@ from ..evaluate.beats import (
     count_octave_errors,
     count_other_tempo,
     evaluate,
-    not_seconds_detail,
     tempo_octave,
 )
-from ..units import MAX_BPM
+from .beat_tracks import ANNOTATION_SUFFIX, Track, TrackList, find_tracks, read_annotation
 
 __all__ = [
     "Track",
@@ -59,156 +59,6 @@ __all__ = [
 
 #: Files a run writes in its output folder.
 RESULT_FILES = ("tracks.jsonl", "tracks.csv", "summary.csv")
-
-#: Suffix of beat annotation files: one time [s] per line, optionally a second column.
-ANNOTATION_SUFFIX = ".beats"
-
-
-@dataclass(frozen=True)
-class Track:
-    """One audio file and its annotation.
-
-    Attributes
-    ----------
-    key : str
-        The audio file's path relative to the audio folder, without suffix (POSIX).
-    group : str
-        Its folder relative to the audio folder (``"."`` at the top).
-    audio, annotation : Path
-    """
-
-    key: str
-    group: str
-    audio: Path
-    annotation: Path
-
-
-@dataclass(frozen=True)
-class TrackList:
-    """Output of :func:`find_tracks`: the pairs, and the audio files left without one.
-
-    Attributes
-    ----------
-    tracks : list of Track
-    unmatched : list of Path
-        Audio files with no annotation of their name.
-    shared : dict of Path -> list of Path
-        Annotations found by name only (a flat folder) that more than one audio file
-        would use (``a/x.wav`` and ``b/x.wav`` for ``x.beats``): those audio files are
-        skipped, as the annotation fits one recording at most.
-    duplicates : list of Path
-        Audio files skipped because a file of the same path and name with another
-        suffix was taken (``x.wav`` beside ``x.flac``: the first in sorted order).
-    """
-
-    tracks: list[Track]
-    unmatched: list[Path] = field(default_factory=list)
-    shared: dict[Path, list[Path]] = field(default_factory=dict)
-    duplicates: list[Path] = field(default_factory=list)
-
-
-def _folder(path: str | os.PathLike[str], what: str) -> Path:
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"{what} folder {str(p)!r} does not exist")
-    if not p.is_dir():
-        raise ParameterError(f"{what} folder {str(p)!r} is a file, not a folder")
-    return p
-
-
-def find_tracks(
-    audio_dir: str | os.PathLike[str], annotation_dir: str | os.PathLike[str]
-) -> TrackList:
-    """Pair every audio file under ``audio_dir`` with the ``.beats`` file of its stem.
-
-    The annotation at the same relative path is preferred (``a/x.wav`` ->
-    ``a/x.beats``); otherwise the only ``x.beats`` anywhere under ``annotation_dir``
-    (flat annotation folders, as in most datasets). Audio files are those with a
-    suffix in :data:`beatsync.io.AUDIO_SUFFIXES`, searched recursively.
-
-    Raises
-    ------
-    ParameterError
-        A folder that is missing or a file; no audio file; no annotation file; no
-        audio file with an annotation (of its own: one that several audio files would
-        share by name does not count, see :class:`TrackList`).
-    """
-    a_dir = _folder(audio_dir, "audio")
-    b_dir = _folder(annotation_dir, "annotation")
-    audio = sorted(
-        p for p in a_dir.rglob("*") if p.suffix.lower() in io.AUDIO_SUFFIXES and p.is_file()
-    )
-    if not audio:
-        raise ParameterError(
-            f"audio folder {str(a_dir)!r} holds no audio file ({', '.join(io.AUDIO_SUFFIXES)})"
-        )
-    notes = sorted(p for p in b_dir.rglob(f"*{ANNOTATION_SUFFIX}") if p.is_file())
-    if not notes:
-        raise ParameterError(
-            f"annotation folder {str(b_dir)!r} holds no {ANNOTATION_SUFFIX} file "
-            "(one beat time [s] per line)"
-        )
-    by_rel = {p.relative_to(b_dir).with_suffix("").as_posix(): p for p in notes}
-    by_stem: dict[str, list[Path]] = {}
-    for p in notes:
-        by_stem.setdefault(p.stem, []).append(p)
-    tracks, unmatched, duplicates = [], [], []
-    by_name: dict[Path, list[Path]] = {}  # annotations found by name only, and their users
-    seen: set[str] = set()
-    for p in audio:
-        rel = p.relative_to(a_dir)
-        key = rel.with_suffix("").as_posix()
-        if key in seen:  # x.wav beside x.flac
-            duplicates.append(p)
-            continue
-        note = by_rel.get(key)
-        if note is None and len(by_stem.get(p.stem, [])) == 1:
-            note = by_stem[p.stem][0]
-            by_name.setdefault(note, []).append(p)
-        if note is None:
-            unmatched.append(p)
-            continue
-        seen.add(key)
-        group = rel.parent.as_posix()
-        tracks.append(Track(key, group, p, note))
-    shared = {note: users for note, users in by_name.items() if len(users) > 1}
-    if shared:
-        taken = {p for users in shared.values() for p in users}
-        tracks = [t for t in tracks if t.audio not in taken]
-    if not tracks:
-        raise ParameterError(
-            f"none of the {len(audio)} audio files under {str(a_dir)!r} has an annotation "
-            f"of the same name ({ANNOTATION_SUFFIX}) under {str(b_dir)!r}, e.g. "
-            f"{audio[0].stem}{ANNOTATION_SUFFIX}"
-        )
-    return TrackList(tracks, unmatched, shared, duplicates)
-
-
-def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
-    """Beat times [s] of an annotation file, refused if they are not seconds.
-
-    Raises
-    ------
-    ParameterError
-        Unreadable, empty, unsorted, non-numeric (:func:`beatsync.io.read_beats`),
-        values that look like frame indices or milliseconds (the message says which),
-        or times closer than a beat at 400 BPM (minutes, or onsets).
-    """
-    times = io.read_beats(path)
-    detail = not_seconds_detail(times)
-    if detail is not None:
-        raise ParameterError(
-            f"annotation {str(path)!r} is not beat times in seconds: it ends at {detail}"
-        )
-    if times.size >= 3:
-        step = float(np.median(np.diff(times)))
-        if step < 60.0 / MAX_BPM:
-            raise ParameterError(
-                f"annotation {str(path)!r} is not beat times in seconds: its times are a "
-                f"median {step:.4g} apart ({60.0 / step:.0f} BPM read as seconds, faster "
-                f"than any beat, over {MAX_BPM:g} BPM): minutes, or onsets rather than beats?"
-            )
-    return times
 
 
 def evaluate_track(
