@@ -377,6 +377,29 @@ def test_annotation_of_another_recording_and_empty_references(dataset, scheduler
     assert "1 track(s) have no annotated beat after --min-beat-time 7.9 s" in stdout
 
 
+def test_a_swallowed_interrupt_stops_the_run_at_the_next_track(
+    dataset, scheduler, tmp_path, capsys, monkeypatch
+):
+    # SIGINT's exception, raised inside a garbage-collector callback, was swallowed
+    # ("Exception ignored in ... Interrupted: 2") and the run went on to the end
+    import signal
+
+    from beatsync.commands import _common
+
+    real_append = TrackLog.append
+
+    def append_then_swallowed_signal(self, row):
+        real_append(self, row)
+        _common._RECEIVED.append(signal.SIGINT)  # received, its exception lost
+
+    monkeypatch.setattr(TrackLog, "append", append_then_swallowed_signal)
+    out = tmp_path / "results"
+    code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
+    assert code == 130, err
+    assert "interrupted by SIGINT" in err
+    assert len(TrackLog(out / "tracks.jsonl").rows()) == 1
+
+
 def test_interrupt_before_any_track_finished_says_so(dataset, scheduler, tmp_path, capsys,
                                                       monkeypatch):  # fmt: skip
     def interrupt(*args, **kwargs):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import Any
 
 from ._common import add_output_flags, emit
 
@@ -98,7 +99,7 @@ def run_beats(args: argparse.Namespace) -> int:
     from ..evaluate.beats import EMPTY_REFERENCE_TEXT
     from ..study.beat_dataset import RESULT_FILES, evaluate_dataset, find_tracks
     from ..units import check_positive
-    from ._common import check_output, feedback
+    from ._common import Interrupted, check_output, feedback, interrupted_by
 
     fb = feedback(args)
     # cheapest first: options, then the output folder, then the inputs
@@ -146,7 +147,17 @@ def run_beats(args: argparse.Namespace) -> int:
             f"another suffix is scored instead: {', '.join(names[:SHOWN])}{more}"
         )
     try:
-        with fb.step(f"evaluate {args.method}") as progress:
+        with fb.step(f"evaluate {args.method}") as bar:
+
+            def progress(*a: Any, **k: Any) -> None:
+                # a signal whose exception a garbage-collector callback swallowed ("Exception
+                # ignored in ... Interrupted") let the run go on to the end: stop at the next
+                # finished track
+                signum = interrupted_by()
+                if signum is not None:
+                    raise Interrupted(signum)
+                bar(*a, **k)
+
             run = evaluate_dataset(
                 found.tracks,
                 out,
