@@ -61,6 +61,16 @@ def test_one_flat_annotation_is_not_shared_by_two_recordings(tmp_path):
     found = find_tracks(a, b)
     assert [t.key for t in found.tracks] == ["a/y"]
     assert found.shared == {b / "x.beats": [a / "a" / "x.wav", a / "b" / "x.wav"]}
+    # the one x.beats sits at a/x's relative path: a/x keeps it, b/x may not borrow it
+    (b / "x.beats").unlink()
+    (b / "a").mkdir()
+    (b / "a" / "x.beats").write_text("0.5\n1.0\n")
+    found = find_tracks(a, b)
+    assert [(t.key, t.annotation) for t in found.tracks] == [
+        ("a/x", b / "a" / "x.beats"),
+        ("a/y", b / "y.beats"),
+    ]
+    assert found.shared == {b / "a" / "x.beats": [a / "b" / "x.wav"]}
 
 
 def test_ambiguous_stem_is_unmatched(tmp_path):

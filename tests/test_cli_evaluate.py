@@ -153,6 +153,21 @@ def test_resume_reruns_a_track_whose_audio_or_annotation_changed(
     assert "2 scored before and run again" not in stdout and "4 already scored" in stdout
 
 
+def test_resume_through_another_path_to_the_same_files(
+    dataset, scheduler, tmp_path, capsys, monkeypatch
+):
+    # the folder given relative, then absolute: every track was re-run as "changed"
+    ds = _copy_dataset(dataset, tmp_path)
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "results"
+    where = ["--scheduler", scheduler, "--json"]
+    relative = (ds[0].relative_to(tmp_path), ds[1].relative_to(tmp_path))
+    assert _run(_argv(relative, out, *where), capsys)[0] == 0
+    code, stdout, err = _run(_argv(ds, out, *where), capsys)
+    res = json.loads(stdout)
+    assert (res["changed"], res["skipped"]) == (0, 4), err
+
+
 def test_force_on_some_tracks_keeps_the_others(dataset, scheduler, tmp_path, capsys):
     # --force dropped every row of the method, also of tracks outside the run
     ds = _copy_dataset(dataset, tmp_path)
@@ -338,7 +353,7 @@ def test_an_annotation_shared_by_name_is_not_used(dataset, scheduler, tmp_path, 
     res = json.loads(stdout)
     assert res["tracks"] == 1 and res["duplicates"] == [str(audio / "a" / "drums_132.wav")]
     assert list(res["shared_annotations"]) == [str(notes / "drums_96.beats")]
-    assert "is the only one of its name, and 2 audio files would use it" in err
+    assert "would serve more than one recording (found by name only for" in err
     assert "another file of the same name with another suffix is scored instead" in err
 
 

@@ -122,9 +122,10 @@ def test_output_that_is_a_folder_is_refused(case, inputs, tmp_path, capsys):
     assert _listing(tmp_path) == before
 
 
+@pytest.mark.parametrize("ending", ["/", "/."])
 @pytest.mark.parametrize("exists", [False, True])
 @pytest.mark.parametrize("case", sorted(OUTPUT_OPTIONS))
-def test_output_ending_in_a_slash_is_refused(case, exists, inputs, tmp_path, capsys):
+def test_output_ending_in_a_slash_is_refused(case, exists, ending, inputs, tmp_path, capsys):
     # "out/" names a folder; Path() dropped the slash and wrote (or replaced) a file "out"
     template, option = OUTPUT_OPTIONS[case]
     assert template[-1].startswith("{out}")
@@ -136,7 +137,7 @@ def test_output_ending_in_a_slash_is_refused(case, exists, inputs, tmp_path, cap
         victim.write_text("keep me\n")
     before = _listing(tmp_path)
     argv = _argv(template, inputs, target, outdir)
-    argv[-1] += "/"
+    argv[-1] += ending
     code, _, err = _run(argv, capsys)
     _assert_refused(code, err, "which names a folder", option)
     assert _listing(tmp_path) == before

@@ -22,6 +22,8 @@ from beatsync.errors import ParameterError
         # a typo such as 10**12 started workers until the command hung
         (10**12, r"more worker processes than a local cluster here can start \(at most"),
         ("99999999999999999999999", "more worker processes"),
+        (10**400, "more worker processes"),  # too large for a float: an internal error
+        (float("nan"), "whole number of workers"),
     ],
 )
 def test_bad_worker_counts(n, match):

@@ -254,12 +254,15 @@ def test_a_file_cut_short_is_refused_naming_both_lengths(tmp_path, fmt, suffix):
         io.read_audio(cut)
 
 
-def test_a_streamed_wav_with_no_data_size_is_read(tmp_path):
-    # writers that cannot seek leave the data size at 0xFFFFFFFF: not a truncation
-    path = io.write_audio(tmp_path / "s.wav", np.zeros(4410, np.float32) + 0.1, 22050)
+@pytest.mark.parametrize("placeholder", [b"\xff\xff\xff\xff", b"\x00\xf0\xff\x7f"])
+def test_a_streamed_wav_with_no_data_size_is_read(tmp_path, placeholder):
+    # writers that cannot seek leave the data size at 0xFFFFFFFF, SoX at 0x7FFFF000:
+    # not a truncation (the SoX one was refused as announcing 134217 s)
+    y = (0.1 * np.sin(np.arange(4410) / 5.0)).astype(np.float32)
+    path = io.write_audio(tmp_path / "s.wav", y, 22050)
     raw = bytearray(path.read_bytes())
     at = raw.index(b"data")
-    raw[at + 4 : at + 8] = b"\xff\xff\xff\xff"
+    raw[at + 4 : at + 8] = placeholder
     path.write_bytes(bytes(raw))
     y, sr = io.read_audio(path)
     assert sr == 22050 and y.size == 4410

@@ -68,6 +68,8 @@ def check_workers(n_workers: Any, *, name: str = "--workers") -> int | None:
         raise ParameterError(f"{name}={n_workers!r} must be a whole number of workers >= 1")
     try:
         value = float(n_workers)
+    except OverflowError:  # an int too large for a float
+        value = float(max_local_workers() + 1)
     except ValueError:
         raise ParameterError(f"{name}={n_workers!r} is not a number of workers") from None
     if not math.isfinite(value) or value != int(value) or value < 1:

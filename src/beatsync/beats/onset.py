@@ -141,7 +141,11 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     band = _bin_bands(np.fft.rfftfreq(n_fft, d=1.0 / sr), edges)
     empty = np.flatnonzero(np.bincount(band[band >= 0], minlength=edges.size - 1) == 0)
     # the default top band (4-22 kHz) is empty below 8 kHz: only edges a user gave count
-    if empty.size and "band_edges_hz" in params:
+    # (onset_strength_psf and phase_slope pass the defaults on explicitly)
+    given = "band_edges_hz" in params and tuple(
+        float(e) for e in params["band_edges_hz"]
+    ) != tuple(FRONTEND_DEFAULTS["band_edges_hz"])
+    if empty.size and given:
         k = int(empty[0])
         why = (
             f"it lies above {sr / 2:g} Hz, the highest frequency at the analysis rate "

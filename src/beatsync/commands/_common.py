@@ -185,11 +185,12 @@ def check_output(
     if not raw:
         raise ParameterError(f"{option} is an empty name; give a file name")
     seps = tuple(x for x in (os.sep, os.altsep) if x)
-    if raw.endswith(seps) and not p.is_dir():
+    ends_in_folder = raw.endswith(seps) or raw.endswith(tuple(s_ + "." for s_ in seps))
+    if ends_in_folder and not p.is_dir():
         # Path() drops the slash: "out/" would be written as a file named "out"
         raise ParameterError(
-            f"{name} ends in {raw[-1]!r}, which names a folder, but {option} is a file: "
-            f"drop the {raw[-1]!r} or add a file name (e.g. {str(p / 'output')!r})"
+            f"{name} ends in {raw.rstrip('.')[-1]!r}, which names a folder, but {option} "
+            f"is a file: drop it or add a file name (e.g. {str(p / 'output')!r})"
         )
     if suffixes is not None:
         allowed = tuple(s.lower() for s in suffixes)

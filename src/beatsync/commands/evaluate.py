@@ -133,9 +133,10 @@ def run_beats(args: argparse.Namespace) -> int:
         )
     for note, users in list(found.shared.items())[:SHOWN]:
         fb.warn(
-            f"annotation {str(note)!r} is the only one of its name, and {len(users)} audio "
-            f"files would use it ({', '.join(str(p) for p in users[:SHOWN])}): they are "
-            "skipped; put each annotation at its audio file's relative path"
+            f"annotation {str(note)!r} would serve more than one recording (found by name "
+            f"only for {', '.join(str(p) for p in users[:SHOWN])}): skipped for "
+            f"{'it' if len(users) == 1 else 'them'}; put each annotation at its audio "
+            "file's relative path"
         )
     if len(found.shared) > SHOWN:
         fb.warn(f"... and {len(found.shared) - SHOWN} more annotations shared by name")

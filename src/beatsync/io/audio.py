@@ -137,13 +137,25 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
     """Refuse a file cut short: fewer samples than its header announces.
 
     libsndfile reads what is there without a word: it trims a WAV's length to the bytes
-    present, and decodes an MP3 until its data ends. The WAV's own ``data`` chunk size
-    (:func:`_wav_announced_frames`) and libsndfile's announced frame count for other
-    formats are compared with the samples read.
+    present, and decodes an MP3 until its data ends. A WAV's own ``data`` chunk size
+    bytes (:func:`_wav_data_bytes`; not when it is a placeholder), an MP3's frame count
+    (only with a Xing, Info or VBRI header) and libsndfile's count for other formats
+    are compared with the samples read. (libsndfile trims AIFF, W64 and RF64 lengths to
+    the bytes present too: those are not checked.)
     """
-    wav = _wav_announced_frames(p)
-    if wav is not None:
-        announced = max(announced, wav)
+    if _is_riff_wave(p):
+        # libsndfile's count is already trimmed to the bytes present: compare the bytes
+        # the data chunk announces with those there (no frame size needed; a wrong
+        # block alignment in the header does not matter)
+        sizes = _wav_data_bytes(p)
+        if sizes is None or sizes[1] <= 0:
+            return  # data size unknown (streamed) or a header this walk cannot follow
+        declared, present = sizes
+        announced = int(round(n_read * declared / present)) if declared > present else n_read
+    elif p.suffix.lower() == ".mp3" and not _mp3_has_length_header(p):
+        # without a Xing/Info/VBRI header libsndfile guesses the length of a VBR file
+        # from its first frame's bit rate (a quiet intro: a guess too long)
+        return
     missing = announced - n_read
     if rate <= 0 or missing <= 0:
         return
@@ -155,35 +167,60 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
         )
 
 
-def _wav_announced_frames(p: Path) -> int | None:
-    """Frames announced by a RIFF WAVE file's ``data`` chunk, or None (another format,
-    an unknown size, or a header this walk does not understand)."""
+#: ``data`` chunk sizes that mean "unknown" rather than a length.
+_UNKNOWN_DATA_SIZES = (0, 0x7FFFF000, 0x7FFFFFFF, 0xFFFFFFFF)
+
+
+def _is_riff_wave(p: Path) -> bool:
+    try:
+        with open(p, "rb") as f:
+            head = f.read(12)
+    except OSError:
+        return False
+    return head[:4] == b"RIFF" and head[8:12] == b"WAVE"
+
+
+def _mp3_has_length_header(p: Path) -> bool:
+    """Whether an MP3's first frame carries a Xing, Info or VBRI header (a frame count)."""
+    try:
+        with open(p, "rb") as f:
+            head = f.read(10)
+            start = 0
+            if head[:3] == b"ID3" and len(head) == 10:  # skip an ID3v2 tag (syncsafe size)
+                size = 0
+                for byte in head[6:10]:
+                    size = (size << 7) | (byte & 0x7F)
+                start = 10 + size
+            f.seek(start)
+            frame = f.read(4096)
+    except OSError:
+        return False
+    return any(tag in frame for tag in (b"Xing", b"Info", b"VBRI"))
+
+
+def _wav_data_bytes(p: Path) -> tuple[int, int] | None:
+    """A RIFF WAVE file's ``data`` chunk: the bytes its header announces and the bytes
+    present after it, or None (another format, an unknown size, or a header this walk
+    does not understand)."""
     import struct
 
     try:
+        size_on_disk = p.stat().st_size
         with open(p, "rb") as f:
             head = f.read(12)
             if len(head) < 12 or head[:4] != b"RIFF" or head[8:12] != b"WAVE":
                 return None
-            block_align = None
             for _ in range(64):  # chunks before the data: fmt, fact, LIST, ...
                 chunk = f.read(8)
                 if len(chunk) < 8:
                     return None
                 cid, size = chunk[:4], struct.unpack("<I", chunk[4:])[0]
-                if cid == b"fmt ":
-                    fmt = f.read(size)
-                    if len(fmt) < 14:
-                        return None
-                    block_align = struct.unpack("<H", fmt[12:14])[0]
-                    if size % 2:
-                        f.seek(1, os.SEEK_CUR)
-                    continue
                 if cid == b"data":
-                    # 0 and 0xFFFFFFFF: a writer that could not seek back to fill it in
-                    if not block_align or size in (0, 0xFFFFFFFF):
+                    # placeholders of writers that could not seek back to fill the size
+                    # in (0, 0xFFFFFFFF; SoX writes 0x7FFFF000 to a pipe)
+                    if size in _UNKNOWN_DATA_SIZES:
                         return None
-                    return size // block_align
+                    return size, size_on_disk - f.tell()
                 f.seek(size + size % 2, os.SEEK_CUR)
     except OSError:
         return None

@@ -407,8 +407,9 @@ def evaluate_dataset(
                     progress=progress,
                 )  # fmt: skip
     except BaseException:
-        if created and out.is_dir() and not any(out.iterdir()):
-            out.rmdir()  # interrupted before any track finished: no empty folder left
+        with contextlib.suppress(OSError):  # never hide the interrupt behind this
+            if created and out.is_dir() and not any(out.iterdir()):
+                out.rmdir()  # interrupted before any track finished: no empty folder left
         raise
     if force and previous:
         # appended, not replaced up front: an interrupted --force keeps the earlier rows
@@ -448,8 +449,9 @@ def _audio_bytes(path: str | os.PathLike[str]) -> int | None:
 def _same_inputs(row: dict[str, Any], track: Track, reference: np.ndarray) -> bool:
     """Was ``row`` scored on this track's audio file and annotation? Rows written before
     the digest and size were recorded are taken as they are."""
-    if row.get("audio") not in (None, str(track.audio)):
-        return False
+    stored = row.get("audio")
+    if stored is not None and os.path.realpath(stored) != os.path.realpath(track.audio):
+        return False  # (the same file given through another path is the same file)
     size = row.get("audio_bytes")
     if size is not None and size != _audio_bytes(track.audio):
         return False

@@ -55,8 +55,9 @@ class TrackList:
         Audio files with no annotation of their name.
     shared : dict of Path -> list of Path
         Annotations found by name only (a flat folder) that more than one audio file
-        would use (``a/x.wav`` and ``b/x.wav`` for ``x.beats``): those audio files are
-        skipped, as the annotation fits one recording at most.
+        would use (``a/x.wav`` and ``b/x.wav`` for ``x.beats``), or that another audio
+        file has at its own relative path: the audio files that found them by name are
+        skipped, as an annotation fits one recording at most.
     duplicates : list of Path
         Audio files skipped because a file of the same path and name with another
         suffix was taken (``x.wav`` beside ``x.flac``: the first in sorted order).
@@ -115,6 +116,7 @@ def find_tracks(
         by_stem.setdefault(p.stem, []).append(p)
     tracks, unmatched, duplicates = [], [], []
     by_name: dict[Path, list[Path]] = {}  # annotations found by name only, and their users
+    by_path: set[Path] = set()  # annotations found at their audio file's relative path
     seen: set[str] = set()
     for p in audio:
         rel = p.relative_to(a_dir)
@@ -123,7 +125,9 @@ def find_tracks(
             duplicates.append(p)
             continue
         note = by_rel.get(key)
-        if note is None and len(by_stem.get(p.stem, [])) == 1:
+        if note is not None:
+            by_path.add(note)
+        elif len(by_stem.get(p.stem, [])) == 1:
             note = by_stem[p.stem][0]
             by_name.setdefault(note, []).append(p)
         if note is None:
@@ -132,7 +136,9 @@ def find_tracks(
         seen.add(key)
         group = rel.parent.as_posix()
         tracks.append(Track(key, group, p, note))
-    shared = {note: users for note, users in by_name.items() if len(users) > 1}
+    # an annotation found by name that another audio file uses by its path, or that
+    # several use by name, fits one recording at most
+    shared = {note: users for note, users in by_name.items() if len(users) > 1 or note in by_path}
     if shared:
         taken = {p for users in shared.values() for p in users}
         tracks = [t for t in tracks if t.audio not in taken]
