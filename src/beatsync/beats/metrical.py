@@ -318,23 +318,33 @@ def resonator_salience(
     n_bands = bands.shape[0]
     length = int(max(b - a for a, b in zip(starts, stops, strict=True)))
     n_fft = resonator_fft_size(length, fps, half_time_s)
-    seg = np.zeros((len(starts), n_bands, n_fft))
-    for i, (a, b) in enumerate(zip(starts, stops, strict=True)):
-        x = bands[:, a:b]
-        seg[i, :, : b - a] = (x - x.mean(axis=1, keepdims=True)) * np.hanning(b - a)
-    spec = scipy.fft.rfft(seg, axis=2)
-    power = spec.real**2 + spec.imag**2  # (window, band, frequency)
-    n_bins = power.shape[2]
+    n_bins = n_fft // 2 + 1
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
     gain, gamma = _resonator_gain(
         np.ascontiguousarray(periods, dtype=np.float64).tobytes(), fps, n_fft, n_bins, half_time_s
     )
-    total = power.sum(axis=2)  # (window, band)
-    n_win = power.shape[0]
-    low = power[:, :, :n_bins].reshape(-1, n_bins)
-    energy = (gain @ low.T).reshape(periods.size, n_win, n_bands)
-    energy += gamma[:, None, None] * (total - low.sum(axis=1).reshape(n_win, n_bands))[None]
+    n_win = len(starts)
+    total = np.empty((n_win, n_bands))  # (window, band)
+    energy = np.empty((periods.size, n_win, n_bands))
+    # windows in chunks: the padded spectra of a whole song at once took 360 MB for
+    # 10 minutes of audio (only the bins below max_hz are kept)
+    for c0 in range(0, n_win, WINDOW_CHUNK):
+        chunk = list(
+            zip(starts[c0 : c0 + WINDOW_CHUNK], stops[c0 : c0 + WINDOW_CHUNK], strict=True)
+        )
+        seg = np.zeros((len(chunk), n_bands, n_fft))
+        for i, (a, b) in enumerate(chunk):
+            x = bands[:, a:b]
+            seg[i, :, : b - a] = (x - x.mean(axis=1, keepdims=True)) * np.hanning(b - a)
+        spec = scipy.fft.rfft(seg, axis=2)
+        power = spec.real**2 + spec.imag**2  # (window, band, frequency)
+        tot = power.sum(axis=2)
+        low = power[:, :, :n_bins]
+        e = (gain @ low.reshape(-1, n_bins).T).reshape(periods.size, len(chunk), n_bands)
+        e += gamma[:, None, None] * (tot - low.sum(axis=2))[None]
+        total[c0 : c0 + len(chunk)] = tot
+        energy[:, c0 : c0 + len(chunk)] = e
     ratio = np.divide(energy, total[None], out=np.zeros_like(energy), where=total[None] > 0)
     r = (ratio - gamma[:, None, None]) / (1 - gamma[:, None, None])
     # fewer than two periods inside the window: no evidence either way
@@ -342,6 +352,9 @@ def resonator_salience(
     r[periods[:, None] > span[None, :] / 2] = 0.0
     return r.sum(axis=2)
 
+
+#: Analysis windows whose spectra :func:`resonator_salience` holds at once.
+WINDOW_CHUNK = 32
 
 #: FFT bins per resonator pass band (see :func:`resonator_fft_size`).
 BINS_PER_PASS_BAND = 3
