@@ -137,10 +137,10 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
     """Refuse a file cut short: fewer samples than its header announces.
 
     libsndfile reads what is there without a word: it trims a WAV's length to the bytes
-    present, and decodes an MP3 until its data ends. A WAV's own ``data`` chunk size
-    bytes (:func:`_wav_data_bytes`; not when it is a placeholder), an MP3's frame count
-    (only with a Xing, Info or VBRI header) and libsndfile's count for other formats
-    are compared with the samples read. (libsndfile trims AIFF, W64 and RF64 lengths to
+    present, and decodes an MP3 until its data ends. For a WAV, the bytes its ``data``
+    chunk announces are compared with the bytes present (:func:`_wav_data_bytes`; not
+    when the size is a placeholder); for other formats, libsndfile's announced count
+    with the samples read (for an MP3 only with a Xing, Info or VBRI header). (libsndfile trims AIFF, W64 and RF64 lengths to
     the bytes present too: those are not checked.)
     """
     if _is_riff_wave(p):
