@@ -125,11 +125,9 @@ def run_beats(args: argparse.Namespace) -> int:
     peers.get(args.method)
     found = find_tracks(args.audio, args.annotations)
     if found.unmatched:
-        names = [str(p) for p in found.unmatched]
-        more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
         fb.warn(
-            f"{len(names)} audio file(s) without an annotation (NAME.beats) are skipped: "
-            f"{', '.join(names[:SHOWN])}{more}"
+            f"{len(found.unmatched)} audio file(s) without an annotation (NAME.beats) are "
+            f"skipped: {_some(found.unmatched)}"
         )
     for note, users in list(found.shared.items())[:SHOWN]:
         fb.warn(
@@ -141,11 +139,9 @@ def run_beats(args: argparse.Namespace) -> int:
     if len(found.shared) > SHOWN:
         fb.warn(f"... and {len(found.shared) - SHOWN} more annotations shared by name")
     if found.duplicates:
-        names = [str(p) for p in found.duplicates]
-        more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
         fb.warn(
-            f"{len(names)} audio file(s) skipped: another file of the same name with "
-            f"another suffix is scored instead: {', '.join(names[:SHOWN])}{more}"
+            f"{len(found.duplicates)} audio file(s) skipped: another file of the same name "
+            f"with another suffix is scored instead: {_some(found.duplicates)}"
         )
     try:
         with fb.step(f"evaluate {args.method}") as bar:
@@ -227,6 +223,13 @@ def run_beats(args: argparse.Namespace) -> int:
     )
     emit(result, "\n".join(lines), args)
     return 0 if len(failed) < len(t) else EXIT_FAILED_ITEMS
+
+
+def _some(paths: list) -> str:
+    """The first :data:`SHOWN` paths, and how many more."""
+    names = [str(p) for p in paths]
+    more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
+    return ", ".join(names[:SHOWN]) + more
 
 
 def _interrupted(exc: KeyboardInterrupt, log: object, args: argparse.Namespace) -> int:
