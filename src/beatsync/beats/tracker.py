@@ -89,9 +89,9 @@ MIN_DURATION_S = 1.5
 #: geometric middle of 2.53 and 3.33. (With the coarser sampling before: noises
 #: 0.36-1.97, real 3.22-12.5, threshold 2.5.)
 MIN_PULSE_CLARITY = 2.9
-#: Path salience below which the pulse is unclear whatever the null says: the noises'
-#: that pass the ratio (one 2 s white noise) is 0.054, the real recordings' 0.11
-#: (DANCE_W_10) to 0.67; 0.08 is about their geometric middle.
+#: Path salience below which the pulse is unclear whatever the null says: the one noise
+#: that passes the ratio (a 2 s white noise) has 0.054, the real recordings 0.11
+#: (DANCE_W_10) to 0.67; 0.08 is about the geometric middle of 0.054 and 0.11.
 MIN_PATH_SALIENCE = 0.08
 #: Path salience above which the pulse is clear without the null (noises reached 0.13,
 #: real recordings 0.11-0.67; with the coarser sampling before, noises of 2 s 0.61).
@@ -474,7 +474,7 @@ def _warn_if_no_clear_pulse(
                 if clarity < MIN_PULSE_CLARITY * null
                 else f"below {MIN_PATH_SALIENCE}"
             )
-            + f"): "
+            + "): "
             f"{why} the beats may be meaningless or at another metrical level; if you "
             "know the tempo, give it with bpm= (--bpm) and only the phase is tracked",
             BeatsyncWarning,
