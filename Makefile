@@ -42,8 +42,12 @@ $(UV):
 # --compile-bytecode: every process of the tests and the study would otherwise parse
 # scipy, pandas and matplotlib from source again where bytecode is not written
 # (PYTHONDONTWRITEBYTECODE, read-only installs): 9 s instead of 3 s per import.
+# Then librosa's numba functions are compiled into their on-disk cache by one process:
+# the parallel test workers and notebook kernels compiling them at once can pair cache
+# files written by different processes and crash (numba issue 10128; beatsync.peers.prepare).
 $(STAMP): uv.lock pyproject.toml | $(UV)
 	$(UV) sync --locked --compile-bytecode --python $(PYTHON) $(EXTRAS)
+	$(BIN)/python -c "from beatsync import peers; peers.prepare('librosa')"
 	@touch $(STAMP)
 
 setup: $(STAMP)

@@ -1,4 +1,4 @@
-"""Dataset pieces of beat evaluation without a cluster: pairing, annotations, the log."""
+"""Dataset pieces of beat evaluation: pairing, annotations, the log, preparing workers."""
 
 import json
 
@@ -204,3 +204,35 @@ def test_summary_states_the_settings_the_rows_were_scored_with():
     assert s.loc[("psf", "all"), "min_beat_time"] == 5.0
     assert pd.isna(s.loc[("psf", "all"), "min_bpm"])  # the rows differ: not one range
     assert s.loc[("librosa", "all"), ["min_beat_time", "min_bpm", "max_bpm"]].isna().all()
+
+
+_PREPARED: list[tuple[str, str, float, float]] = []
+
+
+async def _slow_prepare(name, dask_worker=None):
+    # module level: dask pickles it by reference, even in-process. A coroutine: the
+    # in-process workers share one event loop, where two plain calls could not overlap
+    import asyncio
+    import time
+
+    start = time.monotonic()
+    await asyncio.sleep(0.3)
+    _PREPARED.append((name, dask_worker.address, start, time.monotonic()))
+
+
+def test_workers_are_prepared_one_at_a_time_for_librosa(monkeypatch):
+    # a fresh install's workers compiling librosa's numba cache together can crash
+    from beatsync import peers
+    from beatsync.cluster import dask_client
+    from beatsync.study.beat_dataset import _prepare_workers
+
+    _PREPARED.clear()
+    monkeypatch.setattr(peers, "prepare", _slow_prepare)
+    with dask_client(n_workers=2, processes=False) as client:
+        _prepare_workers(client, "psf")
+        assert _PREPARED == []
+        _prepare_workers(client, "librosa")
+    spans = sorted(_PREPARED, key=lambda s: s[2])
+    assert [s[0] for s in spans] == ["librosa", "librosa"]
+    assert spans[0][1] != spans[1][1]  # each worker once
+    assert spans[1][2] >= spans[0][3]  # never two at once

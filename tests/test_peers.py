@@ -273,3 +273,15 @@ def test_bad_audio_refused_for_every_method(y, sr, match):
     for name in ("psf", "librosa"):
         with pytest.raises(ParameterError, match=match):
             peers.track(name, y, sr)
+
+
+def test_prepare_checks_the_name_and_compiles_only_for_librosa(monkeypatch):
+    with pytest.raises(ParameterError, match="unknown beat-tracking method"):
+        peers.prepare("madmom")
+    calls = []
+    librosa = pytest.importorskip("librosa")
+    monkeypatch.setattr(librosa.beat, "beat_track", lambda **kw: calls.append(kw))
+    peers.prepare("psf")
+    assert calls == []
+    peers.prepare("librosa")
+    assert len(calls) == 1 and calls[0]["y"].dtype == np.float32

@@ -43,6 +43,7 @@ __all__ = [
     "get",
     "available",
     "track",
+    "prepare",
     "check_tempo_range",
     "ESSENTIA_SR",
     "ESSENTIA_TEMPO",
@@ -122,6 +123,30 @@ def track_librosa(
         y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
     )
     return _as_beats(beats)
+
+
+def prepare(name: str) -> None:
+    """Compile what method ``name`` needs into its on-disk cache, in this process.
+
+    Call it in one process before several processes track with the method at once (the
+    workers of a cluster, parallel tests). librosa's beat tracker is built on numba
+    functions cached on disk; numba writes a generalised ufunc's cache as two files,
+    and processes compiling the same function at the same time can leave a pair written
+    by different processes, which crashes a later process with a segmentation fault
+    when it loads them (numba issue 10128). Compiled once first, the other processes
+    only read the cache. A no-op for the methods without a JIT cache (ours, essentia).
+    """
+    get(name)
+    if name != "librosa":
+        return
+    import librosa
+
+    from .beats.tracker import LIBROSA_HOP
+
+    sr = 22050
+    clicks = np.zeros(2 * sr, dtype=np.float32)
+    clicks[:: sr // 2] = 1.0
+    librosa.beat.beat_track(y=clicks, sr=sr, hop_length=LIBROSA_HOP, units="time")
 
 
 def _essentia_audio(y: np.ndarray, sr: float) -> np.ndarray:

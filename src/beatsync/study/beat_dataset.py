@@ -512,9 +512,24 @@ def _range_text(bounds: tuple[float | None, float | None]) -> str:
     return " and ".join(given) if given else "the default tempo range"
 
 
+def _prepare_workers(client, method: str) -> None:
+    """:func:`beatsync.peers.prepare` on each worker in turn, never on two at once.
+
+    A fresh install's workers would otherwise compile librosa's numba cache together,
+    which can crash them (see :func:`~beatsync.peers.prepare`). A worker that fails here
+    is left to record the error with its first track.
+    """
+    if method != "librosa":
+        return
+    for address in client.scheduler_info()["workers"]:
+        with contextlib.suppress(Exception):
+            client.run(peers.prepare, method, workers=[address])
+
+
 def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
     from dask.distributed import as_completed
 
+    _prepare_workers(client, method)
     futures = {
         client.submit(
             evaluate_track,
