@@ -234,10 +234,15 @@ print(y.size, "librosa" in sys.modules)
     assert out[3] == "8820 False"
 
 
-@pytest.mark.parametrize("fmt, suffix", [("WAV", ".wav"), ("MP3", ".mp3")])
+@pytest.mark.parametrize(
+    "fmt, suffix",
+    [("WAV", ".wav"), ("MP3", ".mp3"), ("AIFF", ".aiff"), ("W64", ".w64"), ("RF64", ".rf64"),
+     ("AU", ".au")],
+)  # fmt: skip
 def test_a_file_cut_short_is_refused_naming_both_lengths(tmp_path, fmt, suffix):
-    # libsndfile read what was left of a truncated WAV (it trims the length to the bytes
-    # present) or MP3 without a word: 2 s of a 15 s song analysed as the whole song
+    # libsndfile read what was left of a truncated WAV, AIFF, W64, RF64 or AU (it trims
+    # the length to the bytes present) or MP3 without a word: 2 s of a 15 s song
+    # analysed as the whole song
     import soundfile as sf
 
     if fmt not in sf.available_formats():
@@ -252,6 +257,42 @@ def test_a_file_cut_short_is_refused_naming_both_lengths(tmp_path, fmt, suffix):
     cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 4])
     with pytest.raises(ParameterError, match=r"is cut short: its header announces 15\.0"):
         io.read_audio(cut)
+
+
+def _ogg_pages(data: bytes) -> list[int]:
+    """Offsets of an Ogg file's pages (by walking their headers)."""
+    at, pages = 0, []
+    while at < len(data):
+        assert data[at : at + 4] == b"OggS"
+        pages.append(at)
+        n = data[at + 26]
+        at += 27 + n + sum(data[at + 27 : at + 27 + n])
+    assert at == len(data)
+    return pages
+
+
+def test_an_ogg_file_cut_short_is_refused(tmp_path):
+    # libsndfile decodes an Ogg stream until its data ends: a cut file read silently
+    import soundfile as sf
+
+    sr = 22050
+    t = np.arange(15 * sr) / sr
+    y = (0.3 * np.sin(2 * np.pi * 440.0 * t) * (np.sin(2 * np.pi * 2 * t) > 0)).astype(np.float32)
+    whole = tmp_path / "whole.ogg"
+    sf.write(whole, y, sr, format="OGG", subtype="VORBIS")
+    assert io.read_audio(whole)[0].size == y.size
+    data = whole.read_bytes()
+    pages = _ogg_pages(data)
+    assert len(pages) > 4
+    for name, size in (("mid_page", len(data) // 3), ("page_boundary", pages[len(pages) // 2])):
+        cut = tmp_path / f"{name}.ogg"
+        cut.write_bytes(data[:size])
+        with pytest.raises(ParameterError, match=r"cut short: its Ogg stream stops without"):
+            io.read_audio(cut)
+    # bytes after the last page (a tag some tools append) are not a truncation
+    trailing = tmp_path / "trailing.ogg"
+    trailing.write_bytes(data + b"TAG" + b"\0" * 125)
+    assert io.read_audio(trailing)[0].size == y.size
 
 
 @pytest.mark.parametrize("placeholder", [b"\xff\xff\xff\xff", b"\x00\xf0\xff\x7f"])

@@ -6,6 +6,7 @@ import os
 import warnings
 from pathlib import Path
 from types import MappingProxyType
+from typing import Literal
 
 import numpy as np
 
@@ -136,18 +137,18 @@ SHORT_FILE_MIN_S = 0.1
 def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
     """Refuse a file cut short: fewer samples than its header announces.
 
-    libsndfile reads what is there without a word: it trims a WAV's length to the bytes
-    present, and decodes an MP3 until its data ends. For a WAV, the bytes its ``data``
-    chunk announces are compared with the bytes present (:func:`_wav_data_bytes`; not
-    when the size is a placeholder); for other formats, libsndfile's announced count
-    with the samples read (for an MP3 only with a Xing, Info or VBRI header). (libsndfile trims AIFF, W64 and RF64 lengths to
-    the bytes present too: those are not checked.)
+    libsndfile reads what is there without a word: it trims the length of a WAV, RF64,
+    W64, AIFF or AU file to the bytes present, decodes an MP3 until its data ends, and
+    an Ogg stream until its last page. For the first five, the bytes the header
+    announces for the audio are compared with the bytes present (:func:`_data_bytes`;
+    not when the size is a placeholder); an Ogg file must end with its stream's last
+    page (:func:`_ogg_is_cut`); for other formats, libsndfile's announced count is
+    compared with the samples read (for an MP3 only with a Xing, Info or VBRI header).
     """
-    if _is_riff_wave(p):
+    if (sizes := _data_bytes(p)) is not False:
         # libsndfile's count is already trimmed to the bytes present: compare the bytes
-        # the data chunk announces with those there (no frame size needed; a wrong
-        # block alignment in the header does not matter)
-        sizes = _wav_data_bytes(p)
+        # the header announces with those there (no frame size needed; a wrong block
+        # alignment in the header does not matter)
         if sizes is None or sizes[1] <= 0:
             return  # data size unknown (streamed) or a header this walk cannot follow
         declared, present = sizes
@@ -156,6 +157,12 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
         # without a Xing/Info/VBRI header libsndfile guesses the length of a VBR file
         # from its first frame's bit rate (a quiet intro: a guess too long)
         return
+    elif _ogg_is_cut(p):
+        raise ParameterError(
+            f"audio file {str(p)!r} is cut short: its Ogg stream stops without its last "
+            f"page (read {n_read / rate:.3f} s); an interrupted copy or download? Copy "
+            "the file again"
+        )
     missing = announced - n_read
     if rate <= 0 or missing <= 0:
         return
@@ -167,17 +174,11 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
         )
 
 
-#: ``data`` chunk sizes that mean "unknown" rather than a length.
+#: 32-bit data sizes that mean "unknown" rather than a length.
 _UNKNOWN_DATA_SIZES = (0, 0x7FFFF000, 0x7FFFFFFF, 0xFFFFFFFF)
 
-
-def _is_riff_wave(p: Path) -> bool:
-    try:
-        with open(p, "rb") as f:
-            head = f.read(12)
-    except OSError:
-        return False
-    return head[:4] == b"RIFF" and head[8:12] == b"WAVE"
+#: The first sixteen bytes of a Sony Wave64 file: the GUID of its "riff" chunk.
+_W64_RIFF = b"riff\x2e\x91\xcf\x11\xa5\xd6\x28\xdb\x04\xc1\x00\x00"
 
 
 def _mp3_has_length_header(p: Path) -> bool:
@@ -198,33 +199,104 @@ def _mp3_has_length_header(p: Path) -> bool:
     return any(tag in frame for tag in (b"Xing", b"Info", b"VBRI"))
 
 
-def _wav_data_bytes(p: Path) -> tuple[int, int] | None:
-    """A RIFF WAVE file's ``data`` chunk: the bytes its header announces and the bytes
-    present after it, or None (another format, an unknown size, or a header this walk
-    does not understand)."""
+def _data_bytes(p: Path) -> tuple[int, int] | None | Literal[False]:
+    """The bytes of audio a WAV, RF64, W64, AIFF(-C) or AU header announces, and the
+    bytes present after the header, by the magic bytes; None for one of these with an
+    unknown size or a header this walk does not understand; False for other formats."""
     import struct
 
     try:
         size_on_disk = p.stat().st_size
         with open(p, "rb") as f:
-            head = f.read(12)
-            if len(head) < 12 or head[:4] != b"RIFF" or head[8:12] != b"WAVE":
-                return None
-            for _ in range(64):  # chunks before the data: fmt, fact, LIST, ...
-                chunk = f.read(8)
-                if len(chunk) < 8:
+            head = f.read(40)
+            if head[:4] == b"RIFF" and head[8:12] == b"WAVE":
+                return _known(_walk_chunks(f, 12, size_on_disk, "<I", b"data"))
+            if head[:4] == b"RF64" and head[8:12] == b"WAVE":
+                # the sizes are 64-bit, in the ds64 chunk that comes first
+                if head[12:16] != b"ds64" or len(head) < 36:
                     return None
-                cid, size = chunk[:4], struct.unpack("<I", chunk[4:])[0]
-                if cid == b"data":
-                    # placeholders of writers that could not seek back to fill the size
-                    # in (0, 0xFFFFFFFF; SoX writes 0x7FFFF000 to a pipe)
-                    if size in _UNKNOWN_DATA_SIZES:
+                declared = struct.unpack("<Q", head[28:36])[0]
+                found = _walk_chunks(f, 12, size_on_disk, "<I", b"data")
+                return (declared, found[1]) if found and declared else None
+            if head[:4] == b"FORM" and head[8:12] in (b"AIFF", b"AIFC"):
+                sizes = _known(_walk_chunks(f, 12, size_on_disk, ">I", b"SSND"))
+                # the chunk's size counts its 8-byte offset and block size
+                return None if sizes is None else (sizes[0] - 8, sizes[1] - 8)
+            if head[:16] == _W64_RIFF and len(head) == 40 and head[24:28] == b"wave":
+                f.seek(40)
+                for _ in range(64):
+                    chunk = f.read(24)
+                    if len(chunk) < 24:
                         return None
-                    return size, size_on_disk - f.tell()
-                f.seek(size + size % 2, os.SEEK_CUR)
+                    size = struct.unpack("<Q", chunk[16:24])[0]  # counts the 24-byte header
+                    if chunk[:4] == b"data":
+                        return (size - 24, size_on_disk - f.tell()) if size > 24 else None
+                    if size < 24:
+                        return None
+                    f.seek(size - 24 + (-size) % 8, os.SEEK_CUR)
+                return None
+            if head[:4] == b".snd" and len(head) >= 12:
+                offset, size = struct.unpack(">II", head[4:12])
+                if size in _UNKNOWN_DATA_SIZES or offset < 24:
+                    return None
+                return size, size_on_disk - offset
     except OSError:
         return None
+    return False
+
+
+def _walk_chunks(f, start: int, size_on_disk: int, fmt: str, target: bytes):
+    """Follow 4-byte-ID chunks from ``start`` to ``target``: (its announced size, the
+    bytes present after its header), or None (not found)."""
+    import struct
+
+    f.seek(start)
+    for _ in range(64):  # chunks before the data: fmt, fact, LIST, COMM, ...
+        chunk = f.read(8)
+        if len(chunk) < 8:
+            return None
+        cid, size = chunk[:4], struct.unpack(fmt, chunk[4:])[0]
+        if cid == target:
+            return size, size_on_disk - f.tell()
+        f.seek(size + size % 2, os.SEEK_CUR)
     return None
+
+
+def _known(sizes: tuple[int, int] | None) -> tuple[int, int] | None:
+    # placeholders of writers that could not seek back to fill the size in (0,
+    # 0xFFFFFFFF; SoX writes 0x7FFFF000 to a pipe) say nothing about the length
+    return None if sizes is None or sizes[0] in _UNKNOWN_DATA_SIZES else sizes
+
+
+#: Longest Ogg page [bytes]: a 27-byte header, 255 lacing values of up to 255 each.
+_OGG_MAX_PAGE = 27 + 255 + 255 * 255
+
+
+def _ogg_is_cut(p: Path) -> bool:
+    """Whether an Ogg file stops inside a page, or after a page that does not end its
+    stream (no end-of-stream flag): a download cut short. False for other files and
+    for an Ogg file whose last page cannot be found (nothing is claimed then)."""
+    try:
+        size_on_disk = p.stat().st_size
+        with open(p, "rb") as f:
+            if f.read(4) != b"OggS":
+                return False
+            start = max(0, size_on_disk - _OGG_MAX_PAGE)
+            f.seek(start)
+            tail = f.read()
+    except OSError:
+        return False
+    at = len(tail)
+    while (at := tail.rfind(b"OggS", 0, at)) >= 0:
+        header = tail[at : at + 27]
+        if len(header) == 27 and header[4] == 0:  # stream structure version 0
+            n_segments = header[26]
+            lacing = tail[at + 27 : at + 27 + n_segments]
+            page_end = at + 27 + n_segments + sum(lacing)
+            if len(lacing) < n_segments or page_end > len(tail):
+                return True  # the file ends inside this page
+            return not header[5] & 0x04  # the last page must carry end-of-stream
+    return False
 
 
 def _check_wav_header_rate(p: Path) -> None:
