@@ -236,3 +236,17 @@ def test_workers_are_prepared_one_at_a_time_for_librosa(monkeypatch):
     assert [s[0] for s in spans] == ["librosa", "librosa"]
     assert spans[0][1] != spans[1][1]  # each worker once
     assert spans[1][2] >= spans[0][3]  # never two at once
+
+
+def test_a_rows_warning_gives_advice_the_dataset_command_can_follow(tmp_path):
+    # the tracker's no-clear-pulse warning says "give it with bpm= (--bpm)": evaluate
+    # beats has no --bpm, but a tempo range
+    rng = np.random.default_rng(3)
+    audio = io.write_audio(tmp_path / "noise.wav", 0.1 * rng.standard_normal(10 * SR), SR)
+    row = evaluate_track(
+        str(audio), np.arange(0.5, 9.5, 0.5), method="psf", min_beat_time=0.0, name="noise"
+    )
+    assert row["status"] == "ok"
+    assert "no clear pulse" in row["warning"]
+    assert "--bpm" not in row["warning"]
+    assert "a tempo range (--min-bpm, --max-bpm) narrows the search" in row["warning"]

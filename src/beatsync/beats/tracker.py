@@ -96,6 +96,8 @@ MIN_PATH_SALIENCE = 0.08
 #: Path salience above which the pulse is clear without the null (noises reached 0.13,
 #: real recordings 0.11-0.67; with the coarser sampling before, noises of 2 s 0.61).
 CLEAR_PULSE = 0.7
+#: How the no-clear-pulse warning ends: what a user who knows the tempo can do.
+KNOWN_TEMPO_HINT = "if you know the tempo, give it with bpm= (--bpm) and only the phase is tracked"
 #: Seconds of shuffled onsets the null is averaged over, and the most draws.
 NULL_AUDIO_S = 15.0
 NULL_MAX_DRAWS = 8
@@ -475,8 +477,7 @@ def _warn_if_no_clear_pulse(
                 else f"below {MIN_PATH_SALIENCE}"
             )
             + "): "
-            f"{why} the beats may be meaningless or at another metrical level; if you "
-            "know the tempo, give it with bpm= (--bpm) and only the phase is tracked",
+            f"{why} the beats may be meaningless or at another metrical level; " + KNOWN_TEMPO_HINT,
             BeatsyncWarning,
             stacklevel=4,
         )

@@ -145,7 +145,7 @@ def evaluate_track(
         return row
     row.update(
         status="ok",
-        warning="; ".join(dict.fromkeys(str(w.message) for w in caught)),
+        warning="; ".join(dict.fromkeys(_dataset_hint(str(w.message)) for w in caught)),
         n_ref=int(reference.size),
         n_est=int(est.size),
         **tempo_octave(reference, est),
@@ -155,6 +155,15 @@ def evaluate_track(
         beats=[round(float(b), 6) for b in est],
     )
     return row
+
+
+def _dataset_hint(message: str) -> str:
+    """A tracker's warning with the advice a dataset run can follow (it has no --bpm)."""
+    from ..beats.tracker import KNOWN_TEMPO_HINT
+
+    return message.replace(
+        KNOWN_TEMPO_HINT, "a tempo range (--min-bpm, --max-bpm) narrows the search"
+    )
 
 
 class TrackLog:
