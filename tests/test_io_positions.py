@@ -228,6 +228,17 @@ def test_c3d_round_trip_rate_labels_units(tmp_path):
     assert io.read_motion(out, fps=FPS).fps == FPS  # agreeing is fine
 
 
+def test_c3d_cut_short_is_refused(tmp_path):
+    # the c3d package stops at the end of the data with a warning (which the reader
+    # ignores): two thirds of a file read as the whole motion
+    m = io.read_motion(_dwm_json(tmp_path / "a.json", _body()), fps=FPS)
+    whole = io.write_motion(tmp_path / "whole.c3d", m).read_bytes()
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(whole[: len(whole) * 2 // 3])
+    with pytest.raises(ParameterError, match=rf"cut short: its header declares {m.n_frames} "):
+        io.read_motion(cut)
+
+
 def test_c3d_without_points_refused(tmp_path):
     import c3d
 

@@ -533,12 +533,20 @@ def read_c3d(
             labels = [str(s).strip() for s in reader.point_labels][:n_points] if n_points else []
             file_units = _param_str(reader, "POINT:UNITS")
             screen = _param_str(reader, "POINT:Y_SCREEN")
+            declared = int(reader.frame_count)
             frames = []
             if n_points > 0:
                 for _, points, _ in reader.read_frames():
                     xyz = np.array(points[:, :3], dtype=np.float64)
                     xyz[points[:, 3] < 0] = np.nan
                     frames.append(xyz)
+        if frames and len(frames) < declared:
+            # the c3d package stops at the end of the file with a warning (ignored above)
+            raise ParameterError(
+                f"C3D file {str(p)!r} is cut short: its header declares {declared} frames "
+                f"but it holds {len(frames)}; an interrupted copy or download? Copy the "
+                "file again"
+            )
     except ParameterError:
         raise
     except Exception as exc:  # the c3d package raises several types for bad files
