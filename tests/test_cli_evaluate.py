@@ -621,3 +621,42 @@ def test_exit_code_and_message_on_bad_input(dataset, tmp_path, capsys):
     code, _, err = _run(_bad(tmp_path, dataset, extra=["--workers", "-1"]), capsys)
     assert code == 3  # bad input (2 is for usage errors)
     assert err.startswith("beatsync evaluate: error: --workers=-1")
+
+
+@pytest.mark.slow
+def test_ctrl_c_in_a_terminal_prints_no_worker_traceback(tmp_path):
+    # a terminal's Ctrl-C reaches the whole process group: each local worker printed a
+    # KeyboardInterrupt traceback, and one could log a failed heartbeat with two more,
+    # before the command's own message
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    sr = 22050
+    songs = tmp_path / "songs"
+    songs.mkdir()
+    for i in range(40):
+        ref = beat_times(100.0 + i, duration=20.0, start=0.2)
+        io.write_audio(songs / f"s{i:02d}.wav", click_track(ref, sr=sr, duration=20.0), sr)
+        io.write_beats(songs / f"s{i:02d}.beats", ref)
+    out = tmp_path / "results"
+    argv = ["evaluate", "beats", "--audio", str(songs), "--annotations", str(songs)]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "beatsync.cli", *argv, "--out", str(out), "--workers", "2"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # its own process group, as a terminal's foreground job
+    )
+    log = out / "tracks.jsonl"
+    deadline = time.monotonic() + 120
+    while proc.poll() is None and time.monotonic() < deadline:
+        if log.exists() and log.stat().st_size:  # the workers are up and tracking
+            break
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert "interrupted by SIGINT; the finished tracks are recorded in" in err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err

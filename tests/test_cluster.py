@@ -135,6 +135,37 @@ def test_local_workers_keep_glibc_default_malloc():
     assert env == (None, "1")
 
 
+def _sigint_and_heartbeat_record():
+    import logging
+    import signal
+
+    record = logging.LogRecord(
+        "distributed.worker", logging.ERROR, __file__, 1,
+        "Failed to communicate with scheduler during heartbeat.", None, None,
+    )  # fmt: skip
+    shown = logging.getLogger("distributed.worker").filter(record)
+    return signal.getsignal(signal.SIGINT) is signal.SIG_IGN, bool(shown)
+
+
+def test_local_worker_processes_ignore_ctrl_c_and_keep_configured_preloads(monkeypatch):
+    # the command closes its workers on Ctrl-C; each worker printed a traceback too
+    import dask
+
+    with dask.config.set({"distributed.worker.preload": ["json"]}):
+        assert cluster._worker_preloads() == ["json", "beatsync._dask_worker"]
+    with cluster.dask_client(n_workers=1, processes=True) as client:
+        (state,) = client.run(_sigint_and_heartbeat_record).values()
+    assert state == (True, False)  # SIGINT ignored, the lost-heartbeat record dropped
+    # worker threads of this process change nothing here
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    with cluster.dask_client(n_workers=1, processes=False) as client:
+        client.submit(sum, [1]).result()
+    assert signal.getsignal(signal.SIGINT) is before
+    assert _sigint_and_heartbeat_record() == (False, True)
+
+
 class _FlakyHandshake:
     """A stand-in for ``distributed.Client`` whose first ``fail`` connections trip the
     handshake assertion, as when a broadcast is batched with "stream-start"."""

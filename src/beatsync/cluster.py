@@ -7,7 +7,9 @@ before starting anything, gives up on an unreachable scheduler after
 ``timeout`` seconds with a :class:`~beatsync.errors.ParameterError` (not a hang, not
 a traceback), connects again when a busy scheduler's handshake reply came batched with
 another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and
-the local cluster on the way out, also on Ctrl-C. Local workers run with glibc's
+the local cluster on the way out, also on Ctrl-C (local worker processes ignore
+SIGINT, :mod:`beatsync._dask_worker`: the terminal's Ctrl-C reaches them too, and they
+printed a traceback each). Local workers run with glibc's
 default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
 about 1.8x slower).
 
@@ -158,6 +160,8 @@ def dask_client(
             # no dashboard; the scheduler's small HTTP server on a free port, not 8787
             scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
             silence_logs=logging.ERROR,
+            # worker processes ignore Ctrl-C: this process closes them (no tracebacks)
+            **({"preload": _worker_preloads()} if processes else {}),
         )
         client = Client(cluster)
     else:
@@ -171,6 +175,14 @@ def dask_client(
             with contextlib.suppress(Exception):
                 cluster.close()
         stack.close()
+
+
+def _worker_preloads() -> list[str]:
+    """The preloads configured for Dask workers, and :mod:`beatsync._dask_worker`."""
+    import dask
+
+    configured = dask.config.get("distributed.worker.preload", default=None) or []
+    return [*configured, "beatsync._dask_worker"]
 
 
 def _glibc_default_malloc() -> Any:
