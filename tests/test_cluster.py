@@ -152,7 +152,7 @@ def test_local_worker_processes_ignore_ctrl_c_and_keep_configured_preloads(monke
     import dask
 
     with dask.config.set({"distributed.worker.preload": ["json"]}):
-        assert cluster._worker_preloads() == ["json", "beatsync._dask_worker"]
+        assert cluster._worker_preloads() == ["json", "beatsync.cluster"]
     with cluster.dask_client(n_workers=1, processes=True) as client:
         (state,) = client.run(_sigint_and_heartbeat_record).values()
     assert state == (True, False)  # SIGINT ignored, the lost-heartbeat record dropped

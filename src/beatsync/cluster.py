@@ -8,8 +8,7 @@ before starting anything, gives up on an unreachable scheduler after
 a traceback), connects again when a busy scheduler's handshake reply came batched with
 another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and
 the local cluster on the way out, also on Ctrl-C (local worker processes ignore
-SIGINT, :mod:`beatsync._dask_worker`: the terminal's Ctrl-C reaches them too, and they
-printed a traceback each). Local workers run with glibc's
+SIGINT: see :func:`dask_setup`). Local workers run with glibc's
 default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
 about 1.8x slower).
 
@@ -23,6 +22,8 @@ import contextlib
 import logging
 import math
 import os
+import signal
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -178,11 +179,11 @@ def dask_client(
 
 
 def _worker_preloads() -> list[str]:
-    """The preloads configured for Dask workers, and :mod:`beatsync._dask_worker`."""
+    """The preloads configured for Dask workers, and this module (:func:`dask_setup`)."""
     import dask
 
     configured = dask.config.get("distributed.worker.preload", default=None) or []
-    return [*configured, "beatsync._dask_worker"]
+    return [*configured, "beatsync.cluster"]
 
 
 def _glibc_default_malloc() -> Any:
@@ -320,3 +321,31 @@ def _connect(address: str, timeout: float) -> Any:
             f"could not connect to the Dask scheduler at {address!r} {reason}; is `dask "
             "scheduler` running there and reachable? Omit --scheduler to run on a local cluster"
         ) from None
+
+
+#: The start of the record a worker logs when a heartbeat finds the scheduler gone.
+HEARTBEAT_FAILED = "Failed to communicate with scheduler during heartbeat"
+
+
+def _not_a_lost_heartbeat(record: logging.LogRecord) -> bool:
+    return not str(record.msg).startswith(HEARTBEAT_FAILED)
+
+
+def dask_setup(worker: Any) -> None:
+    """Preload of the local clusters' worker processes: Ctrl-C ignored, quiet closing.
+
+    A Ctrl-C in a terminal reaches every process of its group: the local workers too,
+    which printed a KeyboardInterrupt traceback each before the command's own message.
+    The command stops its workers itself when it is interrupted (it closes the
+    cluster), so they ignore SIGINT from the moment this runs (after a second or two
+    of start-up). Not by ignoring SIGINT in this process while the workers start: that
+    lost a Ctrl-C pressed meanwhile. And while the cluster closes, a worker can still
+    send a heartbeat to the scheduler that has just gone, which distributed logs as an
+    ERROR with two tracebacks: only the command's own process can lose a local
+    cluster's scheduler, and it says why, so the workers drop that one record.
+    Nothing for a worker thread of this process (``processes=False``).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    logging.getLogger("distributed.worker").addFilter(_not_a_lost_heartbeat)
