@@ -250,3 +250,68 @@ def test_a_rows_warning_gives_advice_the_dataset_command_can_follow(tmp_path):
     assert "no clear pulse" in row["warning"]
     assert "--bpm" not in row["warning"]
     assert "a tempo range (--min-bpm, --max-bpm) narrows the search" in row["warning"]
+
+
+def test_each_thread_collects_its_own_warnings():
+    # warnings.catch_warnings swaps process-wide state: with two tracks on the threads
+    # of one worker, the first one's warning landed in the second one's record
+    import threading
+
+    from beatsync.errors import BeatsyncWarning, collect_warnings, warn
+
+    step = threading.Barrier(2)
+    seen = {}
+
+    def first():
+        with collect_warnings() as mine:
+            step.wait()  # both inside their blocks
+            step.wait()
+            warn("first")
+            step.wait()
+        seen["first"] = list(mine)
+
+    def second():
+        step.wait()
+        with collect_warnings() as mine:
+            step.wait()
+            step.wait()
+            warn("second")
+        seen["second"] = list(mine)
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=30)
+    assert seen == {"first": ["first"], "second": ["second"]}
+    with collect_warnings() as outer:
+        with collect_warnings() as inner:
+            warn("inner")
+        warn("outer")
+    assert (outer, inner) == (["outer"], ["inner"])
+    with pytest.warns(BeatsyncWarning, match="issued"):  # outside a block: a warning
+        warn("issued")
+
+
+def test_rows_keep_their_own_warnings_on_a_threaded_worker(tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
+    rng = np.random.default_rng(5)
+    ref = beat_times(120, duration=10.0, start=0.3)
+    jobs = []
+    for i in range(6):
+        noise = io.write_audio(tmp_path / f"n{i}.wav", 0.1 * rng.standard_normal(10 * SR), SR)
+        clicks = io.write_audio(tmp_path / f"c{i}.wav", click_track(ref, sr=SR, duration=10.0), SR)
+        jobs += [(str(noise), f"n{i}"), (str(clicks), f"c{i}")]
+    with ThreadPoolExecutor(4) as pool:
+        rows = list(
+            pool.map(
+                lambda job: evaluate_track(
+                    job[0], ref, method="psf", min_beat_time=0.0, name=job[1]
+                ),
+                jobs,
+            )
+        )
+    for row in rows:
+        assert row["status"] == "ok"
+        assert ("no clear pulse" in row["warning"]) == row["key"].startswith("n"), row

@@ -383,7 +383,7 @@ def test_annotation_of_another_recording_and_empty_references(dataset, scheduler
     assert "failed: drums_132: no annotated beat falls inside the audio: the first is at 100" in (
         stdout
     )
-    (audio / "drums_132.wav").unlink()  # one track: the thread workers share warnings
+    # both tracks on the two worker threads: each row keeps its own warnings
     where = ["--out", str(tmp_path / "r2"), "--scheduler", scheduler, "--json"]
     code, stdout, err = _run([*argv, *where, "--min-beat-time", "7.9"], capsys)
     res = json.loads(stdout)

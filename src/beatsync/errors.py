@@ -3,11 +3,22 @@
 Every check of user input raises :class:`ParameterError`, a :class:`ValueError`
 whose message names the offending value and the likely mistake (wrong units,
 frames instead of seconds, an unreadable file, silence, a clip too short).
+
+Every :class:`BeatsyncWarning` is issued through :func:`warn`, so that
+:func:`collect_warnings` can keep one thread's warnings apart from another's (the
+threads of a Dask worker run several tracks at once; :func:`warnings.catch_warnings`
+swaps process-wide state, and a warning could land on another track's record or be
+lost).
 """
 
 from __future__ import annotations
 
-__all__ = ["ParameterError", "BeatsyncWarning"]
+import contextlib
+import threading
+import warnings
+from collections.abc import Iterator
+
+__all__ = ["ParameterError", "BeatsyncWarning", "warn", "collect_warnings"]
 
 
 class ParameterError(ValueError):
@@ -16,3 +27,30 @@ class ParameterError(ValueError):
 
 class BeatsyncWarning(UserWarning):
     """Degenerate but legal input (e.g. no beats to score): a defined result is returned."""
+
+
+_local = threading.local()
+
+
+def warn(message: str, *, stacklevel: int = 1) -> None:
+    """Issue a :class:`BeatsyncWarning`, or record it if this thread collects them.
+
+    ``stacklevel`` as for :func:`warnings.warn` called where this is called.
+    """
+    collected = getattr(_local, "collected", None)
+    if collected is not None:
+        collected.append(str(message))
+        return
+    warnings.warn(message, BeatsyncWarning, stacklevel=stacklevel + 1)
+
+
+@contextlib.contextmanager
+def collect_warnings() -> Iterator[list[str]]:
+    """Record the messages of the :class:`BeatsyncWarning` this thread issues inside the
+    block, in order, instead of issuing them (thread-safe; blocks may nest)."""
+    outer = getattr(_local, "collected", None)
+    _local.collected = []
+    try:
+        yield _local.collected
+    finally:
+        _local.collected = outer

@@ -37,14 +37,13 @@ Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 from scipy.signal import find_peaks
 
-from .errors import BeatsyncWarning, ParameterError
+from .errors import ParameterError, warn
 from .units import check_finite, check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
@@ -178,9 +177,7 @@ def zscore(x: Any, *, name: str = "values") -> np.ndarray:
     sd = float(arr.std())
     if sd <= 1e-12 * max(1.0, float(np.abs(arr).max())):
         if arr.size > 1:
-            warnings.warn(
-                f"{name} is constant; its z-score is set to 0", BeatsyncWarning, stacklevel=2
-            )
+            warn(f"{name} is constant; its z-score is set to 0", stacklevel=2)
         return np.zeros_like(arr)
     return (arr - arr.mean()) / sd
 
@@ -331,10 +328,9 @@ def kinematic_beat_frames(
         frames = _thin(frames, distance)
     frames = np.asarray(frames, dtype=np.int64)
     if frames.size == 0:
-        warnings.warn(
+        warn(
             f"no motion beats found in {pos.shape[0]} frames (method={method!r}, "
             f"smooth={smooth} s): the motion may be static or too short",
-            BeatsyncWarning,
             stacklevel=2,
         )
     return frames

@@ -347,7 +347,7 @@ def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) ->
     """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it."""
     if not tempo or beats.size < 3:
         return
-    from .errors import BeatsyncWarning
+    from .errors import warn
 
     bounds = {**_default_range(PEERS[name]), **tempo}
     lo, hi = bounds["min_bpm"], bounds["max_bpm"]
@@ -363,10 +363,9 @@ def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) ->
     else:  # ours decodes only tempi inside the range: beats are missing or doubled
         why = "some beats were skipped or doubled"
     alt = "" if name == "psf" else " (psf keeps to the range)"
-    warnings.warn(
+    warn(
         f"{name} tapped a median tempo of {bpm:.0f} BPM, {OUT_OF_RANGE_TEXT} "
         f"({lo:g}-{hi:g} BPM): {why}; check the beats{alt}",
-        BeatsyncWarning,
         stacklevel=3,
     )
 

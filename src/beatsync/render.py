@@ -29,14 +29,13 @@ import os
 import shutil
 import subprocess
 import tempfile
-import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .errors import BeatsyncWarning, ParameterError
+from .errors import ParameterError, warn
 from .units import (
     check_fps,
     check_motion_fps,
@@ -604,5 +603,5 @@ def _write_gif_fallback(
         write_audio(wav, y[: min(y.size, int(np.ceil(duration * sr)))], sr)
         msg += f" and the music as {str(wav)!r}; play them together"
     msg += " (install ffmpeg or `pip install imageio-ffmpeg` for an MP4 with sound)"
-    warnings.warn(msg, BeatsyncWarning, stacklevel=3)
+    warn(msg, stacklevel=3)
     return gif

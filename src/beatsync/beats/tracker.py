@@ -15,13 +15,12 @@ noises and the bundled real recordings (numbers beside them).
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, warn
 from ..units import (
     MAX_BPM,
     MIN_BPM,
@@ -343,7 +342,7 @@ def track_beats(
 
 
 def _empty(method: str, msg: str) -> BeatTrack:
-    warnings.warn(msg, BeatsyncWarning, stacklevel=3)
+    warn(msg, stacklevel=3)
     e = np.empty(0)
     return BeatTrack(e, float("nan"), e, e, method)
 
@@ -468,17 +467,15 @@ def _warn_if_no_clear_pulse(
                 "tempo window: give a longer excerpt if you can (or it is noise or free "
                 "rhythm);"
             )
-        warnings.warn(
-            f"no clear pulse in the audio (pulse clarity {clarity:.2f}: "
-            + (
-                f"less than {MIN_PULSE_CLARITY} times the {null:.2f} of the same onsets in "
-                "random order"
-                if clarity < MIN_PULSE_CLARITY * null
-                else f"below {MIN_PATH_SALIENCE}"
-            )
-            + "): "
-            f"{why} the beats may be meaningless or at another metrical level; " + KNOWN_TEMPO_HINT,
-            BeatsyncWarning,
+        against = (
+            f"less than {MIN_PULSE_CLARITY} times the {null:.2f} of the same onsets in "
+            "random order"
+            if clarity < MIN_PULSE_CLARITY * null
+            else f"below {MIN_PATH_SALIENCE}"
+        )
+        warn(
+            f"no clear pulse in the audio (pulse clarity {clarity:.2f}: {against}): {why} the "
+            f"beats may be meaningless or at another metrical level; {KNOWN_TEMPO_HINT}",
             stacklevel=4,
         )
 

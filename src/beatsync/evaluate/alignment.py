@@ -40,12 +40,11 @@ Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb`` (alignment before/afte
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, warn
 from ..units import beat_phase, check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
@@ -114,10 +113,9 @@ def nearest_distance(events: Any, reference: Any) -> np.ndarray:
 
 def _score(averaged: np.ndarray, other: np.ndarray, sigma: float, what: str) -> float:
     if averaged.size == 0 or other.size == 0:
-        warnings.warn(
+        warn(
             f"no {what} to score (motion beats: averaged={averaged.size}, other={other.size}); "
             "returning 0",
-            BeatsyncWarning,
             stacklevel=3,
         )
         return 0.0
@@ -288,8 +286,7 @@ def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
         raise ParameterError("beat_phase_consistency needs at least 2 music beats")
     phase = beat_phase(mb, yb)
     if phase.size == 0:
-        warnings.warn("no motion beats inside the music's beats; returning 0", BeatsyncWarning,
-                      stacklevel=2)
+        warn("no motion beats inside the music's beats; returning 0", stacklevel=2)
         return 0.0
     return float(np.abs(np.mean(np.exp(2j * np.pi * phase))))
 

@@ -27,7 +27,7 @@ from typing import Any
 import mir_eval
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, warn
 from ..units import MIN_BPM, check_positive, check_times
 
 __all__ = [
@@ -240,11 +240,7 @@ def evaluate(
     est = mir_eval.beat.trim_beats(est, min_beat_time=mbt)
     if ref.size == 0 or est.size == 0:
         which = EMPTY_REFERENCE_TEXT if ref.size == 0 else "the estimated beats are empty"
-        warnings.warn(
-            f"{which} after min_beat_time={mbt:g} s: every score is 0",
-            BeatsyncWarning,
-            stacklevel=2,
-        )
+        warn(f"{which} after min_beat_time={mbt:g} s: every score is 0", stacklevel=2)
         return {k: 0.0 for k in METRICS}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # mir_eval warns about what we have checked

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import BeatsyncWarning, ParameterError, warn
 from ..units import time_to_frames
 from .alignment import alignment_scores
 
@@ -68,9 +68,7 @@ def intensity_correlation(motion_intensity: Any, music_level: Any) -> float:
     inten = np.asarray(motion_intensity, dtype=np.float64)
     level = np.asarray(music_level, dtype=np.float64)[: inten.size]
     if inten.size < 2:
-        warnings.warn(
-            "fewer than two beat intervals: correlation set to NaN", BeatsyncWarning, stacklevel=2
-        )
+        warn("fewer than two beat intervals: correlation set to NaN", stacklevel=2)
         return float("nan")
     if np.std(inten) == 0 or np.std(level) == 0:
         return float("nan")

@@ -57,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import BeatsyncWarning, ParameterError, warn
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
 from ..units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
 from .distance import aligned_distance_matrix, point_clouds, typical_speed
@@ -426,11 +426,10 @@ def _beat_frames(beats: Any, clip: Any) -> np.ndarray:
     fr = time_to_frames(bt, fps=clip.fps, mode="round")
     merged = np.flatnonzero(np.diff(fr) == 0)
     if merged.size:
-        warnings.warn(
+        warn(
             f"{merged.size} pair(s) of {what} round to the same frame at {clip.fps:g} fps "
             f"(first: {bt[merged[0]]:g} s and {bt[merged[0] + 1]:g} s -> frame "
             f"{fr[merged[0]]}); they are merged into one beat node",
-            BeatsyncWarning,
             stacklevel=3,
         )
     return np.unique(fr)
@@ -530,11 +529,7 @@ def build_graph(
         else:
             fr = _beat_frames(beats[i], c)
         if fr.size < 2:
-            warnings.warn(
-                f"clip {c.name!r} has {fr.size} beat(s): it contributes no interval",
-                BeatsyncWarning,
-                stacklevel=2,
-            )
+            warn(f"clip {c.name!r} has {fr.size} beat(s): it contributes no interval", stacklevel=2)
         frames_list.append(np.asarray(fr, dtype=np.int64))
 
     node_clip = np.concatenate(

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import BeatsyncWarning, ParameterError, warn
 from ..motion import Motion
 from ..motion_beats import zscore
 from ..units import check_finite, check_fps, check_times
@@ -243,7 +243,7 @@ def compose(
     syn_s = time.perf_counter() - t0
     plaus, notes = plausibility(syn.motion, graph.speed_reference(), res.scales, bound)
     for note in notes:
-        warnings.warn(note, BeatsyncWarning, stacklevel=2)
+        warn(note, stacklevel=2)
     return Composition(
         motion=syn.motion,
         search=res,

@@ -18,12 +18,11 @@ Only :func:`select_channels` validates its input (it is called at the public ent
 from __future__ import annotations
 
 import re
-import warnings
 from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, warn
 
 __all__ = [
     "CONSTANT_REL_STD",
@@ -123,10 +122,9 @@ def select_channels(
             )
         chosen = tuple(n for n in names if _is_default_channel(n))
         if not chosen:
-            warnings.warn(
+            warn(
                 "no limb/spine rotation or *_angle channel found among "
                 f"{list(names[:4])}...; using all channels",
-                BeatsyncWarning,
                 stacklevel=3,
             )
             return names

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from .. import io, peers
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, collect_warnings
 from ..evaluate.beats import (
     METRICS,
     count_octave_errors,
@@ -124,9 +124,10 @@ def evaluate_track(
     try:
         tempo = peers.check_tempo_range(method, min_bpm, max_bpm)
         row.update(min_bpm=tempo.get("min_bpm"), max_bpm=tempo.get("max_bpm"))
-        with warnings.catch_warnings(record=True) as caught:
+        # ours collected per thread (several tracks may share a worker's threads); any
+        # other package's warnings are not the row's
+        with collect_warnings() as caught, warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            warnings.simplefilter("always", BeatsyncWarning)
             y, sr = io.read_audio(audio)
             if reference.size and reference[0] >= y.size / sr:
                 raise ParameterError(
@@ -145,7 +146,7 @@ def evaluate_track(
         return row
     row.update(
         status="ok",
-        warning="; ".join(dict.fromkeys(_dataset_hint(str(w.message)) for w in caught)),
+        warning="; ".join(dict.fromkeys(_dataset_hint(message) for message in caught)),
         n_ref=int(reference.size),
         n_est=int(est.size),
         **tempo_octave(reference, est),

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import BeatsyncWarning, ParameterError, warn
 from ..units import (
     check_motion_fps,
     check_range,
@@ -130,7 +130,7 @@ def _events(
             f"the periodicity test refused the motion ({exc}); fell back to warping the "
             "dancer's own motion beats onto the music's beats (mode='beats')"
         )
-        warnings.warn(note, BeatsyncWarning, stacklevel=3)
+        warn(note, stacklevel=3)
         return _motion_beats(motion, "the fallback to motion beats"), "beats", note
     return np.asarray(seg.boundaries, dtype=np.float64), "periods", ""
 
@@ -353,7 +353,7 @@ def synchronize(
     else:
         count = choose_count(unit / beat_period, dance=dance, bar=bar)
     if count.meter_fit is False:
-        warnings.warn(count.note, BeatsyncWarning, stacklevel=2)
+        warn(count.note, stacklevel=2)
     counts = (
         beats_per_unit(intervals, count.m)
         if used_mode == "beats"
@@ -388,11 +388,10 @@ def synchronize(
         res = _resample(plan, -lag)
     ratio = unit / beat_period / count.m
     if ratio > 2.0 or ratio < 0.5:
-        warnings.warn(
+        warn(
             f"motion {'beats' if used_mode == 'beats' else 'periods'} ({unit:.3f} s) become "
             f"{count.m} beat(s) of {beat_period:.3f} s: the dance is played {ratio:.2f}x its "
             "speed; check the beats or set beats_per_period",
-            BeatsyncWarning,
             stacklevel=2,
         )
     res.report.update(
