@@ -309,6 +309,50 @@ def test_a_streamed_wav_with_no_data_size_is_read(tmp_path, placeholder):
     assert sr == 22050 and y.size == 4410
 
 
+@pytest.mark.parametrize("size", [2**63 - 1, 2**64 - 1])
+def test_a_streamed_w64_with_no_data_size_is_read(tmp_path, size):
+    # ffmpeg writing W64 to a pipe leaves the 64-bit size at 0x7FFF...FF: it was
+    # refused as announcing 96 million million seconds
+    import struct
+
+    import soundfile as sf
+
+    y = (0.3 * np.sin(np.arange(3 * 8000) / 5)).astype(np.float32)
+    path = tmp_path / "s.w64"
+    sf.write(path, y, 8000, format="W64", subtype="PCM_16")
+    raw = bytearray(path.read_bytes())
+    at = raw.index(b"data\xf3\xac\xd3\x11")
+    raw[at + 16 : at + 24] = struct.pack("<Q", size)
+    path.write_bytes(bytes(raw))
+    assert io.read_audio(path)[0].size == y.size
+    # a chunk before the data whose size no file can hold: read, not a traceback
+    raw = bytearray(path.read_bytes())
+    fmt = raw.index(b"fmt \xf3\xac\xd3\x11")
+    junk = b"junk\xf3\xac\xd3\x11\x8c\xd1\x00\xc0\x4f\x8e\xdb\x8a" + struct.pack("<Q", 2**64 - 1)
+    raw[fmt:fmt] = junk  # (libsndfile skips a chunk of that size; not one of 2**63 - 1)
+    path.write_bytes(bytes(raw))
+    assert io.read_audio(path)[0].size == y.size
+
+
+def test_an_aiff_sox_wrote_to_a_pipe_is_read(tmp_path):
+    # SoX announces 0x7F000000 bytes of audio (in whole frames) when it cannot seek back
+    import math
+    import struct
+
+    channels, width, sr = 2, 2, 44100
+    frames = 0x7F000000 // (channels * width)
+    exponent = math.floor(math.log2(sr))
+    rate = struct.pack(">HQ", exponent + 16383, int(sr / 2**exponent * 2**63))
+    data = (np.sin(np.arange(3 * sr * channels) / 7) * 3000).astype(">i2").tobytes()
+    head = b"FORM" + struct.pack(">I", 46 + frames * channels * width) + b"AIFF"
+    head += b"COMM" + struct.pack(">IhIh", 18, channels, frames, 16) + rate
+    head += b"SSND" + struct.pack(">III", 8 + frames * channels * width, 0, 0)
+    path = tmp_path / "sox.aiff"
+    path.write_bytes(head + data)
+    y, got_sr = io.read_audio(path)
+    assert (y.size, got_sr) == (3 * sr, sr)
+
+
 def test_beats_files(tmp_path):
     y, sr, beats = datasets.load_madmom_sample()
     np.testing.assert_allclose(beats, [0.0913, 0.7997, 1.4806, 2.1478])

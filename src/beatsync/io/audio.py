@@ -177,6 +177,14 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
 #: 32-bit data sizes that mean "unknown" rather than a length.
 _UNKNOWN_DATA_SIZES = (0, 0x7FFFF000, 0x7FFFFFFF, 0xFFFFFFFF)
 
+#: 64-bit data sizes from here up mean "unknown" (writers that could not seek back put
+#: 0x7FFF...FF or 0xFFFF...FF; ffmpeg writing W64 to a pipe, the former).
+_UNKNOWN_64 = 2**62
+
+#: The audio bytes SoX announces in an AIFF(-C) written to a pipe: 0x7F000000 rounded
+#: down to whole frames (never filled in).
+_SOX_AIFF_PIPE = 0x7F000000
+
 #: The first sixteen bytes of a Sony Wave64 file: the GUID of its "riff" chunk.
 _W64_RIFF = b"riff\x2e\x91\xcf\x11\xa5\xd6\x28\xdb\x04\xc1\x00\x00"
 
@@ -217,11 +225,15 @@ def _data_bytes(p: Path) -> tuple[int, int] | None | Literal[False]:
                     return None
                 declared = struct.unpack("<Q", head[28:36])[0]
                 found = _walk_chunks(f, 12, size_on_disk, "<I", b"data")
-                return (declared, found[1]) if found and declared else None
+                if not found or not declared or declared >= _UNKNOWN_64:
+                    return None
+                return declared, found[1]
             if head[:4] == b"FORM" and head[8:12] in (b"AIFF", b"AIFC"):
                 sizes = _known(_walk_chunks(f, 12, size_on_disk, ">I", b"SSND"))
+                if sizes is None or _SOX_AIFF_PIPE - 256 < sizes[0] - 8 <= _SOX_AIFF_PIPE:
+                    return None
                 # the chunk's size counts its 8-byte offset and block size
-                return None if sizes is None else (sizes[0] - 8, sizes[1] - 8)
+                return sizes[0] - 8, sizes[1] - 8
             if head[:16] == _W64_RIFF and len(head) == 40 and head[24:28] == b"wave":
                 f.seek(40)
                 for _ in range(64):
@@ -230,8 +242,10 @@ def _data_bytes(p: Path) -> tuple[int, int] | None | Literal[False]:
                         return None
                     size = struct.unpack("<Q", chunk[16:24])[0]  # counts the 24-byte header
                     if chunk[:4] == b"data":
-                        return (size - 24, size_on_disk - f.tell()) if size > 24 else None
-                    if size < 24:
+                        if size <= 24 or size >= _UNKNOWN_64:
+                            return None
+                        return size - 24, size_on_disk - f.tell()
+                    if size < 24 or size > size_on_disk:
                         return None
                     f.seek(size - 24 + (-size) % 8, os.SEEK_CUR)
                 return None
@@ -240,7 +254,7 @@ def _data_bytes(p: Path) -> tuple[int, int] | None | Literal[False]:
                 if size in _UNKNOWN_DATA_SIZES or offset < 24:
                     return None
                 return size, size_on_disk - offset
-    except OSError:
+    except (OSError, ValueError, OverflowError):  # a seek past what an offset can hold
         return None
     return False
 
