@@ -257,7 +257,20 @@ def test_resume_after_interrupted_run(dataset, cluster, request, tmp_path, capsy
     assert sorted(table.loc[table["status"] == "ok", "key"]) == sorted(GOOD)
 
 
-def test_library_entry_in_process_threads(dataset, tmp_path):
+def test_library_entry_in_process_threads(dataset, tmp_path, monkeypatch):
+    # the tracks' warnings.catch_warnings blocks, interleaved on threads of this process,
+    # could leave its (process-wide) filters changed: here each track changes them
+    import warnings
+
+    real_track = beat_dataset.evaluate_track
+
+    def track_and_change_the_filters(*args, **kwargs):
+        row = real_track(*args, **kwargs)
+        warnings.simplefilter("ignore")
+        return row
+
+    monkeypatch.setattr(beat_dataset, "evaluate_track", track_and_change_the_filters)
+    filters = list(warnings.filters)
     found = find_tracks(*dataset)
     assert [t.key for t in found.tracks] == sorted(t.key for t in found.tracks)
     assert {t.group for t in found.tracks} == {".", "rock", "clicks"}
@@ -269,6 +282,7 @@ def test_library_entry_in_process_threads(dataset, tmp_path):
     assert (run.tracks["status"] == "ok").all()
     assert (run.tracks["F-measure"] >= 0.9).all()
     assert run.files["summary"].is_file()
+    assert warnings.filters == filters
 
 
 # ----------------------------------------------------------------------------- bad input

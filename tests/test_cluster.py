@@ -150,12 +150,25 @@ def _sigint_and_heartbeat_record():
 def test_local_worker_processes_ignore_ctrl_c_and_keep_configured_preloads(monkeypatch):
     # the command closes its workers on Ctrl-C; each worker printed a traceback too
     import dask
+    import distributed  # noqa: F401 (its defaults loaded first: config.set would drop them)
 
     with dask.config.set({"distributed.worker.preload": ["json"]}):
-        assert cluster._worker_preloads() == ["json", "beatsync.cluster"]
-    with cluster.dask_client(n_workers=1, processes=True) as client:
-        (state,) = client.run(_sigint_and_heartbeat_record).values()
+        assert cluster._worker_preloads() == {"preload": ["json", "beatsync.cluster"]}
+    # one string (as an environment variable gives it), arguments per preload or shared
+    settings = {
+        "distributed.worker.preload": "json",
+        "distributed.worker.preload-argv": [["--x"]],
+    }
+    with dask.config.set(settings):
+        assert cluster._worker_preloads() == {
+            "preload": ["json", "beatsync.cluster"],
+            "preload_argv": [["--x"], []],
+        }
+        with cluster.dask_client(n_workers=1, processes=True) as client:
+            (state,) = client.run(_sigint_and_heartbeat_record).values()
     assert state == (True, False)  # SIGINT ignored, the lost-heartbeat record dropped
+    with dask.config.set({"distributed.worker.preload-argv": ["--y"]}):
+        assert "preload_argv" not in cluster._worker_preloads()  # passed to each
     # worker threads of this process change nothing here
     import signal
 

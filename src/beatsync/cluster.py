@@ -162,7 +162,7 @@ def dask_client(
             scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
             silence_logs=logging.ERROR,
             # worker processes ignore Ctrl-C: this process closes them (no tracebacks)
-            **({"preload": _worker_preloads()} if processes else {}),
+            **(_worker_preloads() if processes else {}),
         )
         client = Client(cluster)
     else:
@@ -178,12 +178,23 @@ def dask_client(
         stack.close()
 
 
-def _worker_preloads() -> list[str]:
-    """The preloads configured for Dask workers, and this module (:func:`dask_setup`)."""
+def _worker_preloads() -> dict[str, list[Any]]:
+    """``preload`` (and ``preload_argv``) for the local workers: those configured for
+    Dask workers, and this module (:func:`dask_setup`).
+
+    A configured preload may be one string; arguments given per preload get an empty
+    list for ours (distributed refuses lists of different lengths).
+    """
     import dask
 
     configured = dask.config.get("distributed.worker.preload", default=None) or []
-    return [*configured, "beatsync.cluster"]
+    if isinstance(configured, str):
+        configured = [configured]
+    kwargs: dict[str, list[Any]] = {"preload": [*configured, "beatsync.cluster"]}
+    argv = dask.config.get("distributed.worker.preload-argv", default=None) or []
+    if argv and not isinstance(argv[0], str):  # one list per preload
+        kwargs["preload_argv"] = [*argv, []]
+    return kwargs
 
 
 def _glibc_default_malloc() -> Any:

@@ -47,7 +47,13 @@ def warn(message: str, *, stacklevel: int = 1) -> None:
 @contextlib.contextmanager
 def collect_warnings() -> Iterator[list[str]]:
     """Record the messages of the :class:`BeatsyncWarning` this thread issues inside the
-    block, in order, instead of issuing them (thread-safe; blocks may nest)."""
+    block, in order, instead of issuing them (thread-safe; blocks may nest).
+
+    Every one is recorded, whatever the :mod:`warnings` filters say: they are
+    process-wide, and another thread's filters must not decide this thread's record. A
+    warning that code inside the block silences with :func:`warnings.simplefilter` is
+    recorded all the same.
+    """
     outer = getattr(_local, "collected", None)
     _local.collected = []
     try:

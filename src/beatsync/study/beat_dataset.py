@@ -406,6 +406,10 @@ def evaluate_dataset(
     created = not out.exists()
     try:
         with contextlib.ExitStack() as stack:
+            # the tracks silence other packages' warnings with warnings.catch_warnings,
+            # whose filters are process-wide: tracks on the threads of this process
+            # (processes=False) could leave them changed; restored when the run ends
+            stack.enter_context(warnings.catch_warnings())
             if todo:  # connect first: an unreachable scheduler changes nothing on disk
                 client = stack.enter_context(
                     dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes)
@@ -531,7 +535,7 @@ def _prepare_workers(client, method: str) -> None:
     """
     if method != "librosa":
         return
-    for address in client.scheduler_info()["workers"]:
+    for address in client.nthreads():  # every worker (scheduler_info held 5 in some versions)
         with contextlib.suppress(Exception):
             client.run(peers.prepare, method, workers=[address])
 
