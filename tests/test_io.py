@@ -1,3 +1,4 @@
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -6,7 +7,7 @@ import numpy as np
 import pytest
 
 from beatsync import datasets, io
-from beatsync.errors import ParameterError
+from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.motion import Motion
 
 
@@ -214,7 +215,7 @@ def test_damaged_soundfile_formats_are_refused_without_librosa(tmp_path):
 import sys
 from pathlib import Path
 from beatsync import io
-from beatsync.errors import ParameterError
+from beatsync.errors import BeatsyncWarning, ParameterError
 d = Path(sys.argv[1])
 for name in ("junk.wav", "junk.flac", "junk.mp3"):
     (d / name).write_bytes(b"RIFF garbage not audio" * 10)
@@ -293,6 +294,41 @@ def test_an_ogg_file_cut_short_is_refused(tmp_path):
     trailing = tmp_path / "trailing.ogg"
     trailing.write_bytes(data + b"TAG" + b"\0" * 125)
     assert io.read_audio(trailing)[0].size == y.size
+
+
+def _mp3_cut(tmp_path, fraction):
+    import soundfile as sf
+
+    if "MP3" not in sf.available_formats():
+        pytest.skip("this libsndfile does not write MP3")
+    y = (0.3 * np.sin(np.arange(10 * 22050) / 5)).astype(np.float32)
+    whole = tmp_path / "whole.mp3"
+    sf.write(whole, y, 22050, format="MP3")
+    cut = tmp_path / f"cut{fraction}.mp3"
+    cut.write_bytes(whole.read_bytes()[: int(whole.stat().st_size * fraction)])
+    return cut
+
+
+def test_the_mp3_decoders_own_messages_become_a_warning(tmp_path, capfd):
+    # libmpg123 printed "Warning: Xing stream size off..." to the process's stderr,
+    # beside (and with --json, inside) the command's own output
+    cut = _mp3_cut(tmp_path, 0.985)  # short by less than the cut-short check refuses
+    with pytest.warns(BeatsyncWarning, match=r"the MP3 decoder \(libmpg123\) reported on"):
+        y, sr = io.read_audio(cut)
+    assert y.size > 9 * sr
+    assert "Xing" not in capfd.readouterr().err
+
+
+def test_a_cut_mp3_gives_only_the_json_error_on_stderr(tmp_path):
+    cut = _mp3_cut(tmp_path, 0.66)
+    proc = subprocess.run(
+        [sys.executable, "-m", "beatsync.cli", "beats", str(cut), "--json"],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 3
+    error = json.loads(proc.stderr)
+    assert "is cut short" in error["error"]
 
 
 @pytest.mark.parametrize("placeholder", [b"\xff\xff\xff\xff", b"\x00\xf0\xff\x7f"])

@@ -10,10 +10,9 @@ happen only after tracking succeeded, and never overwrite the input.
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, collect_warnings
 from . import COMMAND_HELP
 from ._common import Outputs, add_output_flags, emit, feedback
 from ._tempo import add_tempo_range, tempo_options
@@ -80,12 +79,11 @@ def run(args: Any) -> int:
             if args.click is not None
             else None
         )
-        with fb.step("reading audio"):
-            y, sr = io.read_audio(args.audio)
-        with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
-            warnings.simplefilter("always", BeatsyncWarning)
-            track = track_beats(y, sr, method=args.method, **tempo)
-        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        with collect_warnings() as notes:  # the decoder's and the tracker's
+            with fb.step("reading audio"):
+                y, sr = io.read_audio(args.audio)
+            with fb.step("tracking beats"):
+                track = track_beats(y, sr, method=args.method, **tempo)
         for note in notes:
             fb.warn(note)
         if track.beats.size == 0:

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import BeatsyncWarning, ParameterError, collect_warnings
 from . import COMMAND_HELP
 from ._common import Outputs, add_output_flags, emit, feedback
 from ._tempo import add_music_beat_options, tempo_options
@@ -219,7 +219,10 @@ def run(args: argparse.Namespace) -> int:
     mult = check_multiplicity(mult)
     files = chk["files"]
     t_read = time.perf_counter()
-    y, sr = io.read_audio(chk["audio"])
+    with collect_warnings() as read_notes:  # e.g. the MP3 decoder's
+        y, sr = io.read_audio(chk["audio"])
+    for note in read_notes:
+        fb.warn(note)
     beats = None
     if args.beats is not None:  # cheap checks first: the beats file before the clips
         try:
@@ -237,14 +240,15 @@ def run(args: argparse.Namespace) -> int:
     from ..music import track_music_beats
 
     check_library(clips)
-    notes: list[str] = []
+    notes: list[str] = list(read_notes)
     if beats is None:
         with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
             warnings.simplefilter("always", BeatsyncWarning)
             beats = track_music_beats(y, sr, **tempo_options(args))
-        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
-        for note in notes:
+        tracked = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        for note in tracked:
             fb.warn(note)
+        notes += tracked
     params = {
         "th": chk["th"],
         "weight_rule": args.weight_rule,

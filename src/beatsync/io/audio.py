@@ -2,15 +2,20 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
+import tempfile
+import threading
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, warn
 from ..resampling import resample
 from ..units import as_float, check_audio, check_finite, check_sample_rate, check_times
 from ._files import atomic_write, check_input_file
@@ -66,8 +71,11 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     p = check_input_file(path, "audio")
     if sr is not None:
         sr = _integral_rate(sr, name="sr")
+    decoder: list[str] = []
     try:
-        with sf.SoundFile(p) as f:
+        # libmpg123 prints its own warnings to the process's stderr ("Xing stream size
+        # off by more than 1%"): kept apart, then said once the read is judged
+        with _c_stderr_captured(p.suffix.lower() == ".mp3") as decoder, sf.SoundFile(p) as f:
             announced, file_sr = f.frames, f.samplerate
             data = f.read(dtype="float32", always_2d=True)
         y = data.mean(axis=1)
@@ -95,7 +103,14 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
                 "is it a WAV/FLAC/OGG/MP3 file?"
             ) from None
     else:
-        _check_complete(p, announced, y.size, file_sr)
+        _check_complete(p, announced, y.size, file_sr)  # its own words if cut short
+        if decoder:
+            warn(
+                f"the MP3 decoder (libmpg123) reported on {str(p)!r}: "
+                + "; ".join(decoder)
+                + " (the file was read; if it sounds wrong, copy it again)",
+                stacklevel=2,
+            )
     y = np.asarray(y, dtype=np.float32)
     try:
         file_sr = _integral_rate(file_sr, name="sample rate")
@@ -132,6 +147,37 @@ def resample_audio(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarra
 #: announced length (its Xing header) may be an estimate off by a frame or two.
 SHORT_FILE_FRACTION = 0.01
 SHORT_FILE_MIN_S = 0.1
+
+
+@contextlib.contextmanager
+def _c_stderr_captured(active: bool = True) -> Iterator[list[str]]:
+    """The lines C code writes to file descriptor 2 inside the block, kept from the
+    terminal (and from ``--json`` output on stderr).
+
+    Only in the main thread (the descriptor is the whole process's: a worker thread
+    would hide the other threads' output); elsewhere, or when not ``active``, nothing
+    is captured.
+    """
+    lines: list[str] = []
+    if not active or threading.current_thread() is not threading.main_thread():
+        yield lines
+        return
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no descriptor 2 (a closed or replaced stderr)
+        yield lines
+        return
+    with tempfile.TemporaryFile() as held:
+        os.dup2(held.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            held.seek(0)
+            text = held.read().decode("utf-8", errors="replace")
+            lines.extend(line.strip() for line in text.splitlines() if line.strip())
 
 
 def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
