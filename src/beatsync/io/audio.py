@@ -165,7 +165,7 @@ def _c_stderr_captured(active: bool = True) -> Iterator[list[str]]:
     try:
         sys.stderr.flush()
         saved = os.dup(2)
-    except (OSError, ValueError):  # no descriptor 2 (a closed or replaced stderr)
+    except (OSError, ValueError, AttributeError):  # no descriptor 2 or no sys.stderr
         yield lines
         return
     with tempfile.TemporaryFile() as held:
