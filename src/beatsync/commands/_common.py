@@ -505,6 +505,25 @@ class Feedback:
         print(f"beatsync {self.command}: warning: {text}", file=self.stream, flush=True)
 
     @contextlib.contextmanager
+    def noted(self) -> Iterator[list[str]]:
+        """The :class:`~beatsync.errors.BeatsyncWarning` messages issued in the block.
+
+        Filled when the block ends, and each said with :meth:`warn` then (other
+        warnings inside the block are dropped).
+        """
+        import warnings
+
+        from ..errors import BeatsyncWarning
+
+        notes: list[str] = []
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", BeatsyncWarning)
+            yield notes
+        notes += [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        for note in notes:
+            self.warn(note)
+
+    @contextlib.contextmanager
     def step(self, desc: str, total: float | None = None) -> Iterator[ProgressCallback]:
         """A bar for one step; yields the ``progress(done, total=None)`` callable.
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..errors import ParameterError, collect_warnings
+from ..errors import ParameterError
 from . import COMMAND_HELP
 from ._common import Outputs, add_output_flags, emit, feedback
 from ._tempo import add_tempo_range, tempo_options
@@ -79,13 +79,11 @@ def run(args: Any) -> int:
             if args.click is not None
             else None
         )
-        with collect_warnings() as notes:  # the decoder's and the tracker's
+        with fb.noted() as notes:  # the decoder's and the tracker's
             with fb.step("reading audio"):
                 y, sr = io.read_audio(args.audio)
             with fb.step("tracking beats"):
                 track = track_beats(y, sr, method=args.method, **tempo)
-        for note in notes:
-            fb.warn(note)
         if track.beats.size == 0:
             raise ParameterError(
                 f"no beats found in {args.audio!r} (no onsets: no attack in any band, e.g. near "

@@ -16,13 +16,12 @@ from __future__ import annotations
 
 import argparse
 import time
-import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError, collect_warnings
+from ..errors import ParameterError
 from . import COMMAND_HELP
 from ._common import Outputs, add_output_flags, emit, feedback
 from ._tempo import add_music_beat_options, tempo_options
@@ -219,10 +218,8 @@ def run(args: argparse.Namespace) -> int:
     mult = check_multiplicity(mult)
     files = chk["files"]
     t_read = time.perf_counter()
-    with collect_warnings() as read_notes:  # e.g. the MP3 decoder's
+    with fb.noted() as read_notes:  # e.g. the MP3 decoder's
         y, sr = io.read_audio(chk["audio"])
-    for note in read_notes:
-        fb.warn(note)
     beats = None
     if args.beats is not None:  # cheap checks first: the beats file before the clips
         try:
@@ -242,12 +239,8 @@ def run(args: argparse.Namespace) -> int:
     check_library(clips)
     notes: list[str] = list(read_notes)
     if beats is None:
-        with warnings.catch_warnings(record=True) as caught, fb.step("tracking beats"):
-            warnings.simplefilter("always", BeatsyncWarning)
+        with fb.noted() as tracked, fb.step("tracking beats"):
             beats = track_music_beats(y, sr, **tempo_options(args))
-        tracked = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
-        for note in tracked:
-            fb.warn(note)
         notes += tracked
     params = {
         "th": chk["th"],
@@ -259,8 +252,7 @@ def run(args: argparse.Namespace) -> int:
         graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
     build_s = time.perf_counter() - t0
     kw = {"tempo_weight": args.tempo_weight} if args.method == "dp" and args.tempo_weight else {}
-    with warnings.catch_warnings(record=True) as caught, fb.step("composing"):
-        warnings.simplefilter("always", BeatsyncWarning)
+    with fb.noted() as composed, fb.step("composing"):
         comp = compose_music(
             graph,
             y,
@@ -273,10 +265,7 @@ def run(args: argparse.Namespace) -> int:
             tempo_select=not args.all_clips,
             **kw,
         )
-    for w in caught:
-        if issubclass(w.category, BeatsyncWarning):
-            notes.append(str(w.message))
-            fb.warn(str(w.message))
+    notes += composed
     out = chk["out"]
     video_path = chk["video"]
     result = {

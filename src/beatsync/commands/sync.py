@@ -17,13 +17,12 @@ from __future__ import annotations
 
 import argparse
 import time
-import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError
 from . import COMMAND_HELP
 from ._common import (
     Feedback,
@@ -208,12 +207,8 @@ def run(args: argparse.Namespace) -> int:
     outs, out, video, report_path = _check_inputs(args)
     fb = feedback(args)
     with outs:  # the motion, video and report are all written, or none of them
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", BeatsyncWarning)
+        with fb.noted() as notes:
             result = _pipeline(args, outs, out, video, fb)
-        notes = [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
-        for note in notes:
-            fb.warn(note)
         result["warnings"] = notes
         if report_path is not None:
             io.write_json(outs.path(report_path), result)

@@ -187,7 +187,7 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
     W64, AIFF or AU file to the bytes present, decodes an MP3 until its data ends, and
     an Ogg stream until its last page. For the first five, the bytes the header
     announces for the audio are compared with the bytes present (:func:`_data_bytes`;
-    not when the size is a placeholder); an Ogg file must end with its stream's last
+    not when the size says "unknown"); an Ogg file must end with its stream's last
     page (:func:`_ogg_is_cut`); for other formats, libsndfile's announced count is
     compared with the samples read (for an MP3 only with a Xing, Info or VBRI header).
     """
@@ -323,7 +323,7 @@ def _walk_chunks(f, start: int, size_on_disk: int, fmt: str, target: bytes):
 
 
 def _known(sizes: tuple[int, int] | None) -> tuple[int, int] | None:
-    # placeholders of writers that could not seek back to fill the size in (0,
+    # the sizes writers put when they cannot seek back to fill the real one in (0,
     # 0xFFFFFFFF; SoX writes 0x7FFFF000 to a pipe) say nothing about the length
     return None if sizes is None or sizes[0] in _UNKNOWN_DATA_SIZES else sizes
 
