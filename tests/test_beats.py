@@ -607,6 +607,11 @@ def test_banded_tempo_decoder_equals_the_dense_viterbi(grid, p_jump):
             obs[rng.integers(periods.size), 20:] += 5 * scale  # a tempo change halfway
             path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=p_jump)
             np.testing.assert_array_equal(path, viterbi(obs, log_trans))
+    # one window (a short clip): no transition, with and without an initial distribution
+    for log_prior in (None, rng.normal(size=periods.size)):
+        obs = rng.normal(size=(periods.size, 1))
+        path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=p_jump, log_prior=log_prior)
+        np.testing.assert_array_equal(path, viterbi(obs, log_trans, log_prior))
 
 
 def test_front_end_blocks_equal_one_pass(monkeypatch):
@@ -621,3 +626,103 @@ def test_front_end_blocks_equal_one_pass(monkeypatch):
     blocks = onset.compute_onsets(y.astype(np.float64), SR, fe)
     np.testing.assert_allclose(blocks.bands, whole.bands, rtol=1e-5, atol=1e-9)
     np.testing.assert_allclose(blocks.onset_times, whole.onset_times, atol=1e-9)
+
+
+def _salience_by_spectrum(bands, fps, starts, stops, periods, half_time_s, max_hz):
+    """The resonators' salience as its definition reads: the padded window's power
+    spectrum times each comb filter's squared gain, summed over the one-sided bins."""
+    from beatsync.beats.metrical import resonator_fft_size
+
+    length = max(b - a for a, b in zip(starts, stops, strict=True))
+    n_fft = resonator_fft_size(length, fps, half_time_s)
+    freq = np.arange(n_fft // 2 + 1) * fps / n_fft
+    alpha = 0.5 ** (periods / half_time_s)
+    a = alpha[:, None]
+    gain = (1 - a) ** 2 / (1 - 2 * a * np.cos(2 * np.pi * np.outer(periods, freq)) + a**2)
+    gamma = (1 - alpha) ** 2 / (1 - alpha**2)
+    if max_hz is not None:
+        gain[:, int(np.ceil(max_hz / fps * n_fft)) + 1 :] = gamma[:, None]  # passed as is
+    out = np.zeros((periods.size, len(starts)))
+    for w, (a0, a1) in enumerate(zip(starts, stops, strict=True)):
+        x = bands[:, a0:a1]
+        seg = (x - x.mean(axis=1, keepdims=True)) * np.hanning(a1 - a0)
+        power = np.abs(np.fft.rfft(seg, n=n_fft, axis=1)) ** 2
+        r = (gain @ power.T / power.sum(axis=1) - gamma[:, None]) / (1 - gamma[:, None])
+        r[periods > (a1 - a0) / fps / 2] = 0.0
+        out[:, w] = r.sum(axis=1)
+    return out
+
+
+@pytest.mark.parametrize(
+    "windows",
+    [
+        [(0, 483)],  # the madmom sample: one window of 2.8 s
+        [(0, 1378), (172, 1550), (600, 1978), (1624, 3000)],  # 8 s windows, one shorter
+        [(0, 5000)],  # longer than half the FFT: its autocorrelation wraps the spectrum
+    ],
+)
+@pytest.mark.parametrize("max_hz", [None, 34.0])
+def test_resonator_salience_equals_the_spectrum_sum(windows, max_hz):
+    # resonator_salience sums the power spectrum against the comb gains in the lag
+    # domain; it must equal the sum over the padded spectrum's bins
+    from beatsync.beats.metrical import resonator_salience
+
+    fps = 22050 / 128
+    rng = np.random.default_rng(3)
+    bands = np.abs(rng.standard_normal((4, max(b for _, b in windows)))) ** 3
+    bands[1, ::86] += 5.0  # a pulse at 120 BPM in one band
+    starts, stops = [a for a, _ in windows], [b for _, b in windows]
+    periods = np.exp(np.linspace(np.log(0.08), np.log(4.0), 200))
+    got = resonator_salience(bands, fps, starts, stops, periods, 3.0, max_hz)
+    want = _salience_by_spectrum(bands, fps, starts, stops, periods, 3.0, max_hz)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
+    # several sets of bands at once (the null's draws): each as on its own
+    sets = resonator_salience(np.stack([bands, bands[::-1]]), fps, starts, stops, periods, 3.0)
+    one = resonator_salience(bands[::-1], fps, starts, stops, periods, 3.0)
+    np.testing.assert_allclose(sets[..., 1], one, rtol=0, atol=1e-12 * np.abs(one).max())
+
+
+def test_pulse_clarity_null_draws_in_one_batch_equal_draws_one_by_one():
+    from beatsync.beats import tracker
+    from beatsync.beats.metrical import METER_MODEL, beat_observation
+    from beatsync.beats.onset import compute_onsets, frontend_settings
+    from beatsync.beats.tempo import analysis_windows, period_grid, tempo_hmm
+
+    y, sr = datasets.load_madmom_sample()[:2]
+    y, sr = tracker.check_audio(y, sr)
+    ons = compute_onsets(y, sr, frontend_settings({}, sr))
+    starts, stops, _ = analysis_windows(ons.envelope.size, ons.fps, 8.0, 1.0)
+    periods = period_grid(40, 240)
+    n = ons.bands.shape[1]
+    n_draws = int(np.clip(np.ceil(tracker.NULL_AUDIO_S * ons.fps / n), 1, tracker.NULL_MAX_DRAWS))
+    assert n_draws > 1
+    rng = np.random.default_rng(0)
+    values = []
+    for _ in range(n_draws):
+        acc = tracker._accents(ons.bands[:, rng.permutation(n)], ons.fps)
+        log_obs, sal = beat_observation(acc, ons.fps, starts, stops, periods, METER_MODEL, 30.0)
+        path = tempo_hmm(log_obs, periods, trans_sigma=tracker.TRANS_SIGMA, p_jump=tracker.P_JUMP)
+        values.append(np.mean(sal[path, np.arange(path.size)]))
+    null = tracker.pulse_clarity_null(ons, starts, stops, periods, METER_MODEL, 30.0)
+    assert null == pytest.approx(np.mean(values), rel=1e-12)
+
+
+def test_small_filters_equal_scipy_ndimage():
+    from scipy import ndimage
+
+    from beatsync.beats.filters import gaussian_smooth, moving_max, moving_mean
+
+    x = np.random.default_rng(4).random((3, 2, 40))
+    for sigma in (0.5, 1.72, 12.0):  # 12: the kernel is wider than the signal
+        want = ndimage.gaussian_filter1d(x, sigma, axis=-1)
+        np.testing.assert_allclose(gaussian_smooth(x, sigma), want, atol=1e-12)
+        np.testing.assert_allclose(gaussian_smooth(x[0, 0], sigma), want[0, 0], atol=1e-12)
+    for size, origin in ((5, 0), (6, 1), (7, -2)):
+        np.testing.assert_allclose(
+            moving_mean(x, size, origin),
+            ndimage.uniform_filter1d(x, size, origin=origin),
+            atol=1e-12,
+        )
+        np.testing.assert_array_equal(
+            moving_max(x, size, origin), ndimage.maximum_filter1d(x, size, origin=origin)
+        )

@@ -38,9 +38,16 @@ def moving_max(x: np.ndarray, size: int, origin: int = 0) -> np.ndarray:
 
 
 def gaussian_smooth(x: np.ndarray, sigma: float, truncate: float = 4.0) -> np.ndarray:
-    """Gaussian smoothing of a 1-D signal (scipy's gaussian_filter1d)."""
+    """Gaussian smoothing along the last axis (scipy's gaussian_filter1d)."""
     r = int(truncate * float(sigma) + 0.5)
     k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
     k /= k.sum()
-    xp = np.pad(np.asarray(x, dtype=np.float64), r, mode="symmetric")
-    return np.convolve(xp, k, mode="valid")
+    x = np.asarray(x, dtype=np.float64)
+    if x.ndim == 1:
+        return np.convolve(np.pad(x, r, mode="symmetric"), k, mode="valid")
+    xp, _ = _padded(x, 2 * r + 1, 0)
+    n = x.shape[-1]
+    out = k[0] * xp[..., :n]
+    for j in range(1, 2 * r + 1):  # a few taps: one pass over the whole array each
+        out += k[j] * xp[..., j : j + n]
+    return out

@@ -135,11 +135,46 @@ def tempo_hmm(
     log_prior : np.ndarray, optional
         Log initial distribution over the periods.
     """
+    if log_obs.shape[1] == 1:  # one window (a clip shorter than it): no transition
+        value = log_obs[:, 0] + (0.0 if log_prior is None else log_prior)
+        return np.array([int(np.argmax(value))], dtype=np.int64)
     periods = np.ascontiguousarray(periods, dtype=np.float64)
-    log_trans, reach = _log_transitions(periods.tobytes(), float(trans_sigma), float(p_jump))
+    key = (periods.tobytes(), float(trans_sigma), float(p_jump))
+    log_trans, reach = _log_transitions(*key)
     if reach is not None and 2 * reach + 1 < periods.size:
-        return viterbi_banded(log_obs, log_trans, reach, np.log(p_jump / periods.size), log_prior)
+        return viterbi_banded(
+            log_obs,
+            log_trans,
+            reach,
+            np.log(p_jump / periods.size),
+            log_prior,
+            band_terms=_band_terms(*key),
+        )
     return viterbi(log_obs, log_trans, log_prior)
+
+
+@functools.lru_cache(maxsize=8)
+def _band_terms(
+    periods_key: bytes, trans_sigma: float, p_jump: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`viterbi_banded`'s band of the tempo HMM's transitions (cached per grid)."""
+    log_trans, reach = _log_transitions(periods_key, trans_sigma, p_jump)
+    return _band(log_trans, reach)
+
+
+def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(band, src)``: ``log_trans[src[d, j], j]`` for the predecessors ``src[d, j] =
+    j + d - reach`` of each state ``j`` (-inf outside the grid; ``src`` clipped to it)."""
+    n_states = log_trans.shape[0]
+    offsets = np.arange(-reach, reach + 1)
+    src = np.arange(n_states)[None, :] + offsets[:, None]  # predecessor i of j, (width, n)
+    valid = (src >= 0) & (src < n_states)
+    band = np.full(src.shape, -np.inf)
+    band[valid] = log_trans[src[valid], np.nonzero(valid)[1]]
+    src = np.clip(src, 0, n_states - 1)
+    for arr in (band, src):
+        arr.flags.writeable = False
+    return band, src
 
 
 def viterbi_banded(
@@ -148,6 +183,8 @@ def viterbi_banded(
     reach: int,
     log_jump: float,
     log_init: np.ndarray | None = None,
+    *,
+    band_terms: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """:func:`viterbi` for transitions that are a band plus a uniform jump.
 
@@ -155,16 +192,11 @@ def viterbi_banded(
     (and be at least ``log_jump`` everywhere): the best predecessor of ``j`` is then the
     best inside the band, or the best state overall jumping. Each step costs
     ``(2 reach + 1) n`` instead of ``n**2``; the path is the dense decoder's (up to exact
-    ties).
+    ties). ``band_terms``: :func:`_band` of ``log_trans`` and ``reach``, if already at
+    hand.
     """
     n_states, n_steps = log_obs.shape
-    width = 2 * reach + 1
-    offsets = np.arange(-reach, reach + 1)
-    src = np.arange(n_states)[None, :] + offsets[:, None]  # predecessor i of j, (width, n)
-    valid = (src >= 0) & (src < n_states)
-    band = np.full((width, n_states), -np.inf)
-    band[valid] = log_trans[src[valid], np.nonzero(valid)[1]]
-    src = np.clip(src, 0, n_states - 1)
+    band, src = _band(log_trans, reach) if band_terms is None else band_terms
     cols = np.arange(n_states)
     value = log_obs[:, 0] + (0.0 if log_init is None else log_init)
     back = np.empty((n_steps, n_states), dtype=np.int64)
