@@ -32,6 +32,7 @@ density of onset strength: a tone gives 0.5-0.7 per second, but a click track at
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -142,9 +143,9 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     empty = np.flatnonzero(np.bincount(band[band >= 0], minlength=edges.size - 1) == 0)
     # the default top band (4-22 kHz) is empty below 8 kHz: only edges a user gave count
     # (onset_strength_psf and phase_slope pass the defaults on explicitly)
-    given = "band_edges_hz" in params and tuple(
-        float(e) for e in params["band_edges_hz"]
-    ) != tuple(FRONTEND_DEFAULTS["band_edges_hz"])
+    given = "band_edges_hz" in params and tuple(float(e) for e in params["band_edges_hz"]) != tuple(
+        FRONTEND_DEFAULTS["band_edges_hz"]
+    )
     if empty.size and given:
         k = int(empty[0])
         why = (
@@ -224,6 +225,19 @@ def _frame_window(window: np.ndarray, n_fft: int) -> np.ndarray:
     return w
 
 
+@functools.lru_cache(maxsize=8)
+def _stft_terms(sr: float, fe: FrontEnd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The front end's two frame windows (Hann, and Hann times the time ramp) and its
+    band membership matrix (:func:`_band_matrix`), cached per rate and settings."""
+    win, n_fft = fe.win_length, fe.n_fft
+    w = _hann(win)
+    ramp = np.arange(win) - (win - 1) / 2.0  # time ramp centred on the frame centre
+    terms = (_frame_window(w, n_fft), _frame_window(w * ramp, n_fft), _band_matrix(sr, fe))
+    for arr in terms:
+        arr.flags.writeable = False
+    return terms
+
+
 def _bin_bands(freqs: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Band index of each FFT bin (-1 outside the edges; the top edge is inclusive)."""
     band = np.searchsorted(edges, freqs, side="right") - 1
@@ -252,12 +266,9 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
 
-    win, hop, n_fft = fe.win_length, fe.hop_length, fe.n_fft
-    w = _hann(win)
-    ramp = np.arange(win) - (win - 1) / 2.0  # time ramp centred on the frame centre
+    hop, n_fft = fe.hop_length, fe.n_fft
     frames = _frames(y.astype(np.float32), n_fft, hop)
-    w_x, w_y = _frame_window(w, n_fft), _frame_window(w * ramp, n_fft)
-    member = _band_matrix(sr, fe)  # (n_bins, n_bands)
+    w_x, w_y, member = _stft_terms(float(sr), fe)
     n_frames, n_bands = frames.shape[0], member.shape[1]
     energy = np.empty((n_frames, n_bands), dtype=np.float32)
     num = np.empty((n_frames, n_bands), dtype=np.float32)
@@ -276,7 +287,11 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
         m = np.sqrt(power)
         if mag is not None:
             mag[a:b] = m
-        logmag = np.log1p(np.float32(100.0) * m)
+        # log(1 + 100 m): numpy's float32 log is vectorised, its log1p is not (6x
+        # slower); in float32 both are within 5e-7 of the exact value
+        logmag = np.float32(100.0) * m
+        logmag += np.float32(1.0)
+        np.log(logmag, out=logmag)
         diff = np.diff(logmag, axis=0, prepend=logmag[:1] if prev is None else prev)
         np.maximum(diff, 0.0, out=diff)
         flux[a:b] = diff @ member
