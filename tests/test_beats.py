@@ -665,7 +665,7 @@ def _salience_by_spectrum(bands, fps, starts, stops, periods, half_time_s, max_h
 def test_resonator_salience_equals_the_spectrum_sum(windows, max_hz):
     # resonator_salience sums the power spectrum against the comb gains in the lag
     # domain; it must equal the sum over the padded spectrum's bins
-    from beatsync.beats.metrical import resonator_salience
+    from beatsync.beats.metrical import resonator_salience, resonator_saliences
 
     fps = 22050 / 128
     rng = np.random.default_rng(3)
@@ -680,6 +680,11 @@ def test_resonator_salience_equals_the_spectrum_sum(windows, max_hz):
     sets = resonator_salience(np.stack([bands, bands[::-1]]), fps, starts, stops, periods, 3.0)
     one = resonator_salience(bands[::-1], fps, starts, stops, periods, 3.0)
     np.testing.assert_allclose(sets[..., 1], one, rtol=0, atol=1e-12 * np.abs(one).max())
+    # several period grids at once (tactus, tatum, measure): each as on its own
+    blocks = resonator_saliences(bands, fps, starts, stops, [periods[::2], periods[1::3]], 3.0)
+    for got, grid in zip(blocks, [periods[::2], periods[1::3]], strict=True):
+        want = resonator_salience(bands, fps, starts, stops, grid, 3.0)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
 
 
 def test_pulse_clarity_null_draws_in_one_batch_equal_draws_one_by_one():

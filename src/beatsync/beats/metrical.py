@@ -215,6 +215,7 @@ __all__ = [
     "MeterModel",
     "METER_MODEL",
     "resonator_salience",
+    "resonator_saliences",
     "tactus_observation",
     "estimate_meter",
     "ratio_weight",
@@ -328,6 +329,22 @@ def resonator_salience(
     (:func:`_resonator_lag_weights`, once per period grid), and ``a`` needs an FFT of
     only ``2 L - 1`` points instead of the ``n_fft`` of the fine spectral sampling.
     """
+    return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
+
+
+def resonator_saliences(
+    bands: np.ndarray,
+    fps: float,
+    starts: Sequence[int],
+    stops: Sequence[int],
+    period_blocks: Sequence[np.ndarray],
+    half_time_s: float,
+    max_hz: float | None = None,
+) -> list[np.ndarray]:
+    """:func:`resonator_salience` for several period grids, one per block (the tactus,
+    tatum and measure grids of :func:`tactus_observation`): the windows'
+    autocorrelations are computed once, and each grid's lag weights are cached on
+    their own (the pulse-clarity null reuses the tactus grid's)."""
     import scipy.fft  # noqa: PLC0415 (batched real FFTs)
 
     bands = np.asarray(bands, dtype=np.float64)
@@ -340,18 +357,23 @@ def resonator_salience(
     n_bins = n_fft // 2 + 1
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
-    lag_w, total_w, gamma = _resonator_lag_weights(
-        np.ascontiguousarray(periods, dtype=np.float64).tobytes(),
-        fps,
-        n_fft,
-        n_bins,
-        half_time_s,
-        length,
-    )
+    weights = [
+        _resonator_lag_weights(
+            np.ascontiguousarray(periods, dtype=np.float64).tobytes(),
+            fps,
+            n_fft,
+            n_bins,
+            half_time_s,
+            length,
+        )
+        for periods in period_blocks
+    ]
+    # the lag weights of the window's total energy (every gain 1)
+    total_w = _bin_cosine_sums(n_fft, length) * _lag_multiplicity(length)
     n_acf = scipy.fft.next_fast_len(2 * length - 1, real=True)  # linear, not circular
     n_win = len(starts)
     total = np.empty((n_win, n_sets * n_bands))
-    energy = np.empty((periods.size, n_win, n_sets * n_bands))
+    energies = [np.empty((w[0].shape[0], n_win, n_sets * n_bands)) for w in weights]
     # windows in chunks: a whole song's windows at once would hold 10 minutes of audio
     # in about 600 padded copies
     for c0 in range(0, n_win, WINDOW_CHUNK):
@@ -366,14 +388,18 @@ def resonator_salience(
         acf = scipy.fft.irfft(spec.real**2 + spec.imag**2, n=n_acf, axis=3)[..., :length]
         acf = acf.reshape(-1, length).T  # (lag, window x set x band)
         total[c0 : c0 + len(chunk)] = (total_w @ acf).reshape(len(chunk), -1)
-        energy[:, c0 : c0 + len(chunk)] = (lag_w @ acf).reshape(periods.size, len(chunk), -1)
-    ratio = np.divide(energy, total[None], out=np.zeros_like(energy), where=total[None] > 0)
-    r = (ratio - gamma[:, None, None]) / (1 - gamma[:, None, None])
-    # fewer than two periods inside the window: no evidence either way
+        for (lag_w, _), energy in zip(weights, energies, strict=True):
+            energy[:, c0 : c0 + len(chunk)] = (lag_w @ acf).reshape(lag_w.shape[0], len(chunk), -1)
     span = (np.asarray(stops) - np.asarray(starts)) / fps
-    r[periods[:, None] > span[None, :] / 2] = 0.0
-    r = r.reshape(periods.size, n_win, n_sets, n_bands).sum(axis=3)
-    return r if sets else r[:, :, 0]
+    out = []
+    for periods, (_, gamma), energy in zip(period_blocks, weights, energies, strict=True):
+        ratio = np.divide(energy, total[None], out=np.zeros_like(energy), where=total[None] > 0)
+        r = (ratio - gamma[:, None, None]) / (1 - gamma[:, None, None])
+        # fewer than two periods inside the window: no evidence either way
+        r[np.asarray(periods)[:, None] > span[None, :] / 2] = 0.0
+        r = r.reshape(r.shape[0], n_win, n_sets, n_bands).sum(axis=3)
+        out.append(r if sets else r[:, :, 0])
+    return out
 
 
 #: Analysis windows whose autocorrelations :func:`resonator_salience` holds at once.
@@ -403,49 +429,63 @@ def resonator_fft_size(length: int, fps: float, half_time_s: float) -> int:
     return int(2 ** np.ceil(np.log2(need)))
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=8)
 def _resonator_lag_weights(
     periods_key: bytes, fps: float, n_fft: int, n_bins: int, half_time_s: float, n_lags: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Lag weights of the resonators' energy and of the window's total energy (cached).
+) -> tuple[np.ndarray, np.ndarray]:
+    """Lag weights of the resonators' energy (cached per period grid and window length).
 
     With ``G(b) = |H_tau(b)|^2`` on the one-sided bins ``b < n_bins`` and ``gamma``
-    above, returns ``(lag_w, total_w, gamma)``: ``lag_w[i, k] = m_k c_i(k)`` with
+    above, returns ``(lag_w, gamma)``: ``lag_w[i, k] = m_k c_i(k)`` with
     ``c_i(k) = sum_{b=0}^{n_fft/2} G_i(b) cos(2 pi b k / n_fft)`` for lags
     ``k < n_lags``, and ``m_k`` 1 at lag 0 and 2 elsewhere (the autocorrelation is
     even), so that ``lag_w @ a`` is the resonators' energy ``sum_b P(b) G(b)`` for a
-    window's autocorrelation ``a``; ``total_w`` the same for ``G = 1``
-    (``sum_b P(b)``). The sums over bins are taken by an inverse real FFT.
+    window's autocorrelation ``a``. The sums over bins are taken by an inverse real
+    FFT, a few periods at a time (the whole grid at once took twice as long).
     """
     import scipy.fft  # noqa: PLC0415
 
     periods = np.frombuffer(periods_key, dtype=np.float64)
     omega = 2.0 * np.pi * np.arange(n_bins) / n_fft  # [rad / frame]
     alpha = 0.5 ** (periods / half_time_s)
-    a = alpha[:, None]
     gamma = (1 - alpha) ** 2 / (1 - alpha**2)
-    # G - gamma on the bins below n_bins (zero above): its cosine sums by irfft, where
-    # irfft(X)[k] = (X[0] + 2 sum_{0<b<n/2} X[b] cos(2 pi b k / n) + X[n/2] (-1)^k) / n
     half = n_fft // 2
-    excess = np.zeros((periods.size, half + 1))
-    excess[:, :n_bins] = (1 - a) ** 2 / (
-        1 - 2 * a * np.cos(np.outer(periods * fps, omega)) + a**2
-    ) - gamma[:, None]
-    k = np.arange(n_lags)
-    sign = np.where(k % 2 == 0, 1.0, -1.0)
-    c_excess = (
-        n_fft * scipy.fft.irfft(excess, n=n_fft, axis=1)[:, :n_lags]
-        + excess[:, :1]
-        + excess[:, half : half + 1] * sign[None, :]
-    ) / 2
-    # sum_{b=0}^{n/2} cos(2 pi b k / n): n/2 + 1 at k = 0, else 1 for even k, 0 for odd
-    ones = np.where(k == 0, half + 1.0, np.where(k % 2 == 0, 1.0, 0.0))
-    lag_mult = np.where(k == 0, 1.0, 2.0)
-    lag_w = (c_excess + gamma[:, None] * ones[None, :]) * lag_mult[None, :]
-    total_w = (ones * lag_mult)[None, :]
-    for arr in (lag_w, total_w, gamma):
+    sign = np.where(np.arange(n_lags) % 2 == 0, 1.0, -1.0)
+    ones = _bin_cosine_sums(n_fft, n_lags)  # the sums for G = 1
+    mult = _lag_multiplicity(n_lags)
+    lag_w = np.empty((periods.size, n_lags))
+    excess = np.zeros((LAG_WEIGHT_ROWS, half + 1))
+    for r0 in range(0, periods.size, LAG_WEIGHT_ROWS):
+        rows = slice(r0, min(r0 + LAG_WEIGHT_ROWS, periods.size))
+        a, g = alpha[rows, None], gamma[rows, None]
+        m = a.shape[0]
+        # G - gamma on the bins below n_bins (zero above); its cosine sums by irfft:
+        # irfft(X)[k] = (X[0] + 2 sum_{0<b<n/2} X[b] cos(2 pi b k / n) + X[n/2] (-1)^k) / n
+        excess[:m, :n_bins] = (1 - a) ** 2 / (
+            1 - 2 * a * np.cos(np.outer(periods[rows] * fps, omega)) + a**2
+        ) - g
+        c = n_fft * scipy.fft.irfft(excess[:m], n=n_fft, axis=1)[:, :n_lags]
+        c += excess[:m, :1] + excess[:m, half : half + 1] * sign[None, :]
+        lag_w[rows] = (c / 2 + g * ones[None, :]) * mult[None, :]
+    for arr in (lag_w, gamma):
         arr.flags.writeable = False
-    return lag_w, total_w, gamma
+    return lag_w, gamma
+
+
+#: Periods whose lag weights :func:`_resonator_lag_weights` computes at once.
+LAG_WEIGHT_ROWS = 32
+
+
+def _lag_multiplicity(n_lags: int) -> np.ndarray:
+    """``m_k``: lag 0 counts once, every other lag twice (``k`` and ``-k``)."""
+    return np.where(np.arange(n_lags) == 0, 1.0, 2.0)
+
+
+def _bin_cosine_sums(n_fft: int, n_lags: int) -> np.ndarray:
+    """``sum_{b=0}^{n_fft/2} cos(2 pi b k / n_fft)`` for lags ``0 <= k < n_lags <= n_fft``:
+    ``n_fft/2 + 1`` at lag 0, else 1 at even and 0 at odd lags (a Dirichlet sum)."""
+    k = np.arange(n_lags)
+    return np.where(k == 0, n_fft // 2 + 1.0, np.where(k % 2 == 0, 1.0, 0.0))
 
 
 def _log_prior(periods: np.ndarray, median: float, sigma: float) -> np.ndarray:
@@ -555,12 +595,10 @@ def tactus_observation(
     tatum, measure, g_a, g_c = _level_terms(
         np.ascontiguousarray(periods, dtype=np.float64).tobytes(), model
     )
-    all_p = np.concatenate([periods, tatum, measure])
-    sal = resonator_salience(bands, fps, starts, stops, all_p, model.half_time_s, max_hz)
-    s_b = sal[: periods.size]
+    s_b, s_a, s_c = resonator_saliences(
+        bands, fps, starts, stops, [periods, tatum, measure], model.half_time_s, max_hz
+    )
     log_b = _tactus_terms(s_b, fps, starts, stops, periods, model)
-    s_a = sal[periods.size : periods.size + tatum.size]
-    s_c = sal[periods.size + tatum.size :]
     # the maximisation over tatum and measure in float32: 2.7 times faster than in
     # float64; its rounding (about 1e-5 of a log likelihood) changed no score, tempo or
     # meter of the bundled real recordings or the synthetic set
