@@ -263,6 +263,28 @@ def test_check_audio_refuses(y, sr, kwargs, match):
         check_audio(y, sr, **kwargs)
 
 
+def test_check_audio_finite_and_level_checks_at_the_edges():
+    # finite samples whose sum overflows are not taken for infinite ones
+    loud = np.full(2205, 3e38, dtype=np.float32)
+    loud[::2] *= -1
+    loud[:4] = 3e38
+    with np.errstate(over="ignore", invalid="ignore"):
+        assert not np.isfinite(loud.sum())
+    assert check_audio(loud, 22050, silence_peak=1e-7)[0] is loud
+    # an infinite sample among finite ones whose sum would be finite
+    for bad in (np.inf, -np.inf, np.nan):
+        y = _Y.copy()
+        y[100] = bad
+        with pytest.raises(ParameterError, match="1 NaN or infinite sample.*sample 100"):
+            check_audio(y, 22050)
+    # the peak and the spread are the largest magnitudes either side
+    neg = np.full(2205, -0.5, dtype=np.float32)
+    neg[10] = -0.5 - 2e-7
+    assert check_audio(neg, 22050, silence_peak=1e-7)[0] is neg
+    with pytest.raises(ParameterError, match=r"constant at -0\.5"):
+        check_audio(np.full(2205, -0.5, dtype=np.float32), 22050, silence_peak=1e-7)
+
+
 @pytest.mark.parametrize(
     "values, match",
     [

@@ -271,8 +271,7 @@ def as_float_array(values: Any, *, name: str, dtype: Any = np.float64) -> np.nda
         arr = np.asarray(values)
     except (TypeError, ValueError):
         raise ParameterError(
-            f"{name} must be a numeric array; nested lists of unequal length (ragged) "
-            "cannot be one"
+            f"{name} must be a numeric array; nested lists of unequal length (ragged) cannot be one"
         ) from None
     if arr.dtype.kind == "O":
         try:
@@ -481,8 +480,7 @@ def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
         elif v <= 0:
             hint = "a tempo is a positive number of beats per minute"
         raise ParameterError(
-            f"{name}={bpm!r} is outside the plausible range {MIN_BPM:g}-{MAX_BPM:g} BPM "
-            f"({hint})"
+            f"{name}={bpm!r} is outside the plausible range {MIN_BPM:g}-{MAX_BPM:g} BPM ({hint})"
         )
     return v
 
@@ -529,8 +527,12 @@ def check_audio(
         )
     if arr.size == 0:
         raise ParameterError(f"{name} is empty: the audio has zero samples")
-    bad = ~np.isfinite(arr)
-    if bad.any():
+    # one pass when every sample is finite (the sum is, unless it overflows: then the
+    # samples are checked one by one)
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = arr.sum()
+    if not np.isfinite(total) and not np.isfinite(arr).all():
+        bad = ~np.isfinite(arr)
         raise ParameterError(
             f"{name} contains {int(bad.sum())} NaN or infinite sample(s) "
             f"(first at sample {int(np.argmax(bad))}); repair or trim the audio"
@@ -544,13 +546,14 @@ def check_audio(
                 "check the sample rate)"
             )
     if silence_peak is not None:
-        peak = float(np.max(np.abs(arr)))
+        top, bottom = float(arr.max()), float(arr.min())
+        peak = max(top, -bottom)  # the largest magnitude, without an array of them
         if not peak >= silence_peak:
             raise ParameterError(
                 f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
             )
-        level = float(np.mean(arr))
-        if not float(np.max(np.abs(arr - level))) >= silence_peak:
+        level = float(np.mean(arr, dtype=np.float64))  # float32 sums can overflow
+        if not max(top - level, level - bottom) >= silence_peak:
             raise ParameterError(
                 f"the audio is constant at {level:.6g} (a DC offset, no sound; it varies by "
                 f"less than {silence_peak:g}): check the file and the recording chain"

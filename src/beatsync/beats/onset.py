@@ -267,7 +267,7 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
     import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
 
     hop, n_fft = fe.hop_length, fe.n_fft
-    frames = _frames(y.astype(np.float32), n_fft, hop)
+    frames = _frames(np.asarray(y, dtype=np.float32), n_fft, hop)
     w_x, w_y, member = _stft_terms(float(sr), fe)
     n_frames, n_bands = frames.shape[0], member.shape[1]
     energy = np.empty((n_frames, n_bands), dtype=np.float32)
@@ -423,8 +423,11 @@ def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
         # soxr's high-quality filter (23 ms per minute of 44.1 kHz audio; an ideal low-pass
         # by FFT over the whole signal took 140 ms), keeping round(n * ratio) samples
         n_out = int(round(y.size * fe.analysis_sr / sr))
-        y = resample(y, sr, fe.analysis_sr, n_out).astype(np.float64)
+        y = resample(y, sr, fe.analysis_sr, n_out)  # float32
         sr = fe.analysis_sr
+    # float32 samples are divided in float32: correctly rounded, the same as dividing in
+    # float64 and rounding to the front end's float32 (double rounding is innocuous for
+    # a division when the wider format has 2p + 2 bits), without the float64 copies
     y = y / np.max(np.abs(y))
     psf, _, fps, _, flux, _ = _phase_slope(y, sr, fe, keep_mag=False)
     n_bands, n_frames = psf.shape

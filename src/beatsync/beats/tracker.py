@@ -295,7 +295,9 @@ def track_beats(
     >>> round(bt.tempo)
     120
     """
-    y, sr = check_audio(y, sr)
+    # float32 audio stays float32 for our tracker (its front end runs in float32: the
+    # same samples, without a float64 copy); librosa's gets float64, as always
+    y, sr = _units_check_audio(y, sr, silence_peak=SILENCE_PEAK)
     min_bpm, max_bpm = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="bpm")
     check_bpm(min_bpm, name="min_bpm")
     check_bpm(max_bpm, name="max_bpm")
@@ -312,6 +314,7 @@ def track_beats(
             raise ParameterError(
                 f"front-end parameters {sorted(frontend_params)} only apply to method='psf'"
             )
+        y = np.asarray(y, dtype=np.float64)
         return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
     if method != "psf":
         raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
