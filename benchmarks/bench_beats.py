@@ -803,9 +803,9 @@ def main() -> int:
         "librosa analyses at the input rate. Steady-state times exclude each tracker's "
         "first call; the first-call rows show it. Absolute times depend on the machine's "
         "load (see load_average above): read the ratios. Per audio minute, a 2.8 s clip "
-        f"costs most (the madmom sample: {clip_ms:.1f} ms a call, most of it per call, not "
-        "per second: the front end's set-up, the tempo path and the six draws of the "
-        "pulse-clarity null). It took 27 ms a call (0.57 s per audio minute) before the "
+        f"costs most (the madmom sample: {clip_ms:.1f} ms a call; the pulse-clarity null "
+        "draws six shuffles of a clip this short, one of a song over 15 s). It took 27 ms "
+        "a call (0.57 s per audio minute, 1.70 times librosa's time) before the "
         "resonators' energy was summed in the lag domain and the null's draws batched "
         "(`beatsync.beats.metrical.resonator_salience`); the same run's librosa is the "
         "baseline to read it against.",
