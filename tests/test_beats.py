@@ -731,3 +731,39 @@ def test_small_filters_equal_scipy_ndimage():
         np.testing.assert_array_equal(
             moving_max(x, size, origin), ndimage.maximum_filter1d(x, size, origin=origin)
         )
+
+
+def test_clips_of_other_lengths_share_the_resonator_weights():
+    # the lag weights are cached per power of two of the window length: clips shorter
+    # than the tempo window (each its own length) computed all three grids again
+    from beatsync.beats import metrical
+
+    ref = beat_times(120, duration=6.0, start=0.3)
+    y = click_track(ref, sr=SR, duration=6.0)
+    track_beats(y[: int(4.0 * SR)], SR)
+    before = metrical._resonator_lag_weights.cache_info()
+    for seconds in (4.2, 4.5, 5.0):  # 723-861 frames: lags up to 1024, as for 4 s
+        track_beats(y[: int(seconds * SR)], SR)
+    after = metrical._resonator_lag_weights.cache_info()
+    assert after.misses == before.misses and after.hits > before.hits
+
+
+@pytest.mark.parametrize("sr", [22050, 44100])
+def test_tracker_input_types_and_extreme_levels_give_the_same_beats(sr):
+    # float32 stays float32 through the front end, every other type becomes float64;
+    # a level near the float maxima is scaled down by a power of two before soxr (which
+    # returned NaN from about 1e37: no beats, "no onsets found")
+    ref = beat_times(120, duration=6.0, start=0.3)
+    y = click_track(ref, sr=sr, duration=6.0).astype(np.float64)
+    y *= 0.5 / np.abs(y).max()
+    want = track_beats(y, sr).beats
+    assert want.size >= 10
+    np.testing.assert_array_equal(
+        track_beats(y.astype(np.float16), sr).beats,
+        track_beats(y.astype(np.float16).astype(np.float64), sr).beats,
+    )
+    y32 = y.astype(np.float32)
+    np.testing.assert_array_equal(
+        track_beats(y32 * np.float32(2.0**127), sr).beats, track_beats(y32, sr).beats
+    )
+    np.testing.assert_array_equal(track_beats(y * 2.0**1020, sr).beats, want)

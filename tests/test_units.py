@@ -1,3 +1,5 @@
+import warnings
+
 import numpy as np
 import pytest
 
@@ -283,6 +285,18 @@ def test_check_audio_finite_and_level_checks_at_the_edges():
     assert check_audio(neg, 22050, silence_peak=1e-7)[0] is neg
     with pytest.raises(ParameterError, match=r"constant at -0\.5"):
         check_audio(np.full(2205, -0.5, dtype=np.float32), 22050, silence_peak=1e-7)
+
+
+def test_check_audio_near_the_float64_maximum_warns_nothing():
+    # the float64 mean of samples near 1.8e308 overflows: the level is taken relative
+    # to the peak instead (an overflow warning and "constant at nan" before)
+    huge = np.full(2205, 1.7e308)
+    huge[::2] *= -1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert check_audio(huge, 22050, silence_peak=1e-7)[0] is huge
+        with pytest.raises(ParameterError, match=r"constant at 1\.7e\+308"):
+            check_audio(np.full(2205, 1.7e308), 22050, silence_peak=1e-7)
 
 
 @pytest.mark.parametrize(

@@ -552,7 +552,10 @@ def check_audio(
             raise ParameterError(
                 f"the audio is all silent (peak below {silence_peak:g}): check the file and gain"
             )
-        level = float(np.mean(arr, dtype=np.float64))  # float32 sums can overflow
+        with np.errstate(over="ignore", invalid="ignore"):
+            level = float(np.mean(arr, dtype=np.float64))  # float32 sums can overflow
+        if not np.isfinite(level):  # so can float64 ones, near 1.8e308
+            level = peak * float(np.mean(arr / peak, dtype=np.float64))
         if not max(top - level, level - bottom) >= silence_peak:
             raise ParameterError(
                 f"the audio is constant at {level:.6g} (a DC offset, no sound; it varies by "

@@ -357,6 +357,10 @@ def resonator_saliences(
     n_bins = n_fft // 2 + 1
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
+    # the weights are cached for lags up to the next power of two: clips of other
+    # lengths under it share them (with the exact length as the key, every new clip
+    # length computed three grids again, about 0.2 s)
+    n_lags = min(n_fft, 1 << (length - 1).bit_length())
     weights = [
         _resonator_lag_weights(
             np.ascontiguousarray(periods, dtype=np.float64).tobytes(),
@@ -364,10 +368,11 @@ def resonator_saliences(
             n_fft,
             n_bins,
             half_time_s,
-            length,
+            n_lags,
         )
         for periods in period_blocks
     ]
+    weights = [(lag_w[:, :length], gamma) for lag_w, gamma in weights]
     # the lag weights of the window's total energy (every gain 1)
     total_w = _bin_cosine_sums(n_fft, length) * _lag_multiplicity(length)
     n_acf = scipy.fft.next_fast_len(2 * length - 1, real=True)  # linear, not circular

@@ -296,8 +296,10 @@ def track_beats(
     120
     """
     # float32 audio stays float32 for our tracker (its front end runs in float32: the
-    # same samples, without a float64 copy); librosa's gets float64, as always
+    # same samples, without a float64 copy); any other type becomes float64, as always
     y, sr = _units_check_audio(y, sr, silence_peak=SILENCE_PEAK)
+    if y.dtype != np.float32:
+        y = np.asarray(y, dtype=np.float64)
     min_bpm, max_bpm = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="bpm")
     check_bpm(min_bpm, name="min_bpm")
     check_bpm(max_bpm, name="max_bpm")
@@ -314,7 +316,7 @@ def track_beats(
             raise ParameterError(
                 f"front-end parameters {sorted(frontend_params)} only apply to method='psf'"
             )
-        y = np.asarray(y, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)  # as librosa was always given it
         return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
     if method != "psf":
         raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
