@@ -742,7 +742,7 @@ def test_clips_of_other_lengths_share_the_resonator_weights():
     y = click_track(ref, sr=SR, duration=6.0)
     track_beats(y[: int(4.0 * SR)], SR)
     before = metrical._resonator_lag_weights.cache_info()
-    for seconds in (4.2, 4.5, 5.0):  # 723-861 frames: lags up to 1024, as for 4 s
+    for seconds in (4.2, 4.5, 5.0):  # 723-861 frames: 1024 lags cached, as for 4 s
         track_beats(y[: int(seconds * SR)], SR)
     after = metrical._resonator_lag_weights.cache_info()
     assert after.misses == before.misses and after.hits > before.hits

@@ -357,10 +357,10 @@ def resonator_saliences(
     n_bins = n_fft // 2 + 1
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
-    # the weights are cached for lags up to the next power of two: clips of other
-    # lengths under it share them (with the exact length as the key, every new clip
-    # length computed three grids again, about 0.2 s)
-    n_lags = min(n_fft, 1 << (length - 1).bit_length())
+    # the weights are cached for lags up to the next multiple of LAG_BUCKET: clips of
+    # other lengths under it share them (with the exact length as the key, every new
+    # clip length computed three grids again, about 0.2 s)
+    n_lags = min(n_fft, -(-length // LAG_BUCKET) * LAG_BUCKET)
     weights = [
         _resonator_lag_weights(
             np.ascontiguousarray(periods, dtype=np.float64).tobytes(),
@@ -434,7 +434,7 @@ def resonator_fft_size(length: int, fps: float, half_time_s: float) -> int:
     return int(2 ** np.ceil(np.log2(need)))
 
 
-@functools.lru_cache(maxsize=8)
+@functools.lru_cache(maxsize=12)
 def _resonator_lag_weights(
     periods_key: bytes, fps: float, n_fft: int, n_bins: int, half_time_s: float, n_lags: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -479,6 +479,10 @@ def _resonator_lag_weights(
 
 #: Periods whose lag weights :func:`_resonator_lag_weights` computes at once.
 LAG_WEIGHT_ROWS = 32
+
+#: Lags are cached in multiples of this: windows of 0-8 s at 172 frames/s fall in three
+#: sizes (512, 1024, 1536 lags), three grids each.
+LAG_BUCKET = 512
 
 
 def _lag_multiplicity(n_lags: int) -> np.ndarray:
