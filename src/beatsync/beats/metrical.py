@@ -438,7 +438,7 @@ def resonator_fft_size(length: int, fps: float, half_time_s: float) -> int:
 def _resonator_lag_weights(
     periods_key: bytes, fps: float, n_fft: int, n_bins: int, half_time_s: float, n_lags: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Lag weights of the resonators' energy (cached per period grid and window length).
+    """Lag weights of the resonators' energy (cached per period grid and number of lags).
 
     With ``G(b) = |H_tau(b)|^2`` on the one-sided bins ``b < n_bins`` and ``gamma``
     above, returns ``(lag_w, gamma)``: ``lag_w[i, k] = m_k c_i(k)`` with
