@@ -43,8 +43,6 @@ def gaussian_smooth(x: np.ndarray, sigma: float, truncate: float = 4.0) -> np.nd
     k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
     k /= k.sum()
     x = np.asarray(x, dtype=np.float64)
-    if x.ndim == 1:
-        return np.convolve(np.pad(x, r, mode="symmetric"), k, mode="valid")
     xp, _ = _padded(x, 2 * r + 1, 0)
     n = x.shape[-1]
     out = k[0] * xp[..., :n]

@@ -90,12 +90,13 @@ def _backtrack(back: np.ndarray, value: np.ndarray) -> np.ndarray:
 @functools.lru_cache(maxsize=8)
 def _log_transitions(
     periods_key: bytes, trans_sigma: float, p_jump: float
-) -> tuple[np.ndarray, int | None]:
+) -> tuple[np.ndarray, int | None, tuple[np.ndarray, np.ndarray] | None]:
     """Log transition matrix of the tempo HMM and its band (cached per period grid).
 
     The band ``reach`` is the largest ``|i - j|`` whose log transition is not exactly
     ``log(p_jump / n)``: further apart, the Gaussian part is lost in rounding next to
-    the jump probability. None when ``p_jump`` is 0 (no jump: no band).
+    the jump probability. None when ``p_jump`` is 0 (no jump: no band). The third
+    value is :func:`viterbi_banded`'s band terms (:func:`_band`), None without a band.
     """
     logp = np.log(np.frombuffer(periods_key, dtype=np.float64))
     d = logp[:, None] - logp[None, :]
@@ -106,10 +107,10 @@ def _log_transitions(
         log_trans = np.log(trans)
     log_trans.flags.writeable = False
     if p_jump <= 0:
-        return log_trans, None
+        return log_trans, None, None
     i, j = np.nonzero(log_trans != np.log(p_jump / logp.size))
     reach = int(np.max(np.abs(i - j))) if i.size else 0
-    return log_trans, reach
+    return log_trans, reach, _band(log_trans, reach)
 
 
 def tempo_hmm(
@@ -139,27 +140,11 @@ def tempo_hmm(
         value = log_obs[:, 0] + (0.0 if log_prior is None else log_prior)
         return np.array([int(np.argmax(value))], dtype=np.int64)
     periods = np.ascontiguousarray(periods, dtype=np.float64)
-    key = (periods.tobytes(), float(trans_sigma), float(p_jump))
-    log_trans, reach = _log_transitions(*key)
+    log_trans, reach, band = _log_transitions(periods.tobytes(), float(trans_sigma), float(p_jump))
     if reach is not None and 2 * reach + 1 < periods.size:
-        return viterbi_banded(
-            log_obs,
-            log_trans,
-            reach,
-            np.log(p_jump / periods.size),
-            log_prior,
-            band_terms=_band_terms(*key),
-        )
+        log_jump = np.log(p_jump / periods.size)
+        return viterbi_banded(log_obs, log_trans, reach, log_jump, log_prior, band_terms=band)
     return viterbi(log_obs, log_trans, log_prior)
-
-
-@functools.lru_cache(maxsize=8)
-def _band_terms(
-    periods_key: bytes, trans_sigma: float, p_jump: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`viterbi_banded`'s band of the tempo HMM's transitions (cached per grid)."""
-    log_trans, reach = _log_transitions(periods_key, trans_sigma, p_jump)
-    return _band(log_trans, reach)
 
 
 def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
