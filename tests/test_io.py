@@ -193,6 +193,23 @@ def test_resample_audio_keeps_a_tone_and_the_length(orig, target):
     np.testing.assert_allclose(out[inner], np.sin(2 * np.pi * 440.0 * t)[inner], atol=2e-3)
 
 
+def test_loud_audio_resamples_to_the_same_samples_scaled(tmp_path):
+    # soxr's float32 filter returned NaN for a peak from about 1e37: read_audio(sr=) gave
+    # a NaN signal without a word. It now filters at a level lowered by a power of two.
+    import soundfile as sf
+
+    n = 12345
+    y = (0.5 * np.sin(2 * np.pi * 440.0 * np.arange(n) / 44100)).astype(np.float32)
+    gain = np.float32(2.0**126)  # a peak of 4e37
+    want = io.resample_audio(y, 44100, 22050) * gain
+    np.testing.assert_array_equal(io.resample_audio(y * gain, 44100, 22050), want)
+    path = tmp_path / "loud.wav"
+    sf.write(path, y * gain, 44100, subtype="FLOAT")
+    got, sr = io.read_audio(path, sr=22050)[:2]
+    assert sr == 22050
+    np.testing.assert_array_equal(got, want)
+
+
 @pytest.mark.parametrize(
     "y, orig, target, match",
     [

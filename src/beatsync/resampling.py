@@ -14,17 +14,37 @@ import numpy as np
 __all__ = ["resample"]
 
 
+#: Audio louder than this [peak magnitude] goes through soxr at a lower level, by an exact
+#: power-of-two gain (soxr's float32 filter returns NaN from a peak of about 1e37).
+LOUDEST = 2.0**100
+
+
 def resample(
-    y: np.ndarray, orig_sr: float, target_sr: float, n_out: int | None = None
+    y: np.ndarray,
+    orig_sr: float,
+    target_sr: float,
+    n_out: int | None = None,
+    *,
+    keep_level: bool = True,
 ) -> np.ndarray:
     """Resample mono audio from ``orig_sr`` to ``target_sr`` [Hz] (float32).
 
     ``n_out`` samples are returned (default ``ceil(n * target_sr / orig_sr)``, as
     librosa does), trimmed or zero-padded at the end. Trusts its input (finite mono
-    audio, rates > 0): validate at the public entry.
+    audio, rates > 0): validate at the public entry. Audio louder than :data:`LOUDEST`
+    is filtered at a level lowered by a power of two, then raised again (the same
+    samples, scaled exactly); ``keep_level=False`` leaves it lowered, for a caller that
+    normalises (float64 audio beyond float32's range can only be returned so).
     """
     import soxr  # noqa: PLC0415 (only where audio is resampled)
 
+    y = np.asarray(y)
+    shift = 0
+    if orig_sr != target_sr and y.size:
+        peak = max(float(y.max()), -float(y.min()))
+        if peak > LOUDEST:
+            shift = 30 - int(np.frexp(peak)[1])  # peak about 2**30 when filtered
+            y = np.ldexp(y, shift)
     y = np.asarray(y, dtype=np.float32)
     if n_out is None:
         n_out = int(np.ceil(y.size * float(target_sr) / orig_sr))
@@ -32,6 +52,8 @@ def resample(
         out = y
     else:
         out = np.asarray(soxr.resample(y, orig_sr, target_sr, quality="HQ"), dtype=np.float32)
+    if shift and keep_level:
+        out = np.ldexp(out, -shift).astype(np.float32)
     if out.size >= n_out:
         return out[:n_out]
     return np.concatenate([out, np.zeros(n_out - out.size, dtype=np.float32)])

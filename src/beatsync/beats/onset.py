@@ -417,23 +417,15 @@ def onset_strength_psf(
     return compute_onsets(y, sr, fe)
 
 
-#: Audio louder than this [peak magnitude] is scaled down by a power of two before it is
-#: resampled (soxr returns NaN for float32 samples from about 1e37).
-LOUDEST_RESAMPLED = 2.0**100
-
-
 def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     """:func:`onset_strength_psf` on validated input (``y`` finite mono, not silent)."""
     if fe.analysis_sr != sr:
         # soxr's high-quality filter (23 ms per minute of 44.1 kHz audio; an ideal low-pass
         # by FFT over the whole signal took 140 ms), keeping round(n * ratio) samples
         n_out = int(round(y.size * fe.analysis_sr / sr))
-        peak = max(float(y.max()), -float(y.min()))
-        if peak > LOUDEST_RESAMPLED:
-            # soxr's float32 filter overflows (NaN) from about 1e37; a power-of-two gain
-            # is exact, and the normalisation below removes it
-            y = y * y.dtype.type(2.0 ** (30 - np.frexp(peak)[1]))
-        y = resample(y, sr, fe.analysis_sr, n_out)  # float32
+        # float32; a very loud signal comes back lowered by a power of two, which the
+        # normalisation below removes
+        y = resample(y, sr, fe.analysis_sr, n_out, keep_level=False)
         sr = fe.analysis_sr
     # float32 samples are divided in float32: correctly rounded, the same as dividing in
     # float64 and rounding to the front end's float32 (double rounding is innocuous for
