@@ -722,7 +722,8 @@ def test_small_filters_equal_scipy_ndimage():
         want = ndimage.gaussian_filter1d(x, sigma, axis=-1)
         np.testing.assert_allclose(gaussian_smooth(x, sigma), want, atol=1e-12)
         np.testing.assert_allclose(gaussian_smooth(x[0, 0], sigma), want[0, 0], atol=1e-12)
-    for size, origin in ((5, 0), (6, 1), (7, -2)):
+    # 81 and 80: edges as long as the signal, and longer (numpy's repeated reflections)
+    for size, origin in ((5, 0), (6, 1), (7, -2), (81, 0), (80, -1), (90, 3)):
         np.testing.assert_allclose(
             moving_mean(x, size, origin),
             ndimage.uniform_filter1d(x, size, origin=origin),

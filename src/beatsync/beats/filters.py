@@ -17,8 +17,14 @@ def _padded(x: np.ndarray, size: int, origin: int) -> tuple[np.ndarray, int]:
     """Pad the last axis symmetrically for a window of ``size`` shifted by ``origin``."""
     left = size // 2 + origin
     right = size - 1 - left
-    width = [(0, 0)] * (x.ndim - 1) + [(max(left, 0), max(right, 0))]
-    return np.pad(x, width, mode="symmetric"), left
+    lo, hi = max(left, 0), max(right, 0)
+    n = x.shape[-1]
+    if lo > n or hi > n:  # wider than the signal: numpy's repeated reflections
+        width = [(0, 0)] * (x.ndim - 1) + [(lo, hi)]
+        return np.pad(x, width, mode="symmetric"), left
+    # np.pad's "symmetric" edges, without its bookkeeping (15 times slower on a clip)
+    edges = (x[..., :lo][..., ::-1], x, x[..., n - hi :][..., ::-1])
+    return np.concatenate(edges, axis=-1), left
 
 
 def moving_mean(x: np.ndarray, size: int, origin: int = 0) -> np.ndarray:
