@@ -40,7 +40,10 @@ def moving_max(x: np.ndarray, size: int, origin: int = 0) -> np.ndarray:
     """Maximum over a window of ``size`` samples along the last axis (maximum_filter1d)."""
     xp, _ = _padded(np.asarray(x), size, origin)
     n = x.shape[-1]
-    return np.lib.stride_tricks.sliding_window_view(xp, size, axis=-1)[..., :n, :].max(axis=-1)
+    out = xp[..., :n].copy()
+    for j in range(1, size):  # a few taps: one pass each (a strided window view's max
+        np.maximum(out, xp[..., j : j + n], out=out)  # over its last axis took 3.5x longer)
+    return out
 
 
 def gaussian_smooth(x: np.ndarray, sigma: float, truncate: float = 4.0) -> np.ndarray:
