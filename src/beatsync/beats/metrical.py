@@ -330,12 +330,19 @@ def resonator_salience(
     -----
     The energy is the sum over the one-sided FFT bins ``b`` of the padded window's
     power ``P(b)`` times ``|H_tau(b)|^2`` (:func:`resonator_fft_size`). It is computed
-    in the lag domain, which gives the same sum up to rounding (about 1e-15 of the
-    salience) at a fraction of the cost: ``P(b)`` is the transform of the window's
+    in the lag domain, which gives the same sum up to rounding at a fraction of the
+    cost: ``P(b)`` is the transform of the window's
     autocorrelation ``a(k)`` (``|k| < L``, the window length), so the sum is
     ``sum_k a(k) c(k)`` with ``c(k) = sum_b |H_tau(b)|^2 cos(2 pi b k / n_fft)``
     (:func:`_resonator_lag_weights`, once per period grid), and ``a`` needs an FFT of
     only ``2 L - 1`` points instead of the ``n_fft`` of the fine spectral sampling.
+    The product ``sum_k a(k) c(k)`` is taken in float32 (the weights are computed in
+    float64 and stored in float32): each band's energy ratio is off by about 1e-7 of
+    its range (in float64, 1e-15), and the product's memory traffic and the cached
+    weights halve (the whole tracker took 0.95 times the time on the 2.8 s madmom
+    sample and on a 32 s song, interleaved in one process with the float64 code). It
+    changed no beat, tempo, meter or warning of 75 items (the bundled recordings, 18
+    clips of them and the 20 s synthetic set); saliences moved by at most 8e-7.
     """
     return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
 
@@ -399,7 +406,7 @@ def resonator_saliences(
             seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * np.hanning(b - a)
         spec = scipy.fft.rfft(seg, axis=3)
         acf = scipy.fft.irfft(spec.real**2 + spec.imag**2, n=n_acf, axis=3)[..., :length]
-        acf = acf.reshape(-1, length).T  # (lag, window x set x band)
+        acf = acf.reshape(-1, length).T.astype(np.float32)  # (lag, window x set x band)
         total[c0 : c0 + len(chunk)] = (total_w @ acf).reshape(len(chunk), -1)
         for (lag_w, _), energy in zip(weights, energies, strict=True):
             energy[:, c0 : c0 + len(chunk)] = (lag_w @ acf).reshape(lag_w.shape[0], len(chunk), -1)
@@ -454,7 +461,8 @@ def _resonator_lag_weights(
     ``k < n_lags``, and ``m_k`` 1 at lag 0 and 2 elsewhere (the autocorrelation is
     even), so that ``lag_w @ a`` is the resonators' energy ``sum_b P(b) G(b)`` for a
     window's autocorrelation ``a``. The sums over bins are taken by an inverse real
-    FFT, a few periods at a time (the whole grid at once took twice as long).
+    FFT, a few periods at a time (the whole grid at once took twice as long), and
+    stored in float32 (see :func:`resonator_salience`).
     """
     import scipy.fft  # noqa: PLC0415
 
@@ -480,6 +488,7 @@ def _resonator_lag_weights(
         c = n_fft * scipy.fft.irfft(excess[:m], n=n_fft, axis=1)[:, :n_lags]
         c += excess[:m, :1] + excess[:m, half : half + 1] * sign[None, :]
         lag_w[rows] = (c / 2 + g * ones[None, :]) * mult[None, :]
+    lag_w = lag_w.astype(np.float32)
     for arr in (lag_w, gamma):
         arr.flags.writeable = False
     return lag_w, gamma
