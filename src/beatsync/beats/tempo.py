@@ -148,14 +148,15 @@ def tempo_hmm(
 
 
 def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(band, src)``: ``log_trans[src[d, j], j]`` for the predecessors ``src[d, j] =
-    j + d - reach`` of each state ``j`` (-inf outside the grid; ``src`` clipped to it)."""
+    """``(band, src)``: ``log_trans[src[j, d], j]`` for the predecessors ``src[j, d] =
+    j + d - reach`` of each state ``j`` (-inf outside the grid; ``src`` clipped to it).
+    Shape (n_states, 2 reach + 1): each state's predecessors in a contiguous row."""
     n_states = log_trans.shape[0]
     offsets = np.arange(-reach, reach + 1)
-    src = np.arange(n_states)[None, :] + offsets[:, None]  # predecessor i of j, (width, n)
+    src = np.arange(n_states)[:, None] + offsets[None, :]  # predecessor i of j, (n, width)
     valid = (src >= 0) & (src < n_states)
     band = np.full(src.shape, -np.inf)
-    band[valid] = log_trans[src[valid], np.nonzero(valid)[1]]
+    band[valid] = log_trans[src[valid], np.nonzero(valid)[0]]
     src = np.clip(src, 0, n_states - 1)
     for arr in (band, src):
         arr.flags.writeable = False
@@ -188,10 +189,12 @@ def viterbi_banded(
     pad = np.full(n_states + 2 * reach, -np.inf)
     for t in range(1, n_steps):
         pad[reach : reach + n_states] = value
-        scores = np.lib.stride_tricks.sliding_window_view(pad, n_states) + band
-        k = np.argmax(scores, axis=0)
-        best = scores[k, cols]
-        i_best = src[k, cols]
+        # row j: the values of j's predecessors j - reach .. j + reach (a reduction over
+        # contiguous rows: 2x faster than over the columns of the transposed layout)
+        scores = np.lib.stride_tricks.sliding_window_view(pad, 2 * reach + 1) + band
+        k = np.argmax(scores, axis=1)
+        best = scores[cols, k]
+        i_best = src[cols, k]
         top = int(np.argmax(value))
         jump = value[top] + log_jump
         use_jump = jump > best
