@@ -19,7 +19,8 @@ the warning marks the clips that disagree).
 Speed, each as a ratio against librosa measured in the same run:
 
 - steady state: seconds of computation per minute of audio on one core (60 s drum
-  pattern at 22.05 and 44.1 kHz; median of ``--repeats``, after a warm-up call);
+  pattern at 22.05 and 44.1 kHz; median of ``--repeats``, after a warm-up call; ours
+  and librosa's calls interleaved);
 - import: a fresh interpreter importing ``beatsync.beats`` vs importing ``librosa``;
 - first call: a fresh interpreter's first ``track_beats`` on a 30 s song (imports
   excluded) vs librosa's first ``beat_track`` (numba compilation included);
@@ -66,13 +67,17 @@ SPEED_SONG_S = 60.0
 PROCESS_SONG_S = 30.0
 
 
-def _median_time(fn, repeats):
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
+def _median_times(fns, repeats):
+    """Median time of each function, their calls interleaved (the order alternating each
+    round), so that a slow spell of the shared machine falls on all of them alike."""
+    times = [[] for _ in fns]
+    for r in range(repeats):
+        order = range(len(fns)) if r % 2 == 0 else reversed(range(len(fns)))
+        for i in order:
+            t0 = time.perf_counter()
+            fns[i]()
+            times[i].append(time.perf_counter() - t0)
+    return [float(np.median(t)) for t in times]
 
 
 def _md_table(df, floatfmt=3) -> str:
@@ -198,8 +203,13 @@ def real_speed_rows(repeats: int, track_beats, librosa) -> list[dict]:
         # at least a minute of audio timed per recording: a 2.8 s clip takes 10 ms a call,
         # and the median of 3 such calls moved by 30 % between runs on this machine
         n = max(repeats, int(np.ceil(per_min)))
-        t_psf = _median_time(lambda y=y, sr=sr: track_beats(y, sr), n)
-        t_lib = _median_time(lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr), n)
+        t_psf, t_lib = _median_times(
+            [
+                lambda y=y, sr=sr: track_beats(y, sr),
+                lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr),
+            ],
+            n,
+        )
         rows.append(
             {
                 "recording": name,
@@ -578,8 +588,13 @@ def main() -> int:
         y = drum_pattern(ref, sr=sr, duration=SPEED_SONG_S, seed=1)
         track_beats(y, sr)  # warm-up (imports, FFT plans)
         librosa.beat.beat_track(y=y, sr=sr)  # warm-up (numba compilation)
-        t_psf = _median_time(lambda y=y, sr=sr: track_beats(y, sr), args.repeats)
-        t_lib = _median_time(lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr), args.repeats)
+        t_psf, t_lib = _median_times(
+            [
+                lambda y=y, sr=sr: track_beats(y, sr),
+                lambda y=y, sr=sr: librosa.beat.beat_track(y=y, sr=sr),
+            ],
+            args.repeats,
+        )
         per_min = 60.0 / SPEED_SONG_S
         speed_rows.append(
             {
@@ -731,13 +746,14 @@ def main() -> int:
         _md_table(targets),
         "",
         "## Speed: steady state (one core, 60 s drum pattern, median of "
-        f"{args.repeats}; ratio measured in the same run)",
+        f"{args.repeats}, ours and librosa's calls interleaved; ratio measured in the same run)",
         "",
         _md_table(speed),
         "",
         "## Speed: steady state on every bundled real recording (one core, median of "
-        f"{args.repeats} calls or of as many as make a minute of audio, whichever is more; "
-        "44.1 kHz files are resampled to 22.05 kHz inside the tracker)",
+        f"{args.repeats} calls or of as many as make a minute of audio, whichever is more, "
+        "ours and librosa's interleaved; 44.1 kHz files are resampled to 22.05 kHz inside "
+        "the tracker)",
         "",
         _md_table(real_speed),
         "",
@@ -802,13 +818,17 @@ def main() -> int:
         "- Speed: `psf` analyses at 22.05 kHz (higher rates are resampled first, by soxr); "
         "librosa analyses at the input rate. Steady-state times exclude each tracker's "
         "first call; the first-call rows show it. Absolute times depend on the machine's "
-        "load (see load_average above): read the ratios. Per audio minute, a 2.8 s clip "
-        f"costs most (the madmom sample: {clip_ms:.1f} ms a call; the pulse-clarity null "
-        "draws six shuffles of a clip this short, one of a song over 15 s). It took 27 ms "
-        "a call (0.57 s per audio minute, 1.70 times librosa's time) before the "
-        "resonators' energy was summed in the lag domain and the null's draws batched "
-        "(`beatsync.beats.metrical.resonator_salience`); the same run's librosa is the "
-        "baseline to read it against.",
+        "load (see load_average above; on the same code, runs an hour apart differed by up "
+        "to half): read the ratios. Per audio minute, the 44.1 kHz "
+        "recordings (resampled first) and the 2.8 s madmom sample cost most (the sample: "
+        f"{clip_ms:.1f} ms a call; the pulse-clarity null draws six shuffles of a clip this "
+        "short, one of a song over 15 s). It took 27 ms a call (0.57 s per audio minute, "
+        "1.70 times librosa's time) before the resonators' energy was summed in the lag "
+        "domain and the null's draws batched "
+        "(`beatsync.beats.metrical.resonator_salience`). The resonators' product in float32 "
+        "and the cached constant terms of the next change took 0.86 times the time on it "
+        "and 0.86-0.89 on two 30 s songs (each call interleaved in one process with the "
+        "code before; CHANGELOG).",
         "",
     ]
     (out_dir / "beats.md").write_text("\n".join(md))
