@@ -1,0 +1,126 @@
+"""Time the beat tracker of this working tree against an earlier revision, in one process.
+
+The shared machine's speed drifts by up to half between runs an hour apart, more than
+most changes to the tracker are worth. This script takes the earlier revision's
+``src/beatsync`` out of git (``git archive``) into a temporary folder, imports it under
+another name (``beatsync_base``; the package imports itself relatively) and calls both
+trackers in turn, the order alternating, on the bundled recordings: a slow spell falls
+on both alike. It reports each tracker's fastest and median call and the median of the
+per-pair time ratios, and checks that both give the same beats.
+
+Usage::
+
+    .venv/bin/python benchmarks/compare_revisions.py --base 5d3b6f9
+    .venv/bin/python benchmarks/compare_revisions.py --base HEAD~3 --pairs 200 20
+
+One core, as in the other benchmarks (``_machine.pin_one_core``).
+"""
+
+from __future__ import annotations
+
+import os
+
+import _machine  # noqa: E402  (benchmarks/ is on sys.path when a script runs)
+
+_machine.pin_one_core()  # before numpy is imported
+
+import argparse  # noqa: E402
+import importlib  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tarfile  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def load_revision(rev: str, dest: Path):
+    """The ``beatsync.beats`` package of git revision ``rev``, imported as ``beatsync_base``."""
+    archive = dest / "src.tar"
+    with archive.open("wb") as fh:
+        subprocess.run(
+            ["git", "-C", str(ROOT), "archive", "--format=tar", rev, "src/beatsync"],
+            stdout=fh,
+            check=True,
+        )
+    with tarfile.open(archive) as tar:
+        tar.extractall(dest, filter="data")
+    (dest / "src" / "beatsync").rename(dest / "beatsync_base")
+    sys.path.insert(0, str(dest))
+    return importlib.import_module("beatsync_base.beats")
+
+
+def items():
+    """(name, audio, rate, pairs factor): the madmom sample, 30 s of two recordings."""
+    from beatsync import datasets
+
+    y, sr = datasets.load_madmom_sample()[:2]
+    out = [("madmom sample (2.8 s)", y, sr, 1.0)]
+    for name, start in (("ballroom_waltz", 0.0), ("hainsworth_001", 10.0)):
+        y, sr = datasets.load_real_dev(name)[:2]
+        out.append(
+            (f"{name}, 30 s from {start:g} s", y[int(start * sr) : int((start + 30) * sr)], sr, 0.1)
+        )
+    return out
+
+
+def compare(base, new, y, sr, pairs: int) -> dict:
+    b_beats = base.track_beats(y, sr).beats  # warm-up, and the beats to compare
+    n_beats = new.track_beats(y, sr).beats
+    same = b_beats.shape == n_beats.shape
+    diff = float(np.max(np.abs(b_beats - n_beats))) if same and b_beats.size else 0.0
+    times = {"base": [], "new": []}
+    for i in range(pairs):
+        order = (("base", base), ("new", new)) if i % 2 == 0 else (("new", new), ("base", base))
+        for key, mod in order:
+            t0 = time.perf_counter()
+            mod.track_beats(y, sr)
+            times[key].append(time.perf_counter() - t0)
+    tb, tn = (np.array(times[k]) * 1e3 for k in ("base", "new"))
+    return {
+        "base min [ms]": tb.min(),
+        "base median [ms]": np.median(tb),
+        "new min [ms]": tn.min(),
+        "new median [ms]": np.median(tn),
+        "new/base (median of pair ratios)": float(np.median(tn / tb)),
+        "same beats": "yes"
+        if same and diff == 0.0
+        else ("no" if not same else f"within {diff:.1e} s"),
+    }
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--base", required=True, help="git revision to compare against")
+    ap.add_argument(
+        "--pairs",
+        type=int,
+        default=300,
+        help="call pairs on the madmom sample (a tenth on the 30 s items)",
+    )
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")  # the no-clear-pulse warning, on both
+    import beatsync.beats as new
+
+    with tempfile.TemporaryDirectory() as tmp:
+        base = load_revision(args.base, Path(tmp))
+        print(f"base {args.base} ({base.__file__}) against the working tree ({new.__file__})")
+        print(f"one core (OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']})")
+        for name, y, sr, factor in items():
+            row = compare(base, new, y, sr, max(int(args.pairs * factor), 5))
+            print(
+                f"{name}: "
+                + ", ".join(
+                    f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()
+                )
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
