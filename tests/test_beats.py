@@ -691,6 +691,24 @@ def test_resonator_salience_equals_the_spectrum_sum(windows, max_hz):
         np.testing.assert_allclose(got, want, rtol=0, atol=tol)
 
 
+def test_resonator_salience_does_not_depend_on_the_accents_scale():
+    # the salience is a ratio of energies: any scale of the accent signals gives the
+    # same salience, also where the float32 lag-domain product would overflow (1e18)
+    # or lose its precision to underflow (1e-24) without the normalisation
+    from beatsync.beats.metrical import resonator_salience
+
+    fps = 22050 / 128
+    bands = np.abs(np.random.default_rng(5).standard_normal((4, 1378))) ** 3
+    bands[2, ::69] += 4.0  # a pulse at 150 BPM in one band
+    periods = np.exp(np.linspace(np.log(0.1), np.log(3.0), 120))
+    want = resonator_salience(bands, fps, [0], [1378], periods, 3.0)
+    for scale in (1e-24, 1e-6, 1e18, 1e30):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no overflow on the way
+            got = resonator_salience(bands * scale, fps, [0], [1378], periods, 3.0)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-6)
+
+
 def test_pulse_clarity_null_draws_in_one_batch_equal_draws_one_by_one():
     from beatsync.beats import tracker
     from beatsync.beats.metrical import METER_MODEL, beat_observation
