@@ -756,6 +756,29 @@ def test_small_filters_equal_scipy_ndimage():
         )
 
 
+def test_small_filters_refuse_an_empty_window():
+    from beatsync.beats.filters import moving_max, moving_mean
+
+    x = np.arange(10.0)
+    for fn in (moving_max, moving_mean):
+        with pytest.raises(ValueError, match="size=0"):
+            fn(x, 0)
+
+
+def test_default_front_end_is_cached_on_the_defaults_and_the_checked_rate(monkeypatch):
+    # the default front end is cached per rate: the same settings as given explicitly,
+    # for any type of rate, and new settings when the defaults change
+    from beatsync.beats import onset
+    from beatsync.errors import ParameterError
+
+    for sr in (16000, np.int64(16000), np.float32(16000), 16000.0):
+        assert onset.frontend_settings({}, sr) == onset.frontend_settings({"win_s": 0.023}, sr)
+    with pytest.raises(ParameterError, match="did you mean sr=44100"):
+        onset.frontend_settings({}, 44.1)
+    monkeypatch.setitem(onset.FRONTEND_DEFAULTS, "win_s", 0.046)
+    assert onset.frontend_settings({}, 22050.0).win_length == 1014
+
+
 def test_clips_of_other_lengths_share_the_resonator_weights():
     # the lag weights are cached per power of two of the window length: clips shorter
     # than the tempo window (each its own length) computed all three grids again

@@ -15,6 +15,8 @@ __all__ = ["moving_mean", "moving_max", "gaussian_smooth"]
 
 def _padded(x: np.ndarray, size: int, origin: int) -> tuple[np.ndarray, int]:
     """Pad the last axis symmetrically for a window of ``size`` shifted by ``origin``."""
+    if size < 1:
+        raise ValueError(f"size={size!r}: a filter window holds at least one sample")
     left = size // 2 + origin
     right = size - 1 - left
     lo, hi = max(left, 0), max(right, 0)

@@ -40,7 +40,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..resampling import resample
-from ..units import check_audio, check_positive, frames_to_time, time_to_frames
+from ..units import (
+    check_audio,
+    check_positive,
+    check_sample_rate,
+    frames_to_time,
+    time_to_frames,
+)
 from .filters import moving_max, moving_mean
 
 __all__ = [
@@ -107,18 +113,24 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     Raises
     ------
     ParameterError
-        Unknown key, non-positive window or hop, a hop over half the window, an FFT
+        An implausible sample rate (:func:`beatsync.units.check_sample_rate`), an
+        unknown key, non-positive window or hop, a hop over half the window, an FFT
         shorter than the window, band edges that do not increase, or given band edges
         with a band that holds no FFT bin at the analysis rate (above its Nyquist
         frequency, or too narrow).
     """
-    if not params:
-        return _default_frontend(float(sr))
+    sr = check_sample_rate(sr)
+    if not params:  # the defaults (an empty dict, or None)
+        defaults = tuple(FRONTEND_DEFAULTS.items())  # the key: they may have been changed
+        try:
+            return _default_frontend(sr, defaults)
+        except TypeError:  # a default changed to something unhashable
+            return _frontend_settings({}, sr)
     return _frontend_settings(params, sr)
 
 
 @functools.lru_cache(maxsize=16)
-def _default_frontend(sr: float) -> FrontEnd:
+def _default_frontend(sr: float, defaults: tuple) -> FrontEnd:
     """The default front end at rate ``sr`` (cached: validating it took 0.1 ms a call)."""
     return _frontend_settings({}, sr)
 
