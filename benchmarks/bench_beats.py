@@ -825,10 +825,9 @@ def main() -> int:
         "short, one of a song over 15 s). It took 27 ms a call (0.57 s per audio minute, "
         "1.70 times librosa's time) before the resonators' energy was summed in the lag "
         "domain and the null's draws batched "
-        "(`beatsync.beats.metrical.resonator_salience`). The resonators' product in float32 "
-        "and the cached constant terms of the next change took 0.86 times the time on it "
-        "and 0.86-0.89 on two 30 s songs (each call interleaved in one process with the "
-        "code before; CHANGELOG).",
+        "(`beatsync.beats.metrical.resonator_salience`). A change to the tracker is timed "
+        "against the code before it by `benchmarks/compare_revisions.py` (both in one "
+        "process, calls interleaved; its own section below).",
         "",
     ]
     (out_dir / "beats.md").write_text("\n".join(md))

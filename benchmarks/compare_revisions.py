@@ -11,14 +11,15 @@ per-pair time ratios, and checks that both give the same beats.
 Usage::
 
     .venv/bin/python benchmarks/compare_revisions.py --base 5d3b6f9
-    .venv/bin/python benchmarks/compare_revisions.py --base HEAD~3 --pairs 200 20
+    .venv/bin/python benchmarks/compare_revisions.py --base HEAD~3 --pairs 100
+
+It prints a table and writes it to ``benchmarks/results/compare_revisions.md`` (and
+``.json``), with the command and the machine, for ``run_all.py --collect``.
 
 One core, as in the other benchmarks (``_machine.pin_one_core``).
 """
 
 from __future__ import annotations
-
-import os
 
 import _machine  # noqa: E402  (benchmarks/ is on sys.path when a script runs)
 
@@ -26,6 +27,7 @@ _machine.pin_one_core()  # before numpy is imported
 
 import argparse  # noqa: E402
 import importlib  # noqa: E402
+import json  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tarfile  # noqa: E402
@@ -41,6 +43,20 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def load_revision(rev: str, dest: Path):
     """The ``beatsync.beats`` package of git revision ``rev``, imported as ``beatsync_base``."""
+    found = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"],
+        capture_output=True,
+        text=True,
+    )
+    if found.returncode != 0:
+        sys.exit(f"--base {rev!r}: not a commit of {ROOT} (a hash, tag, branch or HEAD~N)")
+    listed = subprocess.run(
+        ["git", "-C", str(ROOT), "ls-tree", "--name-only", rev, "src/beatsync/beats/"],
+        capture_output=True,
+        text=True,
+    )
+    if "src/beatsync/beats/tracker.py" not in listed.stdout.split():
+        sys.exit(f"--base {rev!r}: that revision has no src/beatsync/beats/tracker.py to compare")
     archive = dest / "src.tar"
     with archive.open("wb") as fh:
         subprocess.run(
@@ -94,6 +110,21 @@ def compare(base, new, y, sr, pairs: int) -> dict:
     }
 
 
+def _git(*args: str) -> str:
+    return subprocess.run(
+        ["git", "-C", str(ROOT), *args], capture_output=True, text=True, check=True
+    ).stdout.strip()
+
+
+def _md_table(rows: list[dict]) -> str:
+    cols = list(rows[0])
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        cells = [f"{v:.3f}" if isinstance(v, float) else str(v) for v in r.values()]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--base", required=True, help="git revision to compare against")
@@ -104,21 +135,58 @@ def main() -> int:
         help="call pairs on the madmom sample (a tenth on the 30 s items)",
     )
     args = ap.parse_args()
+    if args.pairs < 1:
+        ap.error(f"--pairs {args.pairs}: give at least one pair of calls")
     warnings.simplefilter("ignore")  # the no-clear-pulse warning, on both
     import beatsync.beats as new
 
+    rows = []
     with tempfile.TemporaryDirectory() as tmp:
         base = load_revision(args.base, Path(tmp))
         print(f"base {args.base} ({base.__file__}) against the working tree ({new.__file__})")
-        print(f"one core (OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']})")
         for name, y, sr, factor in items():
-            row = compare(base, new, y, sr, max(int(args.pairs * factor), 5))
+            row = {"item": name, **compare(base, new, y, sr, max(int(args.pairs * factor), 5))}
+            rows.append(row)
             print(
-                f"{name}: "
-                + ", ".join(
+                ", ".join(
                     f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()
                 )
             )
+    base_hash = _git("rev-parse", "--short", f"{args.base}^{{commit}}")
+    head = _git("rev-parse", "--short", "HEAD")
+    dirty = " (with uncommitted changes)" if _git("status", "--porcelain", "--", "src") else ""
+    facts = _machine.machine_facts()
+    md = [
+        "# The tracker against an earlier revision (interleaved, one process)",
+        "",
+        "Command:",
+        "",
+        f"  .venv/bin/python benchmarks/compare_revisions.py --base {args.base} "
+        f"--pairs {args.pairs}",
+        "",
+        "Machine: " + ", ".join(f"{k} {v}" for k, v in facts.items()),
+        "",
+        f"Base: {args.base} ({base_hash}); new: the working tree at {head}{dirty}. Each call "
+        "of one tracker is followed by a call of the other, the order alternating; "
+        "new/base is the median of the per-pair time ratios, which a slow spell of the "
+        "shared machine moves much less than the medians themselves. `same beats`: the "
+        "two trackers' beats compared exactly.",
+        "",
+        _md_table(rows),
+        "",
+    ]
+    out = Path(__file__).resolve().parent / "results"
+    out.mkdir(exist_ok=True)
+    (out / "compare_revisions.md").write_text("\n".join(md))
+    payload = {
+        "base": args.base,
+        "base_hash": base_hash,
+        "head": head,
+        "rows": rows,
+        "machine": facts,
+    }
+    (out / "compare_revisions.json").write_text(json.dumps(payload, indent=1, default=float))
+    print(f"wrote {out / 'compare_revisions.md'}")
     return 0
 
 
