@@ -676,8 +676,8 @@ def test_resonator_salience_equals_the_spectrum_sum(windows, max_hz):
     got = resonator_salience(bands, fps, starts, stops, periods, 3.0, max_hz)
     want = _salience_by_spectrum(bands, fps, starts, stops, periods, 3.0, max_hz)
     # the lag-domain product is taken in float32: each band's energy ratio (at most 1)
-    # is off by about 1e-7, the sum over four bands here by up to 1.6e-6; a wrong comb
-    # gain or lag weight is off by more than 1e-3
+    # is off by about 1e-7, the sum over four bands here by up to 1.6e-6 (lag weights
+    # off by a relative 1e-4 fail it)
     tol = 5e-6
     np.testing.assert_allclose(got, want, rtol=0, atol=tol)
     # several sets of bands at once (the null's draws): each as on its own
@@ -744,7 +744,7 @@ def test_small_filters_equal_scipy_ndimage():
         want = ndimage.gaussian_filter1d(x, sigma, axis=-1)
         np.testing.assert_allclose(gaussian_smooth(x, sigma), want, atol=1e-12)
         np.testing.assert_allclose(gaussian_smooth(x[0, 0], sigma), want[0, 0], atol=1e-12)
-    # 81 and 80: edges as long as the signal, and longer (numpy's repeated reflections)
+    # 81 and 80: edges as long as the signal; 90: longer (numpy's repeated reflections)
     for size, origin in ((5, 0), (6, 1), (7, -2), (81, 0), (80, -1), (90, 3)):
         np.testing.assert_allclose(
             moving_mean(x, size, origin),
