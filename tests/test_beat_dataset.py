@@ -293,6 +293,57 @@ def test_each_thread_collects_its_own_warnings():
         warn("issued")
 
 
+def test_silenced_warnings_are_neither_issued_nor_collected_and_only_in_their_thread():
+    # code that expects a warning drops it with errors.silenced (thread-local); with
+    # warnings.simplefilter (process-wide) a collecting block recorded it all the same
+    import threading
+    import warnings
+
+    from beatsync.errors import collect_warnings, silenced, warn
+    from beatsync.evaluate.composition import quality_proxies
+
+    with collect_warnings() as got:
+        with silenced():
+            warn("dropped")
+            with silenced():
+                warn("dropped too")
+            warn("still dropped")
+        warn("kept")
+    assert got == ["kept"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing issued either
+        with silenced():
+            warn("dropped")
+    # another thread's warning while this one is silenced: issued as usual
+    other = []
+
+    def elsewhere():
+        with collect_warnings() as mine:
+            warn("other thread")
+        other.extend(mine)
+
+    with silenced():
+        t = threading.Thread(target=elsewhere)
+        t.start()
+        t.join(timeout=30)
+    assert other == ["other thread"]
+    # a library step that drops its parts' warnings (no motion beats to align: the
+    # proxies say 0 themselves); they were collected before
+    with collect_warnings() as got:
+        scores = quality_proxies(
+            motion_beats=np.array([]),
+            music_beats=np.array([0.5, 1.0, 1.5]),
+            span=(0.0, 2.0),
+            positions=np.zeros((50, 3, 3)),
+            foot_positions=np.zeros((50, 2, 3)),
+            fps=25.0,
+            transition_times=np.array([]),
+            motion_intensity=np.ones(3),
+            music_level=np.ones(3),
+        )
+    assert got == [] and scores["alignment_motion"] == 0.0
+
+
 def test_rows_keep_their_own_warnings_on_a_threaded_worker(tmp_path):
     from concurrent.futures import ThreadPoolExecutor
 

@@ -18,7 +18,7 @@ import threading
 import warnings
 from collections.abc import Iterator
 
-__all__ = ["ParameterError", "BeatsyncWarning", "warn", "collect_warnings"]
+__all__ = ["ParameterError", "BeatsyncWarning", "warn", "collect_warnings", "silenced"]
 
 
 class ParameterError(ValueError):
@@ -37,6 +37,8 @@ def warn(message: str, *, stacklevel: int = 1) -> None:
 
     ``stacklevel`` as for :func:`warnings.warn` called where this is called.
     """
+    if getattr(_local, "silent", 0):
+        return
     collected = getattr(_local, "collected", None)
     if collected is not None:
         collected.append(str(message))
@@ -50,9 +52,9 @@ def collect_warnings() -> Iterator[list[str]]:
     block, in order, instead of issuing them (thread-safe; blocks may nest).
 
     Every one is recorded, whatever the :mod:`warnings` filters say: they are
-    process-wide, and another thread's filters must not decide this thread's record. A
-    warning that code inside the block silences with :func:`warnings.simplefilter` is
-    recorded all the same.
+    process-wide, and another thread's filters must not decide this thread's record.
+    Code that expects a warning and has nothing to say about it drops it with
+    :func:`silenced` (this thread's too), and then it is not recorded.
     """
     outer = getattr(_local, "collected", None)
     _local.collected = []
@@ -60,3 +62,20 @@ def collect_warnings() -> Iterator[list[str]]:
         yield _local.collected
     finally:
         _local.collected = outer
+
+
+@contextlib.contextmanager
+def silenced() -> Iterator[None]:
+    """Drop the :class:`BeatsyncWarning` this thread issues inside the block: neither
+    issued nor recorded by :func:`collect_warnings` (thread-safe; blocks may nest).
+
+    For a step whose warning says nothing to its caller (no motion beats to count, a
+    constant intensity to standardise). Unlike :func:`warnings.catch_warnings`, it
+    leaves other threads' warnings alone.
+    """
+    depth = getattr(_local, "silent", 0)
+    _local.silent = depth + 1
+    try:
+        yield
+    finally:
+        _local.silent = depth

@@ -508,18 +508,19 @@ class Feedback:
     def noted(self) -> Iterator[list[str]]:
         """The :class:`~beatsync.errors.BeatsyncWarning` messages issued in the block.
 
-        Filled when the block ends, and each said with :meth:`warn` then (other
-        warnings inside the block are dropped).
+        Filled when the block ends (:func:`~beatsync.errors.collect_warnings`), and each
+        said with :meth:`warn` then; other packages' warnings inside the block are
+        dropped.
         """
         import warnings
 
-        from ..errors import BeatsyncWarning
+        from ..errors import collect_warnings
 
         notes: list[str] = []
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", BeatsyncWarning)
+        with collect_warnings() as caught, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
             yield notes
-        notes += [str(w.message) for w in caught if issubclass(w.category, BeatsyncWarning)]
+        notes += caught
         for note in notes:
             self.warn(note)
 

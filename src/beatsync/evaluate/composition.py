@@ -31,12 +31,11 @@ Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 4 (
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError, warn
+from ..errors import ParameterError, silenced, warn
 from ..units import time_to_frames
 from .alignment import alignment_scores
 
@@ -198,8 +197,7 @@ def quality_proxies(
         beats / music beats), ``intensity_r``, ``transition_jump_mean``,
         ``transition_jump_max``, ``foot_sliding``.
     """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BeatsyncWarning)
+    with silenced():
         al = alignment_scores(motion_beats, music_beats, sigma=sigma, span=span)
         jumps = transition_jumps(positions, transition_times, fps=fps, blend=blend)
         r = intensity_correlation(motion_intensity, music_level)

@@ -50,14 +50,13 @@ from __future__ import annotations
 
 import dataclasses
 import time
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError, warn
+from ..errors import ParameterError, silenced, warn
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
 from ..units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
 from .distance import aligned_distance_matrix, point_clouds, typical_speed
@@ -521,8 +520,7 @@ def build_graph(
         pos = motion_positions(c, joints=joints)
         positions.append(pos)
         if beats is None:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", BeatsyncWarning)
+            with silenced():
                 fr = kinematic_beat_frames(
                     pos, fps=c.fps, method=beat_method, smooth=smooth, min_interval=min_interval
                 )
@@ -553,8 +551,7 @@ def build_graph(
             "use longer clips or a smaller min_interval"
         )
     z = np.full(n, np.nan)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BeatsyncWarning)
+    with silenced():
         z[ok] = zscore(intensity[ok], name="motion intensity")
 
     # eq. 1: scale-free distances between all pairs of beat frames

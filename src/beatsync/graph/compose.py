@@ -15,13 +15,12 @@ Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 from __future__ import annotations
 
 import time
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError, warn
+from ..errors import ParameterError, silenced, warn
 from ..motion import Motion
 from ..motion_beats import zscore
 from ..units import check_finite, check_fps, check_times
@@ -232,8 +231,7 @@ def compose(
         graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
     )
     grid, grid_level = music_grid(beats, level, plan.subdivision)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BeatsyncWarning)
+    with silenced():
         z = zscore(grid_level, name="music intensity")
     res = _search(graph, z, np.diff(grid), method, lam, seed, plan, search_kwargs)
     t0 = time.perf_counter()

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError, warn
+from ..errors import ParameterError, silenced, warn
 from ..units import (
     check_motion_fps,
     check_range,
@@ -163,8 +162,7 @@ def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
     from ..motion_beats import kinematic_beats
 
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)  # no beats: no count, no news
+        with silenced():  # no beats: no count, no news
             mb = kinematic_beats(motion)
     except ParameterError:  # no positions
         return None
