@@ -123,16 +123,39 @@ def test_existing_scheduler_by_address():
         assert lc.status.name == "running"  # an existing cluster is left running
 
 
-def test_local_workers_keep_glibc_default_malloc():
-    """Dask's MALLOC_TRIM_THRESHOLD_=65536 made every track about 1.8x slower."""
+def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
+    """Dask's MALLOC_TRIM_THRESHOLD_=65536 made every track about 1.8x slower; the
+    periodic work of LOCAL_CLUSTER_CONFIG took 7-10 % of a core per process."""
     import os
 
-    def environ():
-        return os.environ.get("MALLOC_TRIM_THRESHOLD_"), os.environ.get("OMP_NUM_THREADS")
+    import dask
 
+    def settings(dask_worker):
+        return (
+            os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+            os.environ.get("OMP_NUM_THREADS"),
+            "profile" in dask_worker.periodic_callbacks,
+            dask_worker._tick_interval,
+            dask_worker.periodic_callbacks["monitor"].callback_time,
+            dask_worker.memory_manager.memory_monitor_interval,
+        )
+
+    import distributed  # noqa: F401 (its defaults loaded)
+
+    keys = [*cluster.LOCAL_CLUSTER_CONFIG, "distributed.nanny.pre-spawn-environ"]
+    before = {key: dask.config.get(key) for key in keys}
     with cluster.dask_client(n_workers=1, processes=True) as client:
-        (env,) = client.run(environ).values()
-    assert env == (None, "1")
+        (worker,) = client.run(settings).values()
+        scheduler = client.run_on_scheduler(
+            lambda dask_scheduler: (
+                dask_scheduler._tick_interval,
+                dask_scheduler.periodic_callbacks["monitor"].callback_time,
+            )
+        )
+    assert worker == (None, "1", False, 1.0, 2000, 1.0)
+    assert scheduler == (1.0, 2000)
+    # only while the cluster starts: this process's own settings are left as they were
+    assert {key: dask.config.get(key) for key in keys} == before
 
 
 def _sigint_and_heartbeat_record():

@@ -10,7 +10,9 @@ another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client 
 the local cluster on the way out, also on Ctrl-C (local worker processes ignore
 SIGINT: see :func:`dask_setup`). Local workers run with glibc's
 default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
-about 1.8x slower).
+about 1.8x slower), and a local cluster leaves out the periodic work that only a
+dashboard reads and checks its event loops and memory less often
+(:data:`LOCAL_CLUSTER_CONFIG`).
 
 Workers of an existing cluster must see the same file paths as the client (a shared
 file system) and have beatsync installed.
@@ -39,6 +41,29 @@ __all__ = [
 
 #: Seconds to wait for an existing scheduler before giving up.
 CONNECT_TIMEOUT = 5.0
+
+#: Dask settings of the local clusters (a cluster given by address keeps its own).
+#: The scheduler, each nanny and each worker run periodic callbacks tens of times a
+#: second, and on a machine of a few cores that work competes with the tracking. These
+#: four are for the dashboard (none is started) or need not run so often.
+#: Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py`` (runs
+#: alternating, median of the pair ratios): the Dask path of ``beatsync evaluate
+#: beats`` on 40 songs of 30 s took 0.93 of the time with 1 worker and with 2; idle,
+#: this process used 1.6 % of a core instead of 8.6 %, each worker 0.6 % instead of 5.8 %.
+LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
+    # the statistical profiler: a stack sample of every thread every 10 ms, in every
+    # worker, for the dashboard's profile and performance reports
+    "distributed.worker.profile.enabled": False,
+    # the event loop's health check (every 20 ms): it logs a loop held for 3 s or more,
+    # which a check every second still sees
+    "distributed.admin.tick.interval": "1s",
+    # CPU, memory, network and disk counters for the dashboard (every 500 ms)
+    "distributed.admin.system-monitor.interval": "2s",
+    # the memory check against the spill, pause and terminate thresholds (every 100 ms):
+    # a task holds one song and returns a row of a few kB, so nothing is spilled; a
+    # worker past its memory limit is still stopped within about a second
+    "distributed.worker.memory.monitor-interval": "1s",
+}
 
 
 def default_workers() -> int:
@@ -152,7 +177,8 @@ def dask_client(
     cluster = None
     stack = contextlib.ExitStack()
     if scheduler is None:
-        stack.enter_context(_glibc_default_malloc())
+        # read by the scheduler, nannies and workers as they start
+        stack.enter_context(_local_cluster_config())
         cluster = LocalCluster(
             n_workers=n or default_workers(),
             threads_per_worker=1,
@@ -197,21 +223,22 @@ def _worker_preloads() -> dict[str, list[Any]]:
     return kwargs
 
 
-def _glibc_default_malloc() -> Any:
-    """Start local workers without Dask's ``MALLOC_TRIM_THRESHOLD_=65536``.
+def _local_cluster_config() -> Any:
+    """The Dask settings a local cluster starts with: :data:`LOCAL_CLUSTER_CONFIG`, and
+    worker processes without Dask's ``MALLOC_TRIM_THRESHOLD_=65536``.
 
-    Dask sets it in its worker processes to hand freed memory back to the system at
-    once; glibc then stops adapting its thresholds, and beat tracking (arrays of a few
-    MB allocated and freed per call) runs about 1.8x slower: 1.29 s against 0.72 s
-    per 30 s song, measured in one process with and without the variable. The other
-    variables (one thread for OpenMP, MKL, OpenBLAS) are kept.
+    Dask sets that variable in its worker processes to hand freed memory back to the
+    system at once; glibc then stops adapting its thresholds, and beat tracking (arrays
+    of a few MB allocated and freed per call) runs about 1.8x slower: 1.29 s against
+    0.72 s per 30 s song, measured in one process with and without the variable. The
+    other variables (one thread for OpenMP, MKL, OpenBLAS) are kept.
     """
     import dask
 
     key = "distributed.nanny.pre-spawn-environ"
     env = dict(dask.config.get(key, default={}) or {})
     env.pop("MALLOC_TRIM_THRESHOLD_", None)
-    return dask.config.set({key: env})
+    return dask.config.set({**LOCAL_CLUSTER_CONFIG, key: env})
 
 
 #: Connection attempts when the scheduler's first reply is not the lone "stream-start".
