@@ -125,10 +125,12 @@ def test_existing_scheduler_by_address():
 
 def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
     """Dask's MALLOC_TRIM_THRESHOLD_=65536 made every track about 1.8x slower; the
-    periodic work of LOCAL_CLUSTER_CONFIG took 7-10 % of a core per process."""
+    periodic work of LOCAL_CLUSTER_CONFIG took 5-9 % of a core per process, idle. A
+    key the user sets keeps the user's value."""
     import os
 
     import dask
+    import distributed  # noqa: F401 (its defaults loaded)
 
     def settings(dask_worker):
         return (
@@ -140,22 +142,51 @@ def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
             dask_worker.memory_manager.memory_monitor_interval,
         )
 
-    import distributed  # noqa: F401 (its defaults loaded)
+    keys = [*cluster.LOCAL_CLUSTER_CONFIG, "distributed.nanny.pre-spawn-environ"]
+    with dask.config.set({"distributed.admin.tick.interval": "500ms"}):  # the user's
+        before = {key: dask.config.get(key) for key in keys}
+        with cluster.dask_client(n_workers=1, processes=True) as client:
+            (worker,) = client.run(settings).values()
+            scheduler = client.run_on_scheduler(
+                lambda dask_scheduler: (
+                    dask_scheduler._tick_interval,
+                    dask_scheduler.periodic_callbacks["monitor"].callback_time,
+                )
+            )
+            (nanny,) = client.cluster.workers.values()  # in this process; it stops a
+            nanny_interval = nanny.memory_manager.memory_monitor_interval  # worker
+            # restored once the cluster has started: this process keeps its settings
+            during = {key: dask.config.get(key) for key in keys}
+    assert worker == (None, "1", False, 0.5, 2000, 1.0)
+    assert scheduler == (0.5, 2000)
+    assert nanny_interval == 1.0
+    assert during == before
 
+
+def test_local_cluster_that_fails_to_start_leaves_settings_and_no_cluster(monkeypatch):
+    import dask
+    import dask.distributed
+
+    started = []
+
+    class Recorded(dask.distributed.LocalCluster):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            started.append(self)
+
+    def refuse(*args, **kwargs):
+        raise RuntimeError("no client")
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", Recorded)
+    monkeypatch.setattr(dask.distributed, "Client", refuse)
     keys = [*cluster.LOCAL_CLUSTER_CONFIG, "distributed.nanny.pre-spawn-environ"]
     before = {key: dask.config.get(key) for key in keys}
-    with cluster.dask_client(n_workers=1, processes=True) as client:
-        (worker,) = client.run(settings).values()
-        scheduler = client.run_on_scheduler(
-            lambda dask_scheduler: (
-                dask_scheduler._tick_interval,
-                dask_scheduler.periodic_callbacks["monitor"].callback_time,
-            )
-        )
-    assert worker == (None, "1", False, 1.0, 2000, 1.0)
-    assert scheduler == (1.0, 2000)
-    # only while the cluster starts: this process's own settings are left as they were
+    with pytest.raises(RuntimeError, match="no client"):
+        with cluster.dask_client(n_workers=1, processes=False):
+            pass
     assert {key: dask.config.get(key) for key in keys} == before
+    (local,) = started
+    assert local.status.name == "closed"
 
 
 def _sigint_and_heartbeat_record():

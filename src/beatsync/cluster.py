@@ -37,31 +37,36 @@ __all__ = [
     "check_cluster_options",
     "default_workers",
     "CONNECT_TIMEOUT",
+    "LOCAL_CLUSTER_CONFIG",
 ]
 
 #: Seconds to wait for an existing scheduler before giving up.
 CONNECT_TIMEOUT = 5.0
 
-#: Dask settings of the local clusters (a cluster given by address keeps its own).
-#: The scheduler, each nanny and each worker run periodic callbacks tens of times a
-#: second, and on a machine of a few cores that work competes with the tracking. These
-#: four are for the dashboard (none is started) or need not run so often.
-#: Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py`` (runs
-#: alternating, median of the pair ratios): the Dask path of ``beatsync evaluate
-#: beats`` on 40 songs of 30 s took 0.93 of the time with 1 worker and with 2; idle,
-#: this process used 1.6 % of a core instead of 8.6 %, each worker 0.6 % instead of 5.8 %.
+#: Dask settings of the local clusters, set while a cluster starts (its scheduler,
+#: nannies and workers read them then; a nanny passes them on to a worker it starts
+#: again). A key that the user's Dask configuration sets (a YAML file, a ``DASK_*``
+#: variable, ``dask.config.set``) keeps the user's value, and a cluster given by address
+#: keeps its own settings. The scheduler, each nanny and each worker run periodic
+#: callbacks tens of times a second, and on a machine of a few cores that work competes
+#: with the tracking; these four are for the dashboard (none is started) or need not run
+#: so often. Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py``
+#: (runs alternating, see benchmarks/RESULTS.md): idle, this process used 1.6 % of a
+#: core instead of 8.6 % and each worker 0.6 % instead of 5.8 %, lower in every pair;
+#: the time of a run over 40 songs, a difference of a few per cent, is within the noise
+#: of the shared machine.
 LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
-    # the statistical profiler: a stack sample of every thread every 10 ms, in every
-    # worker, for the dashboard's profile and performance reports
+    # the statistical profiler: a stack sample of the threads running tasks every 10 ms,
+    # in every worker, for the dashboard's profile and performance reports
     "distributed.worker.profile.enabled": False,
-    # the event loop's health check (every 20 ms): it logs a loop held for 3 s or more,
-    # which a check every second still sees
+    # the event loop's health check (every 20 ms) logs, at level INFO, a loop held for
+    # 3 s or more; checked every second, it may also log one held for 2 s
     "distributed.admin.tick.interval": "1s",
     # CPU, memory, network and disk counters for the dashboard (every 500 ms)
     "distributed.admin.system-monitor.interval": "2s",
     # the memory check against the spill, pause and terminate thresholds (every 100 ms):
-    # a task holds one song and returns a row of a few kB, so nothing is spilled; a
-    # worker past its memory limit is still stopped within about a second
+    # a worker past 95 % of its memory limit is sent SIGTERM within a second and killed
+    # a second later if it is still there; the tasks hold one song or one clip each
     "distributed.worker.memory.monitor-interval": "1s",
 }
 
@@ -175,22 +180,27 @@ def dask_client(
     from dask.distributed import Client, LocalCluster
 
     cluster = None
-    stack = contextlib.ExitStack()
     if scheduler is None:
-        # read by the scheduler, nannies and workers as they start
-        stack.enter_context(_local_cluster_config())
-        cluster = LocalCluster(
-            n_workers=n or default_workers(),
-            threads_per_worker=1,
-            processes=processes,
-            dashboard_address=None,
-            # no dashboard; the scheduler's small HTTP server on a free port, not 8787
-            scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
-            silence_logs=logging.ERROR,
-            # worker processes ignore Ctrl-C: this process closes them (no tracebacks)
-            **(_worker_preloads() if processes else {}),
-        )
-        client = Client(cluster)
+        # read by the scheduler, nannies and workers as they start; this process's own
+        # settings are restored at once, also when the start fails
+        with _local_cluster_config():
+            cluster = LocalCluster(
+                n_workers=n or default_workers(),
+                threads_per_worker=1,
+                processes=processes,
+                dashboard_address=None,
+                # no dashboard; the scheduler's small HTTP server on a free port, not 8787
+                scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
+                silence_logs=logging.ERROR,
+                # worker processes ignore Ctrl-C: this process closes them (no tracebacks)
+                **(_worker_preloads() if processes else {}),
+            )
+        try:
+            client = Client(cluster)
+        except BaseException:
+            with contextlib.suppress(Exception):
+                cluster.close()  # no worker processes left behind
+            raise
     else:
         client = _connect(scheduler.strip(), CONNECT_TIMEOUT if timeout is None else timeout)
     try:
@@ -201,7 +211,6 @@ def dask_client(
         if cluster is not None:
             with contextlib.suppress(Exception):
                 cluster.close()
-        stack.close()
 
 
 def _worker_preloads() -> dict[str, list[Any]]:
@@ -224,8 +233,9 @@ def _worker_preloads() -> dict[str, list[Any]]:
 
 
 def _local_cluster_config() -> Any:
-    """The Dask settings a local cluster starts with: :data:`LOCAL_CLUSTER_CONFIG`, and
-    worker processes without Dask's ``MALLOC_TRIM_THRESHOLD_=65536``.
+    """The Dask settings a local cluster starts with: :data:`LOCAL_CLUSTER_CONFIG` (each
+    key the user's configuration leaves at distributed's default), and worker processes
+    without Dask's ``MALLOC_TRIM_THRESHOLD_=65536``.
 
     Dask sets that variable in its worker processes to hand freed memory back to the
     system at once; glibc then stops adapting its thresholds, and beat tracking (arrays
@@ -235,10 +245,16 @@ def _local_cluster_config() -> Any:
     """
     import dask
 
+    defaults = dask.config.merge(*dask.config.defaults)  # distributed's, once imported
+    ours = {
+        key: value
+        for key, value in LOCAL_CLUSTER_CONFIG.items()
+        if dask.config.get(key, None) == dask.config.get(key, None, config=defaults)
+    }
     key = "distributed.nanny.pre-spawn-environ"
     env = dict(dask.config.get(key, default={}) or {})
     env.pop("MALLOC_TRIM_THRESHOLD_", None)
-    return dask.config.set({**LOCAL_CLUSTER_CONFIG, key: env})
+    return dask.config.set({**ours, key: env})
 
 
 #: Connection attempts when the scheduler's first reply is not the lone "stream-start".
