@@ -88,6 +88,7 @@ def main() -> int:
     ap.add_argument("--idle", type=float, default=5.0, help="idle measurement [s]")
     args = ap.parse_args()
 
+    import dask
     import distributed  # noqa: F401 (its config defaults loaded before any change)
     from bench_evaluate import SR, make_dataset
 
@@ -95,6 +96,8 @@ def main() -> int:
     from beatsync.cluster import LOCAL_CLUSTER_CONFIG
     from beatsync.study.beat_dataset import find_tracks, read_annotation
 
+    # the baseline: this process's values (Dask's defaults unless configured otherwise)
+    baseline = {key: dask.config.get(key) for key in LOCAL_CLUSTER_CONFIG}
     load_before = os.getloadavg()
     idle = {s: {"main": [], "workers": []} for s in SETTINGS}
     runs = {n: {s: [] for s in SETTINGS} for n in (1, 2)}
@@ -139,6 +142,7 @@ def main() -> int:
     data = {
         "facts": facts,
         "settings": LOCAL_CLUSTER_CONFIG,
+        "baseline_settings": baseline,
         "input": f"{len(tracks)} synthetic drum songs of {args.seconds:g} s at {SR} Hz",
         "idle_cpu_per_second": idle,
         "idle_cpu_median": med_idle,
@@ -158,8 +162,10 @@ def main() -> int:
         "",
         "Ours: "
         + ", ".join(f"`{k}: {v}`" for k, v in LOCAL_CLUSTER_CONFIG.items())
-        + f". Baseline: Dask's defaults, alternating with ours run by run ({args.pairs} pairs,"
-        " the first of each pair alternating). Input: "
+        + ". Baseline: Dask's defaults, "
+        + ", ".join(f"`{k}: {v}`" for k, v in baseline.items())
+        + f", alternating with ours run by run ({args.pairs} pairs, the first of each pair "
+        "alternating). Input: "
         + data["input"]
         + "; the Dask path of `beatsync evaluate beats` on warmed single-threaded workers.",
         "",
@@ -177,11 +183,20 @@ def main() -> int:
             f"{np.median(runs[n][SETTINGS[1]]):.2f} | {np.median(runs[n]['ours']):.2f} | "
             f"{ratio[n]:.3f} |"
         )
+    lower = {
+        part: sum(
+            np.mean(o) < np.mean(d) if part == "workers" else o < d
+            for o, d in zip(idle["ours"][part], idle[SETTINGS[1]][part], strict=True)
+        )
+        for part in ("main", "workers")
+    }
     lines += [
         f"| throughput 2 workers / 1 worker (median over pairs) | "
         f"{speedup[SETTINGS[1]]:.2f}x | {speedup['ours']:.2f}x | |",
         "",
-        "Per-pair ratios, ours / defaults: 1 worker "
+        f"Idle CPU lower with ours in {lower['main']} of {args.pairs} pairs for this "
+        f"process and in {lower['workers']} of {args.pairs} for the workers (their mean). "
+        "Per-pair ratios of the run times, ours / defaults: 1 worker "
         + ", ".join(f"{r:.2f}" for r in ratios[1])
         + "; 2 workers "
         + ", ".join(f"{r:.2f}" for r in ratios[2])

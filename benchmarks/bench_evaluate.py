@@ -23,7 +23,7 @@ drifts between runs a minute apart: a pair of runs side by side shares its spell
 
 Usage::
 
-    .venv/bin/python benchmarks/bench_evaluate.py [--tracks 40] [--seconds 30] [--repeats 1]
+    .venv/bin/python benchmarks/bench_evaluate.py [--tracks 40] [--seconds 30] [--repeats 2]
 
 Writes ``benchmarks/results/evaluate.md`` and ``benchmarks/results/evaluate.json``.
 """
@@ -116,7 +116,12 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tracks", type=int, default=40)
     ap.add_argument("--seconds", type=float, default=30.0, help="length of each song [s]")
-    ap.add_argument("--repeats", type=int, default=1, help="runs of each measurement (median)")
+    ap.add_argument(
+        "--repeats",
+        type=int,
+        default=2,
+        help="runs of each measurement (median); an even count runs each order equally",
+    )
     args = ap.parse_args()
 
     from beatsync import io
