@@ -38,3 +38,18 @@ def machine_facts() -> dict[str, object]:
         if hasattr(os, "getloadavg")
         else None,
     }
+
+
+def write_results(name: str, data: dict, lines: list[str]) -> None:
+    """Write ``benchmarks/results/<name>.json`` and ``<name>.md`` (atomic; the Markdown
+    for ``run_all.py --collect``) and print the Markdown."""
+    from pathlib import Path
+
+    from beatsync import io
+
+    results = Path(__file__).resolve().parent / "results"
+    results.mkdir(exist_ok=True)
+    io.write_json(results / f"{name}.json", data)
+    with io.atomic_write(results / f"{name}.md") as fh:
+        fh.write("\n".join(lines))
+    print("\n".join(lines))

@@ -82,7 +82,6 @@ def main() -> int:
     imp = {k: statistics.median(v) for k, v in imports.items()}
     ratio_help = med["beatsync --help"] / med["beatsync --help, eager (baseline)"]
     ratio_beats = med["beatsync beats --help"] / med["beatsync beats --help, eager (baseline)"]
-    from beatsync import io
 
     facts = _machine.machine_facts()
     lines = [
@@ -117,11 +116,7 @@ def main() -> int:
         "ratio_help_vs_eager": ratio_help,
         "ratio_beats_help_vs_eager": ratio_beats,
     }
-    (HERE / "results").mkdir(exist_ok=True)
-    io.write_json(HERE / "results" / "cli.json", data)
-    with io.atomic_write(HERE / "results" / "cli.md") as fh:
-        fh.write("\n".join(lines))
-    print("\n".join(lines))
+    _machine.write_results("cli", data, lines)
     return 0
 
 

@@ -39,7 +39,6 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-HERE = Path(__file__).resolve().parent
 SETTINGS = ("ours", "Dask's defaults")
 
 
@@ -92,7 +91,6 @@ def main() -> int:
     import distributed  # noqa: F401 (its config defaults loaded before any change)
     from bench_evaluate import SR, make_dataset
 
-    from beatsync import io
     from beatsync.cluster import LOCAL_CLUSTER_CONFIG
     from beatsync.study.beat_dataset import find_tracks, read_annotation
 
@@ -203,11 +201,7 @@ def main() -> int:
         + ".",
         "",
     ]
-    (HERE / "results").mkdir(exist_ok=True)
-    io.write_json(HERE / "results" / "cluster_config.json", data)
-    with io.atomic_write(HERE / "results" / "cluster_config.md") as fh:
-        fh.write("\n".join(lines))
-    print("\n".join(lines))
+    _machine.write_results("cluster_config", data, lines)
     return 0
 
 

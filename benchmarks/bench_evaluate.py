@@ -45,7 +45,6 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-HERE = Path(__file__).resolve().parent
 TARGET_SPEEDUP = 1.7
 SR = 22050
 
@@ -124,7 +123,6 @@ def main() -> int:
     )
     args = ap.parse_args()
 
-    from beatsync import io
     from beatsync.study.beat_dataset import evaluate_track, find_tracks, read_annotation
 
     load_before = os.getloadavg()
@@ -263,11 +261,7 @@ def main() -> int:
         "work and the ratio says nothing about Dask.",
         "",
     ]
-    (HERE / "results").mkdir(exist_ok=True)
-    io.write_json(HERE / "results" / "evaluate.json", data)
-    with io.atomic_write(HERE / "results" / "evaluate.md") as fh:
-        fh.write("\n".join(lines))
-    print("\n".join(lines))
+    _machine.write_results("evaluate", data, lines)
     return 0 if passed else 1
 
 

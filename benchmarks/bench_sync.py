@@ -45,7 +45,6 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-HERE = Path(__file__).resolve().parent
 TARGET_E2E_S = 10.0
 TARGET_LONG_S = 15.0
 LONG_DANCE_S = 90.0
@@ -270,11 +269,7 @@ def main() -> int:
         f"{long['max_abs_residual_frames']:.2f} frame | {'PASS' if passed_long else 'FAIL'} |",
         "",
     ]
-    (HERE / "results").mkdir(exist_ok=True)
-    io.write_json(HERE / "results" / "sync.json", data)
-    with io.atomic_write(HERE / "results" / "sync.md") as fh:
-        fh.write("\n".join(lines))
-    print("\n".join(lines))
+    _machine.write_results("sync", data, lines)
     return 0 if (passed_res and passed_time and passed_long) else 1
 
 
