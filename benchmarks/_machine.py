@@ -53,3 +53,19 @@ def write_results(name: str, data: dict, lines: list[str]) -> None:
     with io.atomic_write(results / f"{name}.md") as fh:
         fh.write("\n".join(lines))
     print("\n".join(lines))
+
+
+def interleaved_times(fns, rounds: int) -> list[list[float]]:
+    """Seconds of each call of each function, their calls interleaved (the order
+    alternating each round), so that a slow spell of the shared machine falls on all of
+    them alike: ``times[i][r]`` is function ``i`` in round ``r``."""
+    import time
+
+    times: list[list[float]] = [[] for _ in fns]
+    for r in range(rounds):
+        order = range(len(fns)) if r % 2 == 0 else reversed(range(len(fns)))
+        for i in order:
+            t0 = time.perf_counter()
+            fns[i]()
+            times[i].append(time.perf_counter() - t0)
+    return times

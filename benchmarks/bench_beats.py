@@ -68,16 +68,9 @@ PROCESS_SONG_S = 30.0
 
 
 def _median_times(fns, repeats):
-    """Median time of each function, their calls interleaved (the order alternating each
-    round), so that a slow spell of the shared machine falls on all of them alike."""
-    times = [[] for _ in fns]
-    for r in range(repeats):
-        order = range(len(fns)) if r % 2 == 0 else reversed(range(len(fns)))
-        for i in order:
-            t0 = time.perf_counter()
-            fns[i]()
-            times[i].append(time.perf_counter() - t0)
-    return [float(np.median(t)) for t in times]
+    """Median time of each function, their calls interleaved
+    (:func:`_machine.interleaved_times`)."""
+    return [float(np.median(t)) for t in _machine.interleaved_times(fns, repeats)]
 
 
 def _md_table(df, floatfmt=3) -> str:

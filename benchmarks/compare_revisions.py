@@ -32,7 +32,6 @@ import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tarfile  # noqa: E402
 import tempfile  # noqa: E402
-import time  # noqa: E402
 import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -90,14 +89,10 @@ def compare(base, new, y, sr, pairs: int) -> dict:
     n_beats = new.track_beats(y, sr).beats
     same = b_beats.shape == n_beats.shape
     diff = float(np.max(np.abs(b_beats - n_beats))) if same and b_beats.size else 0.0
-    times = {"base": [], "new": []}
-    for i in range(pairs):
-        order = (("base", base), ("new", new)) if i % 2 == 0 else (("new", new), ("base", base))
-        for key, mod in order:
-            t0 = time.perf_counter()
-            mod.track_beats(y, sr)
-            times[key].append(time.perf_counter() - t0)
-    tb, tn = (np.array(times[k]) * 1e3 for k in ("base", "new"))
+    times = _machine.interleaved_times(
+        [lambda: base.track_beats(y, sr), lambda: new.track_beats(y, sr)], pairs
+    )
+    tb, tn = (np.array(t) * 1e3 for t in times)
     return {
         "base min [ms]": tb.min(),
         "base median [ms]": np.median(tb),
