@@ -46,6 +46,7 @@ def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
     bad = table[table["clip"] == "pirouette"]
     assert (bad["status"] == "error").all()
     assert bad["error"].str.contains("periodic").all()
+    assert bad["error"].str.contains("--mode beats").all()  # what syncs a free dance
 
 
 def test_grid_mode_auto_uses_the_motion_beats_of_a_clip_that_is_not_periodic(inputs, tmp_path):

@@ -76,8 +76,11 @@ def prepare_clip(
     try:
         seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
     except ParameterError as exc:
-        if mode == "periods":
-            raise
+        if mode == "periods":  # a free dance, most likely: say what syncs it
+            raise ParameterError(
+                f"{exc}; mode 'beats' (--mode beats) syncs its own motion beats instead, "
+                "and 'auto' (--mode auto) falls back to them"
+            ) from None
         clip["note"] = f"not periodic ({exc}): its motion beats were used"
         return clip
     clip.update(boundaries=seg.boundaries, mean_period_s=seg.mean_period)
