@@ -148,16 +148,12 @@ time (Hainsworth 001's 3 s and 5 s clips: mean F 0.416 and 0.654; now 0.508 and
   On our phase-slope onsets the low band is too dense to show the kick (the score,
   averaged over windows, was 0.05 at most). With weight 100, the cue fixed the 60 BPM
   pattern but not the 180 BPM one. With weight 300, it tapped DANCE_R_3 at 190.
-- Nor does any band's accent between the beats tell a beat tapped at half its tempo
-  (measured on 2026-11-29, a scratch run on the decoded beats: per band, the mean
-  strongest onset within 1/8 of a beat of each beat and of each point halfway between
-  two beats). On the 180 BPM drum pattern tapped at 90 (seed 0), the halfway points
-  carry 1.17 times the beats' accent in the low band and 1.04 times in the next one;
-  on the synthetic drums tapped at their level, 0.09-0.39 times in the low band. But
-  the real recordings tapped at their annotated level have such bands too: the
-  madmom sample 1.12-1.38 times in every band, Hainsworth 001 1.13 in the low band,
-  DANCE_R_3 1.26 and 1.27 in the two lowest. A rule that doubles the tempo when the
-  points between the beats are as strong as the beats would double them.
+- Nor does a band's accent between the decoded beats tell a beat tapped at half its
+  tempo (2026-11-29, scratch run: per band, the strongest onset within 1/8 beat of
+  each beat and of each midpoint). Midpoints over beats: the 180 BPM drum pattern
+  tapped at 90 (seed 0) 1.17 in the low band, the drums at their level 0.09-0.39; but
+  at the annotated level the madmom sample 1.12-1.38 in every band, Hainsworth 001
+  1.13 and DANCE_R_3 1.26-1.27 in low bands. A doubling rule would double them too.
 
 Why 10-20 s clips of the waltz DANCE_W_10 were tapped faster than its beat, measured
 before :attr:`MeterModel.tatum_ratio_weights` weighed a beat of three tatums half (the
