@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from beatsync import datasets, io
-from beatsync.batch import sync_grid
+from beatsync.batch import prepare_clip, sync_grid
 from beatsync.cli import main
-from beatsync.errors import ParameterError
+from beatsync.errors import NotPeriodicError, ParameterError
 from beatsync.synth.audio import beat_times, click_track
 
 SR = 22050
@@ -62,6 +62,29 @@ def test_grid_mode_auto_uses_the_motion_beats_of_a_clip_that_is_not_periodic(inp
         io.read_bvh(row.loc["pirouette", "output"]).n_frames
         == row.loc["pirouette", "output_frames"]
     )
+
+
+@pytest.mark.parametrize("mode", ["periods", "auto"])
+def test_a_bad_setting_is_the_clips_error_not_a_free_dance(inputs, mode):
+    # neither the hint that --mode beats syncs it nor mode auto's fallback to the motion
+    # beats: those are for a dance that is not periodic
+    _, clips, _ = inputs
+    with pytest.raises(ParameterError, match="alpha") as err:
+        prepare_clip(str(clips[0]), fps=60.0, alpha=0.7, mode=mode)
+    assert not isinstance(err.value, NotPeriodicError)
+    assert "--mode beats" not in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [({"period_range": (1.25, 0.25)}, "period_range"), ({"alpha": 10}, "alpha"),
+     ({"fps": 44100.0}, "fps")],
+)  # fmt: skip
+def test_grid_refuses_a_bad_shared_setting_before_any_work(inputs, tmp_path, kwargs, match):
+    _, clips, songs = inputs
+    with pytest.raises(ParameterError, match=match):
+        sync_grid(clips, songs, tmp_path, processes=False, n_workers=1, mode="auto", **kwargs)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_grid_tempo_range_reaches_every_song(inputs, tmp_path):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from beatsync import datasets
-from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.errors import BeatsyncWarning, NotPeriodicError, ParameterError
 from beatsync.evaluate.segmentation import boundary_errors
 from beatsync.motion import Motion, marker_angles
 from beatsync.segment import (
@@ -295,6 +295,24 @@ def test_bad_input_raises(values, kwargs, match):
     kw = {"fps": 25.0} | kwargs
     with pytest.raises(ParameterError, match=match):
         segment_values(values, **kw)
+
+
+@pytest.mark.parametrize(
+    "values,kwargs,not_periodic",
+    [
+        (np.random.default_rng(0).standard_normal((300, 4)), {}, True),  # noise
+        (_vals(50), {"period_range": (1.0, 2.0)}, True),  # 2 s: too short for the range
+        (_vals(), {"period_range": (0.25, 0.06)}, False),  # a mistake in the settings
+        (_vals(), {"alpha": 0.7}, False),
+        (np.ones((300, 4)), {}, False),  # no motion at all
+    ],
+)
+def test_only_a_motion_not_shown_periodic_is_a_not_periodic_error(values, kwargs, not_periodic):
+    # callers fall back to the dancer's motion beats on NotPeriodicError only: a bad
+    # setting must not pass for a free dance
+    with pytest.raises(ParameterError) as err:
+        segment_values(values, **({"fps": 25.0} | kwargs))
+    assert isinstance(err.value, NotPeriodicError) is not_periodic
 
 
 def test_clip_shorter_than_three_own_periods_is_refused():

@@ -533,6 +533,14 @@ def test_mode_periods_refuses_a_motion_that_is_not_periodic(waltz_dancer):
         )
 
 
+def test_mode_periods_does_not_suggest_motion_beats_for_a_dancer_standing_still(waltz_dancer):
+    # no motion at all is not a free dance: motion beats would not sync it either
+    still = waltz_dancer.with_values(np.repeat(waltz_dancer.values[:1], 300, axis=0))
+    with pytest.raises(ParameterError, match="constant") as err:
+        synchronize(still, None, np.arange(0.5, 30.0, 0.5), mode="periods")
+    assert "mode='beats'" not in str(err.value)
+
+
 @pytest.mark.parametrize("mode", ["periods", "beats"])
 def test_real_dancer_positions_both_modes_keep_bones(waltz_dancer, mode):
     # the period range from the song (one to eight beats) holds the waltz's cycle

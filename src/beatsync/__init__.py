@@ -15,8 +15,8 @@ Stages (one module each; see ``DESIGN`` in the README):
 Event times are seconds everywhere (see :mod:`beatsync.units`).
 """
 
-from .errors import BeatsyncWarning, ParameterError
+from .errors import BeatsyncWarning, NotPeriodicError, ParameterError
 
 __version__ = "0.1.0"
 
-__all__ = ["ParameterError", "BeatsyncWarning", "__version__"]
+__all__ = ["ParameterError", "NotPeriodicError", "BeatsyncWarning", "__version__"]

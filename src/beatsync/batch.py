@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .errors import ParameterError
+from .errors import NotPeriodicError, ParameterError
 
 __all__ = ["sync_grid", "prepare_song", "prepare_clip", "sync_pair"]
 
@@ -56,12 +56,13 @@ def prepare_clip(
     """Read a motion clip and find its periods (a task of the graph).
 
     ``mode="beats"``: no segmentation (the pairs use the motion beats);
-    ``mode="auto"``: a clip that segmentation refuses (not periodic) gets no boundaries
-    and the reason in ``note``; ``mode="periods"``: the refusal is the clip's error.
+    ``mode="auto"``: a clip that segmentation refuses as not periodic
+    (:class:`~beatsync.errors.NotPeriodicError`) gets no boundaries and the reason in
+    ``note``; ``mode="periods"``: that refusal is the clip's error. Any other error
+    (bad ``alpha`` or ``period_range``, no motion) is the clip's error in both.
     """
     from . import io
-    from .motion import segmentation_view
-    from .segment import segment
+    from .sync.core import motion_periods
 
     motion = io.read_motion(path, fps=fps)
     clip = {
@@ -74,10 +75,10 @@ def prepare_clip(
     if mode == "beats":
         return clip
     try:
-        seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
-    except ParameterError as exc:
+        seg = motion_periods(motion, alpha=alpha, period_range=period_range)
+    except NotPeriodicError as exc:  # bad settings or no motion stay the clip's error
         if mode == "periods":  # a free dance, most likely: say what syncs it
-            raise ParameterError(
+            raise NotPeriodicError(
                 f"{exc}; mode 'beats' (--mode beats) syncs its own motion beats instead, "
                 "and 'auto' (--mode auto) falls back to them"
             ) from None
@@ -213,16 +214,25 @@ def sync_grid(
     ParameterError
         No clip or song, a missing input, a missing output folder, two inputs of the
         same name, an output that would overwrite an input, a worker count below 1,
-        ``n_workers`` with ``scheduler``, an unreachable scheduler.
+        ``n_workers`` with ``scheduler``, an unreachable scheduler, a bad ``fps``,
+        ``alpha`` or ``period_range`` (checked once, before any work).
     """
     import pandas as pd
 
     from .cluster import check_cluster_options, dask_client
+    from .segment.checks import check_alpha, check_period_range
     from .sync import MODES
+    from .units import check_motion_fps
 
     check_cluster_options(scheduler, n_workers)
     if mode not in MODES:
         raise ParameterError(f"mode={mode!r} must be one of {', '.join(MODES)}")
+    # settings shared by every clip: refused here, once, before any worker starts
+    if fps is not None:
+        fps = check_motion_fps(fps)
+    if mode != "beats":
+        alpha = check_alpha(alpha)
+        period_range = check_period_range(period_range)
     clips = [str(c) for c in clips]
     songs = [str(s) for s in songs]
     if not clips or not songs:

@@ -18,11 +18,25 @@ import threading
 import warnings
 from collections.abc import Iterator
 
-__all__ = ["ParameterError", "BeatsyncWarning", "warn", "collect_warnings", "silenced"]
+__all__ = [
+    "ParameterError",
+    "NotPeriodicError",
+    "BeatsyncWarning",
+    "warn",
+    "collect_warnings",
+    "silenced",
+]
 
 
 class ParameterError(ValueError):
     """Malformed or unusable input: the message says which value and why."""
+
+
+class NotPeriodicError(ParameterError):
+    """The motion was not shown to be periodic: the periodicity test refused it, or the
+    clip is too short to tell. Its own motion beats can still sync it (``mode="beats"``,
+    and ``mode="auto"`` falls back to them); other errors (bad settings, no motion)
+    cannot be helped that way."""
 
 
 class BeatsyncWarning(UserWarning):

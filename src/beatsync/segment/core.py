@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import NotPeriodicError, ParameterError
 from ..units import (
     MAX_BPM,
     MIN_BPM,
@@ -164,7 +164,7 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
     lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
     span = float(frames_to_time(n - 1, fps=fps))
     if span < MIN_CLIP_PERIODS * period_range[0]:
-        raise ParameterError(
+        raise NotPeriodicError(
             f"clip of {n} frames lasts {span:.3f} s at fps={fps:g}, shorter than "
             f"{MIN_CLIP_PERIODS} periods of the shortest requested period "
             f"{period_range[0]:g} s; give a longer clip, a shorter --period-range, or check "
@@ -182,7 +182,7 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
 # ---------------------------------------------------------------------- the entry
 
 
-class _NotPeriodic(ParameterError):
+class _NotPeriodic(NotPeriodicError):
     """The periodicity test refused the optimum (a longer tier may still be periodic)."""
 
 
@@ -228,8 +228,8 @@ def _segment(
         raise RuntimeError("no tier of the period range was searched")
     if len(bands) > 1:
         searched = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
-        raise ParameterError(f"{refusal} (period tiers searched, shortest first: {searched})")
-    raise ParameterError(str(refusal))
+        raise NotPeriodicError(f"{refusal} (period tiers searched, shortest first: {searched})")
+    raise NotPeriodicError(str(refusal))
 
 
 def _search(
@@ -270,7 +270,7 @@ def _search(
     if count is None and (n - 1) < MIN_CLIP_PERIODS * nominal and e_norm >= SHORT_CLIP_MAX_ENERGY:
         per = float(frames_to_time(nominal, fps=fps))
         span = float(frames_to_time(n - 1, fps=fps))
-        raise ParameterError(
+        raise NotPeriodicError(
             f"clip of {span:.3f} s holds only {(n - 1) / nominal:.1f} periods of its "
             f"estimated period {per:.3f} s, and they are not clearly alike (mean Pearson "
             f"distance {e_norm:.3f} >= {SHORT_CLIP_MAX_ENERGY}): too short to tell a "
@@ -369,6 +369,11 @@ def segment_values(
         constant, ``n_periods`` too many for the frames, or a clip that is not
         periodic (normalised energy above :data:`MAX_NORMALISED_ENERGY` or too little
         periodicity contrast; with ``n_periods`` given, often a wrong count).
+    NotPeriodicError
+        (a ``ParameterError``) the last two kinds: a clip not shown to be periodic, or
+        too short (for the shortest period of the range, or too short to tell with its
+        own period); its own motion beats can still sync it
+        (:func:`beatsync.sync.synchronize` with ``mode="beats"``).
 
     Examples
     --------

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, silenced, warn
+from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..units import (
     check_motion_fps,
     check_range,
@@ -27,6 +27,7 @@ __all__ = [
     "FILLS",
     "SyncResult",
     "motion_beat_count",
+    "motion_periods",
     "position_bones",
     "synchronize",
 ]
@@ -112,16 +113,11 @@ def _events(
             return s, "periods", ""
     if mode == "beats":
         return _motion_beats(motion, "mode='beats'"), "beats", ""
-    from ..motion import segmentation_view
-    from ..segment import segment
-
     try:
-        seg = segment(segmentation_view(motion), period_range=period_range)
-        if len(seg.boundaries) < 2:
-            raise ParameterError("segmentation found no full period")
-    except ParameterError as exc:
+        seg = motion_periods(motion, period_range=period_range)
+    except NotPeriodicError as exc:  # bad settings or no motion stay errors
         if mode == "periods":
-            raise ParameterError(
+            raise NotPeriodicError(
                 f"the motion does not look periodic ({exc}); use mode='beats' (--mode beats) "
                 "to warp the dancer's own motion beats instead"
             ) from None
@@ -132,6 +128,32 @@ def _events(
         warn(note, stacklevel=3)
         return _motion_beats(motion, "the fallback to motion beats"), "beats", note
     return np.asarray(seg.boundaries, dtype=np.float64), "periods", ""
+
+
+def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: float = 0.1) -> Any:
+    """Paper A's segmentation of a dance into its periods (:func:`beatsync.segment.segment`
+    on :func:`beatsync.motion.segmentation_view`).
+
+    Raises
+    ------
+    NotPeriodicError
+        The motion is not shown to be periodic, is too short to tell, or has no angles
+        to test (a marker set other than the MoCap Toolbox's): its own motion beats may
+        still sync it.
+    ParameterError
+        Bad settings (``alpha``, ``period_range``) or no motion (every channel constant).
+    """
+    from ..motion import segmentation_view
+    from ..segment import segment
+
+    try:
+        view = segmentation_view(motion)
+    except ParameterError as exc:
+        raise NotPeriodicError(f"its periods cannot be tested: {exc}") from None
+    seg = segment(view, alpha=alpha, period_range=period_range)
+    if len(seg.boundaries) < 2:
+        raise NotPeriodicError("segmentation found no full period")
+    return seg
 
 
 def _motion_beats(motion: Any, what: str) -> np.ndarray:
