@@ -163,6 +163,18 @@ def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
     assert during == before
 
 
+def test_a_key_the_user_sets_to_dasks_default_keeps_it(monkeypatch):
+    """Setting a key back to Dask's default (a DASK_* variable, a YAML file) is how a
+    user gets Dask's behaviour back: it is the user's, not ours to override."""
+    import dask
+    import distributed  # noqa: F401 (its defaults loaded)
+
+    monkeypatch.setenv("DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED", "True")
+    with cluster._local_cluster_config():
+        assert dask.config.get("distributed.worker.profile.enabled") is True
+        assert dask.config.get("distributed.admin.system-monitor.interval") == "2s"  # ours
+
+
 def test_local_cluster_that_fails_to_start_leaves_settings_and_no_cluster(monkeypatch):
     import dask
     import dask.distributed

@@ -10,9 +10,11 @@ another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client 
 the local cluster on the way out, also on Ctrl-C (local worker processes ignore
 SIGINT: see :func:`dask_setup`). Local workers run with glibc's
 default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
-about 1.8x slower), and a local cluster leaves out the periodic work that only a
-dashboard reads and checks its event loops and memory less often
-(:data:`LOCAL_CLUSTER_CONFIG`).
+about 1.8x slower), and a local cluster runs no statistical profiler (it only feeds a
+dashboard), samples the system for the dashboard less often, and checks its event
+loops and memory less often (:data:`LOCAL_CLUSTER_CONFIG`). Dask's configuration is
+global to the process: local clusters start one at a time (a lock), and other threads
+see these settings while one starts.
 
 Workers of an existing cluster must see the same file paths as the client (a shared
 file system) and have beatsync installed.
@@ -40,6 +42,9 @@ __all__ = [
     "LOCAL_CLUSTER_CONFIG",
 ]
 
+#: Held while a local cluster starts under :func:`_local_cluster_config`.
+_START_LOCK = threading.Lock()
+
 #: Seconds to wait for an existing scheduler before giving up.
 CONNECT_TIMEOUT = 5.0
 
@@ -47,10 +52,11 @@ CONNECT_TIMEOUT = 5.0
 #: nannies and workers read them then; a nanny passes them on to a worker it starts
 #: again). A key that the user's Dask configuration sets (a YAML file, a ``DASK_*``
 #: variable, ``dask.config.set``) keeps the user's value, and a cluster given by address
-#: keeps its own settings. The scheduler, each nanny and each worker run periodic
-#: callbacks tens of times a second, and on a machine of a few cores that work competes
-#: with the tracking; these four are for the dashboard (none is started) or need not run
-#: so often. Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py``
+#: keeps its own settings (``dask.config.set`` to distributed's own default is not seen
+#: as the user's: set it in a YAML file or a ``DASK_*`` variable). The scheduler, each
+#: nanny and each worker run periodic callbacks tens of times a second, and on a
+#: machine of a few cores that work competes with the tracking; these four are for the
+#: dashboard (none is started) or need not run so often. Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py``
 #: (16 pairs of runs alternating, see benchmarks/RESULTS.md): idle, this process used
 #: 1.6 % of a core instead of 7.8 % and each worker 0.6 % instead of 5.8 %, lower in
 #: every pair; the Dask path of ``beatsync evaluate beats`` over 40 songs took 0.93x the
@@ -183,8 +189,9 @@ def dask_client(
     cluster = None
     if scheduler is None:
         # read by the scheduler, nannies and workers as they start; this process's own
-        # settings are restored at once, also when the start fails
-        with _local_cluster_config():
+        # settings are restored at once, also when the start fails; one start at a time
+        # (two threads' set and restore of the global configuration would interleave)
+        with _START_LOCK, _local_cluster_config():
             cluster = LocalCluster(
                 n_workers=n or default_workers(),
                 threads_per_worker=1,
@@ -233,9 +240,21 @@ def _worker_preloads() -> dict[str, list[Any]]:
     return kwargs
 
 
+def _user_sets(key: str, defaults: dict, collected: dict) -> bool:
+    """Whether the user's Dask configuration sets ``key``: in a YAML file or a ``DASK_*``
+    variable (``collected``, also to distributed's default value), or to another value
+    than distributed's default (``dask.config.set`` in this process)."""
+    import dask
+
+    missing = object()
+    if dask.config.get(key, missing, config=collected) is not missing:
+        return True
+    return dask.config.get(key, None) != dask.config.get(key, None, config=defaults)
+
+
 def _local_cluster_config() -> Any:
     """The Dask settings a local cluster starts with: :data:`LOCAL_CLUSTER_CONFIG` (each
-    key the user's configuration leaves at distributed's default), and worker processes
+    key the user's configuration does not set, :func:`_user_sets`), and worker processes
     without Dask's ``MALLOC_TRIM_THRESHOLD_=65536``.
 
     Dask sets that variable in its worker processes to hand freed memory back to the
@@ -247,10 +266,11 @@ def _local_cluster_config() -> Any:
     import dask
 
     defaults = dask.config.merge(*dask.config.defaults)  # distributed's, once imported
+    collected = dask.config.collect()  # the user's YAML files and DASK_* variables
     ours = {
         key: value
         for key, value in LOCAL_CLUSTER_CONFIG.items()
-        if dask.config.get(key, None) == dask.config.get(key, None, config=defaults)
+        if not _user_sets(key, defaults, collected)
     }
     key = "distributed.nanny.pre-spawn-environ"
     env = dict(dask.config.get(key, default={}) or {})
