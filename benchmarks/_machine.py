@@ -41,8 +41,10 @@ def machine_facts() -> dict[str, object]:
 
 
 def write_results(name: str, data: dict, lines: list[str]) -> None:
-    """Write ``benchmarks/results/<name>.json`` and ``<name>.md`` (atomic; the Markdown
-    for ``run_all.py --collect``) and print the Markdown."""
+    """Write ``benchmarks/results/<name>.json`` and ``<name>.md`` (each atomic; the
+    Markdown, for ``run_all.py --collect``, last: a failure leaves the old pair, or a new
+    JSON beside the old Markdown, never a new table without its data) and print the
+    Markdown."""
     from pathlib import Path
 
     from beatsync import io
@@ -57,14 +59,15 @@ def write_results(name: str, data: dict, lines: list[str]) -> None:
 
 def interleaved_times(fns, rounds: int) -> list[list[float]]:
     """Seconds of each call of each function, their calls interleaved (the order
-    alternating each round), so that a slow spell of the shared machine falls on all of
-    them alike: ``times[i][r]`` is function ``i`` in round ``r``."""
+    rotating each round, so each function goes first as often as the others, and with
+    two functions the order alternates), so that a slow spell of the shared machine
+    falls on all of them alike: ``times[i][r]`` is function ``i`` in round ``r``."""
     import time
 
+    n = len(fns)
     times: list[list[float]] = [[] for _ in fns]
     for r in range(rounds):
-        order = range(len(fns)) if r % 2 == 0 else reversed(range(len(fns)))
-        for i in order:
+        for i in [(r + k) % n for k in range(n)]:
             t0 = time.perf_counter()
             fns[i]()
             times[i].append(time.perf_counter() - t0)

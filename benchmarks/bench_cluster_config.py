@@ -1,9 +1,9 @@
 """Benchmark of the local cluster's Dask settings (``beatsync.cluster.LOCAL_CLUSTER_CONFIG``).
 
-The local cluster of ``beatsync evaluate beats`` and ``beatsync batch`` runs Dask's
-periodic work that only a dashboard reads (the workers' statistical profiler, the
-system monitor) and the event-loop and memory checks less often than Dask's
-defaults. This script measures what that changes, against Dask's defaults (the
+The local cluster of ``beatsync evaluate beats`` and ``beatsync batch`` runs without
+the workers' statistical profiler (it feeds only a dashboard), and runs the system
+monitor (for the dashboard) and the event-loop and memory checks less often than
+Dask's defaults. This script measures what that changes, against Dask's defaults (the
 baseline), in the same run:
 
 1. idle: the CPU time per second of this process (scheduler, nannies, client) and of
@@ -18,7 +18,7 @@ the per-pair ratios (ours / Dask's defaults: below 1 is faster).
 
 Usage::
 
-    .venv/bin/python benchmarks/bench_cluster_config.py [--tracks 40] [--seconds 30] [--pairs 8]
+    .venv/bin/python benchmarks/bench_cluster_config.py [--tracks 40] [--seconds 30] [--pairs 16]
 
 Writes ``benchmarks/results/cluster_config.md`` and ``.json``.
 """
@@ -83,7 +83,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tracks", type=int, default=40)
     ap.add_argument("--seconds", type=float, default=30.0, help="length of each song [s]")
-    ap.add_argument("--pairs", type=int, default=8, help="alternating pairs of each measure")
+    ap.add_argument("--pairs", type=int, default=16, help="alternating pairs of each measure")
     ap.add_argument("--idle", type=float, default=5.0, help="idle measurement [s]")
     args = ap.parse_args()
 
