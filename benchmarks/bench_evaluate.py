@@ -11,7 +11,11 @@ measures, in the same run:
    cluster of 1 and of 2 single-threaded worker processes, each worker warmed by one
    untimed track, so the times are the steady-state throughput of a long run;
    the per-track overhead of the Dask path is (Dask, 1 worker - plain loop) / tracks;
-3. the whole command as a user runs it (``beatsync evaluate beats --workers 1`` and
+3. this machine's ceiling for 2 workers: the same tracks read, tracked and scored by
+   1 and by 2 plain processes (no Dask; each warmed, then started together), whose
+   time ratio is what any 2 workers could reach here; the Dask ratio is also given as
+   a share of it;
+4. the whole command as a user runs it (``beatsync evaluate beats --workers 1`` and
    ``--workers 2`` in fresh processes: cluster start-up, worker imports and
    compilation included).
 
@@ -90,6 +94,45 @@ def time_dask(tracks, refs, out: Path, n_workers: int) -> tuple[float, float, fl
     return t_run, t_start, float(run.tracks["seconds"].sum())
 
 
+def _plain_process(part, barrier, queue) -> None:
+    """One plain process of :func:`time_plain_processes`: warm up, wait for the others,
+    then read, track and score its tracks (no Dask) and report the seconds."""
+    from beatsync.study.beat_dataset import evaluate_track
+
+    evaluate_track(part[0][0], part[0][1], method="psf", min_beat_time=0.0, name="warm-up")
+    barrier.wait()
+    t0 = time.perf_counter()
+    for path, ref in part:
+        evaluate_track(path, ref, method="psf", min_beat_time=0.0, name="plain")
+    queue.put(time.perf_counter() - t0)
+
+
+def time_plain_processes(tracks, refs, n_proc: int) -> float:
+    """Wall time of ``n_proc`` plain processes (no Dask) sharing the tracks (every
+    ``n_proc``-th each), started together once each has warmed up: what this machine
+    gives ``n_proc`` single-threaded processes doing the same work, the ceiling of
+    ``n_proc`` Dask workers."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("spawn")
+    barrier = ctx.Barrier(n_proc + 1)
+    queue = ctx.Queue()
+    parts = [[(str(t.audio), refs[t.key]) for t in tracks[i::n_proc]] for i in range(n_proc)]
+    procs = [ctx.Process(target=_plain_process, args=(part, barrier, queue)) for part in parts]
+    for proc in procs:
+        proc.start()
+    barrier.wait()
+    t0 = time.perf_counter()
+    for _ in procs:
+        queue.get()
+    wall = time.perf_counter() - t0
+    for proc in procs:
+        proc.join()
+        if proc.exitcode != 0:
+            raise RuntimeError(f"a plain process failed (exit code {proc.exitcode})")
+    return wall
+
+
 def time_command(audio: Path, notes: Path, out: Path, n_workers: int) -> float:
     cmd = [
         sys.executable,
@@ -126,7 +169,9 @@ def main() -> int:
     from beatsync.study.beat_dataset import evaluate_track, find_tracks, read_annotation
 
     load_before = os.getloadavg()
-    res: dict[str, list[float]] = {k: [] for k in ("loop", "dask1", "dask2", "cmd1", "cmd2")}
+    res: dict[str, list[float]] = {
+        k: [] for k in ("loop", "dask1", "dask2", "plain1", "plain2", "cmd1", "cmd2")
+    }
     startup: dict[str, list[float]] = {"dask1": [], "dask2": []}
     work: dict[str, list[float]] = {"loop": [], "dask1": [], "dask2": []}
     with tempfile.TemporaryDirectory(prefix="bench-evaluate-") as tmp:
@@ -153,6 +198,8 @@ def main() -> int:
                 startup[f"dask{n}"].append(t_start)
                 work[f"dask{n}"].append(t_work)
             for n in order:
+                res[f"plain{n}"].append(time_plain_processes(tracks, refs, n))
+            for n in order:
                 res[f"cmd{n}"].append(time_command(audio, notes, tmp / f"cmd{n}_{r}", n))
         f_mean = float(np.mean([row["F-measure"] for row in rows]))
     med = {k: float(np.median(v)) for k, v in res.items()}
@@ -160,8 +207,14 @@ def main() -> int:
     # per repeat: the two runs of a repeat are side by side in time
     ratios = [a / b for a, b in zip(res["dask1"], res["dask2"], strict=True)]
     ratios_cmd = [a / b for a, b in zip(res["cmd1"], res["cmd2"], strict=True)]
+    # the machine's own ceiling: two plain processes against one, same repeat
+    ceilings = [a / b for a, b in zip(res["plain1"], res["plain2"], strict=True)]
+    # Dask's 2-worker ratio as a share of that ceiling, repeat by repeat
+    shares = [d / c for d, c in zip(ratios, ceilings, strict=True)]
     speedup = float(np.median(ratios))
     speedup_cmd = float(np.median(ratios_cmd))
+    ceiling = float(np.median(ceilings))
+    share = float(np.median(shares))
     overhead_ms = 1000.0 * (med["dask1"] - med["loop"]) / n
     med_work = {k: float(np.median(v)) for k, v in work.items()}
     # wall time of 1 worker beyond the reading and tracking it did: scheduling, transfer,
@@ -188,6 +241,10 @@ def main() -> int:
         "speedup_2_vs_1_workers": speedup,
         "speedup_per_repeat": ratios,
         "speedup_of_medians": med["dask1"] / med["dask2"],
+        "plain_processes_2_vs_1": ceiling,
+        "plain_processes_2_vs_1_per_repeat": ceilings,
+        "speedup_share_of_plain_ceiling": share,
+        "speedup_share_of_plain_ceiling_per_repeat": shares,
         "speedup_command": speedup_cmd,
         "speedup_command_per_repeat": ratios_cmd,
         "dask_overhead_ms_per_track": overhead_ms,
@@ -214,6 +271,16 @@ def main() -> int:
             med["dask2"],
             f"start-up + warm-up {np.median(startup['dask2']):.1f} s; reading + tracking "
             f"in the workers {med_work['dask2']:.1f} s (sum of both)",
+        ),
+        (
+            "plain process, no Dask (warmed; the baseline of the ceiling)",
+            med["plain1"],
+            "the loop above, in a process of its own",
+        ),
+        (
+            "2 plain processes, no Dask, started together (warmed)",
+            med["plain2"],
+            "every other track each",
         ),
         ("`beatsync evaluate beats --workers 1` (whole process)", med["cmd1"], ""),
         ("`beatsync evaluate beats --workers 2` (whole process)", med["cmd2"], ""),
@@ -243,6 +310,10 @@ def main() -> int:
         f"| throughput 2 workers / 1 worker (steady state; median of the repeats: "
         f"{', '.join(f'{x:.2f}' for x in ratios)}) | {speedup:.2f}x | >= "
         f"{TARGET_SPEEDUP}x | {'PASS' if passed else 'FAIL'} |",
+        f"| this machine's ceiling: 2 plain processes / 1, no Dask (median of the repeats: "
+        f"{', '.join(f'{x:.2f}' for x in ceilings)}) | {ceiling:.2f}x | (reported) | |",
+        f"| Dask's 2-worker ratio as a share of that ceiling (median of the repeats: "
+        f"{', '.join(f'{x:.2f}' for x in shares)}) | {share:.2f} | (reported) | |",
         f"| whole command, 1 worker / 2 workers (median of the repeats: "
         f"{', '.join(f'{x:.2f}' for x in ratios_cmd)}) | {speedup_cmd:.2f}x | (start-up "
         "included) | |",
@@ -258,7 +329,10 @@ def main() -> int:
         "Reading the table: the 2-worker ratio needs two idle cores. The summed reading + "
         "tracking time of the workers tells whether they had them: with two free cores it "
         "stays near the 1-worker figure; if it doubles, the cores were shared with other "
-        "work and the ratio says nothing about Dask.",
+        "work and the ratio says nothing about Dask. The ceiling is what the machine gives "
+        "two processes doing the same work without Dask, measured in the same repeat: "
+        "when two compute at once, each may run slower than one alone (the two CPUs "
+        "share the machine's hardware), and no scheduler can beat that.",
         "",
     ]
     _machine.write_results("evaluate", data, lines)
