@@ -56,12 +56,12 @@ CONNECT_TIMEOUT = 5.0
 #: as the user's: set it in a YAML file or a ``DASK_*`` variable). The scheduler, each
 #: nanny and each worker run periodic callbacks tens of times a second, and on a
 #: machine of a few cores that work competes with the tracking; these four are for the
-#: dashboard (none is started) or need not run so often. Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py``
-#: (16 pairs of runs alternating, see benchmarks/RESULTS.md): idle, this process used
-#: 1.6 % of a core instead of 7.8 % and each worker 0.6 % instead of 5.8 %, lower in
-#: every pair; the Dask path of ``beatsync evaluate beats`` over 40 songs took 0.93x the
-#: time with 1 worker and 0.92x with 2 (medians of the pair ratios; lower in 15 and in 13
-#: of the 16 pairs).
+#: dashboard (none is started) or need not run so often. Measured against Dask's
+#: defaults by ``benchmarks/bench_cluster_config.py`` (16 pairs of runs alternating, see
+#: benchmarks/RESULTS.md): idle, this process used 1.6 % of a core instead of 7.8 % and
+#: each worker 0.6 % instead of 5.8 %, lower in every pair; the Dask path of ``beatsync
+#: evaluate beats`` over 40 songs took 0.93x the time with 1 worker and 0.92x with 2
+#: (medians of the pair ratios; lower in 15 and in 13 of the 16 pairs).
 LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
     # the statistical profiler: a stack sample of the threads running tasks every 10 ms,
     # in every worker, for the dashboard's profile and performance reports
