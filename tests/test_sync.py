@@ -536,9 +536,21 @@ def test_mode_periods_refuses_a_motion_that_is_not_periodic(waltz_dancer):
 def test_mode_periods_does_not_suggest_motion_beats_for_a_dancer_standing_still(waltz_dancer):
     # no motion at all is not a free dance: motion beats would not sync it either
     still = waltz_dancer.with_values(np.repeat(waltz_dancer.values[:1], 300, axis=0))
-    with pytest.raises(ParameterError, match="constant") as err:
-        synchronize(still, None, np.arange(0.5, 30.0, 0.5), mode="periods")
-    assert "mode='beats'" not in str(err.value)
+    for mode in ("periods", "auto"):
+        with pytest.raises(ParameterError, match="does not move") as err:
+            synchronize(still, None, np.arange(0.5, 30.0, 0.5), mode=mode)
+        assert "mode='beats'" not in str(err.value)
+
+
+def test_mode_auto_falls_back_for_a_dancer_whose_joint_angles_never_change(waltz_dancer):
+    # the whole body sways, rigid: no angle to segment, but motion beats to sync
+    t = np.arange(300) / 25.0
+    sway = np.zeros((300, 69))
+    sway[:, 0::3] = 0.2 * np.sin(2 * np.pi * 1.4 * t)[:, None]  # every joint's x
+    rigid = waltz_dancer.with_values(np.repeat(waltz_dancer.values[:1], 300, axis=0) + sway)
+    with pytest.warns(BeatsyncWarning, match="fell back"):
+        res = synchronize(rigid, None, np.arange(0.5, 30.0, 0.5), mode="auto", fill="loop")
+    assert res.report["mode"] == "beats" and "its joints move" in res.report["mode_note"]
 
 
 @pytest.mark.parametrize("mode", ["periods", "beats"])

@@ -33,10 +33,11 @@ class ParameterError(ValueError):
 
 
 class NotPeriodicError(ParameterError):
-    """The motion was not shown to be periodic: the periodicity test refused it, or the
-    clip is too short to tell. Its own motion beats can still sync it (``mode="beats"``,
-    and ``mode="auto"`` falls back to them); other errors (bad settings, no motion)
-    cannot be helped that way."""
+    """The motion was not shown to be periodic: the periodicity test refused it, the clip
+    is too short to tell, or its periods cannot be searched while its joints move (no
+    joint angles to test). Its own motion beats can still sync it (``mode="beats"``, and
+    ``mode="auto"`` falls back to them); other errors (bad settings, a dancer who does
+    not move) cannot be helped that way."""
 
 
 class BeatsyncWarning(UserWarning):

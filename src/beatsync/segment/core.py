@@ -370,9 +370,9 @@ def segment_values(
         periodic (normalised energy above :data:`MAX_NORMALISED_ENERGY` or too little
         periodicity contrast; with ``n_periods`` given, often a wrong count).
     NotPeriodicError
-        (a ``ParameterError``) the last two kinds: a clip not shown to be periodic, or
-        too short (for the shortest period of the range, or too short to tell with its
-        own period); its own motion beats can still sync it
+        (a ``ParameterError``) of those: a clip that is not periodic, and a clip too
+        short for the shortest period of the range or too short to tell with its own
+        period; its own motion beats can still sync it
         (:func:`beatsync.sync.synchronize` with ``mode="beats"``).
 
     Examples

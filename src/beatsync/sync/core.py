@@ -137,23 +137,50 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     Raises
     ------
     NotPeriodicError
-        The motion is not shown to be periodic, is too short to tell, or has no angles
-        to test (a marker set other than the MoCap Toolbox's): its own motion beats may
-        still sync it.
+        The motion is not shown to be periodic or is too short to tell, or its periods
+        cannot be searched while its joints move (no joint angles to test, as for a
+        marker set other than the MoCap Toolbox's, or joint angles that never change):
+        its own motion beats may still sync it.
     ParameterError
-        Bad settings (``alpha``, ``period_range``) or no motion (every channel constant).
+        Bad settings (``alpha``, ``period_range``), or a dancer whose joints do not move.
     """
     from ..motion import segmentation_view
     from ..segment import segment
+    from ..segment.checks import check_alpha, check_period_range
 
+    alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
+    period_range = check_period_range(period_range)
     try:
-        view = segmentation_view(motion)
-    except ParameterError as exc:
-        raise NotPeriodicError(f"its periods cannot be tested: {exc}") from None
-    seg = segment(view, alpha=alpha, period_range=period_range)
+        seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
+    except NotPeriodicError:
+        raise
+    except ParameterError as exc:  # no angles to test, or angles that never change
+        moves = _joints_move(motion)
+        if moves is None:  # no joint positions either: the segmentation's own message
+            raise
+        if not moves:
+            raise ParameterError(
+                f"the dancer does not move: every joint keeps its position over the "
+                f"{motion.n_frames} frames, so there is nothing to synchronise"
+            ) from None
+        raise NotPeriodicError(f"its periods cannot be searched ({exc}); its joints move") from None
     if len(seg.boundaries) < 2:
         raise NotPeriodicError("segmentation found no full period")
     return seg
+
+
+def _joints_move(motion: Any) -> bool | None:
+    """Whether any joint position changes over the motion (None: no joint positions)."""
+    from ..motion_beats import motion_positions
+
+    try:
+        pos = motion_positions(motion)
+    except ParameterError:
+        return None
+    with np.errstate(invalid="ignore"):
+        span = float(np.nanmax(np.abs(pos - pos[:1]))) if pos.size else 0.0
+        scale = float(np.nanmax(np.abs(pos))) if pos.size else 0.0
+    return bool(np.isfinite(span) and span > 1e-9 * max(scale, 1e-300))
 
 
 def _motion_beats(motion: Any, what: str) -> np.ndarray:
@@ -283,6 +310,10 @@ def synchronize(
         ``mode="beats"``, fewer than two music beats, music too short for one period
         after ``first_beat``, an unknown mode/land/fill, ``land="accents"`` together
         with a ``phase_offset``, a bad ``period_range``, meter or ``out_fps``.
+    NotPeriodicError
+        (a ``ParameterError``) ``mode="periods"`` without ``boundaries``, on a motion
+        that segmentation does not show periodic (:func:`motion_periods`): its own motion
+        beats can sync it (``mode="beats"``; ``mode="auto"`` falls back to them).
 
     Examples
     --------
