@@ -59,8 +59,8 @@ def write_results(name: str, data: dict, lines: list[str]) -> None:
 
 def interleaved_times(fns, rounds: int) -> list[list[float]]:
     """Seconds of each call of each function, their calls interleaved (the order
-    rotating each round, so each function goes first as often as the others, and with
-    two functions the order alternates), so that a slow spell of the shared machine
+    rotating each round, so over any ``len(fns)`` consecutive rounds each function goes
+    first once; with two functions the order alternates), so that a slow spell of the shared machine
     falls on all of them alike: ``times[i][r]`` is function ``i`` in round ``r``."""
     import time
 
