@@ -584,5 +584,8 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
             if progress is not None:
                 progress(done)
     finally:
-        for fut in futures:
-            fut.cancel()
+        # an interrupted run: the tracks still queued or in flight stop (one message; the
+        # finished ones are released with their futures, without a cancel each)
+        pending = [fut for fut in futures if not fut.done()]
+        if pending:
+            client.cancel(pending)
