@@ -201,6 +201,52 @@ def test_local_cluster_that_fails_to_start_leaves_settings_and_no_cluster(monkey
     assert local.status.name == "closed"
 
 
+def test_local_clusters_started_from_two_threads_leave_the_settings_as_they_were(monkeypatch):
+    """dask.config is global: two starts whose set and restore interleaved would leave
+    one start's settings in place for good (the second saves the first's as 'before')."""
+    import threading
+    import time
+
+    import dask
+    import dask.distributed
+
+    class SlowStart:  # a cluster that takes a while to start, and nothing else
+        def __init__(self, *args, **kwargs):
+            time.sleep(0.3)
+
+        def close(self):
+            pass
+
+    class NoClient:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", SlowStart)
+    monkeypatch.setattr(dask.distributed, "Client", NoClient)
+    keys = [*cluster.LOCAL_CLUSTER_CONFIG, "distributed.nanny.pre-spawn-environ"]
+    before = {key: dask.config.get(key) for key in keys}
+    errors = []
+
+    def start():
+        try:
+            with cluster.dask_client(n_workers=1, processes=False):
+                pass
+        except Exception as exc:  # noqa: BLE001 (reported below)
+            errors.append(exc)
+
+    threads = [threading.Thread(target=start) for _ in range(2)]
+    for t in threads:
+        t.start()
+        time.sleep(0.1)  # the second starts while the first is starting
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert {key: dask.config.get(key) for key in keys} == before
+
+
 def _sigint_and_heartbeat_record():
     import logging
     import signal
