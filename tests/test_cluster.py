@@ -173,6 +173,12 @@ def test_a_key_the_user_sets_to_dasks_default_keeps_it(monkeypatch):
     with cluster._local_cluster_config():
         assert dask.config.get("distributed.worker.profile.enabled") is True
         assert dask.config.get("distributed.admin.system-monitor.interval") == "2s"  # ours
+    # and a worker process of a local cluster runs with the user's value
+    with cluster.dask_client(n_workers=1, processes=True) as client:
+        (profiling,) = client.run(
+            lambda dask_worker: "profile" in dask_worker.periodic_callbacks
+        ).values()
+    assert profiling
 
 
 def test_local_cluster_that_fails_to_start_leaves_settings_and_no_cluster(monkeypatch):
