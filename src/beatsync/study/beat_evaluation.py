@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import itertools
 import time
-import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -24,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from .. import peers
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, silenced
 from ..evaluate.beats import (
     TABLE_METRICS,
     count_octave_errors,
@@ -91,12 +90,10 @@ def score_items(
     for it, method in jobs:
         kw = dict(track_kwargs or {}) if method == "psf" else {}
         t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)
+        with silenced():
             est = _track(method, it.y, it.sr, kw)
         seconds = time.perf_counter() - t0
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)
+        with silenced():
             scores = evaluate(it.beats, est, min_beat_time=min_beat_time)
         rows.append(
             {

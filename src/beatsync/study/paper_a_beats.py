@@ -18,7 +18,6 @@ Two or three recordings are a sanity check, not a benchmark.
 from __future__ import annotations
 
 import itertools
-import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -27,7 +26,7 @@ import pandas as pd
 
 from .. import datasets, peers
 from ..beats import FRONTEND_DEFAULTS, beat_tempo, track_beats
-from ..errors import BeatsyncWarning
+from ..errors import silenced
 from ..synth.audio import BeatTestItem, make_beat_test_set
 from . import beat_evaluation
 
@@ -144,8 +143,7 @@ def meter_estimates(items: Sequence[BeatTestItem]) -> pd.DataFrame:
     """Our meter estimate (beats per bar) and tempo for each item (``psf`` only)."""
     rows = []
     for it in items:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", BeatsyncWarning)
+        with silenced():
             bt = track_beats(it.y, it.sr)
         rows.append({"item": it.name, "tempo": bt.tempo, "beats_per_bar": bt.beats_per_bar})
     return pd.DataFrame(rows)

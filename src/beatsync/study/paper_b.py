@@ -31,13 +31,12 @@ Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-from ..errors import BeatsyncWarning, ParameterError
+from ..errors import ParameterError, silenced
 from ..graph.build import WeightedMotionGraph, build_graph
 from ..graph.compose import compose
 from ..graph.search import conventional_search, dp_search
@@ -159,8 +158,7 @@ def song(duration: float, *, bpm: float = 100.0, seed: int = 0) -> tuple[np.ndar
 def _z(level: np.ndarray) -> np.ndarray:
     from ..motion_beats import zscore
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BeatsyncWarning)
+    with silenced():
         return zscore(level)
 
 
@@ -388,8 +386,7 @@ def quality_table(
                 for m in methods:
                     label, method, kw = QUALITY_METHODS[m]
                     g = g_rd if m.startswith("dp_rd") else graph
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore", BeatsyncWarning)
+                    with silenced():
                         comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
                     if m == "dp":  # kept for example_composition (no second search)
                         _COMPOSED[(id(graph), float(bpm), float(dur), int(seed))] = comp
@@ -502,8 +499,7 @@ def example_composition(
     if not kwargs and key in _COMPOSED:
         return _COMPOSED[key]
     beats, level = song(float(duration), bpm=float(bpm), seed=int(seed))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BeatsyncWarning)
+    with silenced():
         return compose(graph, beats, level, **kwargs)
 
 
@@ -530,8 +526,7 @@ def composition_proxies(
     m = comp.motion
     beats = comp.music_beats
     last = float(frames_to_time(m.n_frames - 1, fps=m.fps))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BeatsyncWarning)
+    with silenced():
         mb = kinematic_beats(m, smooth=beat_smooth)
         inside = beats[beats <= last + 1e-9]
         inten = beat_interval_intensity(m, inside) if inside.size >= 2 else np.empty(0)
