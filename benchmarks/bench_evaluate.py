@@ -104,7 +104,7 @@ def _plain_process(items, counter, barrier, done) -> None:
     worker) until none is left; report the seconds."""
     from beatsync.study.beat_dataset import evaluate_track
 
-    evaluate_track(items[0][0], items[0][1], method="psf", min_beat_time=0.0, name="warm-up")
+    _warm(*items[0])
     barrier.wait(timeout=PLAIN_TIMEOUT)
     t0 = time.perf_counter()
     while True:
