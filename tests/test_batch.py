@@ -1,5 +1,6 @@
 """The Dask study runner: every clip x song, errors recorded per pair."""
 
+import json
 import time
 
 import numpy as np
@@ -224,3 +225,52 @@ def test_batch_writes_all_or_nothing(inputs, scheduler, tmp_path, monkeypatch, c
     code = main(_batch_args(inputs, tmp_path, "--fps", "60", "--scheduler", scheduler))
     assert code == 4, capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]
+
+
+def test_grid_writes_joint_positions_back_in_the_inputs_layout(inputs, tmp_path):
+    # a real dancer (Dance-with-Melody JSON, cm, y up) and the same dancer as an
+    # (n_frames, n_joints, 3) .npy: each pair is written as the clip came in, as
+    # `beatsync sync` keeps it, not as a CSV table of metres, z up
+    _, _, songs = inputs
+    src = datasets.path("motion/dance_with_melody/DANCE_W_5/skeletons.json")
+    clips = tmp_path / "clips"
+    clips.mkdir()
+    (clips / "dancer.json").write_bytes(src.read_bytes())
+    dancer = io.read_motion(clips / "dancer.json", fps=25.0)
+    io.write_motion(clips / "dancer_array.npy", dancer)
+    out = tmp_path / "out"
+    out.mkdir()
+    table = sync_grid([clips / "dancer.json", clips / "dancer_array.npy"], songs[:1], out,
+                      processes=False, n_workers=1, fps=25.0, mode="beats")  # fmt: skip
+    assert (table["status"] == "ok").all(), table["error"].tolist()
+    rows = table.set_index("clip")
+    assert rows.loc["dancer", "output"].endswith("dancer__click100.json")
+    assert rows.loc["dancer_array", "output"].endswith("dancer_array__click100.npy")
+    for name in ("dancer", "dancer_array"):
+        back = io.read_motion(rows.loc[name, "output"], fps=25.0)
+        assert back.n_frames == rows.loc[name, "output_frames"] != dancer.n_frames
+        assert back.channels == dancer.channels
+        info = back.position_info
+        assert (info.units, info.up) == (dancer.position_info.units, dancer.position_info.up)
+    layout = json.loads((out / "dancer__click100.json").read_text())
+    assert {"skeletons", "center"} <= set(layout)  # the dataset's own keys
+
+
+@pytest.mark.parametrize("cli", [True, False])
+def test_batch_refuses_a_positions_output_that_is_an_input(inputs, tmp_path, cli):
+    # dancer x click100 would be written as dancer__click100.json: here an input clip
+    _, _, songs = inputs
+    src = datasets.path("motion/dance_with_melody/DANCE_W_5/skeletons.json")
+    clips = [tmp_path / "dancer.json", tmp_path / "dancer__click100.json"]
+    for c in clips:
+        c.write_bytes(src.read_bytes())
+    before = clips[1].read_bytes()
+    if cli:
+        argv = ["batch", "--clips", *map(str, clips), "--songs", str(songs[0]),
+                "--out-dir", str(tmp_path), "--fps", "25", "--mode", "beats"]  # fmt: skip
+        assert main(argv) == 3
+    else:
+        with pytest.raises(ParameterError, match="would overwrite an input"):
+            sync_grid(clips, songs[:1], tmp_path, processes=False, n_workers=1, fps=25.0)
+    assert clips[1].read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(c.name for c in clips)

@@ -12,8 +12,10 @@ beats, or ``"auto"`` (periods when the clip is periodic, else its motion beats: 
 real dancers need); the clip is segmented once either way.
 
 Data contract: every time is in seconds; every output file is written atomically
-under ``out_dir`` as ``<clip>__<song>.bvh`` (or ``.csv`` for motion without a
-skeleton); inputs are never written.
+under ``out_dir`` as ``<clip>__<song>`` in the clip's own kind of file
+(:func:`output_suffix`: ``.bvh`` with a skeleton, joint positions back in their
+input's layout, ``.json``, ``.npy``, ``.npz`` or ``.c3d``, else a ``.csv`` table);
+inputs are never written.
 """
 
 from __future__ import annotations
@@ -25,7 +27,32 @@ from typing import Any
 
 from .errors import NotPeriodicError, ParameterError
 
-__all__ = ["sync_grid", "prepare_song", "prepare_clip", "sync_pair"]
+__all__ = ["sync_grid", "prepare_song", "prepare_clip", "sync_pair", "output_suffix"]
+
+#: Joint-position layouts written back as they were read (the layout names the suffix).
+POSITION_SUFFIXES = (".json", ".npy", ".npz", ".c3d")
+
+
+def output_suffix(motion: Any) -> str:
+    """The suffix a synchronised clip is written with, as ``beatsync sync`` would keep it.
+
+    ``.bvh`` for motion with a skeleton; joint positions in their input's layout
+    (Dance-with-Melody ``.json``, ``.npy``, ``.npz``, ``.c3d``; units and vertical axis
+    as read, see :func:`beatsync.io.write_motion`); anything else (an angle table,
+    MoCap Toolbox markers, positions made in memory) as a ``.csv`` table.
+    """
+    if motion.skeleton is not None:
+        return ".bvh"
+    info = motion.position_info if motion.is_positional else None
+    layout = f".{info.layout}" if info is not None else ""
+    return layout if layout in POSITION_SUFFIXES else ".csv"
+
+
+def output_suffixes(clip: str | os.PathLike[str]) -> tuple[str, ...]:
+    """Every suffix the pairs of the clip file ``clip`` may be written with (the
+    overwrite checks run before the clip is read)."""
+    own = Path(clip).suffix.lower()
+    return (".bvh", ".csv") + ((own,) if own in POSITION_SUFFIXES else ())
 
 
 def prepare_song(
@@ -116,13 +143,8 @@ def sync_pair(
     except Exception as exc:  # one broken pair must not stop a study of thousands
         row.update(status="error", error=f"{type(exc).__name__}: {exc}")
         return row
-    motion = res.motion
-    suffix = ".bvh" if motion.skeleton is not None else ".csv"
-    out = Path(out_dir) / f"{clip_name}__{song_name}{suffix}"
-    if suffix == ".bvh":
-        io.write_bvh(out, motion)
-    else:
-        io.write_table(out, motion)
+    out = Path(out_dir) / f"{clip_name}__{song_name}{output_suffix(res.motion)}"
+    io.write_motion(out, res.motion)
     rep = res.report
     row.update(
         status="ok",
@@ -179,7 +201,8 @@ def sync_grid(
     clips, songs : sequence of path
         Motion files (BVH, ``.mat``, CSV/NPY with ``fps``) and audio files.
     out_dir : path
-        Existing folder for the synchronised clips (``<clip>__<song>.bvh``).
+        Existing folder for the synchronised clips (``<clip>__<song>`` with the suffix
+        of :func:`output_suffix`: BVH, joint positions in the input's layout, or CSV).
     scheduler : str, optional
         Address of an existing Dask scheduler; default: a local cluster. The workers
         read the inputs and write the outputs themselves, so every path must be valid
@@ -254,7 +277,7 @@ def sync_grid(
     inputs = {Path(p).resolve() for p in clips + songs}
     for c in clips:
         for s in songs:
-            for suffix in (".bvh", ".csv"):
+            for suffix in output_suffixes(c):
                 target = (out / f"{Path(c).stem}__{Path(s).stem}{suffix}").resolve()
                 if target in inputs:
                     raise ParameterError(

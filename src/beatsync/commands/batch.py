@@ -14,12 +14,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="sync every motion clip with every song, in parallel on Dask",
         description="Track each song's beats once, segment each clip once, then sync every "
         "(clip, song) pair on a Dask cluster (local by default). Writes "
-        "OUT_DIR/<clip>__<song>.bvh and a summary CSV, all at the end (an error or Ctrl-C "
+        "OUT_DIR/<clip>__<song> in the clip's own kind of file (.bvh with a skeleton; joint "
+        "positions in the input's layout: .json, .npy, .npz, .c3d; else .csv) and a "
+        "summary CSV, all at the end (an error or Ctrl-C "
         "leaves OUT_DIR as it was); a pair that fails on bad input records its error in "
         "the summary instead of stopping the run. Workers of an existing cluster "
         "(--scheduler) must see the same paths.",
     )
-    p.add_argument("--clips", nargs="+", required=True, help="motion files (.bvh/.mat/.csv/.npy)")
+    p.add_argument(
+        "--clips",
+        nargs="+",
+        required=True,
+        help="motion files (.bvh, .mat, .csv, .npy, .npz, .json, .c3d)",
+    )
     p.add_argument("--songs", nargs="+", required=True, help="audio files")
     p.add_argument("--out-dir", required=True, help="existing output folder")
     p.add_argument(
@@ -42,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from .. import io
-    from ..batch import sync_grid
+    from ..batch import output_suffixes, sync_grid
     from ..cluster import check_cluster_options
     from ..io import check_input_file
     from ._common import Outputs, check_output, feedback
@@ -58,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
         for c in args.clips:
             for s in args.songs:
-                for suffix in (".bvh", ".csv"):  # the pair's output, whichever it will be
+                for suffix in output_suffixes(c):  # the pair's output, whichever it will be
                     name = f"{Path(c).stem}__{Path(s).stem}{suffix}"
                     check_output(out_dir / name, option="--out-dir", inputs=inputs)
         with feedback(args).step("batch") as progress:
