@@ -164,3 +164,50 @@ def test_kernels_get_one_blas_thread_unless_the_user_chose(tmp_path, monkeypatch
     assert _outputs(tmp_path / "out" / "one.ipynb").split()[2] == (preset or "1")
     assert os.environ.get("OPENBLAS_NUM_THREADS") == preset  # ours restored
     assert "OMP_NUM_THREADS" not in os.environ
+
+
+def test_a_run_of_some_notebooks_keeps_the_others_in_the_manifest(nbdir, tmp_path):
+    # reproduce --only X: the manifest still describes every notebook in the folder
+    _notebook(nbdir / "other.ipynb")
+    full, ci = tmp_path / "full.yaml", tmp_path / "ci.yaml"
+    full.write_text("other:\n  n: 5\ntiny:\n  n: 21\n")
+    ci.write_text("other:\n  n: 1\ntiny:\n  n: 2\n")
+    out = tmp_path / "out"
+    run_notebooks(full, notebooks_dir=nbdir, output_dir=out, jobs=1)
+    first = json.loads((out / "run_manifest.json").read_text())["notebooks"]
+    run_notebooks(ci, notebooks_dir=nbdir, output_dir=out, only=["tiny"], jobs=1)
+    manifest = json.loads((out / "run_manifest.json").read_text())
+    entries = {n["name"]: n for n in manifest["notebooks"]}
+    assert [n["name"] for n in manifest["notebooks"]] == ["other", "tiny"]
+    assert entries["other"] == first[0]  # not run: as the full run recorded it
+    assert entries["other"]["params_file"] == str(full)
+    assert entries["tiny"]["parameters"] == {"n": 2}
+    assert entries["tiny"]["params_file"] == manifest["params_file"] == str(ci)
+    # a notebook whose executed copy is gone is not described
+    (out / "other.ipynb").unlink()
+    run_notebooks(ci, notebooks_dir=nbdir, output_dir=out, only=["tiny"], jobs=1)
+    manifest = json.loads((out / "run_manifest.json").read_text())
+    assert [n["name"] for n in manifest["notebooks"]] == ["tiny"]
+
+
+def test_entries_of_an_older_manifest_get_its_parameter_file(nbdir, tmp_path):
+    # manifests written before entries named their parameter file and version
+    _notebook(nbdir / "other.ipynb")
+    p = tmp_path / "p.yaml"
+    p.write_text("other:\n  n: 5\ntiny:\n  n: 21\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "other.ipynb").write_text("{}")
+    old = {"beatsync_version": "0.0.9", "params_file": "params/paper.yaml",
+           "notebooks": [{"name": "other", "parameters": {"n": 5}, "seconds": 3.0}]}  # fmt: skip
+    (out / "run_manifest.json").write_text(json.dumps(old))
+    run_notebooks(p, notebooks_dir=nbdir, output_dir=out, only=["tiny"], jobs=1)
+    entries = json.loads((out / "run_manifest.json").read_text())["notebooks"]
+    assert entries[0] == {
+        "name": "other",
+        "params_file": "params/paper.yaml",
+        "beatsync_version": "0.0.9",
+        "parameters": {"n": 5},
+        "seconds": 3.0,
+    }
+    assert entries[1]["name"] == "tiny" and entries[1]["params_file"] == str(p)

@@ -12,7 +12,8 @@ Unlike papermill, which only warns, the runner refuses a parameter that the
 notebook's ``parameters`` cell does not declare, a notebook that is missing, and a
 notebook in ``notebooks/`` that the file does not list. Notebooks run with their own
 folder as working directory. A manifest (``run_manifest.json``) records the
-parameters, package version and time of every notebook.
+parameter file, parameters, package version and time of every notebook in the output
+folder: a run of some notebooks (``only``) keeps the entries of the others.
 
 Every kernel runs with one BLAS/OpenMP thread (unless the caller set
 ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS``): a threaded BLAS
@@ -215,15 +216,61 @@ def _execute(
     tmp.unlink(missing_ok=True)
 
 
-def _previous_seconds(output_dir: Path | None) -> dict[str, float]:
-    """Each notebook's time in the previous manifest of ``output_dir`` (empty if none)."""
+def _previous_entries(output_dir: Path | None) -> list[dict[str, Any]]:
+    """The notebook entries of the previous manifest of ``output_dir`` (none if there is
+    no readable manifest; an entry without a name or time is dropped). An entry without
+    its own parameter file or version (written before entries had them) gets the
+    manifest's."""
     if output_dir is None:
-        return {}
+        return []
     try:
         data = json.loads((output_dir / MANIFEST).read_text())
-        return {str(n["name"]): float(n["seconds"]) for n in data["notebooks"]}
-    except (OSError, ValueError, KeyError, TypeError):
-        return {}
+        entries = [dict(n) for n in data["notebooks"]]
+        shared = {k: data[k] for k in ("params_file", "beatsync_version") if k in data}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return []
+    out = []
+    for n in entries:
+        try:
+            n["name"], n["seconds"] = str(n["name"]), float(n["seconds"])
+        except (KeyError, TypeError, ValueError):
+            continue
+        out.append({"name": n["name"], **shared, **n})
+    return out
+
+
+def _previous_seconds(output_dir: Path | None) -> dict[str, float]:
+    """Each notebook's time in the previous manifest of ``output_dir`` (empty if none)."""
+    return {n["name"]: n["seconds"] for n in _previous_entries(output_dir)}
+
+
+def _manifest_entries(
+    runs: list[NotebookRun], params: dict[str, Any], params_file: str, output_dir: Path
+) -> list[dict[str, Any]]:
+    """This run's notebooks, and the previous manifest's entries of the notebooks it did
+    not run whose executed copy is still in ``output_dir`` (``--only``): the manifest
+    describes every notebook there. Each entry names its parameter file and version."""
+    from . import __version__
+
+    mine = {
+        r.name: {
+            "name": r.name,
+            "params_file": params_file,
+            "beatsync_version": __version__,
+            "parameters": r.parameters,
+            "seconds": round(r.seconds, 1),
+        }
+        for r in runs
+    }
+    kept = {
+        n["name"]: n
+        for n in _previous_entries(output_dir)
+        if n["name"] not in mine and (output_dir / f"{n['name']}.ipynb").is_file()
+    }
+    both = {**kept, **mine}
+    order = [name for name in params if name in both]  # the parameter file's order
+    order += [name for name in kept if name not in order]
+    return [both[name] for name in order]
 
 
 def kernel_env() -> dict[str, str]:
@@ -417,15 +464,13 @@ def run_notebooks(
             seconds = _run_in_process(todo, params, nb_dir, dests, planned, target, progress)
     runs = [NotebookRun(n, planned[n], params[n], seconds[n]) for n in todo]
     if MANIFEST in planned:
+        assert out_dir is not None
         write_json(
             target(planned[MANIFEST]),
             {
                 "beatsync_version": __version__,
                 "params_file": str(params_file),
-                "notebooks": [
-                    {"name": r.name, "parameters": r.parameters, "seconds": round(r.seconds, 1)}
-                    for r in runs
-                ],
+                "notebooks": _manifest_entries(runs, params, str(params_file), out_dir),
             },
         )
     return runs
