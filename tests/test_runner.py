@@ -1,6 +1,8 @@
 """The notebook runner: parameter checks (papermill itself only warns)."""
 
 import json
+import os
+from pathlib import Path
 
 import nbformat
 import pytest
@@ -211,3 +213,24 @@ def test_entries_of_an_older_manifest_get_its_parameter_file(nbdir, tmp_path):
         "seconds": 3.0,
     }
     assert entries[1]["name"] == "tiny" and entries[1]["params_file"] == str(p)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="Unix sockets only where the system has them")
+def test_kernels_talk_over_private_unix_sockets(tmp_path, capfd):
+    # over TCP every kernel warned on stderr that it runs without encryption
+    d = tmp_path / "notebooks"
+    d.mkdir()
+    body = (
+        "from ipykernel.kernelapp import IPKernelApp\n"
+        "app = IPKernelApp.instance()\n"
+        "print(app.transport, app.ip)"
+    )
+    _notebook(d / "where.ipynb", body)
+    p = tmp_path / "p.yaml"
+    p.write_text("where: {}\n")
+    run_notebooks(p, notebooks_dir=d, output_dir=tmp_path / "out", jobs=1)
+    transport, ip = _outputs(tmp_path / "out" / "where.ipynb").split()
+    assert transport == "ipc"
+    folder = Path(ip).parent
+    assert folder.name.startswith("beatsync-kernel-") and not folder.exists()  # removed
+    assert "without encryption" not in capfd.readouterr().err

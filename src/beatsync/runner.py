@@ -193,14 +193,16 @@ def _execute(
 
     tmp = dest.with_name(f".{dest.name}.running.ipynb")
     try:
-        pm.execute_notebook(
-            str(path),
-            str(tmp),
-            parameters=parameters,
-            cwd=str(nb_dir),
-            progress_bar=False,
-            report_mode=False,
-        )
+        with _kernel_transport() as transport:
+            pm.execute_notebook(
+                str(path),
+                str(tmp),
+                parameters=parameters,
+                cwd=str(nb_dir),
+                progress_bar=False,
+                report_mode=False,
+                **transport,
+            )
     except Exception:
         # keep the executed notebook with its traceback cells for the user to read
         if tmp.exists():
@@ -214,6 +216,32 @@ def _execute(
     with atomic_write(write_to) as fh:
         nbformat.write(executed, fh)
     tmp.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def _kernel_transport() -> Iterator[dict[str, Any]]:
+    """Papermill options for a kernel that talks to the runner over Unix sockets.
+
+    Over TCP, every kernel warns on stderr that it runs without encryption, and any
+    local process could reach its ports (the messages are signed, not hidden). The
+    sockets are made in a private temporary folder of this kernel's own (Jupyter's
+    default, ``kernel-ipc`` in the working folder, is shared by notebooks run side by
+    side, whose kernels then answer each other), removed afterwards. Windows has no
+    Unix sockets: TCP there.
+    """
+    if os.name != "posix":
+        yield {}
+        return
+    import shutil
+
+    from traitlets.config import Config
+
+    folder = tempfile.mkdtemp(prefix="beatsync-kernel-")  # mode 0700
+    try:
+        ip = os.path.join(folder, "kernel")
+        yield {"config": Config({"KernelManager": {"transport": "ipc", "ip": ip}})}
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def _previous_entries(output_dir: Path | None) -> list[dict[str, Any]]:
