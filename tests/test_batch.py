@@ -274,3 +274,19 @@ def test_batch_refuses_a_positions_output_that_is_an_input(inputs, tmp_path, cli
             sync_grid(clips, songs[:1], tmp_path, processes=False, n_workers=1, fps=25.0)
     assert clips[1].read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(c.name for c in clips)
+
+
+def test_batch_text_gives_a_line_per_pair_and_its_note_or_error(inputs, scheduler, tmp_path,
+                                                                 capsys):  # fmt: skip
+    # as one table, the notes of real dancers made lines of several hundred characters
+    _, clips, songs = inputs
+    argv = ["batch", "--clips", *map(str, clips), "--songs", str(songs[0]), "--out-dir",
+            str(tmp_path), "--fps", "60", "--scheduler", scheduler]  # fmt: skip
+    assert main(argv) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("salsa x click100: periods, ")
+    assert "frames, largest residual" in lines[0]
+    assert lines[0].endswith(str(tmp_path / "salsa__click100.bvh"))
+    assert lines[1].startswith("pirouette x click100: error: ") and "--mode beats" in lines[1]
+    assert lines[2] == f"1/2 pairs synchronised; {tmp_path / 'summary.csv'}"
+    assert len(lines) == 3

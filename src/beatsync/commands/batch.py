@@ -85,6 +85,27 @@ def run(args: argparse.Namespace) -> int:
             table.loc[i, "output"] = str(outs.adopt(table.loc[i, "output"], option="--out-dir"))
         io.write_csv(outs.path(summary), table)
     n_ok = int((table["status"] == "ok").sum())
-    text = table.to_string(index=False) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
+    text = _text(table) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
     emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
     return 0 if n_ok else 1
+
+
+def _text(table) -> str:
+    """One line per pair, and its note or error on a line of its own (the table's
+    columns are in the summary CSV and ``--json``; as one table the notes made lines
+    of several hundred characters)."""
+    lines = []
+    for row in table.to_dict("records"):
+        head = f"{row['clip']} x {row['song']}"
+        if row["status"] != "ok":
+            lines.append(f"{head}: error: {row['error']}")
+            continue
+        mode = "periods" if row["mode"] == "periods" else "motion beats"
+        lines.append(
+            f"{head}: {mode}, {row['tempo_bpm']:.1f} BPM, {row['input_frames']:.0f} -> "
+            f"{row['output_frames']:.0f} frames, largest residual "
+            f"{row['max_abs_residual_ms']:.2f} ms -> {row['output']}"
+        )
+        if row.get("note"):
+            lines.append(f"  {row['note']}")
+    return "\n".join(lines)
