@@ -234,3 +234,20 @@ def test_kernels_talk_over_private_unix_sockets(tmp_path, capfd):
     folder = Path(ip).parent
     assert folder.name.startswith("beatsync-kernel-") and not folder.exists()  # removed
     assert "without encryption" not in capfd.readouterr().err
+
+
+def test_a_temporary_folder_too_long_for_a_socket_path_falls_back_to_tcp(tmp_path, monkeypatch):
+    import tempfile
+
+    long_tmp = tmp_path / ("t" * 100)
+    long_tmp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(long_tmp))
+    d = tmp_path / "notebooks"
+    d.mkdir()
+    body = "from ipykernel.kernelapp import IPKernelApp\nprint(IPKernelApp.instance().transport)"
+    _notebook(d / "where.ipynb", body)
+    p = tmp_path / "p.yaml"
+    p.write_text("where: {}\n")
+    run_notebooks(p, notebooks_dir=d, output_dir=tmp_path / "out", jobs=1)
+    assert _outputs(tmp_path / "out" / "where.ipynb").split() == ["tcp"]
+    assert list(long_tmp.iterdir()) == []  # its socket folder removed

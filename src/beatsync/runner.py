@@ -58,6 +58,10 @@ __all__ = [
 
 MANIFEST = "run_manifest.json"
 
+#: Longest Unix socket path, in bytes, on every system we run on (``sun_path`` holds
+#: 108 bytes on Linux, 104 on macOS and the BSDs, with the closing NUL).
+MAX_SOCKET_PATH = 103
+
 
 #: Environment variables that set the BLAS/OpenMP thread count of a kernel.
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -226,8 +230,9 @@ def _kernel_transport() -> Iterator[dict[str, Any]]:
     local process could reach its ports (the messages are signed, not hidden). The
     sockets are made in a private temporary folder of this kernel's own (Jupyter's
     default, ``kernel-ipc`` in the working folder, is shared by notebooks run side by
-    side, whose kernels then answer each other), removed afterwards. Windows has no
-    Unix sockets: TCP there.
+    side, whose kernels then answer each other), removed afterwards. TCP where that is
+    not possible: on Windows (no Unix sockets), and under a temporary folder
+    (``TMPDIR``) too long for a socket path (:data:`MAX_SOCKET_PATH`).
     """
     if os.name != "posix":
         yield {}
@@ -239,7 +244,10 @@ def _kernel_transport() -> Iterator[dict[str, Any]]:
     folder = tempfile.mkdtemp(prefix="beatsync-kernel-")  # mode 0700
     try:
         ip = os.path.join(folder, "kernel")
-        yield {"config": Config({"KernelManager": {"transport": "ipc", "ip": ip}})}
+        if len(os.fsencode(ip)) + len("-65535") > MAX_SOCKET_PATH:
+            yield {}
+        else:
+            yield {"config": Config({"KernelManager": {"transport": "ipc", "ip": ip}})}
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
