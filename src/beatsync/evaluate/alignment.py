@@ -5,14 +5,17 @@ compare motion beats (kinematic beats of the dance) with music beats through a
 Gaussian of the distance to the nearest beat of the other kind, but they average
 over different sets:
 
-- :func:`beat_alignment_music` averages over **music beats**: for every music beat,
-  how close is the nearest motion beat? This is the score as written in Li et al.
-  2021 (AIST++ / FACT, "AI Choreographer", eq. of BeatAlign). It asks whether every
-  beat of the song is danced; a dance with many extra motion beats is not penalised.
 - :func:`beat_alignment_motion` averages over **motion beats**: for every motion
-  beat, how close is the nearest music beat? This is the score of Siyao et al. 2022
-  (Bailando, "BAS"), who noted the difference. It asks whether every accent of the
-  dance falls on a beat; a dance that skips beats is not penalised.
+  beat, how close is the nearest music beat? This is the score as written in Li et
+  al. 2021 (AIST++ / FACT, "AI Choreographer", the BeatAlign equation over the
+  kinematic beats; their ``tools/calculate_beat_scores.py`` loops over the motion
+  beats too). It asks whether every accent of the dance falls on a beat; a dance
+  that skips beats is not penalised.
+- :func:`beat_alignment_music` averages over **music beats**: for every music beat,
+  how close is the nearest motion beat? This is the score of Siyao et al. 2022
+  (Bailando, "BAS"; their ``utils/beat_align_score.py`` loops over the music beats).
+  It asks whether every beat of the song is danced; a dance with many extra motion
+  beats is not penalised.
 
 Both use ``exp(-d^2 / (2 sigma^2))`` with ``d`` the distance to the nearest beat
 [s]; the papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (default here).
@@ -126,7 +129,7 @@ def _score(averaged: np.ndarray, other: np.ndarray, sigma: float, what: str) -> 
 def beat_alignment_motion(
     motion_beats: Any, music_beats: Any, *, sigma: float = DEFAULT_SIGMA
 ) -> float:
-    """Beat alignment averaged over motion beats (Siyao et al. 2022, "BAS").
+    """Beat alignment averaged over motion beats (Li et al. 2021, AIST++ "BeatAlign").
 
     ``(1/|M|) sum_{t in M} exp(-min_{b in B} (t - b)^2 / (2 sigma^2))`` with ``M`` the
     motion beats and ``B`` the music beats.
@@ -155,7 +158,7 @@ def beat_alignment_motion(
 def beat_alignment_music(
     motion_beats: Any, music_beats: Any, *, sigma: float = DEFAULT_SIGMA
 ) -> float:
-    """Beat alignment averaged over music beats (Li et al. 2021, AIST++ "BeatAlign").
+    """Beat alignment averaged over music beats (Siyao et al. 2022, Bailando "BAS").
 
     ``(1/|B|) sum_{b in B} exp(-min_{t in M} (b - t)^2 / (2 sigma^2))``.
 

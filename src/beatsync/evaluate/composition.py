@@ -6,8 +6,8 @@ joint positions, intensities) computed by the caller (:mod:`beatsync.study.paper
 runs the stages); nothing here runs a stage.
 
 - **Beat alignment** (:mod:`beatsync.evaluate.alignment`): both published scores,
-  averaged over motion beats (Siyao et al. 2022) and over music beats (Li et al.
-  2021), Gaussian sigma 0.05 s, on the kinematic beats of the composed motion.
+  averaged over motion beats (Li et al. 2021) and over music beats (Siyao et al.
+  2022), Gaussian sigma 0.05 s, on the kinematic beats of the composed motion.
 - **Intensity correlation** (:func:`intensity_correlation`): Pearson r between the
   composed motion's intensity per music beat interval (mean joint kinetic energy) and
   the music level (RMS dB).

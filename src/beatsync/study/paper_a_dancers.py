@@ -221,8 +221,8 @@ def dancer_table(
 
     Columns ``own_*`` are the dancer with their own song, ``after_*`` re-synchronised
     to :data:`OTHER_SONG`, ``*_control_*`` the random-offset control of each; ``_motion``
-    averages over motion beats (Siyao et al. 2022), ``_music`` over music beats (Li et
-    al. 2021); ``sigma`` in seconds.
+    averages over motion beats (Li et al. 2021), ``_music`` over music beats (Siyao et
+    al. 2022); ``sigma`` in seconds.
 
     Returns
     -------

@@ -66,8 +66,8 @@ FRAME_COUNT_COLUMNS = [
     "clip", "fps", "input frames", "song", "periods", "periods used", "beats/period",
     "output frames", "paper output frames", "max residual [frames]", "note",
 ]  # fmt: skip
-#: Alignment columns (``_motion``: averaged over motion beats, Siyao et al. 2022;
-#: ``_music``: averaged over music beats, Li et al. 2021).
+#: Alignment columns (``_motion``: averaged over motion beats, Li et al. 2021;
+#: ``_music``: averaged over music beats, Siyao et al. 2022).
 ALIGNMENT_COLUMNS = [
     "clip", "song", "before_motion", "after_motion", "aligned_motion", "control_motion",
     "before_music", "after_music", "aligned_music", "control_music", "before_phase",
