@@ -18,6 +18,8 @@ PYTEST_ARGS ?= -q
 # (and a module's tests) on one worker. XDIST= runs them in one process.
 XDIST      ?= -n auto --dist loadscope
 NBVAL       = -p no:cacheprovider --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
+# the Examples of the package's docstrings run as tests too
+DOCTEST     = --doctest-modules src/beatsync
 
 # uv never downloads a Python of its own: the machine's Python 3.11 is used.
 export UV_PYTHON_DOWNLOADS = never
@@ -64,10 +66,10 @@ reproduce: setup
 # cells tagged nbval-ignore-output (timings) are run but not compared.
 test: setup
 	$(BIN)/beatsync reproduce --params params/ci.yaml --check
-	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) $(NBVAL) tests notebooks
+	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) $(NBVAL) $(DOCTEST) tests notebooks
 
 test-unit: setup
-	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) tests
+	$(BIN)/python -m pytest $(PYTEST_ARGS) $(XDIST) $(DOCTEST) tests
 
 test-notebooks: setup
 	$(BIN)/beatsync reproduce --params params/ci.yaml --check

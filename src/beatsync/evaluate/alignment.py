@@ -321,7 +321,7 @@ def sync_residuals(landed: Any, targets: Any, *, fps: float | None = None) -> di
 
     Examples
     --------
-    >>> sync_residuals([1.0, 2.001], [1.0, 2.0])["max_abs_residual_ms"]
+    >>> round(sync_residuals([1.0, 2.001], [1.0, 2.0])["max_abs_residual_ms"], 9)
     1.0
     """
     x = check_times(landed, name="landed")
