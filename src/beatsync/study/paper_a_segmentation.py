@@ -186,7 +186,6 @@ def figure(
         plot_segmentation(m, seg, clips.knees[m.name], truth=truth, ax=ax, title=title)
         ax.set_xlim(0, min(m.duration, seconds))
     fig.tight_layout()
-    plt.close(fig)
     return fig
 
 

@@ -599,9 +599,6 @@ def summary_graphs(graphs: dict[str, WeightedMotionGraph]) -> Any:
 
 def plot_speed(speed: Any) -> Any:
     """Log-scale bar chart of search times per library and music length."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 3.5))
@@ -620,9 +617,6 @@ def plot_speed(speed: Any) -> Any:
 
 def plot_intensity(comp: Any) -> Any:
     """Music level and composed-motion intensity per beat interval (both z-scored)."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
     from ..motion_beats import beat_interval_intensity
