@@ -290,3 +290,38 @@ def test_batch_text_gives_a_line_per_pair_and_its_note_or_error(inputs, schedule
     assert lines[1].startswith("pirouette x click100: error: ") and "--mode beats" in lines[1]
     assert lines[2] == f"1/2 pairs synchronised; {tmp_path / 'summary.csv'}"
     assert len(lines) == 3
+
+
+def test_batch_refuses_a_summary_named_like_a_pairs_output(inputs, tmp_path, capsys):
+    # it was written over the synchronised pair, and the command exited 0
+    _, clips, songs = inputs
+    pair = str(tmp_path / "salsa__click100.bvh")
+    argv = ["batch", "--clips", str(clips[0]), "--songs", str(songs[0]), "--out-dir",
+            str(tmp_path), "--fps", "60", "--summary", pair]  # fmt: skip
+    assert main(argv) == 3
+    assert "give the summary another name" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_outputs_adopt_never_takes_another_options_file(tmp_path):
+    from beatsync.commands._common import Outputs
+
+    with pytest.raises(ParameterError, match="both name"):
+        with Outputs(inputs=[]) as outs:
+            folder = outs.add_folder(tmp_path, option="--out-dir")
+            outs.add(folder / "a.csv", option="--summary")
+            staged = outs.staging_folder(folder) / "a.csv"
+            staged.write_text("pair")
+            outs.adopt(staged, option="--out-dir")
+    assert list(tmp_path.iterdir()) == []  # rolled back
+
+
+def test_batch_variable_picks_the_recording_of_a_mat_file(inputs, tmp_path, capsys):
+    # the toolbox's demo file holds several recordings: batch named --variable without having it
+    _, _, songs = inputs
+    mat = datasets.path("motion/mocaptoolbox/mcdemodata.mat")
+    argv = ["batch", "--clips", str(mat), "--songs", str(songs[0]), "--out-dir", str(tmp_path),
+            "--variable", "dance2", "--mode", "beats", "--workers", "1", "--json"]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert row["status"] == "ok" and row["output"].endswith("mcdemodata__click100.csv")

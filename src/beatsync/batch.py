@@ -76,6 +76,7 @@ def prepare_clip(
     path: str,
     *,
     fps: float | None = None,
+    variable: str | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
     mode: str = "periods",
@@ -91,7 +92,7 @@ def prepare_clip(
     from . import io
     from .sync.core import motion_periods
 
-    motion = io.read_motion(path, fps=fps)
+    motion = io.read_motion(path, fps=fps, variable=variable)
     clip = {
         "clip": Path(path).stem,
         "motion": motion,
@@ -186,6 +187,7 @@ def sync_grid(
     n_workers: int | None = None,
     processes: bool = True,
     fps: float | None = None,
+    variable: str | None = None,
     bpm: float | None = None,
     min_bpm: float | None = None,
     max_bpm: float | None = None,
@@ -199,7 +201,9 @@ def sync_grid(
     Parameters
     ----------
     clips, songs : sequence of path
-        Motion files (BVH, ``.mat``, CSV/NPY with ``fps``) and audio files.
+        Motion files (any of :func:`beatsync.io.read_motion`: BVH, MoCap Toolbox ``.mat``,
+        CSV/NPY angle tables, joint positions in ``.json``, ``.npy``, ``.npz`` or
+        ``.c3d``; ``fps`` where the file has none) and audio files.
     out_dir : path
         Existing folder for the synchronised clips (``<clip>__<song>`` with the suffix
         of :func:`output_suffix`: BVH, joint positions in the input's layout, or CSV).
@@ -214,6 +218,9 @@ def sync_grid(
         Local cluster with worker processes (default) or threads.
     fps : float, optional [Hz]
         Frame-rate override for every clip (e.g. 60 for the CMU salsa files).
+    variable : str, optional
+        The recording inside a ``.mat`` file, or the array inside an ``.npz``, of every
+        clip (e.g. ``"dance2"``).
     bpm : float, optional [BPM]
         Known tempo of every song.
     min_bpm, max_bpm : float, optional [BPM]
@@ -297,6 +304,7 @@ def sync_grid(
                 _guard(prepare_clip),
                 c,
                 fps=fps,
+                variable=variable,
                 period_range=period_range,
                 alpha=alpha,
                 mode=mode,

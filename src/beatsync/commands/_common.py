@@ -459,7 +459,10 @@ class Outputs:
         """Declare a file found in a staging folder (e.g. named by a worker) and stage it."""
         s = Path(staged)
         dest = self.final_path(s)
-        p = self.add(dest, option=option) if dest.resolve() not in self._declared else dest
+        declared = self._declared.get(dest.resolve())
+        if declared is not None and declared[1] != option:
+            self.add(dest, option=option)  # another option's file: refused, never overwritten
+        p = self.add(dest, option=option) if declared is None else dest
         self._staged[p.resolve()] = s
         return p
 

@@ -32,6 +32,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fps", type=float, default=None, help="frame-rate override for every clip [Hz]"
     )
+    p.add_argument(
+        "--variable",
+        default=None,
+        help="recording inside a .mat file, or array inside an .npz (e.g. dance2), of every clip",
+    )
     p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
     add_tempo_range(p)
     add_period_range(p)
@@ -51,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
     from .. import io
     from ..batch import output_suffixes, sync_grid
     from ..cluster import check_cluster_options
+    from ..errors import ParameterError
     from ..io import check_input_file
     from ._common import Outputs, check_output, feedback
 
@@ -67,7 +73,13 @@ def run(args: argparse.Namespace) -> int:
             for s in args.songs:
                 for suffix in output_suffixes(c):  # the pair's output, whichever it will be
                     name = f"{Path(c).stem}__{Path(s).stem}{suffix}"
-                    check_output(out_dir / name, option="--out-dir", inputs=inputs)
+                    pair = check_output(out_dir / name, option="--out-dir", inputs=inputs)
+                    if pair.resolve() == summary.resolve():
+                        raise ParameterError(
+                            f"--summary {str(summary)!r} would be the synchronised "
+                            f"{Path(c).name} x {Path(s).name} in --out-dir; give the "
+                            "summary another name"
+                        )
         with feedback(args).step("batch") as progress:
             table = sync_grid(
                 args.clips,
@@ -76,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
                 scheduler=args.scheduler,
                 n_workers=workers,
                 fps=args.fps,
+                variable=args.variable,
                 **tempo,
                 period_range=tuple(args.period_range),
                 mode=args.mode,
@@ -85,15 +98,17 @@ def run(args: argparse.Namespace) -> int:
             table.loc[i, "output"] = str(outs.adopt(table.loc[i, "output"], option="--out-dir"))
         io.write_csv(outs.path(summary), table)
     n_ok = int((table["status"] == "ok").sum())
-    text = _text(table) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
+    text = _text(table, args.out_dir) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
     emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
     return 0 if n_ok else 1
 
 
-def _text(table) -> str:
+def _text(table, out_dir: str) -> str:
     """One line per pair, and its note or error on a line of its own (the table's
     columns are in the summary CSV and ``--json``; as one table the notes made lines
-    of several hundred characters)."""
+    of several hundred characters). Outputs are shown in ``out_dir`` as given."""
+    from pathlib import Path
+
     lines = []
     for row in table.to_dict("records"):
         head = f"{row['clip']} x {row['song']}"
@@ -104,7 +119,7 @@ def _text(table) -> str:
         lines.append(
             f"{head}: {mode}, {row['tempo_bpm']:.1f} BPM, {row['input_frames']:.0f} -> "
             f"{row['output_frames']:.0f} frames, largest residual "
-            f"{row['max_abs_residual_ms']:.2f} ms -> {row['output']}"
+            f"{row['max_abs_residual_ms']:.2f} ms -> {Path(out_dir) / Path(row['output']).name}"
         )
         if row.get("note"):
             lines.append(f"  {row['note']}")
