@@ -251,3 +251,21 @@ def test_a_temporary_folder_too_long_for_a_socket_path_falls_back_to_tcp(tmp_pat
     run_notebooks(p, notebooks_dir=d, output_dir=tmp_path / "out", jobs=1)
     assert _outputs(tmp_path / "out" / "where.ipynb").split() == ["tcp"]
     assert list(long_tmp.iterdir()) == []  # its socket folder removed
+
+
+def test_an_interrupt_after_the_run_leaves_no_running_copy(nbdir, tmp_path, monkeypatch):
+    # Ctrl-C or SIGTERM (a KeyboardInterrupt in the worker) after papermill returned,
+    # while the executed copy is read back: the hidden running copy was left behind
+    import nbformat as nbf
+
+    from beatsync import runner
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(nbf, "read", interrupted)
+    dest = tmp_path / "out" / "tiny.ipynb"
+    dest.parent.mkdir()
+    with pytest.raises(KeyboardInterrupt):
+        runner._execute(nbdir / "tiny.ipynb", {"n": 1}, nbdir, dest, dest)
+    assert list(dest.parent.iterdir()) == []

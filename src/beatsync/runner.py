@@ -195,31 +195,35 @@ def _execute(
 
     from .io import atomic_write
 
-    tmp = dest.with_name(f".{dest.name}.running.ipynb")
-    try:
-        with _kernel_transport() as transport:
-            pm.execute_notebook(
-                str(path),
-                str(tmp),
-                parameters=parameters,
-                cwd=str(nb_dir),
-                progress_bar=False,
-                report_mode=False,
-                **transport,
-            )
-    except Exception:
-        # keep the executed notebook with its traceback cells for the user to read
-        if tmp.exists():
-            os.replace(tmp, dest.with_name(f"{dest.stem}.failed.ipynb"))
-        raise
-    except BaseException:  # Ctrl-C, SIGTERM: leave nothing behind
+    tmp = _running_copy(dest)
+    try:  # Ctrl-C, SIGTERM at any point: the running copy is removed (finally)
+        try:
+            with _kernel_transport() as transport:
+                pm.execute_notebook(
+                    str(path),
+                    str(tmp),
+                    parameters=parameters,
+                    cwd=str(nb_dir),
+                    progress_bar=False,
+                    report_mode=False,
+                    **transport,
+                )
+        except Exception:
+            # keep the executed notebook with its traceback cells for the user to read
+            if tmp.exists():
+                os.replace(tmp, dest.with_name(f"{dest.stem}.failed.ipynb"))
+            raise
+        executed = nbformat.read(tmp, as_version=4)
+        executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
+        with atomic_write(write_to) as fh:
+            nbformat.write(executed, fh)
+    finally:
         tmp.unlink(missing_ok=True)
-        raise
-    executed = nbformat.read(tmp, as_version=4)
-    executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
-    with atomic_write(write_to) as fh:
-        nbformat.write(executed, fh)
-    tmp.unlink(missing_ok=True)
+
+
+def _running_copy(dest: Path) -> Path:
+    """Where papermill writes a notebook while it runs (hidden, beside ``dest``)."""
+    return dest.with_name(f".{dest.name}.running.ipynb")
 
 
 @contextlib.contextmanager
@@ -383,6 +387,8 @@ def _run_parallel(
                         progress(f"  {name} done in {seconds[name]:.1f} s -> {dests[name]}")
         finally:
             _stop_workers([(p, lg) for p, _, _, lg in running.values()])
+            for name in running:  # a worker killed after the grace time could not clean up
+                _running_copy(dests[name]).unlink(missing_ok=True)
     return seconds
 
 
