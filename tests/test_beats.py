@@ -573,6 +573,30 @@ def test_frontend_sweep_lists_the_items_of_a_small_set():
         row.loc["few", "F"], abs=1e-3
     )
     assert row.loc["many", "F per item"] == ""  # more than SWEEP_ITEMS_LISTED items
+    # a set with no items (the notebook run without real recordings) is left out
+    empty = study.frontend_sweep(
+        {"real": [], "few": few}, {"win_s": [0.023], "hop_s": [0.0058]}, min_beat_time=0.0
+    )
+    assert empty["set"].tolist() == ["few"]
+
+
+def test_study_overview_and_methods_note():
+    # what the beat-tracking notebook shows before scoring, now in the package
+    from beatsync.study import paper_a_beats as study
+
+    items = make_beat_test_set(duration=6.0, bpms=[60, 90, 120, 150], kinds=["click"],
+                               groups=["clean", "swing"])  # fmt: skip
+    table = study.items_overview(items, per_group=2)
+    assert table["item"].tolist() == [
+        "click_60_clean", "click_90_clean", "click_60_swing", "click_90_swing"
+    ]  # fmt: skip
+    assert table.columns.tolist() == ["item", "group", "bpm", "beats", "seconds"]
+    assert table["seconds"].tolist() == [6.0] * 4
+    assert study.methods_note(["psf", "librosa"]).splitlines() == [
+        "methods: ['psf', 'librosa']",
+        "essentia is not installed here: its trackers are left out of every table below",
+    ]
+    assert study.methods_note(["psf", "essentia-degara"]) == "methods: ['psf', 'essentia-degara']"
 
 
 @pytest.mark.parametrize(

@@ -58,3 +58,24 @@ def test_make_songs_bad_source():
     with pytest.raises(ParameterError, match="beat_source"):
         study.make_songs([96.0, 132.0], beat_source="guess")
 
+
+def test_residual_table_rounds_for_display_without_negative_zeros():
+    from types import SimpleNamespace
+
+    report = {
+        "input_frames": 10,
+        "output_frames": 12,
+        "periods_used": 2,
+        "beats_per_period": 1,
+        "boundaries_s": [0.5, 1.0],
+        "target_beats_s": [0.5, 1.0],
+        "residual_ms": [-0.0001, 0.004],
+        "residual_nearest_frame_ms": [3.3333, -0.002],
+    }
+    counts, raw = study.residual_table(SimpleNamespace(report=report))
+    assert counts == {"input_frames": 10, "output_frames": 12, "periods_used": 2,
+                      "beats_per_period": 1}  # fmt: skip
+    assert raw["residual warp [ms]"].tolist() == [-0.0001, 0.004]
+    _, shown = study.residual_table(SimpleNamespace(report=report), decimals=2)
+    assert shown["residual nearest frame [ms]"].tolist() == [3.33, 0.0]
+    assert not np.signbit(shown.to_numpy()).any()  # no "-0.0" in the notebook's table

@@ -78,6 +78,27 @@ def available_methods() -> list[str]:
     return [name for name, ok in peers.available().items() if ok]
 
 
+def methods_note(methods: Sequence[str]) -> str:
+    """The trackers that run here, and what is left out (essentia, when not installed)."""
+    text = f"methods: {list(methods)}"
+    if not any(name.startswith("essentia") for name in methods):
+        text += "\nessentia is not installed here: its trackers are left out of every table below"
+    return text
+
+
+def items_overview(items: Sequence[BeatTestItem], per_group: int = 3) -> pd.DataFrame:
+    """The first ``per_group`` items of each group: name, group, tempo [BPM], beats and
+    length [s] (what the study scores)."""
+    table = pd.DataFrame(
+        [
+            {"item": it.name, "group": it.group, "bpm": round(it.bpm, 1),
+             "beats": it.beats.size, "seconds": round(it.duration, 1)}
+            for it in items
+        ]
+    )  # fmt: skip
+    return table.groupby("group", sort=False).head(per_group)
+
+
 def synthetic_items(**kwargs: Any) -> list[BeatTestItem]:
     """The synthetic test set (:func:`beatsync.synth.audio.make_beat_test_set`)."""
     return make_beat_test_set(**kwargs)
@@ -221,7 +242,7 @@ def frontend_sweep(
     Parameters
     ----------
     item_sets : dict of name -> items
-        E.g. ``{"real": real_items(), "synthetic": ...}``.
+        E.g. ``{"real": real_items(), "synthetic": ...}``; an empty set is left out.
     grid : dict
         Front-end parameter (``win_s``, ``hop_s``, ``band_edges_hz``, ...) -> values;
         combinations with ``hop_s > win_s / 2`` are skipped.
@@ -245,6 +266,8 @@ def frontend_sweep(
             for k, v in params.items()
         )
         for set_name, items in item_sets.items():
+            if not len(items):
+                continue
             sc = score_items(items, methods=["psf"], min_beat_time=min_beat_time, **params)
             row = {
                 k: str(list(v)) if isinstance(v, (list, tuple)) else v for k, v in params.items()

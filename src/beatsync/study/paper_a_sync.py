@@ -567,8 +567,13 @@ def alignment_summary(table: Any) -> Any:
 # ------------------------------------------------------------------------ Figure 3
 
 
-def residual_table(result: Any) -> tuple[dict[str, Any], Any]:
+def residual_table(result: Any, decimals: int | None = None) -> tuple[dict[str, Any], Any]:
     """Every boundary of a :class:`~beatsync.sync.SyncResult`, its beat and residuals.
+
+    Parameters
+    ----------
+    decimals : int, optional
+        Round the table for display (a value that rounds to zero shows as 0, not -0).
 
     Returns
     -------
@@ -591,6 +596,8 @@ def residual_table(result: Any) -> tuple[dict[str, Any], Any]:
             "residual nearest frame [ms]": rep["residual_nearest_frame_ms"],
         }
     )
+    if decimals is not None:
+        table = table.round(decimals) + 0.0  # + 0.0 turns -0.0 into 0.0
     return counts, table
 
 
