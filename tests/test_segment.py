@@ -578,3 +578,18 @@ def test_dance_range_keeps_the_step_period_of_salsa():
     seg = segment(m, period_range=DANCE_PERIOD_RANGE)
     assert seg.mean_period == pytest.approx(segment(m).mean_period, abs=1e-9)
     assert 0.95 <= seg.mean_period <= 1.1
+
+
+def test_nonperiodic_refusal_is_shown_whole_or_cut_after_a_word(monkeypatch):
+    # the notebook showed "... and uniform segmentat ...": cut in the middle of a word
+    from beatsync.study import paper_a_segmentation as study
+
+    def refuse(*args, **kwargs):
+        raise ParameterError("the motion is not periodic: uniform segmentations beat it")
+
+    monkeypatch.setattr(study, "segment", refuse)
+    motion = periodic_motion(n_frames=100, n_periods=5, seed=0).motion
+    whole = study.nonperiodic_refusal(motion, alpha=0.1, period_range=(0.25, 1.25), max_chars=600)
+    assert whole == "the motion is not periodic: uniform segmentations beat it"
+    cut = study.nonperiodic_refusal(motion, alpha=0.1, period_range=(0.25, 1.25), max_chars=40)
+    assert cut == "the motion is not periodic: uniform ..."

@@ -192,11 +192,16 @@ def figure(
 def nonperiodic_refusal(
     motion: Motion, *, alpha: float, period_range: Sequence[float], max_chars: int
 ) -> str:
-    """The start of the message with which :func:`segment` refuses a non-periodic clip."""
+    """The message with which :func:`segment` refuses a non-periodic clip, cut after a
+    whole word within ``max_chars`` characters (marked " ...") if it is longer."""
     try:
         segment(motion, alpha=alpha, period_range=tuple(period_range))
     except ParameterError as exc:
-        return f"{str(exc)[:max_chars]} ..."
+        text = str(exc)
+        if len(text) <= max_chars:
+            return text
+        cut = text[: max_chars + 1].rsplit(" ", 1)[0] if " " in text[:max_chars] else ""
+        return f"{cut or text[:max_chars]} ..."
     return f"{motion.name} was segmented (expected a refusal)"
 
 
