@@ -460,9 +460,10 @@ class Outputs:
         s = Path(staged)
         dest = self.final_path(s)
         declared = self._declared.get(dest.resolve())
-        if declared is not None and declared[1] != option:
-            self.add(dest, option=option)  # another option's file: refused, never overwritten
-        p = self.add(dest, option=option) if declared is None else dest
+        # declared by this option: staged as it is; by another: add() refuses it (never
+        # overwritten); not declared yet: declared now
+        mine = declared is not None and declared[1] == option
+        p = dest if mine else self.add(dest, option=option)
         self._staged[p.resolve()] = s
         return p
 

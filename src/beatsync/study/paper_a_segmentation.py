@@ -193,15 +193,13 @@ def nonperiodic_refusal(
     motion: Motion, *, alpha: float, period_range: Sequence[float], max_chars: int
 ) -> str:
     """The message with which :func:`segment` refuses a non-periodic clip, cut after a
-    whole word within ``max_chars`` characters (marked " ...") if it is longer."""
+    whole word to at most ``max_chars`` characters, " ..." included, if it is longer."""
+    import textwrap
+
     try:
         segment(motion, alpha=alpha, period_range=tuple(period_range))
     except ParameterError as exc:
-        text = str(exc)
-        if len(text) <= max_chars:
-            return text
-        cut = text[: max_chars + 1].rsplit(" ", 1)[0] if " " in text[:max_chars] else ""
-        return f"{cut or text[:max_chars]} ..."
+        return textwrap.shorten(str(exc), width=max_chars, placeholder=" ...")
     return f"{motion.name} was segmented (expected a refusal)"
 
 
