@@ -68,6 +68,111 @@ def test_unreachable_scheduler_fails_fast_and_clearly(monkeypatch, address, matc
     assert time.perf_counter() - t0 < 10.0
 
 
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _connect_error(monkeypatch, address, timeout):
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", timeout)
+    t0 = time.perf_counter()
+    with pytest.raises(ParameterError) as info, cluster.dask_client(scheduler=address):
+        pass  # pragma: no cover
+    return str(info.value), time.perf_counter() - t0
+
+
+def test_refused_connection_is_named_without_waiting_out_the_timeout(monkeypatch):
+    # once: retried until the time-out, then "no answer", for a port where nothing listens
+    message, seconds = _connect_error(monkeypatch, f"tcp://127.0.0.1:{_free_port()}", 30.0)
+    assert "nothing listens on port" in message and "connection refused" in message
+    assert seconds < cluster.REFUSED_GRACE + 8.0  # not the 30 s
+
+
+def test_unknown_host_is_named_at_once(monkeypatch):
+    message, seconds = _connect_error(monkeypatch, "tcp://no-such-host.invalid:8786", 30.0)
+    assert "the host name 'no-such-host.invalid' could not be resolved" in message
+    assert seconds < 20.0
+
+
+def test_unanswered_connection_is_named(monkeypatch):
+    import socket
+
+    def no_answer(*args, **kwargs):
+        raise TimeoutError("timed out")
+
+    monkeypatch.setattr(socket, "create_connection", no_answer)
+    message, _ = _connect_error(monkeypatch, "tcp://10.0.0.5:8786", 1.0)
+    assert message.startswith("could not connect to the Dask scheduler at 'tcp://10.0.0.5:8786'")
+    assert "no answer within 1 s" in message
+
+
+def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
+    # a refused connection is tried again: the listener starts 0.5 s after the probe
+    import socket
+    import struct
+    import threading
+
+    port = _free_port()
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    held = []
+
+    def serve_later():
+        time.sleep(0.5)
+        server.bind(("127.0.0.1", port))
+        server.listen()
+        with contextlib.suppress(OSError):
+            conn, _ = server.accept()
+            held.append(conn)
+            conn.sendall(struct.pack("<Q", 1) + struct.pack("<Q", 0))  # a plausible frame
+
+    thread = threading.Thread(target=serve_later, daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + 5.0
+        cluster._probe_tcp(f"tcp://127.0.0.1:{port}", f"127.0.0.1:{port}", 5.0, deadline)
+    finally:
+        thread.join(timeout=5)
+        server.close()
+        for conn in held:
+            conn.close()
+
+
+def test_the_probe_and_the_client_share_one_timeout(monkeypatch):
+    # the probe's connection answered after 1.5 s, then nothing listens: the client got
+    # the whole timeout again after the probe (3.5 s in all for a 2 s timeout)
+    import socket
+    import struct
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def serve():
+        with contextlib.suppress(OSError):
+            conn, _ = server.accept()
+            held.append(conn)
+            server.close()  # the client's connection is refused
+            time.sleep(1.5)
+            conn.sendall(struct.pack("<Q", 1) + struct.pack("<Q", 0))
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        message, seconds = _connect_error(monkeypatch, address, 2.0)
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+    assert message.startswith("could not connect to the Dask scheduler"), message
+    assert seconds < 3.0
+
+
 @pytest.mark.parametrize("reply", [None, b"HTTP/1.0 400 Bad Request\r\n\r\n", b""])
 def test_a_listener_that_is_not_dask_is_refused_fast(monkeypatch, reply):
     # the dashboard's HTTP port given for the scheduler's: the client waited forever for
@@ -329,6 +434,7 @@ def test_connection_handshake_failing_every_time_is_reported(monkeypatch):
     import dask.distributed
 
     monkeypatch.setattr(dask.distributed, "Client", _FlakyHandshake(fail=99))
+    monkeypatch.setattr(cluster, "_probe_tcp", lambda *args: None)  # nothing listens there
     with pytest.raises(
         ParameterError, match=r"could not connect .*AssertionError: its reply to 3 connections"
     ):

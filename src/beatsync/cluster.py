@@ -3,12 +3,14 @@
 :func:`dask_client` yields a :class:`distributed.Client` on either a local cluster
 (``n_workers`` single-threaded worker processes, default one per core) or an existing
 scheduler given by address (``"tcp://10.0.0.5:8786"``). It checks its arguments
-before starting anything, gives up on an unreachable scheduler after
-``timeout`` seconds with a :class:`~beatsync.errors.ParameterError` (not a hang, not
-a traceback), connects again when a busy scheduler's handshake reply came batched with
-another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and
-the local cluster on the way out, also on Ctrl-C (local worker processes ignore
-SIGINT: see :func:`dask_setup`). Local workers run with glibc's
+before starting anything, refuses an unreachable scheduler with a
+:class:`~beatsync.errors.ParameterError` that says why (not a hang, not a traceback):
+at once for a host name that does not resolve, after :data:`REFUSED_GRACE` seconds
+where nothing listens, after ``timeout`` seconds where nothing answers. It connects
+again when a busy scheduler's handshake reply came batched with another message (up
+to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and the local cluster on
+the way out, also on Ctrl-C (local worker processes ignore SIGINT: see
+:func:`dask_setup`). Local workers run with glibc's
 default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
 about 1.8x slower), and a local cluster runs no statistical profiler (it only feeds a
 dashboard), samples the system for the dashboard less often, and checks its event
@@ -47,6 +49,10 @@ _START_LOCK = threading.Lock()
 
 #: Seconds to wait for an existing scheduler before giving up.
 CONNECT_TIMEOUT = 5.0
+
+#: Seconds a refused connection to a scheduler is tried again (one that is starting)
+#: before the command says that nothing listens there.
+REFUSED_GRACE = 2.0
 
 #: Dask settings of the local clusters, set while a cluster starts (its scheduler,
 #: nannies and workers read them then; a nanny passes them on to a worker it starts
@@ -309,15 +315,24 @@ def _client_with_handshake_retries(client_cls: Any, address: str, timeout: float
 _MAX_FIRST_FRAME = 2**32
 
 
-def _probe_tcp(address: str, location: str, timeout: float) -> None:
-    """Refuse a TCP address where something listens that does not speak Dask.
+def _probe_tcp(address: str, location: str, timeout: float, deadline: float) -> None:
+    """Refuse a TCP address where no Dask scheduler can answer, at once and saying why.
+
+    Three failures are told apart before the client tries (it retries each of them
+    until its time-out and then reports them all as no answer):
+
+    - a host name that does not resolve (a typo) is refused at once;
+    - a refused connection (nothing listens on that port) is tried again for
+      :data:`REFUSED_GRACE` seconds (a scheduler that is starting), then refused;
+    - a connection that is not answered (a firewall, a wrong host) is refused when the
+      time is up.
 
     A Dask scheduler writes its handshake as soon as a connection opens; the client
     then reads it with no time limit of its own, so a server that waits for a request
     (the dashboard's HTTP port, 8787, given for the scheduler's 8786) held the command
-    forever, and one that answered with text was read as a frame of exabytes. Only a
-    silent or non-Dask answer is refused here; a refused connection or no route is
-    left to the client (its own message and retries).
+    forever, and one that answered with text was read as a frame of exabytes. A silent
+    or non-Dask answer is refused too. ``timeout`` is the seconds the caller allows in
+    all, ``deadline`` the :func:`time.monotonic` time when they are up.
     """
     import socket
     import struct
@@ -329,13 +344,33 @@ def _probe_tcp(address: str, location: str, timeout: float) -> None:
         host, port = parse_host_port(location)
     except ValueError:
         return  # the client says what is wrong with it
-    t0 = time.monotonic()
-    try:
-        sock = socket.create_connection((host, port), timeout=timeout)
-    except OSError:
-        return
+    refused_until = min(time.monotonic() + REFUSED_GRACE, deadline)
+    while True:
+        try:
+            sock = socket.create_connection(
+                (host, port), timeout=max(deadline - time.monotonic(), 0.1)
+            )
+            break
+        except socket.gaierror as exc:
+            why = f"the host name {host!r} could not be resolved ({exc.strerror or exc}); a typo?"
+        except ConnectionRefusedError:
+            if time.monotonic() < refused_until:
+                time.sleep(0.1)
+                continue
+            why = (
+                f"nothing listens on port {port} of {host} (connection refused); is `dask "
+                "scheduler` running there, on that port?"
+            )
+        except TimeoutError:
+            why = f"no answer within {timeout:g} s; a firewall, or the wrong host?"
+        except OSError as exc:  # no route to the host, network unreachable
+            why = f"{exc.strerror or exc}; is the host reachable from here?"
+        raise ParameterError(
+            f"could not connect to the Dask scheduler at {address!r}: {why} Omit "
+            "--scheduler to run on a local cluster"
+        )
     with sock:
-        sock.settimeout(max(timeout - (time.monotonic() - t0), 0.5))
+        sock.settimeout(max(deadline - time.monotonic(), 0.5))
         try:
             first = sock.recv(16)
         except OSError:
@@ -362,18 +397,23 @@ def _probe_tcp(address: str, location: str, timeout: float) -> None:
 
 
 def _connect(address: str, timeout: float) -> Any:
+    import time
+
     from dask.distributed import Client
     from distributed.comm import parse_address
     from distributed.comm.registry import get_backend
 
+    deadline = time.monotonic() + timeout  # the probe's time counts against the client's
     try:
         # an unknown scheme is refused here, not inside the client's connection retries
         # (which, on a busy machine, can time out before they report the scheme)
         scheme, location = parse_address(address)
         get_backend(scheme)
         if scheme == "tcp":
-            _probe_tcp(address, location, timeout)
-        return _client_with_handshake_retries(Client, address, timeout)
+            _probe_tcp(address, location, timeout, deadline)
+        return _client_with_handshake_retries(
+            Client, address, max(deadline - time.monotonic(), 0.5)
+        )
     except ParameterError:
         raise
     except ValueError as exc:  # malformed address: unknown scheme, no port
