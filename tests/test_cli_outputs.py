@@ -506,6 +506,24 @@ def test_only_the_chosen_subcommand_is_imported():
     assert loaded == {"beatsync.commands.data", "beatsync.commands._common"}
 
 
+def test_dataset_command_scores_only_in_its_workers_and_skips_mir_eval(tmp_path):
+    """mir_eval (with scipy.stats) took 1.6 s of ``evaluate beats``' start-up in a process
+    that scores nothing: the annotations are read and the scheduler reached without it."""
+    real = Path(__file__).resolve().parents[1] / "data" / "audio" / "real_dev"
+    audio, notes = tmp_path / "audio", tmp_path / "notes"
+    audio.mkdir()
+    notes.mkdir()
+    shutil.copy(real / "hainsworth_001.flac", audio)
+    shutil.copy(real / "hainsworth_001.beats", notes)
+    args = ["evaluate", "beats", "--audio", str(audio), "--annotations", str(notes)]
+    args += ["--out", str(tmp_path / "out"), "--scheduler", "foo://127.0.0.1:1"]
+    mods = _modules_after(
+        f"from beatsync.cli import main\ntry:\n    main({args!r})\nexcept SystemExit:\n    pass"
+    )
+    assert "beatsync.study.beat_dataset" in mods and "dask.distributed" in mods
+    assert "mir_eval" not in mods and "scipy.stats" not in mods
+
+
 def test_listed_help_matches_each_subcommand():
     parser = build_parser()
     action = next(a for a in parser._actions if a.dest == "command")

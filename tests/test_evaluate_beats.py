@@ -194,3 +194,10 @@ def test_summarize_scores_overall_and_by_group():
 def test_summarize_scores_missing_column():
     with pytest.raises(ParameterError, match="no column"):
         summarize_scores(_toy_scores(), by="kind", metrics=["F-measure"])
+
+
+def test_mir_eval_time_limit_is_mir_evals():
+    """Copied so that reading annotations does not import mir_eval: it must stay its value."""
+    import mir_eval.beat
+
+    assert ev.MIR_EVAL_MAX_TIME == mir_eval.beat.MAX_TIME

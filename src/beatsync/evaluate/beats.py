@@ -24,7 +24,6 @@ from __future__ import annotations
 import warnings
 from typing import Any
 
-import mir_eval
 import numpy as np
 
 from ..errors import ParameterError, warn
@@ -58,6 +57,19 @@ __all__ = [
 #: 3 s, the beat period at :data:`beatsync.units.MIN_BPM` (20 BPM), the slowest
 #: tempo the tracker considers.
 MAX_BEAT_INTERVAL = 60.0 / MIN_BPM
+
+#: mir_eval's limit on beat times [s] (``mir_eval.beat.MAX_TIME``; its scores refuse a
+#: later beat), copied so that reading an annotation does not import mir_eval (with
+#: scipy.stats, 1.6 s of a dataset command's start-up, in a process that scores nothing).
+MIR_EVAL_MAX_TIME = 30000.0
+
+
+def _mir_beat():
+    """:mod:`mir_eval.beat`, imported where scores are computed (see above)."""
+    import mir_eval.beat  # noqa: PLC0415
+
+    return mir_eval.beat
+
 
 #: Keys of the dict returned by :func:`evaluate`.
 METRICS = (
@@ -108,13 +120,13 @@ def diagnose_times(times: np.ndarray) -> str | None:
     if times.size == 0:
         return None
     if times.size < 3:
-        return "milliseconds or frame indices" if times[-1] > mir_eval.beat.MAX_TIME else None
+        return "milliseconds or frame indices" if times[-1] > MIR_EVAL_MAX_TIME else None
     step = float(np.median(np.diff(times)))
-    if step <= MAX_BEAT_INTERVAL and times[-1] <= mir_eval.beat.MAX_TIME:
+    if step <= MAX_BEAT_INTERVAL and times[-1] <= MIR_EVAL_MAX_TIME:
         return None
     integers = bool(np.all(times == np.round(times)))
     if step <= MAX_BEAT_INTERVAL and not integers:
-        return f"a recording longer than mir_eval's {mir_eval.beat.MAX_TIME:g} s"
+        return f"a recording longer than mir_eval's {MIR_EVAL_MAX_TIME:g} s"
     if integers and step < 150.0:
         return "frame indices"
     if 150.0 <= step <= 3000.0:
@@ -165,33 +177,33 @@ def _check(beats: Any, name: str) -> np.ndarray:
 
 def f_measure(reference: np.ndarray, estimated: np.ndarray) -> float:
     """F-measure with a +-70 ms window (:func:`mir_eval.beat.f_measure`)."""
-    return float(mir_eval.beat.f_measure(reference, estimated))
+    return float(_mir_beat().f_measure(reference, estimated))
 
 
 def cemgil(reference: np.ndarray, estimated: np.ndarray) -> tuple[float, float]:
     """Cemgil accuracy and its best over metrical variants (:func:`mir_eval.beat.cemgil`)."""
-    a, b = mir_eval.beat.cemgil(reference, estimated)
+    a, b = _mir_beat().cemgil(reference, estimated)
     return float(a), float(b)
 
 
 def goto(reference: np.ndarray, estimated: np.ndarray) -> float:
     """Goto's binary accuracy (:func:`mir_eval.beat.goto`)."""
-    return float(mir_eval.beat.goto(reference, estimated))
+    return float(_mir_beat().goto(reference, estimated))
 
 
 def p_score(reference: np.ndarray, estimated: np.ndarray) -> float:
     """McKinney's P-score (:func:`mir_eval.beat.p_score`)."""
-    return float(mir_eval.beat.p_score(reference, estimated))
+    return float(_mir_beat().p_score(reference, estimated))
 
 
 def continuity(reference: np.ndarray, estimated: np.ndarray) -> tuple[float, ...]:
     """CMLc, CMLt, AMLc, AMLt (:func:`mir_eval.beat.continuity`)."""
-    return tuple(float(v) for v in mir_eval.beat.continuity(reference, estimated))
+    return tuple(float(v) for v in _mir_beat().continuity(reference, estimated))
 
 
 def information_gain(reference: np.ndarray, estimated: np.ndarray) -> float:
     """Normalised information gain (:func:`mir_eval.beat.information_gain`)."""
-    return float(mir_eval.beat.information_gain(reference, estimated))
+    return float(_mir_beat().information_gain(reference, estimated))
 
 
 def evaluate(
@@ -236,8 +248,8 @@ def evaluate(
     """
     mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
     ref, est = validate(reference, estimated)
-    ref = mir_eval.beat.trim_beats(ref, min_beat_time=mbt)
-    est = mir_eval.beat.trim_beats(est, min_beat_time=mbt)
+    ref = _mir_beat().trim_beats(ref, min_beat_time=mbt)
+    est = _mir_beat().trim_beats(est, min_beat_time=mbt)
     if ref.size == 0 or est.size == 0:
         which = EMPTY_REFERENCE_TEXT if ref.size == 0 else "the estimated beats are empty"
         warn(f"{which} after min_beat_time={mbt:g} s: every score is 0", stacklevel=2)
