@@ -173,6 +173,75 @@ def test_the_probe_and_the_client_share_one_timeout(monkeypatch):
     assert seconds < 3.0
 
 
+def test_a_handshake_that_never_comes_does_not_hang(monkeypatch):
+    # the probe's connection answered like a scheduler, the client's never: distributed
+    # reads the handshake with no time limit, and the command waited forever
+    import socket
+    import struct
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def serve():
+        with contextlib.suppress(OSError):
+            conn, _ = server.accept()
+            held.append(conn)
+            conn.sendall(struct.pack("<Q", 1) + struct.pack("<Q", 0))
+            while True:
+                other, _ = server.accept()  # the client's connection: never answered
+                held.append(other)
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        message, seconds = _connect_error(monkeypatch, address, 1.0)
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+    assert "accepted the connection but did not complete the handshake" in message
+    assert seconds < 1.0 + cluster.HANDSHAKE_GRACE + 5.0
+
+
+def test_a_client_made_after_the_command_gave_up_is_closed():
+    import threading
+
+    release = threading.Event()
+    made = []
+
+    class Late:
+        closed = False
+
+        def close(self):
+            Late.closed = True
+
+    def connect():
+        release.wait(5)
+        made.append(Late())
+        return made[-1]
+
+    with pytest.raises(ParameterError, match="did not complete the handshake within 0.2 s"):
+        cluster._given_up_after(connect, 0.2, "tcp://10.0.0.5:8786")
+    release.set()
+    for _ in range(100):
+        if Late.closed:
+            break
+        time.sleep(0.02)
+    assert made and Late.closed
+
+
+def test_a_connection_error_is_raised_by_the_caller():
+    def connect():
+        raise OSError("refused")
+
+    with pytest.raises(OSError, match="refused"):
+        cluster._given_up_after(connect, 5.0, "tcp://10.0.0.5:8786")
+    assert cluster._given_up_after(lambda: "client", 5.0, "x") == "client"
+
+
 @pytest.mark.parametrize("reply", [None, b"HTTP/1.0 400 Bad Request\r\n\r\n", b""])
 def test_a_listener_that_is_not_dask_is_refused_fast(monkeypatch, reply):
     # the dashboard's HTTP port given for the scheduler's: the client waited forever for

@@ -6,7 +6,9 @@ scheduler given by address (``"tcp://10.0.0.5:8786"``). It checks its arguments
 before starting anything, refuses an unreachable scheduler with a
 :class:`~beatsync.errors.ParameterError` that says why (not a hang, not a traceback):
 at once for a host name that does not resolve, after :data:`REFUSED_GRACE` seconds
-where nothing listens, after ``timeout`` seconds where nothing answers. It connects
+where nothing listens, after ``timeout`` seconds where nothing answers (and
+:data:`HANDSHAKE_GRACE` later where a connection is accepted but its handshake never
+comes). It connects
 again when a busy scheduler's handshake reply came batched with another message (up
 to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and the local cluster on
 the way out, also on Ctrl-C (local worker processes ignore SIGINT: see
@@ -311,6 +313,56 @@ def _client_with_handshake_retries(client_cls: Any, address: str, timeout: float
             attempt += 1
 
 
+#: Seconds beyond the time-out that a client's connection may take before the command
+#: gives up on it (see :func:`_given_up_after`).
+HANDSHAKE_GRACE = 1.0
+
+
+def _given_up_after(connect: Any, seconds: float, address: str) -> Any:
+    """``connect()`` (which makes a client) in a thread of its own, given up after
+    ``seconds`` with a :class:`~beatsync.errors.ParameterError`.
+
+    distributed's client reads the scheduler's handshake with no time limit, whatever
+    its ``timeout``: a server that answered :func:`_probe_tcp` and then accepted the
+    client's own connection without a word held the command forever. Given up, the
+    thread is left waiting (a daemon: it does not hold the process at exit), and a
+    client it makes after all is closed at once. Its errors are raised here.
+    """
+    box: dict[str, Any] = {}
+    lock = threading.Lock()
+
+    def run() -> None:
+        try:
+            client = connect()
+        except BaseException as exc:  # noqa: BLE001 (handed to the caller)
+            box["error"] = exc
+            return
+        with lock:
+            late = box.get("abandoned", False)
+            box["client"] = client
+        if late:
+            with contextlib.suppress(Exception):
+                client.close()
+
+    thread = threading.Thread(target=run, name="beatsync-connect", daemon=True)
+    thread.start()
+    try:
+        thread.join(seconds)
+    finally:
+        with lock:
+            if "client" not in box:  # given up, or interrupted (Ctrl-C)
+                box["abandoned"] = True
+    if "error" in box:
+        raise box["error"]
+    if "client" in box:
+        return box["client"]
+    raise ParameterError(
+        f"could not connect to the Dask scheduler at {address!r}: it accepted the "
+        f"connection but did not complete the handshake within {seconds:g} s; is it a "
+        "Dask scheduler, and not overloaded? Omit --scheduler to run on a local cluster"
+    )
+
+
 #: A Dask frame header (a little-endian count of bytes) larger than this is not Dask's.
 _MAX_FIRST_FRAME = 2**32
 
@@ -411,8 +463,11 @@ def _connect(address: str, timeout: float) -> Any:
         get_backend(scheme)
         if scheme == "tcp":
             _probe_tcp(address, location, timeout, deadline)
-        return _client_with_handshake_retries(
-            Client, address, max(deadline - time.monotonic(), 0.5)
+        remaining = max(deadline - time.monotonic(), 0.5)
+        return _given_up_after(
+            lambda: _client_with_handshake_retries(Client, address, remaining),
+            remaining + HANDSHAKE_GRACE,
+            address,
         )
     except ParameterError:
         raise
