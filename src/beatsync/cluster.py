@@ -2,23 +2,22 @@
 
 :func:`dask_client` yields a :class:`distributed.Client` on either a local cluster
 (``n_workers`` single-threaded worker processes, default one per core) or an existing
-scheduler given by address (``"tcp://10.0.0.5:8786"``). It checks its arguments
-before starting anything, refuses an unreachable scheduler with a
+scheduler given by address (``"tcp://10.0.0.5:8786"``). It checks its arguments before
+starting anything, refuses an unreachable scheduler with a
 :class:`~beatsync.errors.ParameterError` that says why (not a hang, not a traceback):
 at once for a host name that does not resolve, after :data:`REFUSED_GRACE` seconds
 where nothing listens, after ``timeout`` seconds where nothing answers (and
 :data:`HANDSHAKE_GRACE` later where a connection is accepted but its handshake never
-comes). It connects
-again when a busy scheduler's handshake reply came batched with another message (up
-to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and the local cluster on
-the way out, also on Ctrl-C (local worker processes ignore SIGINT: see
-:func:`dask_setup`). Local workers run with glibc's
-default memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work
-about 1.8x slower), and a local cluster runs no statistical profiler (it only feeds a
-dashboard), samples the system for the dashboard less often, and checks its event
-loops and memory less often (:data:`LOCAL_CLUSTER_CONFIG`). Dask's configuration is
-global to the process: local clusters start one at a time (a lock), and other threads
-see these settings while one starts.
+comes). It connects again when a busy scheduler's handshake reply came batched with
+another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and
+the local cluster on the way out, also on Ctrl-C (local worker processes ignore
+SIGINT: see :func:`dask_setup`). Local workers run with glibc's default memory-
+allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work about 1.8x
+slower), and a local cluster runs no statistical profiler (it only feeds a dashboard),
+samples the system for the dashboard less often, and checks its event loops and memory
+less often (:data:`LOCAL_CLUSTER_CONFIG`). Dask's configuration is global to the
+process: local clusters start one at a time (a lock), and other threads see these
+settings while one starts.
 
 Workers of an existing cluster must see the same file paths as the client (a shared
 file system) and have beatsync installed.
