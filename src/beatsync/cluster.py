@@ -11,8 +11,8 @@ where nothing listens, after ``timeout`` seconds where nothing answers (and
 comes). It connects again when a busy scheduler's handshake reply came batched with
 another message (up to :data:`HANDSHAKE_ATTEMPTS` times), and closes the client and
 the local cluster on the way out, also on Ctrl-C (local worker processes ignore
-SIGINT: see :func:`dask_setup`). Local workers run with glibc's default memory-
-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work about 1.8x
+SIGINT: see :func:`dask_setup`). Local workers run with glibc's default
+memory-allocator settings (Dask's ``MALLOC_TRIM_THRESHOLD_`` makes our work about 1.8x
 slower), and a local cluster runs no statistical profiler (it only feeds a dashboard),
 samples the system for the dashboard less often, and checks its event loops and memory
 less often (:data:`LOCAL_CLUSTER_CONFIG`). Dask's configuration is global to the
