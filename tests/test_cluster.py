@@ -1,6 +1,7 @@
 """The one Dask set-up: worker counts, scheduler addresses, timeouts, shutdown."""
 
 import contextlib
+import re
 import time
 
 import pytest
@@ -84,6 +85,47 @@ def _connect_error(monkeypatch, address, timeout):
     return str(info.value), time.perf_counter() - t0
 
 
+#: The start of a Dask message: a small frame count, then a frame length.
+PLAUSIBLE_FRAME = (1).to_bytes(8, "little") + (0).to_bytes(8, "little")
+
+
+@contextlib.contextmanager
+def _listener(first_reply, *, delay=0.0, later="silent"):
+    """A TCP server on 127.0.0.1, its ``tcp://`` address yielded. The first connection
+    gets ``first_reply`` after ``delay`` s (None: nothing; b"": closed at once); later
+    ones are held without a word (``later="silent"``) or refused (``"refused"``: the
+    server stops listening after the first)."""
+    import socket
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def serve():
+        with contextlib.suppress(OSError):
+            conn, _ = server.accept()
+            held.append(conn)
+            if later == "refused":
+                server.close()
+            time.sleep(delay)
+            if first_reply is not None:
+                conn.sendall(first_reply)
+                if not first_reply:
+                    conn.close()
+            while later == "silent":
+                held.append(server.accept()[0])
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+
+
 def test_refused_connection_is_named_without_waiting_out_the_timeout(monkeypatch):
     # once: retried until the time-out, then "no answer", for a port where nothing listens
     message, seconds = _connect_error(monkeypatch, f"tcp://127.0.0.1:{_free_port()}", 30.0)
@@ -112,7 +154,6 @@ def test_unanswered_connection_is_named(monkeypatch):
 def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
     # a refused connection is tried again: the listener starts 0.5 s after the probe
     import socket
-    import struct
     import threading
 
     port = _free_port()
@@ -127,7 +168,7 @@ def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
         with contextlib.suppress(OSError):
             conn, _ = server.accept()
             held.append(conn)
-            conn.sendall(struct.pack("<Q", 1) + struct.pack("<Q", 0))  # a plausible frame
+            conn.sendall(PLAUSIBLE_FRAME)
 
     thread = threading.Thread(target=serve_later, daemon=True)
     thread.start()
@@ -144,31 +185,8 @@ def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
 def test_the_probe_and_the_client_share_one_timeout(monkeypatch):
     # the probe's connection answered after 1.5 s, then nothing listens: the client got
     # the whole timeout again after the probe (3.5 s in all for a 2 s timeout)
-    import socket
-    import struct
-    import threading
-
-    server = socket.socket()
-    server.bind(("127.0.0.1", 0))
-    server.listen()
-    held = []
-
-    def serve():
-        with contextlib.suppress(OSError):
-            conn, _ = server.accept()
-            held.append(conn)
-            server.close()  # the client's connection is refused
-            time.sleep(1.5)
-            conn.sendall(struct.pack("<Q", 1) + struct.pack("<Q", 0))
-
-    threading.Thread(target=serve, daemon=True).start()
-    try:
-        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    with _listener(PLAUSIBLE_FRAME, delay=1.5, later="refused") as address:
         message, seconds = _connect_error(monkeypatch, address, 2.0)
-    finally:
-        server.close()
-        for conn in held:
-            conn.close()
     assert message.startswith("could not connect to the Dask scheduler"), message
     assert seconds < 3.0
 
@@ -176,32 +194,8 @@ def test_the_probe_and_the_client_share_one_timeout(monkeypatch):
 def test_a_handshake_that_never_comes_does_not_hang(monkeypatch):
     # the probe's connection answered like a scheduler, the client's never: distributed
     # reads the handshake with no time limit, and the command waited forever
-    import socket
-    import struct
-    import threading
-
-    server = socket.socket()
-    server.bind(("127.0.0.1", 0))
-    server.listen()
-    held = []
-
-    def serve():
-        with contextlib.suppress(OSError):
-            conn, _ = server.accept()
-            held.append(conn)
-            conn.sendall(struct.pack("<Q", 1) + struct.pack("<Q", 0))
-            while True:
-                other, _ = server.accept()  # the client's connection: never answered
-                held.append(other)
-
-    threading.Thread(target=serve, daemon=True).start()
-    try:
-        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    with _listener(PLAUSIBLE_FRAME) as address:
         message, seconds = _connect_error(monkeypatch, address, 1.0)
-    finally:
-        server.close()
-        for conn in held:
-            conn.close()
     assert "accepted the connection but did not complete the handshake" in message
     assert seconds < 1.0 + cluster.HANDSHAKE_GRACE + 5.0
 
@@ -246,36 +240,10 @@ def test_a_connection_error_is_raised_by_the_caller():
 def test_a_listener_that_is_not_dask_is_refused_fast(monkeypatch, reply):
     # the dashboard's HTTP port given for the scheduler's: the client waited forever for
     # a handshake; an HTTP answer was read as a frame of exabytes (a MemoryError)
-    import socket
-    import threading
-
-    server = socket.socket()
-    server.bind(("127.0.0.1", 0))
-    server.listen()
-    held = []
-
-    def serve():
-        with contextlib.suppress(OSError):
-            conn, _ = server.accept()
-            held.append(conn)
-            if reply is not None:
-                conn.sendall(reply)
-                if not reply:
-                    conn.close()
-
-    threading.Thread(target=serve, daemon=True).start()
-    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
-    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
-    t0 = time.perf_counter()
-    try:
-        with pytest.raises(ParameterError, match=r"^--scheduler '[^']*' is not a Dask scheduler: "):
-            with cluster.dask_client(scheduler=address):
-                pass  # pragma: no cover
-    finally:
-        server.close()
-        for conn in held:
-            conn.close()
-    assert time.perf_counter() - t0 < 5.0
+    with _listener(reply) as address:
+        message, seconds = _connect_error(monkeypatch, address, 1.0)
+    assert re.match(r"^--scheduler '[^']*' is not a Dask scheduler: ", message), message
+    assert seconds < 5.0
 
 
 def test_local_cluster_runs_and_shuts_down():
