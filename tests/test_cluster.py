@@ -183,12 +183,12 @@ def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
 
 
 def test_the_probe_and_the_client_share_one_timeout(monkeypatch):
-    # the probe's connection answered after 1.5 s, then nothing listens: the client got
-    # the whole timeout again after the probe (3.5 s in all for a 2 s timeout)
-    with _listener(PLAUSIBLE_FRAME, delay=1.5, later="refused") as address:
-        message, seconds = _connect_error(monkeypatch, address, 2.0)
+    # the probe's connection answered after 2.5 s, then nothing listens: the client got
+    # the whole timeout again after the probe (5.5 s in all for a 3 s timeout)
+    with _listener(PLAUSIBLE_FRAME, delay=2.5, later="refused") as address:
+        message, seconds = _connect_error(monkeypatch, address, 3.0)
     assert message.startswith("could not connect to the Dask scheduler"), message
-    assert seconds < 3.0
+    assert seconds < 4.5
 
 
 def test_a_handshake_that_never_comes_does_not_hang(monkeypatch):
