@@ -45,14 +45,14 @@ def evaluate_track(
     audio : str
         Audio file path (valid on the worker).
     reference : np.ndarray [s]
-        Annotated beats (:func:`read_annotation`).
+        Annotated beats (:func:`~.beat_tracks.read_annotation`).
     method : str
         A name of :data:`beatsync.peers.PEERS`.
     min_beat_time : float >= 0 [s]
     name : str
-        The track's key (:attr:`Track.key`), recorded as ``key``.
+        The track's key (:attr:`~.beat_tracks.Track.key`), recorded as ``key``.
     group : str
-        The track's folder (:attr:`Track.group`).
+        The track's folder (:attr:`~.beat_tracks.Track.group`).
     min_bpm, max_bpm : float, optional [BPM]
         The tempo range searched (:func:`beatsync.peers.check_tempo_range`); ``None``:
         the method's default. Recorded as checked (a bound equal to the default as
