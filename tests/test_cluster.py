@@ -139,13 +139,46 @@ def test_unknown_host_is_named_at_once(monkeypatch):
     assert seconds < 20.0
 
 
-def test_unanswered_connection_is_named(monkeypatch):
+def test_a_silent_name_server_is_named_when_the_time_is_up(monkeypatch):
+    # the system's resolver waits for its own time-outs (tens of seconds) with none of ours
+    import socket
+    import threading
+
+    release = threading.Event()
+
+    def silent(*args, **kwargs):
+        release.wait(30)
+        raise socket.gaierror(socket.EAI_AGAIN, "Temporary failure in name resolution")
+
+    monkeypatch.setattr(socket, "getaddrinfo", silent)
+    try:
+        message, seconds = _connect_error(monkeypatch, "tcp://scheduler.example:8786", 1.0)
+    finally:
+        release.set()
+    assert "the host name 'scheduler.example' was not resolved within 1 s" in message
+    assert seconds < 1.0 + 5.0
+
+
+def test_every_resolved_address_is_tried():
+    # localhost may resolve to ::1 first; a scheduler on 127.0.0.1 alone is still reached
     import socket
 
-    def no_answer(*args, **kwargs):
+    with _listener(PLAUSIBLE_FRAME) as address:
+        port = int(address.rsplit(":", 1)[1])
+        nothing = ("127.0.0.1", _free_port())
+        infos = [
+            (socket.AF_INET, socket.SOCK_STREAM, 6, "", nothing),
+            (socket.AF_INET, socket.SOCK_STREAM, 6, "", ("127.0.0.1", port)),
+        ]
+        with cluster._connect_any(infos, time.monotonic() + 5.0) as sock:
+            assert sock.getpeername()[1] == port
+
+
+def test_unanswered_connection_is_named(monkeypatch):
+    def no_answer(addresses, deadline):
         raise TimeoutError("timed out")
 
-    monkeypatch.setattr(socket, "create_connection", no_answer)
+    monkeypatch.setattr(cluster, "_connect_any", no_answer)
     message, _ = _connect_error(monkeypatch, "tcp://10.0.0.5:8786", 1.0)
     assert message.startswith("could not connect to the Dask scheduler at 'tcp://10.0.0.5:8786'")
     assert "no answer within 1 s" in message

@@ -366,13 +366,65 @@ def _given_up_after(connect: Any, seconds: float, address: str) -> Any:
 _MAX_FIRST_FRAME = 2**32
 
 
+class _NameServerSilent(Exception):
+    """:func:`_resolve` ran out of time."""
+
+
+def _resolve(host: str, port: int, deadline: float) -> list[tuple[Any, ...]]:
+    """``socket.getaddrinfo`` for a TCP connection, given up at ``deadline``.
+
+    The system's resolver has no time limit of its own here (a silent name server
+    keeps it waiting for its own time-outs, tens of seconds), so it runs in a daemon
+    thread. Raises its ``socket.gaierror``, or :class:`_NameServerSilent`.
+    """
+    import socket
+    import time
+
+    box: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            box["infos"] = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+        except OSError as exc:
+            box["error"] = exc
+
+    thread = threading.Thread(target=run, name="beatsync-resolve", daemon=True)
+    thread.start()
+    thread.join(max(deadline - time.monotonic(), 0.1))
+    if "error" in box:
+        raise box["error"]
+    if "infos" not in box:
+        raise _NameServerSilent(host)
+    return box["infos"]
+
+
+def _connect_any(addresses: list[tuple[Any, ...]], deadline: float) -> Any:
+    """A socket connected to the first of the resolved ``addresses`` that accepts (as
+    ``socket.create_connection`` tries them); the last one's error if none does."""
+    import socket
+    import time
+
+    error: OSError = ConnectionRefusedError("no address")
+    for family, kind, proto, _, sockaddr in addresses:
+        sock = socket.socket(family, kind, proto)
+        try:
+            sock.settimeout(max(deadline - time.monotonic(), 0.1))
+            sock.connect(sockaddr)
+            return sock
+        except OSError as exc:
+            sock.close()
+            error = exc
+    raise error
+
+
 def _probe_tcp(address: str, location: str, timeout: float, deadline: float) -> None:
     """Refuse a TCP address where no Dask scheduler can answer, at once and saying why.
 
     Three failures are told apart before the client tries (it retries each of them
     until its time-out and then reports them all as no answer):
 
-    - a host name that does not resolve (a typo) is refused at once;
+    - a host name that does not resolve (a typo) is refused at once, and one that the
+      name server does not answer for when the time is up (:func:`_resolve`);
     - a refused connection (nothing listens on that port) is tried again for
       :data:`REFUSED_GRACE` seconds (a scheduler that is starting), then refused;
     - a connection that is not answered (a firewall, a wrong host) is refused when the
@@ -396,14 +448,20 @@ def _probe_tcp(address: str, location: str, timeout: float, deadline: float) -> 
     except ValueError:
         return  # the client says what is wrong with it
     refused_until = min(time.monotonic() + REFUSED_GRACE, deadline)
+    addresses = None
     while True:
         try:
-            sock = socket.create_connection(
-                (host, port), timeout=max(deadline - time.monotonic(), 0.1)
-            )
+            if addresses is None:
+                addresses = _resolve(host, port, deadline)
+            sock = _connect_any(addresses, deadline)
             break
         except socket.gaierror as exc:
             why = f"the host name {host!r} could not be resolved ({exc.strerror or exc}); a typo?"
+        except _NameServerSilent:
+            why = (
+                f"the host name {host!r} was not resolved within {timeout:g} s (no answer "
+                "from the name server); is this machine's network or DNS working?"
+            )
         except ConnectionRefusedError:
             if time.monotonic() < refused_until:
                 time.sleep(0.1)
