@@ -69,12 +69,15 @@ def test_unreachable_scheduler_fails_fast_and_clearly(monkeypatch, address, matc
     assert time.perf_counter() - t0 < 10.0
 
 
-def _free_port() -> int:
+@contextlib.contextmanager
+def _refusing_port():
+    """A socket bound on 127.0.0.1 that does not listen (yielded): connections to its port
+    are refused, and no other process can take the port meanwhile."""
     import socket
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        yield sock
 
 
 def _connect_error(monkeypatch, address, timeout):
@@ -121,6 +124,8 @@ def _listener(first_reply, *, delay=0.0, later="silent"):
     try:
         yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
     finally:
+        with contextlib.suppress(OSError):
+            server.shutdown(socket.SHUT_RDWR)  # wakes the accept (close alone does not)
         server.close()
         for conn in held:
             conn.close()
@@ -128,15 +133,36 @@ def _listener(first_reply, *, delay=0.0, later="silent"):
 
 def test_refused_connection_is_named_without_waiting_out_the_timeout(monkeypatch):
     # once: retried until the time-out, then "no answer", for a port where nothing listens
-    message, seconds = _connect_error(monkeypatch, f"tcp://127.0.0.1:{_free_port()}", 30.0)
+    with _refusing_port() as sock:
+        address = f"tcp://127.0.0.1:{sock.getsockname()[1]}"
+        message, seconds = _connect_error(monkeypatch, address, 30.0)
     assert "nothing listens on port" in message and "connection refused" in message
     assert seconds < cluster.REFUSED_GRACE + 8.0  # not the 30 s
 
 
-def test_unknown_host_is_named_at_once(monkeypatch):
-    message, seconds = _connect_error(monkeypatch, "tcp://no-such-host.invalid:8786", 30.0)
-    assert "the host name 'no-such-host.invalid' could not be resolved" in message
-    assert seconds < 20.0
+@pytest.mark.parametrize(
+    "error, advice",
+    [
+        ("EAI_NONAME", "; a typo?"),
+        ("EAI_AGAIN", "; is this machine's network or DNS working?"),
+        ("idna", "; a typo?"),  # an empty label: UnicodeError, once a thread traceback
+    ],
+)
+def test_unknown_host_is_named_at_once(monkeypatch, error, advice):
+    import socket
+
+    def unknown(host, *args, **kwargs):
+        if error == "idna":
+            return socket.getaddrinfo.__wrapped__(host, *args, **kwargs)
+        raise socket.gaierror(getattr(socket, error), "no such name")
+
+    unknown.__wrapped__ = socket.getaddrinfo
+    monkeypatch.setattr(socket, "getaddrinfo", unknown)
+    host = "a..b" if error == "idna" else "scheduler.example"
+    message, seconds = _connect_error(monkeypatch, f"tcp://{host}:8786", 30.0)
+    assert f"the host name {host!r} could not be resolved (" in message
+    assert advice + " Omit --scheduler" in message
+    assert seconds < 20.0  # not the 30 s
 
 
 def test_a_silent_name_server_is_named_when_the_time_is_up(monkeypatch):
@@ -163,15 +189,59 @@ def test_every_resolved_address_is_tried():
     # localhost may resolve to ::1 first; a scheduler on 127.0.0.1 alone is still reached
     import socket
 
-    with _listener(PLAUSIBLE_FRAME) as address:
+    with _listener(PLAUSIBLE_FRAME) as address, _refusing_port() as refusing:
         port = int(address.rsplit(":", 1)[1])
-        nothing = ("127.0.0.1", _free_port())
         infos = [
-            (socket.AF_INET, socket.SOCK_STREAM, 6, "", nothing),
+            (socket.AF_INET, socket.SOCK_STREAM, 6, "", refusing.getsockname()),
             (socket.AF_INET, socket.SOCK_STREAM, 6, "", ("127.0.0.1", port)),
         ]
         with cluster._connect_any(infos, time.monotonic() + 5.0) as sock:
             assert sock.getpeername()[1] == port
+
+
+class _FakeSocket:
+    """A stand-in for ``socket.socket`` whose ``connect`` raises the error given for the
+    address, recording the time-out each address got."""
+
+    errors: dict = {}
+    timeouts: list = []
+
+    def __init__(self, *args):
+        pass
+
+    def settimeout(self, seconds):
+        _FakeSocket.timeouts.append(seconds)
+
+    def connect(self, sockaddr):
+        raise _FakeSocket.errors[sockaddr]
+
+    def close(self):
+        pass
+
+
+@pytest.mark.parametrize(
+    "errors, raised",
+    [
+        # IPv4 refused, IPv6 without a route: the refusal (retried for a starting one)
+        ([ConnectionRefusedError(), OSError(113, "No route to host")], ConnectionRefusedError),
+        ([OSError(113, "No route to host"), ConnectionRefusedError()], ConnectionRefusedError),
+        ([TimeoutError(), OSError(101, "Network is unreachable")], TimeoutError),
+        ([OSError(101, "Network is unreachable")], OSError),
+    ],
+)
+def test_the_most_telling_error_of_several_addresses(monkeypatch, errors, raised):
+    import socket
+
+    addresses = [(f"10.0.0.{i}", 8786) for i in range(len(errors))]
+    monkeypatch.setattr(_FakeSocket, "errors", dict(zip(addresses, errors, strict=True)))
+    monkeypatch.setattr(_FakeSocket, "timeouts", [])
+    monkeypatch.setattr(socket, "socket", _FakeSocket)
+    infos = [(socket.AF_INET, socket.SOCK_STREAM, 6, "", a) for a in addresses]
+    with pytest.raises(raised) as info:
+        cluster._connect_any(infos, time.monotonic() + 4.0)
+    assert type(info.value) is raised
+    # each address gets a share of the time left, not the first one all of it
+    assert _FakeSocket.timeouts[0] <= 4.0 / len(errors) + 0.01
 
 
 def test_unanswered_connection_is_named(monkeypatch):
@@ -189,14 +259,13 @@ def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
     import socket
     import threading
 
-    port = _free_port()
     server = socket.socket()
-    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    server.bind(("127.0.0.1", 0))  # bound, not listening: refused until listen()
+    port = server.getsockname()[1]
     held = []
 
     def serve_later():
         time.sleep(0.5)
-        server.bind(("127.0.0.1", port))
         server.listen()
         with contextlib.suppress(OSError):
             conn, _ = server.accept()
@@ -216,12 +285,13 @@ def test_a_scheduler_that_starts_within_the_grace_time_is_reached():
 
 
 def test_the_probe_and_the_client_share_one_timeout(monkeypatch):
-    # the probe's connection answered after 2.5 s, then nothing listens: the client got
-    # the whole timeout again after the probe (5.5 s in all for a 3 s timeout)
-    with _listener(PLAUSIBLE_FRAME, delay=2.5, later="refused") as address:
-        message, seconds = _connect_error(monkeypatch, address, 3.0)
+    # the probe's connection answered after 3.5 s, then nothing listens: the client got
+    # the whole timeout again after the probe (7.5 s in all for a 4 s timeout)
+    with _listener(PLAUSIBLE_FRAME, delay=3.5, later="refused") as address:
+        message, seconds = _connect_error(monkeypatch, address, 4.0)
     assert message.startswith("could not connect to the Dask scheduler"), message
-    assert seconds < 4.5
+    assert "did not complete the handshake" not in message
+    assert seconds < 6.0
 
 
 def test_a_handshake_that_never_comes_does_not_hang(monkeypatch):
@@ -250,8 +320,8 @@ def test_a_client_made_after_the_command_gave_up_is_closed():
         made.append(Late())
         return made[-1]
 
-    with pytest.raises(ParameterError, match="did not complete the handshake within 0.2 s"):
-        cluster._given_up_after(connect, 0.2, "tcp://10.0.0.5:8786")
+    with pytest.raises(ParameterError, match="did not complete the handshake within the 5 s"):
+        cluster._given_up_after(connect, 0.2, "tcp://10.0.0.5:8786", 5.0)
     release.set()
     for _ in range(100):
         if Late.closed:
@@ -265,8 +335,8 @@ def test_a_connection_error_is_raised_by_the_caller():
         raise OSError("refused")
 
     with pytest.raises(OSError, match="refused"):
-        cluster._given_up_after(connect, 5.0, "tcp://10.0.0.5:8786")
-    assert cluster._given_up_after(lambda: "client", 5.0, "x") == "client"
+        cluster._given_up_after(connect, 5.0, "tcp://10.0.0.5:8786", 5.0)
+    assert cluster._given_up_after(lambda: "client", 5.0, "x", 5.0) == "client"
 
 
 @pytest.mark.parametrize("reply", [None, b"HTTP/1.0 400 Bad Request\r\n\r\n", b""])

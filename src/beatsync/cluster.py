@@ -317,9 +317,10 @@ def _client_with_handshake_retries(client_cls: Any, address: str, timeout: float
 HANDSHAKE_GRACE = 1.0
 
 
-def _given_up_after(connect: Any, seconds: float, address: str) -> Any:
+def _given_up_after(connect: Any, seconds: float, address: str, timeout: float) -> Any:
     """``connect()`` (which makes a client) in a thread of its own, given up after
-    ``seconds`` with a :class:`~beatsync.errors.ParameterError`.
+    ``seconds`` with a :class:`~beatsync.errors.ParameterError` that names the caller's
+    ``timeout``.
 
     distributed's client reads the scheduler's handshake with no time limit, whatever
     its ``timeout``: a server that answered :func:`_probe_tcp` and then accepted the
@@ -357,8 +358,9 @@ def _given_up_after(connect: Any, seconds: float, address: str) -> Any:
         return box["client"]
     raise ParameterError(
         f"could not connect to the Dask scheduler at {address!r}: it accepted the "
-        f"connection but did not complete the handshake within {seconds:g} s; is it a "
-        "Dask scheduler, and not overloaded? Omit --scheduler to run on a local cluster"
+        f"connection but did not complete the handshake within the {timeout:g} s "
+        "time-out; is it a Dask scheduler, and not overloaded? Omit --scheduler to run on "
+        "a local cluster"
     )
 
 
@@ -375,7 +377,8 @@ def _resolve(host: str, port: int, deadline: float) -> list[tuple[Any, ...]]:
 
     The system's resolver has no time limit of its own here (a silent name server
     keeps it waiting for its own time-outs, tens of seconds), so it runs in a daemon
-    thread. Raises its ``socket.gaierror``, or :class:`_NameServerSilent`.
+    thread. Raises its ``socket.gaierror`` (also for a name the IDNA codec refuses),
+    or :class:`_NameServerSilent`.
     """
     import socket
     import time
@@ -385,7 +388,9 @@ def _resolve(host: str, port: int, deadline: float) -> list[tuple[Any, ...]]:
     def run() -> None:
         try:
             box["infos"] = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
-        except OSError as exc:
+        except UnicodeError as exc:  # a name the IDNA codec refuses (an empty label)
+            box["error"] = socket.gaierror(socket.EAI_NONAME, str(exc))
+        except Exception as exc:  # noqa: BLE001 (raised by the caller)
             box["error"] = exc
 
     thread = threading.Thread(target=run, name="beatsync-resolve", daemon=True)
@@ -399,22 +404,30 @@ def _resolve(host: str, port: int, deadline: float) -> list[tuple[Any, ...]]:
 
 
 def _connect_any(addresses: list[tuple[Any, ...]], deadline: float) -> Any:
-    """A socket connected to the first of the resolved ``addresses`` that accepts (as
-    ``socket.create_connection`` tries them); the last one's error if none does."""
+    """A socket connected to the first of the resolved ``addresses`` that accepts, as
+    ``socket.create_connection`` tries them; each gets an equal share of the time left
+    (an address that drops packets, an IPv6 one without a route, say, must not take the
+    time of the others). If none accepts: a refusal if any refused (nothing listens
+    there, maybe not yet), else a time-out if any timed out, else the last error."""
     import socket
     import time
 
-    error: OSError = ConnectionRefusedError("no address")
-    for family, kind, proto, _, sockaddr in addresses:
+    errors: list[OSError] = []
+    for i, (family, kind, proto, _, sockaddr) in enumerate(addresses):
         sock = socket.socket(family, kind, proto)
         try:
-            sock.settimeout(max(deadline - time.monotonic(), 0.1))
+            share = (deadline - time.monotonic()) / (len(addresses) - i)
+            sock.settimeout(max(share, 0.1))
             sock.connect(sockaddr)
             return sock
         except OSError as exc:
             sock.close()
-            error = exc
-    raise error
+            errors.append(exc)
+    for kind_of_error in (ConnectionRefusedError, TimeoutError):
+        for exc in errors:
+            if isinstance(exc, kind_of_error):
+                raise exc
+    raise errors[-1] if errors else ConnectionRefusedError("no address")
 
 
 def _probe_tcp(address: str, location: str, timeout: float, deadline: float) -> None:
@@ -456,7 +469,12 @@ def _probe_tcp(address: str, location: str, timeout: float, deadline: float) -> 
             sock = _connect_any(addresses, deadline)
             break
         except socket.gaierror as exc:
-            why = f"the host name {host!r} could not be resolved ({exc.strerror or exc}); a typo?"
+            advice = (
+                "is this machine's network or DNS working?"
+                if exc.errno == socket.EAI_AGAIN
+                else "a typo?"
+            )
+            why = f"the host name {host!r} could not be resolved ({exc.strerror or exc}); {advice}"
         except _NameServerSilent:
             why = (
                 f"the host name {host!r} was not resolved within {timeout:g} s (no answer "
@@ -525,6 +543,7 @@ def _connect(address: str, timeout: float) -> Any:
             lambda: _client_with_handshake_retries(Client, address, remaining),
             remaining + HANDSHAKE_GRACE,
             address,
+            timeout,
         )
     except ParameterError:
         raise
