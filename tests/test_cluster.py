@@ -579,3 +579,27 @@ def test_connection_handshake_failing_every_time_is_reported(monkeypatch):
         ParameterError, match=r"could not connect .*AssertionError: its reply to 3 connections"
     ):
         cluster._connect("tcp://127.0.0.1:1", 1.0)
+
+
+def test_a_ctrl_c_before_a_sync_call_starts_logs_no_traceback(caplog):
+    # distributed's sync(): a KeyboardInterrupt before its coroutine has started made the
+    # cancel callback fail with NameError, which tornado logged with a traceback (seen
+    # once in the Ctrl-C test of `evaluate beats`)
+    import asyncio
+    import signal
+    import threading
+
+    from distributed.utils import sync
+
+    async def nothing():
+        await asyncio.sleep(0)
+
+    with cluster.dask_client(n_workers=1, processes=False) as client:
+        client.loop.add_callback(time.sleep, 0.5)  # the loop is busy when Ctrl-C comes
+        main = threading.main_thread().ident
+        threading.Timer(0.1, signal.pthread_kill, (main, signal.SIGINT)).start()
+        with pytest.raises(KeyboardInterrupt):
+            sync(client.loop, nothing)
+        time.sleep(1.0)  # the loop runs the coroutine, then the cancel callback
+    slips = [r for r in caplog.records if r.exc_info and isinstance(r.exc_info[1], NameError)]
+    assert not slips
