@@ -585,7 +585,7 @@ def _not_the_sync_cancel_slip(record: logging.LogRecord) -> bool:
     track's row, say) before its coroutine has started makes the ``cancel`` callback
     read a variable not yet assigned: ``NameError: cannot access free variable
     'future'``, logged by tornado with a traceback on stderr before the command's own
-    message (distributed 2026.8; seen in about one run in ten of the Ctrl-C test). The
+    message (distributed 2026.8; seen once in about ten runs of the Ctrl-C test). The
     interrupt itself is handled; only that record is dropped.
     """
     exc = record.exc_info[1] if record.exc_info else None
