@@ -29,9 +29,6 @@ from .errors import NotPeriodicError, ParameterError
 
 __all__ = ["sync_grid", "prepare_song", "prepare_clip", "sync_pair", "output_suffix"]
 
-#: Joint-position layouts written back as they were read (the layout names the suffix).
-POSITION_SUFFIXES = (".json", ".npy", ".npz", ".c3d")
-
 
 def output_suffix(motion: Any) -> str:
     """The suffix a synchronised clip is written with, as ``beatsync sync`` would keep it.
@@ -41,6 +38,8 @@ def output_suffix(motion: Any) -> str:
     as read, see :func:`beatsync.io.write_motion`); anything else (an angle table,
     MoCap Toolbox markers, positions made in memory) as a ``.csv`` table.
     """
+    from .io.positions import POSITION_SUFFIXES  # the layouts written back as read
+
     if motion.skeleton is not None:
         return ".bvh"
     info = motion.position_info if motion.is_positional else None
@@ -51,6 +50,8 @@ def output_suffix(motion: Any) -> str:
 def output_suffixes(clip: str | os.PathLike[str]) -> tuple[str, ...]:
     """Every suffix the pairs of the clip file ``clip`` may be written with (the
     overwrite checks run before the clip is read)."""
+    from .io.positions import POSITION_SUFFIXES
+
     own = Path(clip).suffix.lower()
     return (".bvh", ".csv") + ((own,) if own in POSITION_SUFFIXES else ())
 

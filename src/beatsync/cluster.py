@@ -318,90 +318,89 @@ def _client_with_handshake_retries(client_cls: Any, address: str, timeout: float
 HANDSHAKE_GRACE = 1.0
 
 
-def _given_up_after(connect: Any, seconds: float, address: str, timeout: float) -> Any:
-    """``connect()`` (which makes a client) in a thread of its own, given up after
-    ``seconds`` with a :class:`~beatsync.errors.ParameterError` that names the caller's
-    ``timeout``.
+class _GaveUp(Exception):
+    """:func:`_in_thread` ran out of time."""
 
-    distributed's client reads the scheduler's handshake with no time limit, whatever
-    its ``timeout``: a server that answered :func:`_probe_tcp` and then accepted the
-    client's own connection without a word held the command forever. Given up, the
-    thread is left waiting (a daemon: it does not hold the process at exit), and a
-    client it makes after all is closed at once. Its errors are raised here.
-    """
+
+def _in_thread(work: Any, seconds: float, *, late: Any = None) -> Any:
+    """``work()`` in a daemon thread: its result, or its exception raised here, or
+    :class:`_GaveUp` after ``seconds`` (the thread is left waiting: a daemon does not
+    hold the process at exit). A result that comes after that is handed to ``late``
+    (e.g. to close it). For calls that take no time limit of their own."""
     box: dict[str, Any] = {}
     lock = threading.Lock()
 
     def run() -> None:
         try:
-            client = connect()
-        except BaseException as exc:  # noqa: BLE001 (handed to the caller)
+            result = work()
+        except BaseException as exc:  # noqa: BLE001 (raised by the caller)
             box["error"] = exc
             return
         with lock:
-            late = box.get("abandoned", False)
-            box["client"] = client
-        if late:
+            given_up = box.get("given_up", False)
+            box["result"] = result
+        if given_up and late is not None:
             with contextlib.suppress(Exception):
-                client.close()
+                late(result)
 
-    thread = threading.Thread(target=run, name="beatsync-connect", daemon=True)
+    thread = threading.Thread(target=run, name="beatsync-wait", daemon=True)
     thread.start()
     try:
         thread.join(seconds)
     finally:
         with lock:
-            if "client" not in box:  # given up, or interrupted (Ctrl-C)
-                box["abandoned"] = True
+            if "result" not in box:  # given up, or interrupted (Ctrl-C)
+                box["given_up"] = True
     if "error" in box:
         raise box["error"]
-    if "client" in box:
-        return box["client"]
-    raise ParameterError(
-        f"could not connect to the Dask scheduler at {address!r}: it accepted the "
-        f"connection but did not complete the handshake within the {timeout:g} s "
-        "time-out; is it a Dask scheduler, and not overloaded? Omit --scheduler to run on "
-        "a local cluster"
-    )
+    if "result" in box:
+        return box["result"]
+    raise _GaveUp
 
 
-#: A Dask frame header (a little-endian count of bytes) larger than this is not Dask's.
-_MAX_FIRST_FRAME = 2**32
+def _given_up_after(connect: Any, seconds: float, address: str, timeout: float) -> Any:
+    """``connect()`` (which makes a client) given up after ``seconds`` with a
+    :class:`~beatsync.errors.ParameterError` that names the caller's ``timeout``.
 
-
-class _NameServerSilent(Exception):
-    """:func:`_resolve` ran out of time."""
+    distributed's client reads the scheduler's handshake with no time limit, whatever
+    its ``timeout``: a server that answered :func:`_probe_tcp` and then accepted the
+    client's own connection without a word held the command forever. So the client is
+    made in a thread (:func:`_in_thread`); one made after the command gave up is closed
+    at once. Its errors are raised here.
+    """
+    try:
+        return _in_thread(connect, seconds, late=lambda client: client.close())
+    except _GaveUp:
+        raise ParameterError(
+            f"could not connect to the Dask scheduler at {address!r}: it accepted the "
+            f"connection but did not complete the handshake within the {timeout:g} s "
+            "time-out; is it a Dask scheduler, and not overloaded? Omit --scheduler to run "
+            "on a local cluster"
+        ) from None
 
 
 def _resolve(host: str, port: int, deadline: float) -> list[tuple[Any, ...]]:
     """``socket.getaddrinfo`` for a TCP connection, given up at ``deadline``.
 
     The system's resolver has no time limit of its own here (a silent name server
-    keeps it waiting for its own time-outs, tens of seconds), so it runs in a daemon
-    thread. Raises its ``socket.gaierror`` (also for a name the IDNA codec refuses),
-    or :class:`_NameServerSilent`.
+    keeps it waiting for its own time-outs, tens of seconds), so it runs in a thread
+    (:func:`_in_thread`). Raises its ``socket.gaierror`` (also for a name the IDNA
+    codec refuses), or :class:`_GaveUp`.
     """
     import socket
     import time
 
-    box: dict[str, Any] = {}
-
-    def run() -> None:
+    def lookup() -> list[tuple[Any, ...]]:
         try:
-            box["infos"] = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+            return socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
         except UnicodeError as exc:  # a name the IDNA codec refuses (an empty label)
-            box["error"] = socket.gaierror(socket.EAI_NONAME, str(exc))
-        except Exception as exc:  # noqa: BLE001 (raised by the caller)
-            box["error"] = exc
+            raise socket.gaierror(socket.EAI_NONAME, str(exc)) from None
 
-    thread = threading.Thread(target=run, name="beatsync-resolve", daemon=True)
-    thread.start()
-    thread.join(max(deadline - time.monotonic(), 0.1))
-    if "error" in box:
-        raise box["error"]
-    if "infos" not in box:
-        raise _NameServerSilent(host)
-    return box["infos"]
+    return _in_thread(lookup, max(deadline - time.monotonic(), 0.1))
+
+
+#: A Dask frame header (a little-endian count of bytes) larger than this is not Dask's.
+_MAX_FIRST_FRAME = 2**32
 
 
 def _connect_any(addresses: list[tuple[Any, ...]], deadline: float) -> Any:
@@ -476,7 +475,7 @@ def _probe_tcp(address: str, location: str, timeout: float, deadline: float) -> 
                 else "a typo?"
             )
             why = f"the host name {host!r} could not be resolved ({exc.strerror or exc}); {advice}"
-        except _NameServerSilent:
+        except _GaveUp:  # the name server did not answer in time (_resolve)
             why = (
                 f"the host name {host!r} was not resolved within {timeout:g} s (no answer "
                 "from the name server); is this machine's network or DNS working?"
