@@ -587,3 +587,23 @@ def test_mode_beats_needs_positions():
     m = _periodic_motion().select(["hip_Zrotation", "knee_Xrotation"])
     with pytest.raises(ParameterError, match="mode='beats' needs joint positions"):
         synchronize(m, None, np.arange(0, 10, 0.5), mode="beats")
+
+
+def test_periodicity_refusal_in_sync_advises_only_what_sync_offers():
+    # it said "Try other channels", and neither sync nor batch has a --channels option
+    from beatsync import datasets
+    from beatsync.errors import NotPeriodicError
+    from beatsync.motion import segmentation_view
+    from beatsync.segment import segment
+    from beatsync.sync.core import motion_periods
+
+    walk = datasets.load_walk("005_02")  # a walk with a turn: not periodic
+    with pytest.raises(NotPeriodicError) as segmenting:
+        segment(segmentation_view(walk), period_range=(0.25, 1.25))
+    assert "Try other channels" in str(segmenting.value)  # segment has channels=
+    with pytest.raises(NotPeriodicError) as syncing:
+        motion_periods(walk, period_range=(0.25, 1.25))
+    text = str(syncing.value)
+    assert "channels" not in text
+    assert "Try another period_range (--period-range), or a clip with repeated movement" in text
+    assert text.startswith("the motion is not periodic: the best segmentation into")

@@ -182,6 +182,12 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
 # ---------------------------------------------------------------------- the entry
 
 
+#: What the periodicity test's refusal advises a caller of :func:`segment` to try; a
+#: caller without some of these settings says what it offers instead
+#: (:func:`beatsync.sync.core.motion_periods`).
+NOT_PERIODIC_ADVICE = "Try other channels, another period_range, or a clip with repeated movement"
+
+
 class _NotPeriodic(NotPeriodicError):
     """The periodicity test refused the optimum (a longer tier may still be periodic)."""
 
@@ -302,8 +308,9 @@ def _search(
             f"{e_norm:.3f} between consecutive periods, and uniform segmentations at this "
             f"period beat those at wrong periods by only {contrast:.3f} (periodic needs "
             f"< {MAX_NORMALISED_ENERGY} and a "
-            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. Try other "
-            "channels, another period_range, or a clip with repeated movement" + hint
+            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. "
+            + NOT_PERIODIC_ADVICE
+            + hint
         )
     times = frames_to_time(frames, fps=fps)
     return Segmentation(

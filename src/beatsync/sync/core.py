@@ -130,6 +130,11 @@ def _events(
     return np.asarray(seg.boundaries, dtype=np.float64), "periods", ""
 
 
+#: The periodicity refusal's advice to a caller of :func:`motion_periods`, which segments
+#: the channels :func:`beatsync.motion.segmentation_view` chooses.
+PERIODS_ADVICE = "Try another period_range (--period-range), or a clip with repeated movement"
+
+
 def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: float = 0.1) -> Any:
     """Paper A's segmentation of a dance into its periods (:func:`beatsync.segment.segment`
     on :func:`beatsync.motion.segmentation_view`).
@@ -147,13 +152,18 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     from ..motion import segmentation_view
     from ..segment import segment
     from ..segment.checks import check_alpha, check_period_range
+    from ..segment.core import NOT_PERIODIC_ADVICE
 
     alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
     period_range = check_period_range(period_range)
     try:
         seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
-    except NotPeriodicError:
-        raise
+    except NotPeriodicError as exc:
+        # the channels are segmentation_view's here (sync and batch have no --channels)
+        text = str(exc).replace(NOT_PERIODIC_ADVICE, PERIODS_ADVICE)
+        if text == str(exc):
+            raise
+        raise NotPeriodicError(text) from None
     except ParameterError as exc:  # no angles to test, or angles that never change
         moves = _joints_move(motion)
         if moves is None:  # no joint positions either: the segmentation's own message
