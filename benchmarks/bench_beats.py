@@ -871,7 +871,7 @@ def main() -> int:
         "strictly periodic pulse's salience falls by about 40 % within 1 % of its period, "
         "so where a period falls between grid points decides its tatum term; the two "
         "fixes measured (aligned grids; a tatum equal to the tactus) traded synthetic "
-        "items without a gain (the `beatsync.beats.metrical` docstring). "
+        "items without a gain (the CHANGELOG has the numbers). "
         "The madmom sample (2.8 s) is tapped at its level since the resonators' "
         "spectrum is sampled at 3 bins per pass band "
         "(`beatsync.beats.metrical.resonator_fft_size`); librosa and essentia do not tap "

@@ -154,28 +154,9 @@ time (Hainsworth 001's 3 s and 5 s clips: mean F 0.416 and 0.654; now 0.508 and
   tapped at 90 (seed 0) 1.17 in the low band, the drums at their level 0.09-0.39; but
   at the annotated level the madmom sample 1.12-1.38 in every band, Hainsworth 001
   1.13 and DANCE_R_3 1.26-1.27 in low bands. A doubling rule would double them too.
-- The tatum and measure grids (1 % log steps) are not aligned with the tactus grid
-  (0.5 % steps), and the salience of a strictly periodic pulse falls by about 40 %
-  within 1 % of its period (clicks at 160 BPM: 1.57 at the tactus, 0.97 at the tatum
-  grid point 0.85 % below it, the nearest that is not longer than the tactus). So the
-  tatum term of a level depends on where its period falls between grid points: on the
-  clean click tracks (seed 0, a scratch run on 2026-11-29) it favoured the half tempo
-  by 5.0-6.4 at 120, 160 and 170 BPM (120 kept its level through the prior) but by
-  0.3-0.5 at 140, 150 and 180, and the clicks at 160, 170 and 190-240 BPM were tapped
-  at half their tempo (the drums at 160-240 BPM too).
-  Level grids on the tactus grid's own steps (every tactus period on the tatum grid,
-  halves and doubles within a quarter step) tapped the clicks at 160-190 BPM at their
-  tempo (200-240 BPM stayed at half), and traded synthetic items without a gain: clean
-  F 0.966, 0.967, 0.933 (seeds 0-2) became 0.933, 0.967, 0.933 (the 60 BPM drums went
-  to 120), AMLt 0.962, 0.975, 0.963 became 0.973, 0.964, 0.963, tempo-change F 0.943,
-  0.928, 0.945 became 0.962, 0.945, 0.945; the meter grid 27 of 42 right became 28
-  (tapped at the beat: 35 became 33); the annotated recordings, their excerpts and
-  the dancers' songs kept their tempo and meter, and Hainsworth 001's 3 s clips fell
-  from mean F 0.778 to 0.766. With twice the level periods it took 1.13 times as long.
-  Not used. A tatum equal to the tactus alone, taken at the tactus period itself (the
-  grids as they are), tapped the clicks at 160, 190, 200 and 240 BPM at their tempo,
-  and the 60 BPM drums with noise at 120 on every seed (clean F 0.933 on seed 0, the
-  clean 60 BPM drums too). Not used either.
+- The tatum grid (1 % steps) misses the tactus periods (0.5 %); a periodic pulse's salience
+  falls ~40 % within 1 % of its period: clicks at 160, 170, 190-240 BPM are tapped at half.
+  Aligned grids fix 160-190 but tap 60 BPM drums at 120: not used (numbers: CHANGELOG).
 
 Why 10-20 s clips of the waltz DANCE_W_10 were tapped faster than its beat, measured
 before :attr:`MeterModel.tatum_ratio_weights` weighed a beat of three tatums half (the
