@@ -13,7 +13,7 @@ import pytest
 from beatsync import cluster, datasets, io
 from beatsync.cli import build_parser, main
 from beatsync.errors import ParameterError
-from beatsync.study import beat_dataset
+from beatsync.study import beat_dataset, beat_task
 from beatsync.study.beat_dataset import TrackLog, find_tracks
 from beatsync.synth.audio import beat_times, click_track, drum_pattern
 
@@ -262,14 +262,16 @@ def test_library_entry_in_process_threads(dataset, tmp_path, monkeypatch):
     # could leave its (process-wide) filters changed: here each track changes them
     import warnings
 
-    real_track = beat_dataset.evaluate_track
+    real_track = beat_task.evaluate_track
+    changed = []
 
     def track_and_change_the_filters(*args, **kwargs):
         row = real_track(*args, **kwargs)
         warnings.simplefilter("ignore")
+        changed.append(row["key"])
         return row
 
-    monkeypatch.setattr(beat_dataset, "evaluate_track", track_and_change_the_filters)
+    monkeypatch.setattr(beat_task, "evaluate_track", track_and_change_the_filters)
     filters = list(warnings.filters)
     found = find_tracks(*dataset)
     assert [t.key for t in found.tracks] == sorted(t.key for t in found.tracks)
@@ -282,7 +284,41 @@ def test_library_entry_in_process_threads(dataset, tmp_path, monkeypatch):
     assert (run.tracks["status"] == "ok").all()
     assert (run.tracks["F-measure"] >= 0.9).all()
     assert run.files["summary"].is_file()
+    assert sorted(changed) == ["clicks/click_110", "rock/drums_96"]  # each track changed them
     assert warnings.filters == filters
+
+
+def test_tracks_go_to_the_workers_in_groups_of_decreasing_size():
+    todo = list(range(40))
+    groups = beat_dataset._groups(todo, 2)
+    assert [len(g) for g in groups] == [8, 8, 8, 8, 4, 2, 1, 1]
+    assert [t for g in groups for t in g] == todo  # every track once, in order
+    assert [len(g) for g in beat_dataset._groups(todo[:5], 2)] == [3, 1, 1]
+    assert [len(g) for g in beat_dataset._groups(todo[:3], 8)] == [1, 1, 1]
+    assert [len(g) for g in beat_dataset._groups(todo[:20], 0)] == [8, 8, 4]  # no worker yet
+    assert beat_dataset._groups([], 2) == []
+
+
+def test_a_failed_group_is_run_again_track_by_track(dataset, tmp_path, monkeypatch):
+    # a task that fails outside evaluate_track (its worker died: one track out of memory)
+    # must not record the other tracks of its group as failed
+    real_track = beat_task.evaluate_track
+
+    def dies_on_one_track(audio, reference, *, name, **kwargs):
+        if name == "rock/drums_96":
+            raise MemoryError("the worker ran out of memory")
+        return real_track(audio, reference, name=name, **kwargs)
+
+    monkeypatch.setattr(beat_task, "evaluate_track", dies_on_one_track)
+    found = find_tracks(*dataset)
+    good = [t for t in found.tracks if t.key in GOOD]
+    assert len(beat_dataset._groups(good, 1)) == 1  # one group: all four in one task
+    run = beat_dataset.evaluate_dataset(good, tmp_path, n_workers=1, processes=False)
+    status = dict(zip(run.tracks["key"], run.tracks["status"], strict=True))
+    assert status == {k: "error" if k == "rock/drums_96" else "ok" for k in GOOD}
+    error = run.tracks.set_index("key").loc["rock/drums_96", "error"]
+    assert error == "MemoryError: the worker ran out of memory"
+    assert len(TrackLog(run.files["log"]).rows()) == 4
 
 
 # ----------------------------------------------------------------------------- bad input
@@ -406,7 +442,7 @@ def test_annotation_of_another_recording_and_empty_references(dataset, scheduler
     assert "1 track(s) have no annotated beat after --min-beat-time 7.9 s" in stdout
 
 
-def test_a_swallowed_interrupt_stops_the_run_at_the_next_track(
+def test_a_swallowed_interrupt_stops_the_run_at_the_next_finished_group(
     dataset, scheduler, tmp_path, capsys, monkeypatch
 ):
     # SIGINT's exception, raised inside a garbage-collector callback, was swallowed
@@ -426,7 +462,9 @@ def test_a_swallowed_interrupt_stops_the_run_at_the_next_track(
     code, _, err = _run(_argv(dataset, out, "--scheduler", scheduler), capsys)
     assert code == 130, err
     assert "interrupted by SIGINT" in err
-    assert len(TrackLog(out / "tracks.jsonl").rows()) == 1
+    # the rows of the group that finished first, not the 6 tracks (2 worker threads)
+    sizes = {len(group) for group in beat_dataset._groups(list(range(6)), 2)}
+    assert len(TrackLog(out / "tracks.jsonl").rows()) in sizes - {6}
 
 
 def test_interrupt_before_any_track_finished_says_so(dataset, scheduler, tmp_path, capsys,

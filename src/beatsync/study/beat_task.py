@@ -20,7 +20,7 @@ from .. import io, peers
 from ..errors import ParameterError, collect_warnings
 from ..evaluate.beats import evaluate, tempo_octave
 
-__all__ = ["evaluate_track", "reference_digest"]
+__all__ = ["evaluate_track", "evaluate_tracks", "reference_digest"]
 
 
 def evaluate_track(
@@ -119,6 +119,17 @@ def evaluate_track(
         beats=[round(float(b), 6) for b in est],
     )
     return row
+
+
+def evaluate_tracks(
+    items: list[tuple[str, np.ndarray, str, str]], **settings: Any
+) -> list[dict[str, Any]]:
+    """:func:`evaluate_track` on each ``(audio, reference, name, group)`` in turn: one
+    task for several short tracks (see :func:`~.beat_dataset.evaluate_dataset`)."""
+    return [
+        evaluate_track(audio, reference, name=name, group=group, **settings)
+        for audio, reference, name, group in items
+    ]
 
 
 def _dataset_hint(message: str) -> str:
