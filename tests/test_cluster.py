@@ -396,6 +396,7 @@ def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
                 lambda dask_scheduler: (
                     dask_scheduler._tick_interval,
                     dask_scheduler.periodic_callbacks["monitor"].callback_time,
+                    dask_scheduler.WORKER_SATURATION,
                 )
             )
             (nanny,) = client.cluster.workers.values()  # in this process; it stops a
@@ -403,7 +404,7 @@ def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
             # restored once the cluster has started: this process keeps its settings
             during = {key: dask.config.get(key) for key in keys}
     assert worker == (None, "1", False, 0.5, 2000, 1.0)
-    assert scheduler == (0.5, 2000)
+    assert scheduler == (0.5, 2000, 1.0)  # a worker gets a task when its thread is free
     assert nanny_interval == 1.0
     assert during == before
 

@@ -62,8 +62,8 @@ REFUSED_GRACE = 2.0
 #: keeps its own settings (``dask.config.set`` to distributed's own default is not seen
 #: as the user's: set it in a YAML file or a ``DASK_*`` variable). The scheduler, each
 #: nanny and each worker run periodic callbacks tens of times a second, and on a
-#: machine of a few cores that work competes with the tracking; these four are for the
-#: dashboard (none is started) or need not run so often. Measured against Dask's
+#: machine of a few cores that work competes with the tracking; the first four are for
+#: the dashboard (none is started) or need not run so often. Measured against Dask's
 #: defaults by ``benchmarks/bench_cluster_config.py`` (16 pairs of runs alternating, see
 #: benchmarks/RESULTS.md): idle, this process used 1.6 % of a core instead of 7.8 % and
 #: each worker 0.6 % instead of 5.8 %, lower in every pair; the Dask path of ``beatsync
@@ -80,8 +80,15 @@ LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
     "distributed.admin.system-monitor.interval": "2s",
     # the memory check against the spill, pause and terminate thresholds (every 100 ms):
     # a worker past 95 % of its memory limit is sent SIGTERM within a second and killed
-    # a second later if it is still there; the tasks hold one song or one clip each
+    # a second later if it is still there; a task holds one song or one clip at a time
     "distributed.worker.memory.monitor-interval": "1s",
+    # tasks a worker holds beyond its threads: Dask's 1.1 hands a one-thread worker two,
+    # so the small last groups of ``beatsync evaluate beats`` (``beat_dataset._groups``) went
+    # out one group early and one worker could finish alone; with 1.0 a worker gets its
+    # next task when its thread is free. Measured by a scratch run of the benchmark below
+    # (6 pairs, 40 songs): 2 workers gave 1.73x the throughput of 1 instead of 1.70x,
+    # higher in 5 of the 6 pairs
+    "distributed.scheduler.worker-saturation": 1.0,
 }
 
 
