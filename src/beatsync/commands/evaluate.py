@@ -33,8 +33,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "them with every mir_eval.beat metric against the annotation of the same name "
         "(NAME.beats under --annotations: one time [s] per line, an optional second column "
         "is ignored), on a Dask cluster (local by default). Each track's row is appended to "
-        "RESULTS_DIR/tracks.jsonl as soon as it finishes, so an interrupted run loses only "
-        "the tracks in flight and a rerun skips the tracks already scored (--force re-runs "
+        "RESULTS_DIR/tracks.jsonl as soon as its group finishes (a worker takes up to 8 "
+        "tracks at a time, fewer toward the end), so an interrupted run loses only the "
+        "tracks in flight and a rerun skips the tracks already scored (--force re-runs "
         "them). At the end RESULTS_DIR/tracks.csv and RESULTS_DIR/summary.csv (means per "
         "method and folder) are written. A track that fails (unreadable, silent) is recorded "
         "with its error; audio without an annotation is listed and skipped.",

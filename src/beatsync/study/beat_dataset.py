@@ -5,9 +5,10 @@
 annotation of the same stem (``.beats``: one time [s] per line, an optional second
 column such as the beat in the bar is ignored);
 :func:`evaluate_dataset` tracks and scores every pair on Dask
-(:func:`beatsync.cluster.dask_client`) and records one row per track as soon as it
-finishes in ``OUT/tracks.jsonl`` (append-only: a crash or Ctrl-C loses at most the
-tracks in flight; a rerun skips the tracks already scored), then writes
+(:func:`beatsync.cluster.dask_client`), in groups of tracks (:func:`_groups`), and
+records one row per track as soon as its group finishes in ``OUT/tracks.jsonl``
+(append-only: a crash or Ctrl-C loses at most the groups in flight; a rerun skips the
+tracks already scored), then writes
 ``OUT/tracks.csv`` and ``OUT/summary.csv`` (means per method and folder) atomically.
 A track that fails (unreadable, silent, too short) is recorded with its error.
 
@@ -202,7 +203,7 @@ def evaluate_dataset(
     processes: bool = True,
     progress: Callable[..., None] | None = None,
 ) -> DatasetRun:
-    """Track and score every track on Dask; record each row as soon as it finishes.
+    """Track and score every track on Dask; record each row as soon as its group finishes.
 
     Parameters
     ----------
