@@ -65,10 +65,12 @@ REFUSED_GRACE = 2.0
 #: machine of a few cores that work competes with the tracking; the first four are for
 #: the dashboard (none is started) or need not run so often. Measured against Dask's
 #: defaults by ``benchmarks/bench_cluster_config.py`` (16 pairs of runs alternating, see
-#: benchmarks/RESULTS.md): idle, this process used 1.6 % of a core instead of 7.8 % and
-#: each worker 0.6 % instead of 5.8 %, lower in every pair; the Dask path of ``beatsync
-#: evaluate beats`` over 40 songs took 0.93x the time with 1 worker and 0.92x with 2
-#: (medians of the pair ratios; lower in 15 and in 13 of the 16 pairs).
+#: benchmarks/RESULTS.md): idle, this process used 0.7 % of a core instead of 2.8 % and
+#: each worker 0.3 % instead of 2.0 %, lower in every pair; the Dask path of ``beatsync
+#: evaluate beats`` over 40 songs took 0.99x the time with 1 worker and 0.95x with 2
+#: (medians of the pair ratios), 2 workers 1.74x the throughput of 1 against 1.68x.
+#: (Before the tracks went to the workers in groups, with the first four settings: 0.93x
+#: and 0.92x, idle 1.6 % against 7.8 % and 0.6 % against 5.8 %, on a busier machine.)
 LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
     # the statistical profiler: a stack sample of the threads running tasks every 10 ms,
     # in every worker, for the dashboard's profile and performance reports
