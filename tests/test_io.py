@@ -795,9 +795,9 @@ def test_jsonl_append_survives_a_torn_line(tmp_path):
     append_jsonl(p, {"a": 1, "x": np.float32(0.5)})
     with open(p, "a") as fh:
         fh.write('{"a": 2, "x"')  # a run killed while appending
-    append_jsonl(p, {"a": 3})
-    assert read_jsonl(p) == [{"a": 1, "x": 0.5}, {"a": 3}]
-    assert p.read_text().count("\n") == 3  # the torn line stays a line of its own
+    append_jsonl(p, {"a": 3}, {"a": 5})  # several rows: one line each, in one write
+    assert read_jsonl(p) == [{"a": 1, "x": 0.5}, {"a": 3}, {"a": 5}]
+    assert p.read_text().count("\n") == 4  # the torn line stays a line of its own
     write_jsonl(p, [{"a": 4}, {"b": [1, 2]}])
     assert read_jsonl(p) == [{"a": 4}, {"b": [1, 2]}]
     append_jsonl(p, {"c": float("nan")})  # JSON has no NaN: null

@@ -35,7 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "is ignored), on a Dask cluster (local by default). Each track's row is appended to "
         "RESULTS_DIR/tracks.jsonl as soon as its group finishes (a worker takes up to 8 "
         "tracks at a time, fewer toward the end), so an interrupted run loses only the "
-        "tracks in flight and a rerun skips the tracks already scored (--force re-runs "
+        "groups in flight and a rerun skips the tracks already scored (--force re-runs "
         "them). At the end RESULTS_DIR/tracks.csv and RESULTS_DIR/summary.csv (means per "
         "method and folder) are written. A track that fails (unreadable, silent) is recorded "
         "with its error; audio without an annotation is listed and skipped.",
@@ -150,7 +150,7 @@ def run_beats(args: argparse.Namespace) -> int:
             def progress(*a: Any, **k: Any) -> None:
                 # a signal whose exception a garbage-collector callback swallowed ("Exception
                 # ignored in ... Interrupted") let the run go on to the end: stop at the next
-                # finished track
+                # finished group of tracks
                 signum = interrupted_by()
                 if signum is not None:
                     raise Interrupted(signum)

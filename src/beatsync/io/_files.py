@@ -192,14 +192,15 @@ def write_jsonl(path: str | os.PathLike[str], rows: Any) -> Path:
     return Path(path)
 
 
-def append_jsonl(path: str | os.PathLike[str], row: dict[str, Any]) -> Path:
-    """Append one object to a JSON-lines file and flush it to disk (``fsync``).
+def append_jsonl(path: str | os.PathLike[str], *rows: dict[str, Any]) -> Path:
+    """Append objects to a JSON-lines file, one per line, in one write, and flush it to
+    disk (``fsync``).
 
-    So a crash loses at most the line being written; a torn last line left by an
+    So a crash loses at most the lines being written; a torn last line left by an
     earlier crash is ended first, so that it stays a line of its own.
     """
     p = Path(path)
-    line = _jsonl_line(row)
+    line = "".join(_jsonl_line(row) for row in rows)
     torn = False
     if p.is_file() and p.stat().st_size > 0:
         with open(p, "rb") as fh:

@@ -59,8 +59,8 @@ RESULT_FILES = ("tracks.jsonl", "tracks.csv", "summary.csv")
 class TrackLog:
     """The append-only JSON-lines record of a dataset run (``OUT/tracks.jsonl``).
 
-    Each :meth:`append` writes one line and flushes it to disk, so a crash loses at
-    most the line being written; :meth:`rows` skips such a torn line.
+    Each :meth:`append` writes its rows' lines at once and flushes them to disk, so a
+    crash loses at most the lines being written; :meth:`rows` skips a torn line.
     """
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
@@ -78,9 +78,9 @@ class TrackLog:
         """Replace the record with ``rows`` (atomic)."""
         io.write_jsonl(self.path, rows)
 
-    def append(self, row: dict[str, Any]) -> None:
-        """Append one row and flush it to disk."""
-        io.append_jsonl(self.path, row)
+    def append(self, *rows: dict[str, Any]) -> None:
+        """Append rows (one line each, in one write) and flush them to disk."""
+        io.append_jsonl(self.path, *rows)
 
 
 #: Columns of ``summary.csv`` after the keys (means of the metrics over ``ok`` tracks).
@@ -231,7 +231,8 @@ def evaluate_dataset(
         See :func:`beatsync.cluster.dask_client`. Workers of an existing cluster must
         see the audio files at the same paths.
     progress : callable ``progress(done, total=None)``, optional
-        Called as tracks finish (e.g. a command's progress bar).
+        Called as groups of tracks finish, with the number of tracks done (e.g. a
+        command's progress bar).
 
     Raises
     ------
@@ -471,7 +472,10 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
             method=method,
             min_beat_time=mbt,
             **tempo,
-            key=f"evaluate-{method}-{group[0].key}-{len(group)}-{uuid.uuid4().hex}",
+            # one prefix for the run: Dask groups tasks by it, and queues a task at the
+            # scheduler (worker-saturation) only if its group has more tasks than twice
+            # the threads; a track's name in the key made a group of each task
+            key=f"evaluate-{method}-{uuid.uuid4().hex}",
         )
 
     n_threads = sum(client.nthreads().values())
@@ -494,8 +498,7 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
                     continue
                 rows = [_failed_row(group[0], refs[group[0].key], exc, method=method,
                                     mbt=mbt, tempo=tempo)]  # fmt: skip
-            for row in rows:
-                log.append(row)
+            log.append(*rows)  # in one write: an interrupt keeps the group or not at all
             done += len(rows)
             if progress is not None:
                 progress(done)

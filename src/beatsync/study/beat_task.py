@@ -1,7 +1,8 @@
-"""One track of a dataset run read, tracked and scored: the task a Dask worker runs.
+"""One track of a dataset run read, tracked and scored, on a Dask worker.
 
-:func:`evaluate_track` is the task of :func:`beatsync.study.beat_dataset.evaluate_dataset`
-(``beatsync evaluate beats``), re-exported there. It lives apart from that module, whose
+:func:`evaluate_tracks` (:func:`evaluate_track` on a group of tracks) is the task of
+:func:`beatsync.study.beat_dataset.evaluate_dataset` (``beatsync evaluate beats``);
+:func:`evaluate_track` is re-exported there. It lives apart from that module, whose
 tables need pandas, so that a worker imports only what a track needs: pandas took
 0.6 s of each worker's first track.
 """
@@ -36,9 +37,9 @@ def evaluate_track(
 ) -> dict[str, Any]:
     """Track one audio file and score it; a failure becomes the row's ``error``.
 
-    A task of :func:`~.beat_dataset.evaluate_dataset` (runs on a Dask worker); never
-    raises for a bad track (unreadable, silent, too short), so one track cannot stop a
-    run.
+    Run by :func:`evaluate_tracks`, the task of :func:`~.beat_dataset.evaluate_dataset`
+    (on a Dask worker); never raises for a bad track (unreadable, silent, too short),
+    so one track cannot stop a run.
 
     Parameters
     ----------
