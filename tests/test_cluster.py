@@ -368,7 +368,7 @@ def test_existing_scheduler_by_address():
         assert lc.status.name == "running"  # an existing cluster is left running
 
 
-def test_local_workers_keep_glibc_default_malloc_and_skip_dashboard_work():
+def test_local_workers_keep_glibc_malloc_skip_dashboard_work_and_take_a_task_at_a_time():
     """Dask's MALLOC_TRIM_THRESHOLD_=65536 made every track about 1.8x slower; the
     periodic work of LOCAL_CLUSTER_CONFIG took 5-9 % of a core per process, idle. A
     key the user sets keeps the user's value."""
