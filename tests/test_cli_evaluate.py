@@ -312,7 +312,7 @@ def test_the_tasks_of_a_run_are_one_dask_task_group(dataset, scheduler, tmp_path
     seen = []
 
     def progress(done, total=None):
-        if not seen:  # every task submitted, none finished
+        if not seen:  # every task submitted (and held by its future)
             with Client(scheduler) as client:
                 seen.extend(
                     client.run_on_scheduler(
