@@ -303,6 +303,18 @@ def test_tracks_go_to_the_workers_in_groups_of_decreasing_size():
     assert beat_dataset._groups([], 2) == []
 
 
+def test_the_longest_tracks_go_to_the_workers_first(tmp_path):
+    from beatsync.study.beat_tracks import Track
+
+    tracks = []
+    for name, n in (("a", 10), ("b", 30), ("c", 20), ("d", 30)):
+        (tmp_path / f"{name}.wav").write_bytes(b"x" * n)
+        tracks.append(Track(name, ".", tmp_path / f"{name}.wav", tmp_path / f"{name}.beats"))
+    tracks.append(Track("gone", ".", tmp_path / "gone.wav", tmp_path / "gone.beats"))
+    order = [t.key for t in beat_dataset._longest_first(tracks)]
+    assert order == ["b", "d", "c", "a", "gone"]  # ties and unreadable files keep their order
+
+
 def test_the_tasks_of_a_run_are_one_dask_task_group(dataset, scheduler, tmp_path):
     # Dask queues tasks at the scheduler (worker-saturation) only for a task group larger
     # than twice the threads; the group is the key's prefix, and a track's name in the

@@ -441,6 +441,19 @@ def _groups(todo: Sequence[Track], n_threads: int) -> list[list[Track]]:
     return groups
 
 
+def _longest_first(todo: Sequence[Track]) -> list[Track]:
+    """The tracks by audio file size, largest first (their order otherwise): the longest
+    go out in the first, largest groups and the shortest last, so the workers finish
+    together (longest processing time first; a file's size stands for its length).
+
+    Measured on 42 copies of the three bundled annotated recordings (2.8-56 s; a scratch
+    run of ``benchmarks/bench_evaluate.py``'s Dask path, 12 pairs alternating): 0.94x
+    the time of the tracks in key order with 1 worker and 0.95x with 2; the 2-worker
+    ratio stayed the same (1.69x against 1.68x).
+    """
+    return sorted(todo, key=lambda t: -(_audio_bytes(t.audio) or 0))
+
+
 def _failed_row(t: Track, ref: np.ndarray, exc: Exception, *, method, mbt, tempo) -> dict:
     """The row of a track whose task failed outside :func:`evaluate_track` (its worker
     died, e.g. out of memory)."""
@@ -479,7 +492,7 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
         )
 
     n_threads = sum(client.nthreads().values())
-    futures = {submit(group): group for group in _groups(todo, n_threads)}
+    futures = {submit(group): group for group in _groups(_longest_first(todo), n_threads)}
     if progress is not None:
         progress(0, total=len(todo))
     done = 0
