@@ -478,21 +478,24 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
 
     _prepare_workers(client, method)
 
-    def submit(group: list[Track]):
-        return client.submit(
+    run = uuid.uuid4().hex
+
+    def submit(groups: list[list[Track]], first: int) -> list:
+        # in one call, so that the scheduler sees the run's tasks as one group and queues
+        # them (worker-saturation) instead of handing the first ones out at once; it runs
+        # them in this order. One key prefix for the run: Dask groups tasks by it, and a
+        # track's name in it made a group of each task
+        return client.map(
             beat_task.evaluate_tracks,
-            [(str(t.audio), refs[t.key], t.key, t.group) for t in group],
+            [[(str(t.audio), refs[t.key], t.key, t.group) for t in group] for group in groups],
+            key=[f"evaluate-{method}-{run}-{first + i:06d}" for i in range(len(groups))],
             method=method,
             min_beat_time=mbt,
             **tempo,
-            # one prefix for the run: Dask groups tasks by it, and queues a task at the
-            # scheduler (worker-saturation) only if its group has more tasks than twice
-            # the threads; a track's name in the key made a group of each task
-            key=f"evaluate-{method}-{uuid.uuid4().hex}",
         )
 
-    n_threads = sum(client.nthreads().values())
-    futures = {submit(group): group for group in _groups(_longest_first(todo), n_threads)}
+    groups = _groups(_longest_first(todo), sum(client.nthreads().values()))
+    futures = dict(zip(submit(groups, 0), groups, strict=True))
     if progress is not None:
         progress(0, total=len(todo))
     done = 0
@@ -504,9 +507,10 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
                 rows = fut.result()
             except Exception as exc:  # the worker died (e.g. out of memory)
                 if len(group) > 1:  # one track may be the cause: each alone, again
-                    for t in group:
-                        single = submit([t])
-                        futures[single] = [t]
+                    singles = [[t] for t in group]
+                    for single, again in zip(submit(singles, len(futures)), singles,
+                                             strict=True):  # fmt: skip
+                        futures[single] = again
                         queue.add(single)
                     continue
                 rows = [_failed_row(group[0], refs[group[0].key], exc, method=method,
