@@ -26,11 +26,17 @@ has 2 cores; the ratio is only meaningful when nothing else runs. Each repeat ru
 repeat; the ratio is the median of the repeats' ratios (the shared machine's speed
 drifts between runs a minute apart: a pair of runs side by side shares its spell).
 
+With ``--source real`` the tracks are copies of the three bundled recordings with
+human beat annotations (Hainsworth 001, the Ballroom waltz, the madmom sample; 2.8-56 s
+long, so the tasks are uneven), in turn.
+
 Usage::
 
     .venv/bin/python benchmarks/bench_evaluate.py [--tracks 40] [--seconds 30] [--repeats 2]
+    .venv/bin/python benchmarks/bench_evaluate.py --source real --tracks 42 --repeats 6
 
-Writes ``benchmarks/results/evaluate.md`` and ``benchmarks/results/evaluate.json``.
+Writes ``benchmarks/results/evaluate.md`` and ``.json`` (``evaluate_real`` with
+``--source real``).
 """
 
 from __future__ import annotations
@@ -70,6 +76,45 @@ def make_dataset(root: Path, n: int, seconds: float, seed: int = 0) -> tuple[Pat
         io.write_audio(audio / f"song{i:03d}.wav", y, SR)
         io.write_beats(notes / f"song{i:03d}.beats", ref)
     return audio, notes
+
+
+#: The bundled recordings with human beat annotations (``--source real``).
+REAL_RECORDINGS = (
+    "audio/real_dev/hainsworth_001.flac",
+    "audio/real_dev/ballroom_Media-105901.wav",
+    "audio/madmom/sample.wav",
+)
+
+
+def make_real_dataset(root: Path, n: int) -> tuple[Path, Path]:
+    """``n`` copies of :data:`REAL_RECORDINGS` in turn, each with its annotation."""
+    import shutil
+
+    from beatsync import datasets
+
+    audio, notes = root / "audio", root / "annotations"
+    audio.mkdir(parents=True)
+    notes.mkdir()
+    for i in range(n):
+        rel = REAL_RECORDINGS[i % len(REAL_RECORDINGS)]
+        src = datasets.path(rel)
+        beats = datasets.path(rel.rsplit("/", 1)[0] + f"/{src.stem}.beats")
+        shutil.copy(src, audio / f"{src.stem}_{i:03d}{src.suffix}")
+        shutil.copy(beats, notes / f"{src.stem}_{i:03d}.beats")
+    return audio, notes
+
+
+def _real_input(n: int) -> str:
+    import soundfile as sf
+
+    from beatsync import datasets
+
+    parts = []
+    for rel in REAL_RECORDINGS:
+        p = datasets.path(rel)
+        count = len(range(REAL_RECORDINGS.index(rel), n, len(REAL_RECORDINGS)))
+        parts.append(f"{count} of {p.name} ({sf.info(str(p)).duration:.1f} s)")
+    return f"{n} copies of the bundled recordings with human beat annotations: " + ", ".join(parts)
 
 
 def _warm(path: str, reference: np.ndarray) -> None:
@@ -183,7 +228,14 @@ def time_command(audio: Path, notes: Path, out: Path, n_workers: int) -> float:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tracks", type=int, default=40)
-    ap.add_argument("--seconds", type=float, default=30.0, help="length of each song [s]")
+    ap.add_argument("--seconds", type=float, default=30.0, help="length of each synthetic song [s]")
+    ap.add_argument(
+        "--source",
+        choices=("synthetic", "real"),
+        default="synthetic",
+        help="the tracks: synthetic drum songs (results/evaluate.md), or copies of the "
+        "bundled recordings with human beat annotations in turn (results/evaluate_real.md)",
+    )
     ap.add_argument(
         "--repeats",
         type=int,
@@ -208,7 +260,10 @@ def main() -> int:
     coordinator: dict[str, list[float]] = {"dask1": [], "dask2": []}
     with tempfile.TemporaryDirectory(prefix="bench-evaluate-") as tmp:
         tmp = Path(tmp)
-        audio, notes = make_dataset(tmp / "data", args.tracks, args.seconds)
+        if args.source == "real":
+            audio, notes = make_real_dataset(tmp / "data", args.tracks)
+        else:
+            audio, notes = make_dataset(tmp / "data", args.tracks, args.seconds)
         tracks = find_tracks(audio, notes).tracks
         refs = {t.key: read_annotation(t.annotation) for t in tracks}
         _warm(str(tracks[0].audio), refs[tracks[0].key])
@@ -259,10 +314,12 @@ def main() -> int:
     # from the workers' cores; with 1 worker it has a core of its own
     coord_ms = {k: 1000.0 * float(np.median(v)) / n for k, v in coordinator.items()}
     passed = speedup >= TARGET_SPEEDUP
+    results_name = "evaluate_real" if args.source == "real" else "evaluate"
     load_after = os.getloadavg()
     facts = {
         "command": f"python benchmarks/bench_evaluate.py --tracks {args.tracks} "
-        f"--seconds {args.seconds:g} --repeats {args.repeats}",
+        + ("--source real" if args.source == "real" else f"--seconds {args.seconds:g}")
+        + f" --repeats {args.repeats}",
         **_machine.machine_facts(),
         "cores_used": 2,
         "load_average_before": [round(x, 2) for x in load_before],
@@ -270,7 +327,10 @@ def main() -> int:
     }
     data = {
         "facts": facts,
-        "input": f"{n} synthetic drum songs of {args.seconds:g} s at {SR} Hz, 70-180 BPM",
+        "input": _real_input(n)
+        if args.source == "real"
+        else f"{n} synthetic drum songs of {args.seconds:g} s at {SR} Hz, 70-180 BPM "
+        "(generated by the benchmark; exact beats as annotations)",
         "seconds": res,
         "startup_seconds": startup,
         "median": med,
@@ -324,7 +384,8 @@ def main() -> int:
         ("`beatsync evaluate beats --workers 2` (whole process)", med["cmd2"], ""),
     ]
     lines = [
-        "## evaluate: dataset-scale beat evaluation on Dask (`beatsync evaluate beats`)",
+        f"## {results_name}: dataset-scale beat evaluation on Dask (`beatsync evaluate beats`)"
+        + (", on copies of the real recordings" if args.source == "real" else ""),
         "",
         f"Command: `{facts['command']}`  ",
         f"Machine: {facts['platform']}, {facts['processor']}, {facts['cpu_count']} CPUs, "
@@ -332,7 +393,7 @@ def main() -> int:
         f"{facts['date_utc']}; load average {facts['load_average_before']} before, "
         f"{facts['load_average_after']} after; median of {args.repeats} run(s).",
         "",
-        f"Input: {data['input']} (generated by the benchmark; exact beats as annotations); "
+        f"Input: {data['input']}; "
         f"method `psf`; mean F-measure {f_mean:.3f}. Each worker is a single-threaded "
         f"process; the Dask path sends the tracks in groups of at most {GROUP_TRACKS}, "
         "smaller toward the end (one task each). Baseline: a plain loop over the same "
@@ -386,7 +447,7 @@ def main() -> int:
         "shorten, are where the 2-worker ratio falls short of the reference.",
         "",
     ]
-    _machine.write_results("evaluate", data, lines)
+    _machine.write_results(results_name, data, lines)
     return 0 if passed else 1
 
 
