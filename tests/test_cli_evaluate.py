@@ -343,6 +343,42 @@ def test_the_tasks_of_a_run_are_one_dask_task_group(dataset, scheduler, tmp_path
     assert set(seen) == {"evaluate-psf"}
 
 
+def test_the_scheduler_hands_out_a_group_when_a_thread_is_free(tmp_path):
+    # the groups go to the scheduler in one call and wait there (worker-saturation 1.0):
+    # submitted one by one, the first 2 x threads went to the workers at once
+    from dask.distributed import get_client
+
+    songs = tmp_path / "songs"
+    songs.mkdir()
+    for i in range(20):
+        ref = beat_times(100.0 + 5 * i, duration=8.0, start=0.2)
+        io.write_audio(songs / f"s{i:02d}.wav", click_track(ref, sr=SR, duration=8.0), SR)
+        io.write_beats(songs / f"s{i:02d}.beats", ref)
+    found = find_tracks(songs, songs)
+    assert len(beat_dataset._groups(found.tracks, 2)) > 4  # enough for Dask to queue them
+    states = []
+
+    def progress(done, total=None):
+        if not states:  # every group submitted
+            states.extend(
+                get_client().run_on_scheduler(
+                    lambda dask_scheduler: [
+                        ts.state
+                        for ts in dask_scheduler.tasks.values()
+                        if ts.key.startswith("evaluate")
+                    ]
+                )
+            )
+
+    run = beat_dataset.evaluate_dataset(
+        found.tracks, tmp_path / "out", n_workers=2, processes=False, progress=progress
+    )
+    assert (run.tracks["status"] == "ok").all()
+    assert len(states) == len(beat_dataset._groups(found.tracks, 2))
+    assert states.count("processing") <= 2, states  # one group a thread, the rest wait
+    assert "queued" in states, states
+
+
 def test_a_failed_group_is_run_again_track_by_track(dataset, tmp_path, monkeypatch):
     # a task that fails outside evaluate_track (its worker died: one track out of memory)
     # must not record the other tracks of its group as failed
