@@ -379,6 +379,50 @@ def test_the_scheduler_hands_out_a_group_when_a_thread_is_free(tmp_path):
     assert "queued" in states, states
 
 
+@pytest.mark.slow
+def test_a_track_that_kills_its_worker_is_the_only_one_recorded_as_failed(tmp_path):
+    # a real worker death (a crash in native code, the kernel's out-of-memory killer):
+    # its group is run again track by track; the tracks finished on the worker that the
+    # bad track then killed lost their results (Dask raised RuntimeError "... bound to a
+    # different event loop") and were recorded as failed
+    import dask
+    from dask.distributed import Client, LocalCluster, WorkerPlugin
+
+    songs = tmp_path / "songs"
+    songs.mkdir()
+    for i in range(10):
+        ref = beat_times(100.0 + 5 * i, duration=6.0, start=0.2)
+        io.write_audio(songs / f"s{i}.wav", click_track(ref, sr=SR, duration=6.0), SR)
+        io.write_beats(songs / f"s{i}.beats", ref)
+
+    class DiesOnOneTrack(WorkerPlugin):  # set up again in every restarted worker
+        def setup(self, worker):
+            import os
+
+            from beatsync.study import beat_task
+
+            real = beat_task.evaluate_track
+
+            def track(audio, reference, **kwargs):
+                if kwargs["name"] == "s2":
+                    os._exit(1)
+                return real(audio, reference, **kwargs)
+
+            beat_task.evaluate_track = track
+
+    with dask.config.set(cluster.LOCAL_CLUSTER_CONFIG):  # as the command's local cluster
+        lc = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+    with lc, Client(lc) as client:
+        client.register_plugin(DiesOnOneTrack())
+        found = find_tracks(songs, songs)
+        run = beat_dataset.evaluate_dataset(found.tracks, tmp_path / "out",
+                                            scheduler=lc.scheduler_address)  # fmt: skip
+    status = dict(zip(run.tracks["key"], run.tracks["status"], strict=True))
+    assert status == {f"s{i}": "error" if i == 2 else "ok" for i in range(10)}
+    assert run.tracks.set_index("key").loc["s2", "error"].startswith("KilledWorker")
+    assert len(TrackLog(run.files["log"]).rows()) == 10
+
+
 def test_a_failed_group_is_run_again_track_by_track(dataset, tmp_path, monkeypatch):
     # a task that fails outside evaluate_track (its worker died: one track out of memory)
     # must not record the other tracks of its group as failed

@@ -474,7 +474,7 @@ def _failed_row(t: Track, ref: np.ndarray, exc: Exception, *, method, mbt, tempo
 
 
 def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
-    from dask.distributed import as_completed
+    from dask.distributed import KilledWorker, as_completed
 
     _prepare_workers(client, method)
 
@@ -494,8 +494,14 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
             **tempo,
         )
 
+    def resubmit(groups: list[list[Track]]) -> None:
+        for fut, group in zip(submit(groups, len(futures)), groups, strict=True):
+            futures[fut] = group
+            queue.add(fut)
+
     groups = _groups(_longest_first(todo), sum(client.nthreads().values()))
     futures = dict(zip(submit(groups, 0), groups, strict=True))
+    again: set[str] = set()  # tracks run alone a second time
     if progress is not None:
         progress(0, total=len(todo))
     done = 0
@@ -505,16 +511,19 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
             group = futures[fut]
             try:
                 rows = fut.result()
-            except Exception as exc:  # the worker died (e.g. out of memory)
+            except Exception as exc:  # a worker died (e.g. out of memory)
                 if len(group) > 1:  # one track may be the cause: each alone, again
-                    singles = [[t] for t in group]
-                    for single, again in zip(submit(singles, len(futures)), singles,
-                                             strict=True):  # fmt: skip
-                        futures[single] = again
-                        queue.add(single)
+                    resubmit([[t] for t in group])
                     continue
-                rows = [_failed_row(group[0], refs[group[0].key], exc, method=method,
-                                    mbt=mbt, tempo=tempo)]  # fmt: skip
+                t = group[0]
+                if not isinstance(exc, KilledWorker) and t.key not in again:
+                    # not its own fault: its result was lost with a worker that another
+                    # track killed (Dask then raised RuntimeError "... bound to a
+                    # different event loop"); once more
+                    again.add(t.key)
+                    resubmit([[t]])
+                    continue
+                rows = [_failed_row(t, refs[t.key], exc, method=method, mbt=mbt, tempo=tempo)]
             log.append(*rows)  # in one write: an interrupt keeps the group or not at all
             done += len(rows)
             if progress is not None:
