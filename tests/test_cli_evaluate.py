@@ -306,13 +306,12 @@ def test_tracks_go_to_the_workers_in_groups_of_decreasing_size():
 def test_the_longest_tracks_go_to_the_workers_first(tmp_path):
     from beatsync.study.beat_tracks import Track
 
-    tracks = []
+    tracks = [Track("gone", ".", tmp_path / "gone.wav", tmp_path / "gone.beats")]
     for name, n in (("a", 10), ("b", 30), ("c", 20), ("d", 30)):
         (tmp_path / f"{name}.wav").write_bytes(b"x" * n)
         tracks.append(Track(name, ".", tmp_path / f"{name}.wav", tmp_path / f"{name}.beats"))
-    tracks.append(Track("gone", ".", tmp_path / "gone.wav", tmp_path / "gone.beats"))
     order = [t.key for t in beat_dataset._longest_first(tracks)]
-    assert order == ["b", "d", "c", "a", "gone"]  # ties and unreadable files keep their order
+    assert order == ["b", "d", "c", "a", "gone"]  # ties keep their order; unreadable: last
 
 
 def test_the_tasks_of_a_run_are_one_dask_task_group(dataset, scheduler, tmp_path):

@@ -19,6 +19,7 @@ Methods are named as in :data:`beatsync.peers.PEERS` (``psf`` is ours); scores a
 from __future__ import annotations
 
 import contextlib
+import itertools
 import os
 import uuid
 import warnings
@@ -474,33 +475,37 @@ def _failed_row(t: Track, ref: np.ndarray, exc: Exception, *, method, mbt, tempo
 
 
 def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
+    from concurrent.futures import CancelledError
+
     from dask.distributed import KilledWorker, as_completed
 
     _prepare_workers(client, method)
 
     run = uuid.uuid4().hex
+    numbers = itertools.count()
 
-    def submit(groups: list[list[Track]], first: int) -> list:
-        # in one call, so that the scheduler sees the run's tasks as one group and queues
-        # them (worker-saturation) instead of handing the first ones out at once; it runs
-        # them in this order. One key prefix for the run: Dask groups tasks by it, and a
-        # track's name in it made a group of each task
+    def submit(groups: list[list[Track]]) -> list:
+        # in one call, so that the scheduler sees the run's tasks as one group and can
+        # queue them (worker-saturation; Dask queues a group of more tasks than twice the
+        # threads) instead of handing the first ones out at once; it runs them in this
+        # order. One key prefix for the run: Dask groups tasks by it, and a track's name
+        # in it made a group of each task
         return client.map(
             beat_task.evaluate_tracks,
             [[(str(t.audio), refs[t.key], t.key, t.group) for t in group] for group in groups],
-            key=[f"evaluate-{method}-{run}-{first + i:06d}" for i in range(len(groups))],
+            key=[f"evaluate-{method}-{run}-{next(numbers):06d}" for _ in groups],
             method=method,
             min_beat_time=mbt,
             **tempo,
         )
 
     def resubmit(groups: list[list[Track]]) -> None:
-        for fut, group in zip(submit(groups, len(futures)), groups, strict=True):
+        for fut, group in zip(submit(groups), groups, strict=True):
             futures[fut] = group
             queue.add(fut)
 
     groups = _groups(_longest_first(todo), sum(client.nthreads().values()))
-    futures = dict(zip(submit(groups, 0), groups, strict=True))
+    futures = dict(zip(submit(groups), groups, strict=True))
     again: set[str] = set()  # tracks run alone a second time
     if progress is not None:
         progress(0, total=len(todo))
@@ -508,18 +513,23 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
     try:
         queue = as_completed(futures)
         for fut in queue:
-            group = futures[fut]
+            # released once read: a finished task's result would stay on its worker,
+            # and Dask computes it again if that worker dies
+            group = futures.pop(fut)
             try:
                 rows = fut.result()
+            except CancelledError as exc:  # cancelled outside the run, or the scheduler lost
+                rows = [_failed_row(t, refs[t.key], exc, method=method, mbt=mbt, tempo=tempo)
+                        for t in group]  # fmt: skip
             except Exception as exc:  # a worker died (e.g. out of memory)
                 if len(group) > 1:  # one track may be the cause: each alone, again
                     resubmit([[t] for t in group])
                     continue
                 t = group[0]
                 if not isinstance(exc, KilledWorker) and t.key not in again:
-                    # not its own fault: its result was lost with a worker that another
-                    # track killed (Dask then raised RuntimeError "... bound to a
-                    # different event loop"); once more
+                    # not its own fault: it finished on a worker that another track then
+                    # killed before its result was fetched (Dask raised RuntimeError "...
+                    # bound to a different event loop"); once more
                     again.add(t.key)
                     resubmit([[t]])
                     continue
@@ -529,8 +539,7 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
             if progress is not None:
                 progress(done)
     finally:
-        # an interrupted run: the tracks still queued or in flight stop (one message; the
-        # finished ones are released with their futures, without a cancel each)
+        # an interrupted run: the tracks still queued or in flight stop (one message)
         pending = [fut for fut in futures if not fut.done()]
         if pending:
             client.cancel(pending)
