@@ -23,6 +23,10 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 
 
+#: Further runs of a benchmark, each with these arguments (after its run with none).
+EXTRA_RUNS = {"bench_evaluate": [["--source", "real", "--tracks", "42"]]}
+
+
 def collect() -> Path:
     parts = [
         "# Benchmark results\n",
@@ -51,9 +55,10 @@ def main() -> int:
         if args.only:
             scripts = [s for s in scripts if s.stem.removeprefix("bench_") in args.only]
         for script in scripts:
-            print(f"== {script.name}", flush=True)
-            if subprocess.run([sys.executable, str(script)]).returncode != 0:
-                failed.append(script.name)
+            for extra in [[], *EXTRA_RUNS.get(script.stem, [])]:
+                print(f"== {' '.join([script.name, *extra])}", flush=True)
+                if subprocess.run([sys.executable, str(script), *extra]).returncode != 0:
+                    failed.append(" ".join([script.name, *extra]))
     print(f"wrote {collect()}")
     if failed:
         print(f"benchmarks that failed to run: {failed}", file=sys.stderr)
