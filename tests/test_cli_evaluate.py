@@ -53,6 +53,16 @@ def dataset(tmp_path_factory):
     return audio, notes
 
 
+def _click_songs(folder, n, *, seconds, bpm_step=5.0):
+    """``n`` click tracks ``sNN.wav`` from 100 BPM up, each with its ``.beats``."""
+    folder.mkdir()
+    for i in range(n):
+        ref = beat_times(100.0 + bpm_step * i, duration=seconds, start=0.2)
+        io.write_audio(folder / f"s{i:02d}.wav", click_track(ref, sr=SR, duration=seconds), SR)
+        io.write_beats(folder / f"s{i:02d}.beats", ref)
+    return folder
+
+
 def _argv(dataset, out, *extra):
     audio, notes = dataset
     return [
@@ -347,12 +357,7 @@ def test_the_scheduler_hands_out_a_group_when_a_thread_is_free(tmp_path):
     # submitted one by one, the first 2 x threads went to the workers at once
     from dask.distributed import get_client
 
-    songs = tmp_path / "songs"
-    songs.mkdir()
-    for i in range(20):
-        ref = beat_times(100.0 + 5 * i, duration=8.0, start=0.2)
-        io.write_audio(songs / f"s{i:02d}.wav", click_track(ref, sr=SR, duration=8.0), SR)
-        io.write_beats(songs / f"s{i:02d}.beats", ref)
+    songs = _click_songs(tmp_path / "songs", 20, seconds=8.0)
     found = find_tracks(songs, songs)
     assert len(beat_dataset._groups(found.tracks, 2)) > 4  # enough for Dask to queue them
     states = []
@@ -387,12 +392,7 @@ def test_a_track_that_kills_its_worker_is_the_only_one_recorded_as_failed(tmp_pa
     import dask
     from dask.distributed import Client, LocalCluster, WorkerPlugin
 
-    songs = tmp_path / "songs"
-    songs.mkdir()
-    for i in range(10):
-        ref = beat_times(100.0 + 5 * i, duration=6.0, start=0.2)
-        io.write_audio(songs / f"s{i}.wav", click_track(ref, sr=SR, duration=6.0), SR)
-        io.write_beats(songs / f"s{i}.beats", ref)
+    songs = _click_songs(tmp_path / "songs", 10, seconds=6.0)
 
     class DiesOnOneTrack(WorkerPlugin):  # set up again in every restarted worker
         def setup(self, worker):
@@ -403,7 +403,7 @@ def test_a_track_that_kills_its_worker_is_the_only_one_recorded_as_failed(tmp_pa
             real = beat_task.evaluate_track
 
             def track(audio, reference, **kwargs):
-                if kwargs["name"] == "s2":
+                if kwargs["name"] == "s02":
                     os._exit(1)
                 return real(audio, reference, **kwargs)
 
@@ -417,8 +417,8 @@ def test_a_track_that_kills_its_worker_is_the_only_one_recorded_as_failed(tmp_pa
         run = beat_dataset.evaluate_dataset(found.tracks, tmp_path / "out",
                                             scheduler=lc.scheduler_address)  # fmt: skip
     status = dict(zip(run.tracks["key"], run.tracks["status"], strict=True))
-    assert status == {f"s{i}": "error" if i == 2 else "ok" for i in range(10)}
-    assert run.tracks.set_index("key").loc["s2", "error"].startswith("KilledWorker")
+    assert status == {f"s{i:02d}": "error" if i == 2 else "ok" for i in range(10)}
+    assert run.tracks.set_index("key").loc["s02", "error"].startswith("KilledWorker")
     assert len(TrackLog(run.files["log"]).rows()) == 10
 
 
@@ -812,13 +812,7 @@ def test_ctrl_c_in_a_terminal_prints_no_worker_traceback(tmp_path):
     import subprocess
     import sys
 
-    sr = 22050
-    songs = tmp_path / "songs"
-    songs.mkdir()
-    for i in range(40):
-        ref = beat_times(100.0 + i, duration=20.0, start=0.2)
-        io.write_audio(songs / f"s{i:02d}.wav", click_track(ref, sr=sr, duration=20.0), sr)
-        io.write_beats(songs / f"s{i:02d}.beats", ref)
+    songs = _click_songs(tmp_path / "songs", 40, seconds=20.0, bpm_step=1.0)
     out = tmp_path / "results"
     argv = ["evaluate", "beats", "--audio", str(songs), "--annotations", str(songs)]
     proc = subprocess.Popen(
