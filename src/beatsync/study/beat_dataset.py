@@ -457,7 +457,7 @@ def _longest_first(todo: Sequence[Track]) -> list[Track]:
 
 def _failed_row(t: Track, ref: np.ndarray, exc: Exception, *, method, mbt, tempo) -> dict:
     """The row of a track whose task failed outside :func:`evaluate_track` (its worker
-    died, e.g. out of memory)."""
+    died, e.g. out of memory, or the task was cancelled)."""
     return {
         "key": t.key,
         "group": t.group,
