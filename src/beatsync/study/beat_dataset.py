@@ -458,20 +458,10 @@ def _longest_first(todo: Sequence[Track]) -> list[Track]:
 def _failed_row(t: Track, ref: np.ndarray, exc: Exception, *, method, mbt, tempo) -> dict:
     """The row of a track whose task failed outside :func:`evaluate_track` (its worker
     died, e.g. out of memory, or the task was cancelled)."""
-    return {
-        "key": t.key,
-        "group": t.group,
-        "audio": str(t.audio),
-        "audio_bytes": _audio_bytes(t.audio),
-        "reference_digest": reference_digest(ref),
-        "method": method,
-        "min_beat_time": mbt,
-        "min_bpm": tempo.get("min_bpm"),
-        "max_bpm": tempo.get("max_bpm"),
-        "status": "error",
-        "error": f"{type(exc).__name__}: {exc}",
-        "warning": "",
-    }
+    return beat_task.failed_row(
+        t.audio, ref, f"{type(exc).__name__}: {exc}", method=method, min_beat_time=mbt,
+        name=t.key, group=t.group, min_bpm=tempo.get("min_bpm"), max_bpm=tempo.get("max_bpm"),
+    )  # fmt: skip
 
 
 def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:

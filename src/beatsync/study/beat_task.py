@@ -21,7 +21,7 @@ from .. import io, peers
 from ..errors import ParameterError, collect_warnings
 from ..evaluate.beats import evaluate, tempo_octave
 
-__all__ = ["evaluate_track", "evaluate_tracks", "reference_digest"]
+__all__ = ["evaluate_track", "evaluate_tracks", "failed_row", "reference_digest"]
 
 
 def evaluate_track(
@@ -70,20 +70,10 @@ def evaluate_track(
         :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking
         time), ``audio_seconds`` and ``beats`` (the estimated times).
     """
-    row: dict[str, Any] = {
-        "key": name,
-        "group": group,
-        "audio": str(audio),
-        "audio_bytes": _audio_bytes(audio),
-        "reference_digest": reference_digest(reference),
-        "method": method,
-        "min_beat_time": float(min_beat_time),
-        "min_bpm": min_bpm,
-        "max_bpm": max_bpm,
-        "status": "error",
-        "error": "",
-        "warning": "",
-    }
+    row = failed_row(
+        audio, reference, "", method=method, min_beat_time=min_beat_time, name=name,
+        group=group, min_bpm=min_bpm, max_bpm=max_bpm,
+    )  # fmt: skip
     t0 = time.perf_counter()
     try:
         tempo = peers.check_tempo_range(method, min_bpm, max_bpm)
@@ -120,6 +110,36 @@ def evaluate_track(
         beats=[round(float(b), 6) for b in est],
     )
     return row
+
+
+def failed_row(
+    audio: str | os.PathLike[str],
+    reference: np.ndarray,
+    error: str,
+    *,
+    method: str,
+    min_beat_time: float,
+    name: str,
+    group: str,
+    min_bpm: float | None,
+    max_bpm: float | None,
+) -> dict[str, Any]:
+    """A track's row with its inputs and settings, ``status`` "error" and ``error``:
+    where :func:`evaluate_track` starts, and the row of a task that failed outside it."""
+    return {
+        "key": name,
+        "group": group,
+        "audio": str(audio),
+        "audio_bytes": _audio_bytes(audio),
+        "reference_digest": reference_digest(reference),
+        "method": method,
+        "min_beat_time": float(min_beat_time),
+        "min_bpm": min_bpm,
+        "max_bpm": max_bpm,
+        "status": "error",
+        "error": error,
+        "warning": "",
+    }
 
 
 def evaluate_tracks(
