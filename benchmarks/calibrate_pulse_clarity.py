@@ -18,6 +18,7 @@ import numpy as np
 
 from beatsync import datasets, io
 from beatsync.beats import metrical, tracker
+from beatsync.beats.drums import DRUM_WEIGHT, drum_cue
 from beatsync.beats.onset import compute_onsets, frontend_settings
 from beatsync.beats.tempo import analysis_windows, period_grid, tempo_hmm
 
@@ -38,6 +39,8 @@ def clarity(y: np.ndarray, sr: float) -> tuple[float, float]:
     log_obs, sal, _ = metrical.tactus_observation(
         accents, fps, starts, stops, periods, model, max_hz=max_hz
     )
+    n = ons.envelope.size
+    log_obs = log_obs + DRUM_WEIGHT * drum_cue(y, sr, fps, n, starts, stops, periods)
     path = tempo_hmm(log_obs, periods, trans_sigma=tracker.TRANS_SIGMA, p_jump=tracker.P_JUMP)
     path_salience = float(np.mean(sal[path, np.arange(path.size)]))
     null = tracker.pulse_clarity_null(ons, starts, stops, periods, model, max_hz)
