@@ -149,3 +149,14 @@ def test_bad_drum_weight(weight):
     y = click_track(beat_times(120, duration=5.0, start=0.3), sr=SR, duration=5.0)
     with pytest.raises(ParameterError, match="drum_weight"):
         track_beats(y, SR, drum_weight=weight)
+
+
+def test_study_sweeps_the_drum_weight():
+    from beatsync.study import paper_a_beats as study
+
+    items = make_beat_test_set(duration=20.0, bpms=[180], kinds=["drums"], groups=["clean"])
+    sweep = study.drum_weight_sweep(items, [0.0, 4.0])
+    assert sweep["drum_weight"].tolist() == [0.0, 4.0]
+    assert sweep["default"].tolist() == [False, True]
+    without, with_cue = sweep["F"]
+    assert without < 0.7 and with_cue >= 0.95  # tapped at half without the cue

@@ -3,8 +3,9 @@
 One function per step of ``notebooks/paper_a_sec4_beat_tracking.ipynb``: build the
 items (the synthetic set with exact beats, and every real recording with human
 annotations in ``data/``), track and score them with every method, summarise per
-group, check the targets, plot the tempo curves of the tempo-change items, and sweep
-the phase-slope front end on the development recordings and the synthetic set.
+group, check the targets, plot the tempo curves of the tempo-change items, sweep
+the phase-slope front end on the development recordings and the synthetic set, and
+sweep the weight of the drum-pattern cue (:mod:`beatsync.beats.drums`).
 
 Methods (:mod:`beatsync.peers`): ``psf`` (ours), ``librosa`` and, when the optional
 ``essentia`` package is installed, essentia's ``BeatTrackerDegara`` and
@@ -43,6 +44,7 @@ __all__ = [
     "tempo_change_figure",
     "frontend_sweep",
     "SWEEP_ITEMS_LISTED",
+    "drum_weight_sweep",
 ]
 
 #: Column names of the study tables.
@@ -205,6 +207,27 @@ def check_targets(scores: pd.DataFrame) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(rows)
+
+
+def drum_weight_sweep(
+    items: Sequence[BeatTestItem], weights: Sequence[float], *, min_beat_time: float = 0.0
+) -> pd.DataFrame:
+    """Our tracker at each weight of the drum-pattern cue (0: without it).
+
+    One row per weight and group (the synthetic groups, and each real recording as a
+    group of its own): mean F, CMLt and AMLt, the count of tempo-octave errors, and
+    whether the weight is the default (:data:`beatsync.beats.drums.DRUM_WEIGHT`).
+    """
+    from ..beats.drums import DRUM_WEIGHT  # noqa: PLC0415
+
+    frames = []
+    for w in weights:
+        sc = score_items(items, methods=["psf"], min_beat_time=min_beat_time, drum_weight=w)
+        sc["group"] = np.where(sc["group"] == "real", sc["item"], sc["group"])
+        table = summarize(sc).drop(columns="method")
+        frames.append(table.assign(drum_weight=float(w), default=float(w) == DRUM_WEIGHT))
+    cols = ["drum_weight", "default", "group", "F", "CMLt", "AMLt", "octave_errors", "n"]
+    return pd.concat(frames, ignore_index=True)[cols]
 
 
 def tempo_change_figure(items: Sequence[BeatTestItem], max_items: int = 4):
