@@ -14,6 +14,8 @@ Layout (along librosa's ``onset`` / ``beat`` / ``sequence`` seams)
 - :mod:`.tempo`: the tempo HMM over beat periods and a numpy Viterbi decoder.
 - :mod:`.phase`: the phase HMM that places the beats for a tempo curve.
 - :mod:`.metrical`: the metrical-level decision (which pulse is the beat).
+- :mod:`.drums`: the drum-pattern cue of that decision (a bass drum and a snare drum
+  that alternate mark the beat; Goto 2001).
 - :mod:`.tracker`: the public :func:`track_beats` and its result :class:`BeatTrack`;
   validation happens there, once.
 

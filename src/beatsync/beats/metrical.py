@@ -83,25 +83,24 @@ click tracks at 180 BPM are tapped at 90 (clean F 0.865-0.898). Either would als
 need the no-clear-pulse constants of :mod:`beatsync.beats.tracker` calibrated again
 (the salience scale changes).
 
-Why the remaining synthetic misses are a matter of the prior (measured on seed 0).
-The synthetic drum pattern at 90 and at 180 BPM is the same pattern, only scaled; any
-salience that does not depend on the tempo gives both the same evidence in beat
-units. A prior can tap both at their labelled level only if the evidence at the
-labelled level is higher than the mean of the levels either side of it. Ours is not.
-At 180 BPM, the labelled level minus the half-note level is -0.10 (``beta * s``
-averaged over windows; -0.24 with the coarser spectral sampling). At 90 BPM, the
-labelled level minus the eighth-note level is -0.02 (-0.03). With the tatum and
-measure terms as well, the labelled level beats the half-note level at 180 BPM by
-0.56 and loses to the eighth-note level at 90 BPM by 0.68, while the tactus prior
-favours 90 over 180 BPM by 1.17: no prior of the period alone can get both. Every
-evaluation above shares this, because the kick and the snare fall in
-different bands and each band on its own repeats every two beats. So with a wider
-tactus prior (sigma 0.45 or 0.6 instead of 0.3) the clean 90 BPM pattern is tapped
-at 180 on every seed (seeds 0-2), and the 180 BPM pattern with drift or noise is
-still tapped at 90. Nothing else we measured helped. Every experiment below was
-measured before :attr:`MeterModel.tatum_ratio_weights`, against the scores of that
-time (Hainsworth 001's 3 s and 5 s clips: mean F 0.416 and 0.654; now 0.508 and
-0.789):
+Why the synthetic drums were missed by the prior (measured on seed 0, before the drum
+cue of :mod:`beatsync.beats.drums`, which now taps them at their beat). The drum
+pattern at 90 and at 180 BPM is the same pattern, only scaled; any salience that does
+not depend on the tempo gives both the same evidence in beat units. A prior can tap
+both at their labelled level only if the evidence at the labelled level is higher than
+the mean of the levels either side of it. Ours is not. At 180 BPM, the labelled level
+minus the half-note level is -0.10 (``beta * s`` averaged over windows; -0.24 with the
+coarser spectral sampling). At 90 BPM, the labelled level minus the eighth-note level
+is -0.02 (-0.03). With the tatum and measure terms as well, the labelled level beats
+the half-note level at 180 BPM by 0.56 and loses to the eighth-note level at 90 BPM by
+0.68, while the tactus prior favours 90 over 180 BPM by 1.17: no prior of the period
+alone can get both. Every evaluation above shares this, because the kick and the snare
+fall in different bands and each band on its own repeats every two beats. So with a
+wider tactus prior (sigma 0.45 or 0.6) the clean 90 BPM pattern is tapped at 180 on
+every seed (0-2), and the 180 BPM pattern with drift or noise still at 90. Every
+experiment below was measured before :attr:`MeterModel.tatum_ratio_weights`, against
+the scores of that time (Hainsworth 001's 3 s and 5 s clips: mean F 0.416 and 0.654;
+now 0.508 and 0.789):
 
 - The band sum added as a fifth band changed no level. The band sum alone tapped
   180 BPM clicks at 90.
@@ -146,8 +145,8 @@ time (Hainsworth 001's 3 s and 5 s clips: mean F 0.416 and 0.654; now 0.508 and
   interval between a bass drum and a snare drum that alternate. We scored it as the
   low band and a higher band both concentrated at twice the period, in antiphase.
   On our phase-slope onsets the low band is too dense to show the kick (the score,
-  averaged over windows, was 0.05 at most). With weight 100, the cue fixed the 60 BPM
-  pattern but not the 180 BPM one. With weight 300, it tapped DANCE_R_3 at 190.
+  averaged over windows, was 0.05 at most); weight 300 tapped DANCE_R_3 at 190. With the
+  energy of its own STFT's bands (30-150 Hz, 150 Hz-5 kHz) it is used (:mod:`.drums`).
 - Nor does a band's accent between the decoded beats tell a beat tapped at half its
   tempo (2026-11-29, scratch run: per band, the strongest onset within 1/8 beat of
   each beat and of each midpoint). Midpoints over beats: the 180 BPM drum pattern
