@@ -27,14 +27,14 @@ def _cue_at(y, bpms, seconds):
     return drum_cue(y, SR, FPS, n, starts, stops, periods).mean(axis=1)
 
 
-@pytest.mark.parametrize("bpm", [60.0, 120.0, 180.0])
+@pytest.mark.parametrize("bpm", [120.0, 180.0])
 def test_cue_marks_the_beat_of_a_rock_pattern(bpm):
     # kick on beats 1 and 3, snare on 2 and 4: they alternate at the beat, and each
-    # repeats every two beats
+    # repeats every two beats (at 60 BPM, two beats do not fit 4 times in a window)
     ref = beat_times(bpm, duration=20.0, start=0.3)
     y = drum_pattern(ref, sr=SR, duration=20.0, seed=2)
     eighth, beat, half = _cue_at(y, [2 * bpm, bpm, bpm / 2], 20.0)
-    assert beat > 0.2
+    assert beat > 0.3
     assert half == 0.0  # each drum repeats at twice the beat: no alternation there
     assert eighth < 0.05
 
@@ -59,7 +59,8 @@ def test_envelopes_put_the_kick_low_and_the_snare_higher():
     kicks = np.array([near(low, f) for f in frames[0::2]])
     snares = np.array([near(low, f) for f in frames[1::2]])
     assert np.median(kicks) > 3 * np.median(snares)  # the low band hears the kick
-    assert np.median([near(mid, f) for f in frames[1::2]]) > 0
+    mid_snares = np.median([near(mid, f) for f in frames[1::2]])
+    assert mid_snares > 2 * np.median([near(mid, f) for f in frames[0::2]])  # the other the snare
 
 
 def test_envelopes_at_44k_match_22k():
@@ -82,43 +83,44 @@ def test_alternation_cue_by_hand():
     cue = alternation_cue(env, FPS, np.array([0]), np.array([n]), periods)[:, 0]
     assert cue[1] > 0.5
     assert cue[0] == 0.0 and cue[2] == 0.0
-    # fewer than four cycles in the window: not scored
-    assert alternation_cue(env, FPS, np.array([0]), np.array([n]), np.array([150 / FPS]))[0, 0] == 0
+    # fewer than four cycles in the window: not scored (at lag 140 the kick and the
+    # snare do alternate, 20 frames off a whole period)
+    assert alternation_cue(env, FPS, np.array([0]), np.array([n]), np.array([140 / FPS]))[0, 0] == 0
     # a silent band: nothing to correlate
     quiet = env.copy()
     quiet[1] = 0.0
     assert not alternation_cue(quiet, FPS, np.array([0]), np.array([n]), periods).any()
 
 
-def test_noise_level_is_subtracted():
+def test_noise_level_is_subtracted(monkeypatch):
+    import beatsync.beats.drums as drums
+
     n = 400
     env = np.zeros((2, n))
     env[0, 5::40] = 1.0
     env[1, 25::40] = 1.0
-    raw = alternation_cue(env, FPS, np.array([0]), np.array([n]), np.array([20 / FPS]))[0, 0]
-    # the same envelopes with uncorrelated noise on top score less, never below 0
-    rng = np.random.default_rng(0)
-    noisy = env + 3.0 * rng.random((2, n))
-    cue = alternation_cue(noisy, FPS, np.array([0]), np.array([n]), np.array([20 / FPS]))[0, 0]
-    assert 0.0 <= cue < raw
-    assert raw <= 1.0 - NOISE_LEVEL + 1e-9
+    args = (FPS, np.array([0]), np.array([n]), np.array([20 / FPS]))
+    cue = alternation_cue(env, *args)[0, 0]
+    monkeypatch.setattr(drums, "NOISE_LEVEL", 0.0)
+    raw = alternation_cue(env, *args)[0, 0]
+    assert raw - cue == pytest.approx(NOISE_LEVEL, abs=1e-12)
+    # uncorrelated noise on top: less alternation, and never below 0 once the level is off
+    monkeypatch.setattr(drums, "NOISE_LEVEL", NOISE_LEVEL)
+    noisy = env + 3.0 * np.random.default_rng(0).random((2, n))
+    assert 0.0 <= alternation_cue(noisy, *args)[0, 0] < cue
 
 
-@pytest.mark.parametrize("bpm", [60.0, 180.0])
-def test_drum_pattern_at_the_edges_is_tapped_at_its_beat(bpm):
-    # the same pattern at 60 and 180 BPM: before the cue, the tactus prior put both
-    # an octave towards 110 BPM (120 and 90)
-    ref = beat_times(bpm, duration=30.0, start=0.4)
-    y = drum_pattern(ref, sr=SR, duration=30.0, seed=2)
-    bt = track_beats(y, SR)
+@pytest.mark.parametrize("bpm, without", [(60.0, 120.0), (180.0, 90.0)])
+def test_drum_pattern_at_the_edges_is_tapped_at_its_beat(bpm, without):
+    # the same pattern at 60 and 180 BPM (the synthetic set's items, seed 1)
+    (item,) = make_beat_test_set(bpms=[bpm], kinds=["drums"], groups=["clean"], seed=1)
+    bt = track_beats(item.y, item.sr)
     assert bt.tempo == pytest.approx(bpm, rel=0.03)
-    assert evaluate_beats(ref, bt.beats, min_beat_time=0.0)["F-measure"] >= 0.95
-
-
-def test_without_the_cue_the_fast_pattern_is_tapped_at_half():
-    ref = beat_times(180, duration=30.0, start=0.4)
-    y = drum_pattern(ref, sr=SR, duration=30.0, seed=2)
-    assert track_beats(y, SR, drum_weight=0).tempo == pytest.approx(90, rel=0.03)
+    assert evaluate_beats(item.beats, bt.beats, min_beat_time=0.0)["F-measure"] >= 0.95
+    # the metrical model alone (a known gap it leaves): the tactus prior puts both an
+    # octave towards 110 BPM
+    alone = track_beats(item.y, item.sr, drum_weight=0)
+    assert alone.tempo == pytest.approx(without, rel=0.03)
 
 
 def test_tempo_change_of_drums_keeps_the_level():

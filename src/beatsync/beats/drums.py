@@ -14,24 +14,26 @@ both an octave towards 110 BPM.
 1. **Two envelopes** (:func:`drum_envelopes`): the energy between 30 and 150 Hz (the
    bass drum's band, :data:`LOW_BAND_HZ`) and between 150 Hz and 5 kHz (the snare
    drum's, :data:`MID_BAND_HZ`), from an STFT with 93 ms windows (:data:`N_FFT_S`, at
-   most 11.025 kHz) every 4 frames of the onset signal (23 ms, :data:`HOP_FRAMES`);
-   half-wave rectified differences (energy that rises), smoothed over 2 frames of the
-   onset signal and interpolated to its frame rate. Every frame (5.8 ms hops) gave the
-   same output of ``bench_beats.py --accuracy-only`` at 2.6 times the cost (40 ms
-   against 15 ms for a minute of audio).
+   most 11.025 kHz) every 23 ms (:data:`HOP_S`); half-wave rectified differences
+   (energy that rises), interpolated to the onset signal's frame rate. A first version
+   with every onset frame (5.8 ms hops) and a 2-frame smoothing gave the same output of
+   ``bench_beats.py --accuracy-only`` at 2.6 times the cost (40 ms against 15 ms for a
+   minute of audio).
 2. **Alternation** (:func:`alternation_cue`): per window and period ``tau``, the
    normalised cross-correlations of the two envelopes at lags ``+tau`` and ``-tau``
    (a bass drum followed by a snare drum one period later, and the other way round),
    minus their normalised autocorrelations at ``tau`` (each drum repeating every
-   period): ``A(tau) = (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``. On
-   the synthetic rock pattern (:func:`beatsync.synth.audio.drum_pattern`) at 60, 120
-   and 180 BPM, ``A`` is +0.56, +0.62 and +0.66 at the beat, -0.64 and -0.70 at twice
-   the beat (each drum repeats every period) and within +-0.02 at half the beat; on
-   click tracks within +-0.01. Only periods with :data:`MIN_CYCLES` cycles in the
-   window are scored.
+   period): ``A(tau) = (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``, each
+   term over the whole window's norms (so ``A`` shrinks by up to ``1 - tau / L``, a
+   quarter at the longest period scored). On the synthetic rock pattern
+   (:func:`beatsync.synth.audio.drum_pattern`, 30 s, seeds 0-2) at 60, 120 and
+   180 BPM, ``A`` averages +0.63-0.68, +0.66-0.70 and +0.71-0.75 at the beat, -0.71 to
+   -0.76 at twice the beat (each drum repeats every period; 120 and 180 BPM) and -0.01
+   at half the beat; on click tracks it stays within +-0.015. Only periods with
+   :data:`MIN_CYCLES` cycles in the window are scored.
 3. **Evidence, never counter-evidence**: ``max(A - NOISE_LEVEL, 0)``. Drums that do not
    alternate are no evidence against a period (at the beat of the bundled songs ``A``
-   is -0.27 for the cha-cha DANCE_C_4 and about -0.06 for the waltzes), and an
+   averages -0.29 for the cha-cha DANCE_C_4 and -0.07 to +0.06 for the others), and an
    alternation no stronger than noise's is none for it (:data:`NOISE_LEVEL`).
 4. **Weight** (:data:`DRUM_WEIGHT`): ``log_obs += DRUM_WEIGHT * max(A - NOISE_LEVEL, 0)``,
    added to the tactus observation of every window before the tempo HMM decodes it.
@@ -40,25 +42,28 @@ Why a separate STFT. The front end's four bands (:mod:`.onset`, 23 ms windows, 4
 bins) put the synthetic bass drum and the snare drum's body in the same 0-250 Hz band;
 with its log-magnitude flux as the two envelopes (0-250 Hz and 250-1000 Hz), ``A`` of
 the rock pattern was within +-0.1 at every level. Why the energy and not its log: with
-the rise of ``log(1 + E / (1e-4 max E))`` (40 dB), the 60 BPM pattern's ``A`` was
--0.09 at its beat (the snare's tail in the low band and the decays count as much as
-the attacks); with ``1e-2`` (20 dB), +0.19; linear, +0.56.
+the rise of ``log(1 + E / (c max E))``, the 60 BPM pattern's ``A`` at its beat was -0.09
+for ``c = 1e-4`` (40 dB: the snare's tail in the low band and the decays count as much
+as the attacks), +0.19 for ``1e-2`` and +0.56 for ``1`` (measured with the first
+version above); linear, it is +0.63-0.68.
 
 What was chosen on what (a scratch sweep, 2026-11-29):
 
-- The bands, the window and the smoothing are a first choice (a bass drum's
-  fundamental is 50-100 Hz, a snare drum's body about 200 Hz), not swept.
+- The bands and the window are a first choice (a bass drum's fundamental is
+  50-100 Hz, a snare drum's body about 200 Hz), not swept.
 - :data:`NOISE_LEVEL` on noise alone: over 140 white and brown noises of 2-30 s
   (seeds 0-9), the largest ``A`` of a window over the period grid has a median of
-  0.12-0.18 and a 95th percentile of 0.18-0.20 for 5-30 s (0.27-0.29 for 2-3 s).
+  0.12-0.14 and a 95th percentile of 0.16-0.20 for 5-30 s. Shorter windows reach more
+  (95th percentile 0.22-0.25 for 2-3 s): on a noise clip that short the cue can add a
+  little evidence for a fast period (up to ``DRUM_WEIGHT`` x 0.08). A known limit.
 - :data:`DRUM_WEIGHT` on the 30 s synthetic set (seeds 0-2): every weight from 3 to 12
   meets the three synthetic targets on every seed; 2 does not (AMLt 0.974 and 0.976 on
   seeds 0 and 1); from 8, the clean drum pattern at 210 and 230 BPM is tapped at a third
   of its tempo. 4 is about the geometric middle of 3 and 6.
 - The bundled real recordings were only scored, and the cue is silent on them: over
   the tempo windows of the seven (Hainsworth 001, the Ballroom waltz, the madmom sample,
-  the four dancers' 28 s songs), it is 0 at every period but in 2 of the waltz's 25
-  windows (at most 0.010), where the synthetic drums at 180 BPM reach 0.54 in every
+  the four dancers' 28 s songs), it is 0 at every period but in 1 of the waltz's 25
+  windows (at most 0.012), where the synthetic drums at 180 BPM reach 0.5 in every
   window. So it is untested on real music where it would fire (drums with a clear
   backbeat): none with beat annotations is bundled. With these constants none of them
   changed (``benchmarks/bench_beats.py --accuracy-only``: the whole recordings, their
@@ -82,13 +87,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .filters import gaussian_smooth
-
 __all__ = [
     "DRUM_WEIGHT",
     "LOW_BAND_HZ",
     "MID_BAND_HZ",
     "CUE_SR",
+    "N_FFT_S",
+    "HOP_S",
+    "NOISE_LEVEL",
+    "MIN_CYCLES",
     "drum_envelopes",
     "alternation_cue",
     "drum_cue",
@@ -110,14 +117,11 @@ N_FFT_S = 0.093
 #: Alternation that noise reaches: subtracted from the score before it counts.
 NOISE_LEVEL = 0.2
 
-#: Smoothing of the envelopes [frames].
-SMOOTH_FRAMES = 2.0
-
 #: Fewest cycles of a period inside a window for the cue to score it.
 MIN_CYCLES = 4
 
-#: Hop of the STFT, in frames of the onset signal.
-HOP_FRAMES = 4
+#: Hop of the STFT [s] (4 frames of the default onset signal, 128-sample hops at 22.05 kHz).
+HOP_S = 4 * 128 / 22050
 
 #: STFT frames computed at once (bounds the memory of a long song).
 BLOCK_FRAMES = 2048
@@ -138,17 +142,15 @@ def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.nd
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs)
 
-    y = np.asarray(y, dtype=np.float64)
-    if sr > CUE_SR:
+    if sr > CUE_SR:  # float32 out; no float64 copy of a long full-rate recording
         from ..resampling import resample  # noqa: PLC0415
 
-        n_out = int(round(y.size * CUE_SR / sr))
-        y = np.asarray(resample(y, sr, CUE_SR, n_out, keep_level=False), dtype=np.float64)
+        y = resample(y, sr, CUE_SR, int(round(y.size * CUE_SR / sr)), keep_level=False)
         sr = CUE_SR
-    peak = np.max(np.abs(y))
-    y = (y / peak if peak > 0 else y).astype(np.float32)
+    peak = float(np.max(np.abs(y)))
+    y = (np.asarray(y) / (peak if peak > 0 else 1.0)).astype(np.float32, copy=False)
     n_fft = int(2 ** np.round(np.log2(N_FFT_S * sr)))
-    hop = max(int(round(HOP_FRAMES * sr / fps)), 1)
+    hop = max(int(round(HOP_S * sr)), 1)
     half = n_fft // 2
     yp = np.concatenate([np.zeros(half, np.float32), y, np.zeros(half, np.float32)])
     frames = np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]  # centred
@@ -166,7 +168,6 @@ def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.nd
     # of its band only in linear scale (log-compressed over 40 dB, the synthetic rock
     # pattern at 60 BPM gave A -0.09 at its beat, linear +0.56)
     rise = np.maximum(np.diff(energy, axis=1, prepend=energy[:, :1]), 0.0)
-    rise = gaussian_smooth(rise, SMOOTH_FRAMES * sr / (fps * hop))  # in STFT frames
     times = np.arange(rise.shape[1]) * hop / sr
     target = np.arange(n_frames) / fps
     return np.stack([np.interp(target, times, r) for r in rise])

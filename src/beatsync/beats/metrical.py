@@ -49,8 +49,9 @@ Known limit of the per-window evaluation (measured, not yet fixed): the Hann-win
 perfectly periodic pattern gets a salience that falls with the period (per band about
 0.35, 0.30, 0.25 and 0.19 at 1, 2, 3 and 4 beats of the synthetic 3/4 pattern at
 90 BPM). The evidence alone therefore prefers the fastest pulse present, the tactus
-prior decides between levels an octave apart (the synthetic drum pattern at 180 BPM
-is tapped at 90), and the bar of a slow 3/4 loses to two beats (meter 2 at 90 BPM).
+prior decides between levels an octave apart (without the drum cue, the synthetic drum
+pattern at 180 BPM is tapped at 90), and the bar of a slow 3/4 loses to two beats
+(meter 2 at 90 BPM).
 Running the resonators in time over the whole signal (as in the paper) reverses the
 bias (steady-state salience 3.23, 3.24 and 3.36 for 1, 2 and 3 beats of that pattern,
 summed over bands) at several times the cost; correcting the window bias analytically
