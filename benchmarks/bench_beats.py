@@ -861,8 +861,7 @@ def main() -> int:
         "path salience of 0.08) were set on 84 noises of 2-30 s (ratios up to 2.53, one "
         "2 s noise 3.32 with salience 0.054) and the seven bundled real recordings (ratios "
         "3.33-22.4, saliences 0.11-0.67; `benchmarks/calibrate_pulse_clarity.py`), never "
-        "on the synthetic set. With the drum cue, one more 2 s noise reaches 2.85 (salience "
-        "0.016); the real recordings keep their ratios.",
+        "on the synthetic set. The drum cue left these numbers as they were.",
         "- Known gaps: the drum pattern was tapped at 90 BPM at 180 BPM (and at 120 BPM at "
         "60 BPM on some seeds), and the drum tempo-change items switched level at the "
         "change, until the drum cue: the pattern at 90 and at 180 BPM is the same pattern "
