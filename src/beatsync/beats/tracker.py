@@ -88,8 +88,8 @@ MIN_DURATION_S = 1.5
 #: white noise 3.32; real recordings 3.33 (the madmom sample) to 22.4; 2.9 is the
 #: geometric middle of 2.53 and 3.33. (With the coarser sampling before: noises
 #: 0.36-1.97, real 3.22-12.5, threshold 2.5.) With the drum cue of
-#: :mod:`beatsync.beats.drums` in the decoded path, the same numbers to the second
-#: decimal (DANCE_W_5 9.79 against 9.78).
+#: :mod:`beatsync.beats.drums` in the decoded path, the calibration prints the same
+#: table as without it.
 MIN_PULSE_CLARITY = 2.9
 #: Path salience below which the pulse is unclear whatever the null says: the one noise
 #: that passes the ratio (a 2 s white noise) has 0.054, the real recordings 0.11
