@@ -65,6 +65,8 @@ __all__ = [
     "segment",
     "segment_values",
     "estimate_period_count",
+    "PeriodicityRefused",
+    "NOT_PERIODIC_ADVICE",
 ]
 
 DEFAULT_PERIOD_RANGE = (0.25, 1.25)
@@ -188,8 +190,20 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
 NOT_PERIODIC_ADVICE = "Try other channels, another period_range, or a clip with repeated movement"
 
 
-class _NotPeriodic(NotPeriodicError):
-    """The periodicity test refused the optimum (a longer tier may still be periodic)."""
+class PeriodicityRefused(NotPeriodicError):
+    """The periodicity test refused the optimum (a longer tier may still be periodic).
+
+    Its message is the finding, the advice (:data:`NOT_PERIODIC_ADVICE`), a hint and
+    the tiers searched; :meth:`advised` gives it with the advice of another caller.
+    """
+
+    def __init__(self, finding: str, hint: str = "", searched: str = "") -> None:
+        self.finding, self.hint, self.searched = finding, hint, searched
+        super().__init__(self.advised(NOT_PERIODIC_ADVICE))
+
+    def advised(self, advice: str) -> str:
+        """The message with ``advice`` in place of :data:`NOT_PERIODIC_ADVICE`."""
+        return f"{self.finding}{advice}{self.hint}{self.searched}"
 
 
 def _segment(
@@ -228,14 +242,15 @@ def _segment(
         try:
             return _search(x, used, fps=fps, alpha=alpha, nominal=nominal, count=None,
                            period_range=tier, method=method)  # fmt: skip
-        except _NotPeriodic as exc:
+        except PeriodicityRefused as exc:
             refusal = exc
     if refusal is None:
         raise RuntimeError("no tier of the period range was searched")
+    searched = ""
     if len(bands) > 1:
-        searched = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
-        raise NotPeriodicError(f"{refusal} (period tiers searched, shortest first: {searched})")
-    raise NotPeriodicError(str(refusal))
+        tried = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
+        searched = f" (period tiers searched, shortest first: {tried})"
+    raise PeriodicityRefused(refusal.finding, refusal.hint, searched)
 
 
 def _search(
@@ -301,16 +316,15 @@ def _search(
                 )
             else:
                 hint = f"; n_periods={p} was given: check the count"
-        raise _NotPeriodic(
+        raise PeriodicityRefused(
             f"the motion is not periodic: the best segmentation into {n_found} periods of "
             f"~{float(frames_to_time((frames[-1] - frames[0]) / n_found, fps=fps)):.3f} s has "
             f"mean Pearson distance "
             f"{e_norm:.3f} between consecutive periods, and uniform segmentations at this "
             f"period beat those at wrong periods by only {contrast:.3f} (periodic needs "
             f"< {MAX_NORMALISED_ENERGY} and a "
-            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. "
-            + NOT_PERIODIC_ADVICE
-            + hint
+            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. ",
+            hint,
         )
     times = frames_to_time(frames, fps=fps)
     return Segmentation(

@@ -152,18 +152,17 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     from ..motion import segmentation_view
     from ..segment import segment
     from ..segment.checks import check_alpha, check_period_range
-    from ..segment.core import NOT_PERIODIC_ADVICE
+    from ..segment.core import PeriodicityRefused
 
     alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
     period_range = check_period_range(period_range)
     try:
         seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
-    except NotPeriodicError as exc:
+    except PeriodicityRefused as exc:
         # the channels are segmentation_view's here (sync and batch have no --channels)
-        text = str(exc).replace(NOT_PERIODIC_ADVICE, PERIODS_ADVICE)
-        if text == str(exc):
-            raise
-        raise NotPeriodicError(text) from None
+        raise NotPeriodicError(exc.advised(PERIODS_ADVICE)) from None
+    except NotPeriodicError:  # too short to tell: its own message
+        raise
     except ParameterError as exc:  # no angles to test, or angles that never change
         moves = _joints_move(motion)
         if moves is None:  # no joint positions either: the segmentation's own message
