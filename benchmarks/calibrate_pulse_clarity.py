@@ -18,9 +18,8 @@ import numpy as np
 
 from beatsync import datasets, io
 from beatsync.beats import metrical, tracker
-from beatsync.beats.drums import DRUM_WEIGHT, drum_cue
 from beatsync.beats.onset import compute_onsets, frontend_settings
-from beatsync.beats.tempo import analysis_windows, period_grid, tempo_hmm
+from beatsync.beats.tempo import tempo_hmm
 
 NOISE_SECONDS = (2, 3, 5, 7, 10, 15, 30)
 SR = 22050
@@ -30,20 +29,13 @@ def clarity(y: np.ndarray, sr: float) -> tuple[float, float]:
     """Path salience and the null, as :func:`beatsync.beats.track_beats` computes them."""
     y, sr = tracker.check_audio(y, sr)
     ons = compute_onsets(y, sr, frontend_settings({}, sr))
-    fps = ons.fps
-    accents = tracker._accents(ons.bands, fps)
-    starts, stops, _ = analysis_windows(ons.envelope.size, fps, 8.0, 1.0)
-    periods = period_grid(tracker.DEFAULT_MIN_BPM, tracker.DEFAULT_MAX_BPM)
-    max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * tracker._accent_sigma(fps) / fps)
     model = metrical.METER_MODEL
-    log_obs, sal, _ = metrical.tactus_observation(
-        accents, fps, starts, stops, periods, model, max_hz=max_hz
+    obs = tracker.observe(ons, (y, sr), model=model)
+    path = tempo_hmm(
+        obs.log_obs, obs.periods, trans_sigma=tracker.TRANS_SIGMA, p_jump=tracker.P_JUMP
     )
-    n = ons.envelope.size
-    log_obs = log_obs + DRUM_WEIGHT * drum_cue(y, sr, fps, n, starts, stops, periods)
-    path = tempo_hmm(log_obs, periods, trans_sigma=tracker.TRANS_SIGMA, p_jump=tracker.P_JUMP)
-    path_salience = float(np.mean(sal[path, np.arange(path.size)]))
-    null = tracker.pulse_clarity_null(ons, starts, stops, periods, model, max_hz)
+    path_salience = float(np.mean(obs.salience[path, np.arange(path.size)]))
+    null = tracker.pulse_clarity_null(ons, obs.starts, obs.stops, obs.periods, model, obs.max_hz)
     return path_salience, null
 
 

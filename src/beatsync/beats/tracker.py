@@ -16,7 +16,7 @@ noises and the bundled real recordings (numbers beside them).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -46,6 +46,8 @@ from .tempo import analysis_windows, period_grid, tempo_hmm
 
 __all__ = [
     "check_audio",
+    "Observation",
+    "observe",
     "SILENCE_PEAK",
     "MIN_SANE_BPM",
     "MAX_SANE_BPM",
@@ -343,7 +345,8 @@ def track_beats(
     ons = compute_onsets(y, sr, fe)
     return _track_psf(
         ons,
-        drums=(drum_weight, y, sr),
+        audio=(y, sr),
+        drum_weight=drum_weight,
         duration=y.size / sr,
         bpm=bpm,
         min_bpm=min_bpm,
@@ -362,25 +365,40 @@ def _empty(method: str, msg: str) -> BeatTrack:
     return BeatTrack(e, float("nan"), e, e, method)
 
 
-def _track_psf(
+class Observation(NamedTuple):
+    """What the tempo HMM decodes (:func:`observe`): the windows, the period grid, the
+    log observation per period and window, the resonator salience and the best measure."""
+
+    starts: np.ndarray
+    stops: np.ndarray
+    centres: np.ndarray
+    periods: np.ndarray
+    max_hz: float
+    log_obs: np.ndarray
+    salience: np.ndarray
+    measure: np.ndarray
+
+
+def observe(
     ons: OnsetSignal,
+    audio: tuple[np.ndarray, float],
     *,
-    drums: tuple[float, np.ndarray, float] | None = None,
-    duration: float,
-    bpm,
-    min_bpm,
-    max_bpm,
-    prior_period_s,
-    prior_sigma,
-    tempo_win_s,
-    tempo_hop_s,
-    time_varying,
-) -> BeatTrack:
+    model: MeterModel,
+    bpm: float | None = None,
+    min_bpm: float = DEFAULT_MIN_BPM,
+    max_bpm: float = DEFAULT_MAX_BPM,
+    tempo_win_s: float = 8.0,
+    tempo_hop_s: float = 1.0,
+    drum_weight: float = DRUM_WEIGHT,
+) -> Observation:
+    """The metrical model's tactus observation plus the drum cue, per tempo window.
+
+    The step of :func:`track_beats` before the tempo HMM (also what
+    ``benchmarks/calibrate_pulse_clarity.py`` decodes); inputs are trusted. A known
+    ``bpm`` gives a grid of one period and no drum cue (no level to choose).
+    """
     fps = ons.fps
     n = ons.envelope.size
-    if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
-        return _empty("psf", "no onsets found in the audio (no attack in any band): no beats")
-    model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
     accents = _accents(ons.bands, fps)
     starts, stops, centres = analysis_windows(n, fps, tempo_win_s, tempo_hop_s)
     if bpm is not None:
@@ -392,9 +410,35 @@ def _track_psf(
     log_obs, salience, measure = tactus_observation(
         accents, fps, starts, stops, periods, model, max_hz=max_hz
     )
-    if bpm is None and drums is not None and drums[0] > 0:  # a known tempo: no level to choose
-        weight, y, sr = drums
-        log_obs = log_obs + weight * drum_cue(y, sr, fps, n, starts, stops, periods)
+    if bpm is None and drum_weight > 0:
+        y, sr = audio
+        log_obs = log_obs + drum_weight * drum_cue(y, sr, fps, n, starts, stops, periods)
+    return Observation(starts, stops, centres, periods, max_hz, log_obs, salience, measure)
+
+
+def _track_psf(
+    ons: OnsetSignal,
+    *,
+    audio: tuple[np.ndarray, float],
+    drum_weight: float,
+    duration: float,
+    bpm,
+    min_bpm,
+    max_bpm,
+    prior_period_s,
+    prior_sigma,
+    tempo_win_s,
+    tempo_hop_s,
+    time_varying,
+) -> BeatTrack:
+    if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
+        return _empty("psf", "no onsets found in the audio (no attack in any band): no beats")
+    model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
+    obs = observe(
+        ons, audio, model=model, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm,
+        tempo_win_s=tempo_win_s, tempo_hop_s=tempo_hop_s, drum_weight=drum_weight,
+    )  # fmt: skip
+    starts, stops, centres, periods, max_hz, log_obs, salience, measure = obs
     if bpm is None:
         if not time_varying:
             log_obs = np.repeat(log_obs.sum(axis=1, keepdims=True), centres.size, axis=1)
