@@ -110,9 +110,9 @@ def _real_input(n: int) -> str:
     from beatsync import datasets
 
     parts = []
-    for rel in REAL_RECORDINGS:
+    for i, rel in enumerate(REAL_RECORDINGS):
         p = datasets.path(rel)
-        count = len(range(REAL_RECORDINGS.index(rel), n, len(REAL_RECORDINGS)))
+        count = len(range(i, n, len(REAL_RECORDINGS)))
         parts.append(f"{count} of {p.name} ({sf.info(str(p)).duration:.1f} s)")
     return f"{n} copies of the bundled recordings with human beat annotations: " + ", ".join(parts)
 
