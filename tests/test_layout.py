@@ -37,6 +37,7 @@ LAYER = {
     "synth": 3,
     "render": 4,
     "study": 5,
+    "learn": 6,
     "datasets": 5,
     "cluster": 5,
     "batch": 6,
