@@ -501,8 +501,11 @@ def test_mode_beats_lands_the_dancers_own_beats():
     assert r["max_abs_residual_frames"] <= 0.5 + 1e-6
     mb = kinematic_beats(res.motion)
     inside = mb[(mb > beats[0]) & (mb < r["covered_s"][1] - 0.5)]
-    d = np.abs(np.subtract.outer(inside, beats)).min(axis=1)
+    # intervals of 0.45-0.8 s on 0.5 s beats: within the speed band some land on half beats
+    grid = np.sort(np.r_[beats, (beats[1:] + beats[:-1]) / 2])
+    d = np.abs(np.subtract.outer(inside, grid)).min(axis=1)
     assert np.median(d) <= 1.0 / 25 + 1e-9  # the dancer's beats now sit on the music's
+    assert r["playback_speed"]["per_interval"]["in_band"] == 1.0
 
 
 @pytest.fixture(scope="module")

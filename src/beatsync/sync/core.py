@@ -16,9 +16,11 @@ from ..units import (
     frames_to_time,
     time_to_frames,
 )
-from .fill import LoopedClip, loop_events
+from .fill import LoopedClip, choose_loop, loop_events, with_center
 from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
+from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
+from .quality import report_entries
 from .warp import TimeWarp, integrate_warp
 
 __all__ = [
@@ -35,8 +37,6 @@ __all__ = [
 MODES = ("periods", "beats", "auto")
 LANDINGS = ("boundaries", "accents")
 FILLS = ("stop", "loop")
-#: width of the blended window at each loop join [s] (capped at half an interval)
-JOIN_S = 0.2
 #: default period range when segmenting, in music beats: one to eight beats
 PERIOD_BEATS = (0.9, 8.5)
 #: period range of the periodicity test in mode="auto": paper A's (steps, not figures)
@@ -408,8 +408,14 @@ def synchronize(
     intervals = np.diff(events)
     unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
     counted = motion_beat_count(motion, events) if used_mode == "periods" else None
+    whole_dance = used_mode == "beats" and override is None
     if override is not None:
         count = BeatCount(override, "override", unit / beat_period)
+    elif whole_dance:
+        count = BeatCount(
+            max(1, int(np.rint(unit / beat_period))), "whole dance (dynamic programming)",
+            unit / beat_period,
+        )  # fmt: skip
     else:
         count = choose_count(unit / beat_period, dance=dance, bar=bar)
     if count.meter_fit is False:
@@ -422,7 +428,9 @@ def synchronize(
     plan = {
         "motion": motion,
         "events": events,
-        "counts": counts,
+        "counts": None if whole_dance else counts,
+        "dance": dance if used_mode == "beats" else None,
+        "bar": bar,
         "beats": beats,
         "fill": fill,
         "first_beat": first_beat,
@@ -447,7 +455,7 @@ def synchronize(
             plan["first_beat"] = first_beat = first_beat + 1
         res = _resample(plan, -lag)
     ratio = unit / beat_period / count.m
-    if ratio > 2.0 or ratio < 0.5:
+    if not whole_dance and (ratio > 2.0 or ratio < 0.5):
         warn(
             f"motion {'beats' if used_mode == 'beats' else 'periods'} ({unit:.3f} s) become "
             f"{count.m} beat(s) of {beat_period:.3f} s: the dance is played {ratio:.2f}x its "
@@ -473,7 +481,34 @@ def synchronize(
             "beat_period_s": beat_period,
         }
     )
+    if whole_dance:  # the count used most
+        used_counts = res.report["beats_per_motion_beat_used"]
+        res.report["beats_per_period"] = float(max(used_counts, key=used_counts.get))
+    _speed_warning(res.report, intervals, beat_period)
     return res
+
+
+#: share of output time within the speed band below which a warning is given
+BAND_SHARE = 0.95
+
+
+def _speed_warning(report: dict[str, Any], intervals: np.ndarray, beat_period: float) -> None:
+    """Warn when the song cannot be followed within the speed band, naming a tempo
+    that would fit."""
+    from .quality import fitting_tempo
+
+    sp = report["playback_speed"]
+    share = (sp["instantaneous"] or sp["per_interval"])["in_band"]
+    report["speed_warning"] = ""
+    if share < BAND_SHARE:
+        lo, hi = sp["band"]
+        note = (
+            f"the dance plays within x{lo:g}-x{hi:g} of its speed for only {share:.0%} of "
+            f"the song ({60.0 / beat_period:.0f} BPM); a song at about "
+            f"{fitting_tempo(intervals, 60.0 / beat_period)} would fit"
+        )
+        report["speed_warning"] = note
+        warn(note, stacklevel=3)
 
 
 def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
@@ -482,43 +517,48 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     first_beat, fps, out_fps = plan["first_beat"], plan["fps"], plan["out_fps"]
     duration = plan["duration"]
     n_avail = events.size - 1
-    cum = np.concatenate([[0], np.cumsum(counts)])
     last_beat = beats.size - 1
     looped: LoopedClip | None = None
-    if plan["fill"] == "loop" and cum[-1] < last_beat - first_beat:
-        # enough repetitions that whole intervals reach the last beat, plus one for the tail
-        per_rep = int(cum[-1] - cum[0])
-        need = -(-(last_beat - first_beat) // max(per_rep, 1)) * n_avail + 1
-        looped = loop_events(events, need, join=JOIN_S)
-        events = looped.events
-        counts = np.resize(counts, events.size - 1)
-        cum = np.concatenate([[0], np.cumsum(counts)])
-    n_fit = int(np.searchsorted(cum, last_beat - first_beat, side="right")) - 1
-    if n_fit < 1:
-        raise ParameterError(
-            f"the music is too short: {beats.size - first_beat} beat(s) from beat {first_beat} "
-            f"(last at {beats[-1]:.2f} s) cannot hold one motion period of {int(counts[0])} "
-            f"beat(s) ({float(events[1] - events[0]):.2f} s of motion); use a longer song, an "
-            "earlier first_beat or fewer beats_per_period"
-        )
-    p = min(n_avail if looped is None else events.size - 1, n_fit)
-    targets = beats[first_beat + cum[: p + 1]] + phase_offset
-    if targets[0] < 0:
-        raise ParameterError(
-            f"phase_offset={phase_offset:.3f} s puts the first boundary at {targets[0]:.3f} s, "
-            "before the music starts; use first_beat >= 1 or a smaller offset"
-        )
-    used = events[: p + 1]
-    end = None
-    if p == events.size - 1 and duration > used[-1]:
-        end = duration  # the clip's tail after its last boundary
-    warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
-    if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
-        # cover the beats after the last whole interval with part of the next one: the
-        # warp goes on at its end rate up to the last beat (within that interval)
-        need = beats[last_beat] + phase_offset - targets[-1]
-        end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
+    if counts is None:  # beats mode: the whole dance's counts at once
+        looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
         warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        p = used.size - 1
+    else:
+        cum = np.concatenate([[0], np.cumsum(counts)])
+        if plan["fill"] == "loop" and cum[-1] < last_beat - first_beat:
+            # enough repetitions that whole intervals reach the last beat, plus one for the tail
+            a, b, angle, shift, dist, join = choose_loop(motion, events)
+            per_rep = max(int(cum[b] - cum[a]), 1)
+            need = b + 1 + -(-max(0, last_beat - first_beat - int(cum[b])) // per_rep) * (b - a)
+            looped = loop_events(
+                events, need, join=join, span=(a, b), angle=angle, shift=shift, distance=dist
+            )
+            counts = counts[looped.event_index[1:] - 1]
+            events = looped.events
+            cum = np.concatenate([[0], np.cumsum(counts)])
+        n_fit = int(np.searchsorted(cum, last_beat - first_beat, side="right")) - 1
+        if n_fit < 1:
+            raise ParameterError(
+                f"the music is too short: {beats.size - first_beat} beat(s) from beat "
+                f"{first_beat} (last at {beats[-1]:.2f} s) cannot hold one motion period of "
+                f"{int(counts[0])} beat(s) ({float(events[1] - events[0]):.2f} s of motion); use "
+                "a longer song, an earlier first_beat or fewer beats_per_period"
+            )
+        p = min(n_avail if looped is None else events.size - 1, n_fit)
+        targets = beats[first_beat + cum[: p + 1]] + phase_offset
+        check_start(targets, phase_offset)
+        used = events[: p + 1]
+        end = None
+        if p == events.size - 1 and duration > used[-1]:
+            end = duration  # the clip's tail after its last boundary
+        warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
+            # cover the beats after the last whole interval with part of the next one: the
+            # warp goes on at its end rate up to the last beat (within that interval)
+            need = beats[last_beat] + phase_offset - targets[-1]
+            end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
+            warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
     tau_end = float(warp.tgt[-1])
     if tau_end <= 0:
         raise ParameterError(
@@ -543,7 +583,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
         )
         values = pos.reshape(n_out, -1)
-    out_motion = motion.with_values(values, fps=out_fps)
+    out_motion = with_center(motion.with_values(values, fps=out_fps), motion, src_times, looped)
 
     # residuals: realised warp (interpolated between output frames) and nearest frame
     live = (out_times > warp.tgt[0]) & (out_times < warp.tgt[-1])
@@ -598,4 +638,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     }
     # the first boundary frame index in the output, for users who trim
     report["first_boundary_frame"] = int(time_to_frames(targets[0], fps=out_fps))
+    report.update(
+        report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed)
+    )
     return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)
