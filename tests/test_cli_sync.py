@@ -290,7 +290,9 @@ def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
     assert r["fill"] == "loop" and r["output_duration_s"] >= beats[-1] - 1 / 25
     assert r["max_abs_residual_frames"] <= 1.0
     assert result["beats_per_bar"] == 3 and r["meter_fit"] is not False
-    assert r["beats_per_period"] in (1, 3, 6, 9)  # never 4 or 5 on a 3/4 song
+    # the counts follow the dancer's speed, not the song's meter alone (a waltz step of
+    # 2 beats where 2 fit); the output plays within x0.8-1.25 of the dancer's speed
+    assert r["playback_speed"]["instantaneous"]["in_band"] >= 0.95
     back = io.read_motion(out, fps=25)
     assert back.is_positional and back.n_frames == r["output_frames"]
     src = io.read_motion(d / "dancer.json", fps=25)
