@@ -306,3 +306,24 @@ def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
     lo, hi = lengths(src).min(axis=0), lengths(src).max(axis=0)
     got = lengths(back)
     assert np.all(got >= 0.99 * lo) and np.all(got <= 1.01 * hi)
+
+
+def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, capsys):
+    d, _, beats = inputs  # 12 s of a real waltz dancer (JSON: skeletons relative to center)
+    out, rep = tmp_path / "out.json", tmp_path / "report.json"
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(out), "--fps", "25",
+            "--beats", str(d / "song.beats"), "--report", str(rep)]  # fmt: skip
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    src, got = json.loads((d / "dancer.json").read_text()), json.loads(out.read_text())
+    # the joints keep their place relative to the dataset's root track: the joints'
+    # centroid (what replaced it) would put their mean on it in every frame
+    off_in = np.linalg.norm(np.asarray(src["skeletons"]).mean(axis=1), axis=1)  # [cm]
+    off_out = np.linalg.norm(np.asarray(got["skeletons"]).mean(axis=1), axis=1)
+    assert np.median(off_in) > 1.0
+    assert np.median(off_out) == pytest.approx(np.median(off_in), rel=0.25)
+    r = json.loads(rep.read_text())["report"]
+    assert len(r["boundaries_s"]) == len(r["target_beats_s"]) == r["periods_used"] + 1
+    assert sum(r["beats_per_motion_beat_used"].values()) == r["periods_used"]
+    assert r["joins"] and all(j["peak_joint_speed"] > 0 for j in r["joins"])
+    assert "beats    per motion beat used: " in stdout and "% of the output within" in stdout
