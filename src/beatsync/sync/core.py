@@ -484,7 +484,7 @@ def synchronize(
     if whole_dance:  # the count used most
         used_counts = res.report["beats_per_motion_beat_used"]
         res.report["beats_per_period"] = float(max(used_counts, key=used_counts.get))
-    _speed_warning(res.report, intervals, beat_period)
+    _speed_warning(res.report, beat_period)
     return res
 
 
@@ -492,7 +492,7 @@ def synchronize(
 BAND_SHARE = 0.95
 
 
-def _speed_warning(report: dict[str, Any], intervals: np.ndarray, beat_period: float) -> None:
+def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
     """Warn when the song cannot be followed within the speed band, naming a tempo
     that would fit."""
     from .quality import fitting_tempo
@@ -505,7 +505,8 @@ def _speed_warning(report: dict[str, Any], intervals: np.ndarray, beat_period: f
         note = (
             f"the dance plays within x{lo:g}-x{hi:g} of its speed for only {share:.0%} of "
             f"the song ({60.0 / beat_period:.0f} BPM); a song at about "
-            f"{fitting_tempo(intervals, 60.0 / beat_period)} would fit"
+            f"{fitting_tempo(sp['per_interval']['median'], 60.0 / beat_period)} would fit "
+            "with the same beat counts"
         )
         report["speed_warning"] = note
         warn(note, stacklevel=3)

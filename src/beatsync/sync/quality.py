@@ -103,14 +103,11 @@ def join_figures(
     return rows
 
 
-def fitting_tempo(intervals: np.ndarray, song_bpm: float, band=DEFAULT_SCALE_BOUND) -> str:
-    """The tempi at which the dance plays within the band, nearest the song's first."""
-    natural = 60.0 / float(np.median(intervals))  # one music beat per motion beat
-    cands = sorted(
-        (natural * k for k in (0.5, 1.0, 1.5, 2.0, 3.0)), key=lambda x: abs(np.log(x / song_bpm))
-    )
-    lo, hi = cands[0] * band[0], cands[0] * band[1]
-    return f"{cands[0]:.0f} BPM ({lo:.0f}-{hi:.0f} BPM)"
+def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND) -> str:
+    """The tempo at which the same beat counts would play the dance at its own speed
+    (``song_bpm / median_speed``), and the tempi that keep that speed within the band."""
+    natural = song_bpm / median_speed
+    return f"{natural:.0f} BPM ({natural * band[0]:.0f}-{natural * band[1]:.0f} BPM)"
 
 
 def report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed) -> dict:
