@@ -15,7 +15,7 @@ script (not read from the sync report):
   speed, loop joins included, against the dancer's own peak (target x1.10);
 - motion-beat alignment with the new song, both published scores
   (:mod:`beatsync.evaluate.alignment`: ``_motion`` Li et al. 2021, ``_music`` Siyao et
-  al. 2022, sigma 0.1 s), against the random-offset control and against the dancer
+  al. 2022, sigma 0.05 s), against the random-offset control and against the dancer
   with their own song (target: >= 0.10 above both, on both scores);
 - bone lengths: the largest deviation of an output bone from the dancer's median
   length of that bone, against the same for the input itself (target: within 1 % of
@@ -76,7 +76,7 @@ def speed_figures(res, out_fps: float) -> dict:
     """Playback speed between consecutive output frames, where the warp is live."""
     src = np.asarray(res.warp_src_times, dtype=np.float64)
     t = np.arange(src.size) / out_fps
-    live = (t[1:] > res.warp.tgt[0]) & (t[:-1] < res.warp.tgt[-1])
+    live = (t[1:] > res.warp.tgt[0]) & (t[1:] <= res.warp.tgt[-1] + 1e-9)
     s = np.diff(src)[live] * out_fps
     return {
         "in_band": float(np.mean((s >= BAND[0]) & (s <= BAND[1]))),
