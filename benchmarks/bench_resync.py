@@ -17,9 +17,9 @@ script (not read from the sync report):
   (:mod:`beatsync.evaluate.alignment`: ``_motion`` Li et al. 2021, ``_music`` Siyao et
   al. 2022, sigma 0.05 s), against the random-offset control and against the dancer
   with their own song (target: >= 0.10 above both, on both scores);
-- bone lengths: the largest deviation of an output bone from the dancer's median
-  length of that bone, against the same for the input itself (target: within 1 % of
-  the input's own deviation).
+- bone lengths: how far an output bone's length goes beyond the range of lengths the
+  dancer shows for that bone (target: within 1 %; the dataset's joint positions are
+  estimated, so a bone's length varies from frame to frame in the input itself).
 
 The whole process ``beatsync sync`` of a 90 s dancer (the rumba excerpt tiled) on a
 4 min song (synthetic drum pattern, 118 BPM), without video, is timed (target < 5 s).
@@ -53,6 +53,28 @@ import numpy as np  # noqa: E402
 BAND = (0.8, 1.25)
 TARGETS = {"in_band": 0.95, "p99_speed": 1.15, "p99_accel": 1.30, "peak": 1.10, "margin": 0.10}
 RESULTS = Path(__file__).resolve().parent / "results"
+NOTES = [
+    "Notes:",
+    "",
+    "- What was tuned on what: the weights of the beat counts' dynamic programme "
+    "(`beatsync.sync.counts`: W_OUT 4 and W_EXCESS 200 per second outside the band, "
+    "W_CHANGE 4, W_HALF 1.5 and W_MERGE 1 per event, W_BAR 3) were set from their scales "
+    "(per-second speed costs against per-event costs) and then checked on these 12 pairs; "
+    "MARGIN (1.05: the counts aim inside 0.84-1.19) was added after the warp was seen to "
+    "overshoot an interval's speed at the band's edges on these same pairs (83-99 % of the "
+    "output in band without it); the peak headroom (no interval played faster than keeps "
+    "its joints within the dancer's own peak) after peaks of x1.16-1.26 were seen on them. "
+    "W_HALF 3-4 and W_MERGE 3 were tried on all 12 pairs: no alignment margin moved by more "
+    "than 0.03, so they were not kept. The loop's blend (0.6 s) and shortest span (half "
+    "the clip's motion beats) were set beforehand. Only four dancers are bundled: these "
+    "are development numbers, with no held-out pair.",
+    "- The pairs that miss the alignment target miss it on the music-beat score (BAS, "
+    "averaged over music beats) only: the waltz dancers' motion beats are 1.0-1.8 s apart, "
+    "2-4 beats of the faster songs, so most music beats have no motion beat near them; "
+    "DANCE_W_5 with its own song already scores 0.20 there. On the motion-beat score every "
+    "pair is at least 0.19 above both references.",
+    "",
+]
 
 
 def kinematics(pos: np.ndarray, fps: float) -> dict:
@@ -66,10 +88,15 @@ def kinematics(pos: np.ndarray, fps: float) -> dict:
     }
 
 
-def bone_deviation(pos: np.ndarray, bones: np.ndarray, ref: np.ndarray) -> float:
-    """Largest |length / reference - 1| over bones and frames."""
-    length = np.linalg.norm(pos[:, bones[:, 1]] - pos[:, bones[:, 0]], axis=-1)
-    return float(np.max(np.abs(length / ref - 1.0)))
+def bone_lengths(pos: np.ndarray, bones: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(pos[:, bones[:, 1]] - pos[:, bones[:, 0]], axis=-1)
+
+
+def bone_excess(pos: np.ndarray, bones: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """Largest excess of an output bone length beyond the dancer's own range of that
+    bone, relative (0: every bone within the range the dancer shows)."""
+    length = bone_lengths(pos, bones)
+    return float(max(0.0, np.max(lo / length - 1.0), np.max(length / hi - 1.0)))
 
 
 def speed_figures(res, out_fps: float) -> dict:
@@ -107,7 +134,8 @@ def run_pairs() -> list[dict]:
         motion = pairs[dancer].motion
         pos_in = motion_positions(motion)
         bones = position_bones(motion)
-        ref = np.median(np.linalg.norm(pos_in[:, bones[:, 1]] - pos_in[:, bones[:, 0]], axis=-1), 0)
+        own_len = bone_lengths(pos_in, bones)
+        lo, hi = own_len.min(axis=0), own_len.max(axis=0)
         own_kin = kinematics(pos_in, motion.fps)
         own = own_song_scores(pairs[dancer], songs[dancer]["beats"])
         for song in DANCE_PAIRS:
@@ -140,8 +168,7 @@ def run_pairs() -> list[dict]:
                     "peak_ratio": kin["peak_speed"] / own_kin["peak_speed"],
                     "own_peak_speed": own_kin["peak_speed"],
                     "join_peak_speeds": [float(j["peak_joint_speed"]) for j in joins],
-                    "bone_dev_out": bone_deviation(pos, bones, ref),
-                    "bone_dev_in": bone_deviation(pos_in, bones, ref),
+                    "bone_excess": bone_excess(pos, bones, lo, hi),
                     "after": {k: after[k] for k in ("motion", "music")},
                     "control": {k: after[f"control_{k}"] for k in ("motion", "music")},
                     "own": {k: own[k] for k in ("motion", "music")},
@@ -196,7 +223,8 @@ def markdown(labels: dict[str, dict]) -> list[str]:
         "0.8-1.25 for >= 95 % of the covered output time; p99 joint speed <= x1.15 and p99 "
         "acceleration <= x1.30 the dancer's own; peak joint speed (joins included) <= x1.10; "
         "both alignment scores >= 0.10 above the random-offset control and above the dancer "
-        "with their own song; bone lengths within 1 % of the input's own deviation.",
+        "with their own song; every bone's length within 1 % of the range the dancer shows "
+        "for it (column bones: the largest excess).",
         "",
     ]
     for label, data in labels.items():
@@ -209,7 +237,7 @@ def markdown(labels: dict[str, dict]) -> list[str]:
             "",
             "| dancer -> song | mode | in band | speed min / med / max | p99 v | p99 a | "
             "peak (joins) | align motion: after / ctrl / own | align music: after / ctrl / "
-            "own | bones out / in | targets |",
+            "own | bones | targets |",
             "|---|---|---:|---|---:|---:|---|---|---|---|---|",
         ]
         n_pass = 0
@@ -226,7 +254,7 @@ def markdown(labels: dict[str, dict]) -> list[str]:
                 "a": r["p99_accel_ratio"] <= TARGETS["p99_accel"],
                 "peak": r["peak_ratio"] <= TARGETS["peak"],
                 "align": margin >= TARGETS["margin"],
-                "bones": r["bone_dev_out"] <= r["bone_dev_in"] + 0.01,
+                "bones": r["bone_excess"] <= 0.01,
             }
             n_pass += all(ok.values())
             failed = [k for k, v in ok.items() if not v]
@@ -238,7 +266,7 @@ def markdown(labels: dict[str, dict]) -> list[str]:
                 f"{r['after']['motion']:.2f} / {r['control']['motion']:.2f} / "
                 f"{r['own']['motion']:.2f} | {r['after']['music']:.2f} / "
                 f"{r['control']['music']:.2f} / {r['own']['music']:.2f} | "
-                f"{r['bone_dev_out']:.3f} / {r['bone_dev_in']:.3f} | "
+                f"{r['bone_excess']:.2%} | "
                 f"{'all PASS' if not failed else 'FAIL: ' + ', '.join(failed)} |"
             )
         lines.append("")
@@ -251,6 +279,7 @@ def markdown(labels: dict[str, dict]) -> list[str]:
                 f"{_ok(lo['seconds'] < 5.0)})."
             )
         lines.append("")
+    lines += NOTES
     return lines
 
 

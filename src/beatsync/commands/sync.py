@@ -88,8 +88,9 @@ def register(subparsers: Any) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="music beats per motion period, or per motion beat with --mode beats "
-        "(default: round(motion period / beat), respecting the meters)",
+        help="music beats per motion period, or per median motion beat with --mode beats "
+        "(default: periods round(motion period / beat), respecting the meters; motion "
+        "beats: chosen for the whole dance within the playback speed band)",
     )
     p.add_argument(
         "--first-beat",
@@ -133,8 +134,9 @@ def register(subparsers: Any) -> None:
         default=None,
         metavar="N",
         help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
-        "a waltz box); beats per period are then a multiple of it, and a warning says so "
-        "when the song's meter does not fit",
+        "a waltz box); with periods, beats per period are then a multiple of it (a warning "
+        "says so when the song's meter does not fit); with motion beats, every N motion "
+        "beats start on a bar line of the song where the speed allows",
     )
     p.add_argument(
         "--period-range",

@@ -286,8 +286,11 @@ def synchronize(
         The music's meter (e.g. ``track.beats_per_bar``); respected when choosing.
     dance_beats_per_period : int >= 1, optional
         The dance's meter: beats of one period of the dance (3 for a waltz step, 6
-        for a waltz box); the count then is a multiple of it (or it halved), and a
-        warning says so when it cannot also respect ``beats_per_bar``. The report's
+        for a waltz box). In ``mode="periods"`` the count then is a multiple of it (or
+        it halved), and a warning says so when it cannot also respect
+        ``beats_per_bar``; in ``mode="beats"`` every such group of motion beats starts
+        on a bar line of the music where the speed band allows, and a loop holds
+        whole groups. The report's
         ``motion_beats_per_period_counted`` (kinematic beats per period) is a hint.
     first_beat : int >= 0
         Index of the beat the first boundary lands on.

@@ -181,18 +181,21 @@ def plan_counts(
     # D[i]: cost over states (k, c, m), stored sparsely per event index
     shape = (k_max + 1, cmax + 1, 2)
     cost: dict[int, np.ndarray] = {}
-    back: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+    back: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}
     start = np.full(shape, inf)
     start[0, 0, 0] = 0.0 if (bar is None or not phrase[0] or bar_ok[0]) else W_BAR
     cost[0] = start
     best_end = (inf, -1, -1, -1, -1)
     at_last: dict[int, np.ndarray] = {}  # event -> costs of (c, m) on the last beat
-    last_reach = 0
+    furthest = (-1, 0, inf, 0, 0)  # (k, -event, cost, c, m): the latest grid point reached
     for i in range(p):
         cur = cost.pop(i, None)
         if cur is None or not np.isfinite(cur).any():
             continue
-        last_reach = i
+        if i in back:  # final now: keep the back pointers of the reached states only
+            raw = np.nonzero(np.isfinite(cur).any(axis=(1, 2)))[0]
+            lo_k, hi_k = int(raw[0]), int(raw[-1]) + 1
+            back[i] = (lo_k, *(a[lo_k:hi_k].copy() for a in back[i][1:]))
         floor = np.min(cur)
         cur = np.where(cur <= floor + BEAM, cur, inf)
         ks = np.nonzero(np.isfinite(cur).any(axis=(1, 2)))[0]
@@ -223,38 +226,44 @@ def plan_counts(
             if nxt is None:
                 nxt = np.full(shape, inf)
                 back[j] = (
+                    0,  # offset of the first grid point stored
                     np.full(shape, -1, dtype=np.int32),
                     np.full(shape, -1, dtype=np.int8),
                     np.full(shape, -1, dtype=np.int8),
                 )
-            bk, bc, bm = back[j]
-            for c in range(1, cmax + 1):
-                tgt_k = kidx + c
-                ok = tgt_k <= k_max
-                if not ok.any():
-                    continue
-                dur = span[kidx[ok], c]
+            _, bk, bc, bm = back[j]
+            # every count c at once: states (k, c_prev, m_prev) -> (k + c, c, merged)
+            cs1 = np.arange(1, cmax + 1)
+            tgt_k = kidx[:, None] + cs1[None, :]  # (nk, C)
+            ok = tgt_k <= k_max
+            dur = np.where(ok, span[kidx[:, None], cs1[None, :]], np.nan)
+            with np.errstate(invalid="ignore"):
                 ls = np.log(src / dur)
-                step = _speed_cost(ls, dur, lo, hi) + odd[tgt_k[ok]] + W_MERGE * merged
-                if bar is not None:
-                    step = step + W_BAR * (phrase[j] & ~bar_ok[tgt_k[ok]])
-                change = np.where(
-                    np.isfinite(prev_ls[ok]), W_CHANGE * (ls[:, None, None] - prev_ls[ok]) ** 2, 0.0
-                )
-                tot = sub[ok] + change  # (n_ok, C+1, 2)
-                flat = tot.reshape(tot.shape[0], -1)
-                arg = np.argmin(flat, axis=1)
-                val = flat[np.arange(flat.shape[0]), arg] + step
-                tk = tgt_k[ok]
-                better = val < nxt[tk, c, merged]
-                if better.any():
-                    tkb = tk[better]
-                    nxt[tkb, c, merged] = val[better]
-                    bk[tkb, c, merged] = kidx[ok][better]
-                    bc[tkb, c, merged] = arg[better] // 2
-                    bm[tkb, c, merged] = arg[better] % 2
+            tk = np.minimum(tgt_k, k_max)
+            step = _speed_cost(ls, dur, lo, hi) + odd[tk] + W_MERGE * merged
+            if bar is not None:
+                step = step + W_BAR * (phrase[j] & ~bar_ok[tk])
+            change = W_CHANGE * (ls[:, :, None, None] - prev_ls[:, None]) ** 2
+            change = np.where(np.isfinite(prev_ls)[:, None], change, 0.0)
+            tot = (sub[:, None] + change).reshape(kidx.size, cmax, -1)  # (nk, C, prev)
+            arg = np.argmin(tot, axis=2)
+            val = np.take_along_axis(tot, arg[:, :, None], axis=2)[:, :, 0] + step
+            val = np.where(ok, val, inf)
+            cc = np.broadcast_to(cs1, tk.shape)
+            better = val < nxt[tk, cc, merged]
+            if better.any():
+                tkb, ccb = tk[better], cc[better]
+                nxt[tkb, ccb, merged] = val[better]
+                bk[tkb, ccb, merged] = np.broadcast_to(kidx[:, None], tk.shape)[better]
+                bc[tkb, ccb, merged] = arg[better] // 2
+                bm[tkb, ccb, merged] = arg[better] % 2
             cost[j] = nxt
             at_last[j] = nxt[k_max]
+            reached = np.nonzero(np.isfinite(nxt).any(axis=(1, 2)))[0]
+            if reached.size and (reached[-1], -j) > furthest[:2]:
+                kf = int(reached[-1])
+                c_, m_ = np.unravel_index(np.argmin(nxt[kf]), nxt[kf].shape)
+                furthest = (kf, -j, float(nxt[kf, c_, m_]), int(c_), int(m_))
             if end == "last_beat" or j == p:
                 cand = nxt[k_max] if end == "last_beat" else None
                 if end == "last_beat":
@@ -276,12 +285,14 @@ def plan_counts(
                 best_end = (float(cand[c_, m_]), j, k_max, int(c_), int(m_))
                 break
     if not np.isfinite(best_end[0]):
-        raise RuntimeError(f"no placement reaches the end (last event reached {last_reach})")
+        # too few events to reach the song's end: stop at the latest grid point reached
+        kf, mj, val, c_, m_ = furthest
+        best_end = (val, -mj, kf, c_, m_)
     total, j, k, c, m = best_end
     ev, gk = [j], [k]
     while j > 0:
-        bk, bc, bm = back[j]
-        pk, pc, pm = int(bk[k, c, m]), int(bc[k, c, m]), int(bm[k, c, m])
+        off, bk, bc, bm = back[j]
+        pk, pc, pm = (int(a[k - off, c, m]) for a in (bk, bc, bm))
         j = j - 1 - m
         k, c, m = pk, pc, pm
         ev.append(j)
