@@ -27,6 +27,7 @@ The whole process ``beatsync sync`` of a 90 s dancer (the rumba excerpt tiled) o
 Usage::
 
     .venv/bin/python benchmarks/bench_resync.py --label after [--skip-long]
+        [--baseline-src /tmp/main/src]   # git archive main src | tar -x -C /tmp/main
 
 Writes ``benchmarks/results/resync_<label>.json``; ``resync.md`` shows every label
 found (``before``: the code before the whole-dance beat counts and seamless loops).
@@ -179,8 +180,10 @@ def run_pairs() -> list[dict]:
     return rows
 
 
-def long_run(repeats: int) -> dict:
-    """``beatsync sync`` of a 90 s dancer on a 4 min song, whole process, no video."""
+def long_run(repeats: int, baseline_src: str | None) -> dict:
+    """``beatsync sync`` of a 90 s dancer on a 4 min song, whole process, no video; with
+    ``baseline_src`` (another revision's ``src/``) both run interleaved, so a busy spell
+    of the shared machine falls on both alike."""
     from beatsync import datasets, io
     from beatsync.synth.audio import beat_times, drum_pattern
 
@@ -194,17 +197,28 @@ def long_run(repeats: int) -> dict:
         song = io.write_audio(tmp / "song4min.wav", y, 44100)
         cmd = [sys.executable, "-m", "beatsync.cli", "sync", str(dance), str(song),
                "-o", str(tmp / "out.json"), "--fps", "25", "--json"]  # fmt: skip
-        times = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            proc = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ))
-            times.append(time.perf_counter() - t0)
-            if proc.returncode != 0:
-                raise RuntimeError(proc.stderr[-400:])
-    return {
-        "seconds": float(np.median(times)),
+        envs = [dict(os.environ)]
+        if baseline_src:
+            data = str(Path(__file__).resolve().parent.parent / "data")
+            envs.append({**os.environ, "PYTHONPATH": baseline_src, "BEATSYNC_DATA": data})
+
+        def run(env):
+            def call():
+                proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+                if proc.returncode != 0:
+                    raise RuntimeError(proc.stderr[-400:])
+
+            return call
+
+        times = _machine.interleaved_times([run(e) for e in envs], repeats)
+    out = {
+        "seconds": float(np.median(times[0])),
         "command": "beatsync sync dancer90.json song4min.wav -o out.json --fps 25",
+        "load_average": _machine.machine_facts()["load_average"],
     }
+    if baseline_src:
+        out["baseline_seconds"] = float(np.median(times[1]))
+    return out
 
 
 def _ok(flag: bool) -> str:
@@ -273,10 +287,17 @@ def markdown(labels: dict[str, dict]) -> list[str]:
         lines.append(f"{n_pass} of {len(data['rows'])} pairs meet every target.")
         if data.get("long"):
             lo = data["long"]
+            base = ""
+            if lo.get("baseline_seconds"):
+                ratio = lo["seconds"] / lo["baseline_seconds"]
+                base = (
+                    f"; the code before, interleaved in the same run: "
+                    f"{lo['baseline_seconds']:.2f} s (ratio {ratio:.2f})"
+                )
             lines.append(
-                f"90 s dancer on a 4 min song, whole process without video: "
-                f"{lo['seconds']:.2f} s (`{lo['command']}`; target < 5 s: "
-                f"{_ok(lo['seconds'] < 5.0)})."
+                f"90 s dancer on a 4 min song, whole process without video, median of the "
+                f"runs: {lo['seconds']:.2f} s (`{lo['command']}`; target < 5 s: "
+                f"{_ok(lo['seconds'] < 5.0)}){base}; load average {lo.get('load_average')}."
             )
         lines.append("")
     lines += NOTES
@@ -288,11 +309,17 @@ def main() -> int:
     ap.add_argument("--label", default="after")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--skip-long", action="store_true")
+    ap.add_argument(
+        "--baseline-src",
+        default=None,
+        help="src/ of another revision (e.g. `git archive main src`): its `sync` is timed "
+        "interleaved with this one's on the long dance",
+    )
     args = ap.parse_args()
     from beatsync import io
 
     data = {"facts": _machine.machine_facts(), "rows": run_pairs()}
-    data["long"] = None if args.skip_long else long_run(args.repeats)
+    data["long"] = None if args.skip_long else long_run(args.repeats, args.baseline_src)
     RESULTS.mkdir(exist_ok=True)
     io.write_json(RESULTS / f"resync_{args.label}.json", data)
     labels = {}
