@@ -260,26 +260,6 @@ def test_outputs_keep_an_existing_files_mode(tmp_path):
     assert a.read_text() == "new" and a.stat().st_mode & 0o777 == 0o640
 
 
-def test_outputs_refuse_undeclared_and_unwritten_files(tmp_path):
-    outs = Outputs()
-    with pytest.raises(RuntimeError, match="not declared"):
-        outs.path(tmp_path / "x.txt")
-    with pytest.raises(RuntimeError, match="declared but not written"):
-        with Outputs() as outs:
-            outs.add(tmp_path / "y.txt")
-            outs.path(tmp_path / "y.txt")
-    assert _listing(tmp_path) == []
-
-
-def test_outputs_refuse_an_input_named_later(tmp_path):
-    out = tmp_path / "o.bvh"
-    out.write_text("x")
-    outs = Outputs()
-    outs.add(out, option="-o")
-    with pytest.raises(ParameterError, match="-o .* same file as the input"):
-        outs.add_inputs(out)
-
-
 def _notebook(path: Path, body: str) -> None:
     nb = nbformat.v4.new_notebook()
     params = nbformat.v4.new_code_cell("n: int = 3  # how many")

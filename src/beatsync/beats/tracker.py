@@ -21,16 +21,14 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..errors import ParameterError, warn
+from ..units import check_audio as _units_check_audio
 from ..units import (
-    MAX_BPM,
-    MIN_BPM,
     check_bpm,
     check_positive,
     check_range,
     check_times,
     frames_to_time,
 )
-from ..units import check_audio as _units_check_audio
 from .drums import DRUM_WEIGHT, drum_cue
 from .filters import gaussian_smooth
 from .metrical import (
@@ -49,8 +47,6 @@ __all__ = [
     "Observation",
     "observe",
     "SILENCE_PEAK",
-    "MIN_SANE_BPM",
-    "MAX_SANE_BPM",
     "DEFAULT_MIN_BPM",
     "DEFAULT_MAX_BPM",
     "BeatTrack",
@@ -68,9 +64,6 @@ __all__ = [
 #: Tempo range [bpm] that :func:`track_beats` searches unless told otherwise.
 DEFAULT_MIN_BPM = 40.0
 DEFAULT_MAX_BPM = 240.0
-#: The plausible tempo range [bpm] (:data:`beatsync.units.MIN_BPM`, ``MAX_BPM``).
-MIN_SANE_BPM = MIN_BPM
-MAX_SANE_BPM = MAX_BPM
 #: Audio shorter than this is refused [s] (:func:`check_duration`): two beat periods
 #: at 80 BPM, three at 120 BPM. A shorter clip cannot show a pulse (two beat periods)
 #: at any but the fastest tempi, and the tracker would return a tempo made up by its
