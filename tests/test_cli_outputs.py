@@ -22,7 +22,6 @@ from beatsync import datasets, io
 from beatsync.cli import build_parser, main
 from beatsync.commands import COMMAND_HELP, COMMAND_MODULES
 from beatsync.commands._common import Feedback, Outputs
-from beatsync.errors import ParameterError
 from beatsync.synth.audio import beat_times, click_track
 
 SR = 22050
