@@ -25,6 +25,7 @@ Data contract
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -211,8 +212,10 @@ class Motion:
                 f"motion has {values.shape[1]} value columns but {len(self.channels)} channel "
                 "names; is the array transposed (it must be time first: frames x channels)?"
             )
-        if self.skeleton is not None and self.skeleton.channel_names() != self.channels:
-            raise ParameterError("channel names do not match the skeleton's channels")
+        if self.skeleton is not None:
+            if self.skeleton.channel_names() != self.channels:
+                raise ParameterError("channel names do not match the skeleton's channels")
+            _check_reach(self.skeleton, values)
         info = self.position_info
         if info is not None:
             if not self.is_positional:
@@ -436,6 +439,36 @@ class Motion:
                 glob.append(quat_multiply(parent_rot, local))
         self._cache["positions"] = pos
         return pos
+
+
+def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
+    """Refuse offsets or translations so large that forward kinematics would overflow.
+
+    A joint's world position is at most the sum, along its chain, of the offsets and
+    translations (rotations keep lengths; each summed as ``|x| + |y| + |z|``, which
+    bounds the length); that sum, times 2 sqrt(3) so that every coordinate of a
+    position and of a difference of two stays finite, must be a finite float.
+    """
+    reach: list[float] = []
+    largest = (0.0, "")
+    col = 0
+    for joint in skeleton.joints:
+        size = sum(abs(float(v)) for v in joint.offset)  # Python floats: inf, no warning
+        if size > largest[0]:
+            largest = (size, f"OFFSET of joint {joint.name!r} ({' '.join(map(str, joint.offset))})")
+        for c in joint.channels:
+            if c in _POS_DOFS:
+                big = float(np.fmax.reduce(np.abs(values[:, col]), initial=0.0))
+                if big > largest[0]:
+                    largest = (big, f"channel {joint.name}_{c} value {big:g}")
+                size += big
+            col += 1
+        reach.append(size + (reach[joint.parent] if joint.parent >= 0 else 0.0))
+    if not math.isfinite(2 * math.sqrt(3) * max(reach, default=0.0)):
+        raise ParameterError(
+            f"{largest[1]} is too large: forward kinematics would overflow float64 (joint "
+            "positions beyond 1e308); a corrupt number or a wrong unit?"
+        )
 
 
 def fill_gaps(motion: Motion) -> Motion:
