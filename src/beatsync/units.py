@@ -53,7 +53,6 @@ __all__ = [
     "MIN_PLAUSIBLE_SR",
     "MIN_BPM",
     "MAX_BPM",
-    "check_whole",
     "beat_phase",
     "MAX_MOTION_FPS",
     "check_motion_fps",
@@ -562,14 +561,6 @@ def check_audio(
                 f"less than {silence_peak:g}): check the file and the recording chain"
             )
     return arr, sr_f
-
-
-def check_whole(value: Any, *, name: str, minimum: int = 0) -> int:
-    """Return ``value`` as an int >= ``minimum`` (``2.5`` beats is a mistake, not 2).
-
-    The same check as :func:`as_int`, with a lower bound that defaults to 0.
-    """
-    return as_int(value, name=name, minimum=minimum)
 
 
 def beat_phase(events: Any, beats: Any) -> np.ndarray:

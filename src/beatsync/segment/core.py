@@ -471,10 +471,24 @@ def segment(
     >>> seg.n_periods, round(seg.mean_period, 3)
     (10, 1.196)
     """
-    alpha = check_alpha(alpha)
     p = check_n_periods(n_periods)
-    lo_s, hi_s = check_period_range(period_range)
-    method = check_period_method(period_method, p)
+    return _segment_motion(motion, alpha=check_alpha(alpha), n_periods=p,
+                           period_range=check_period_range(period_range),
+                           method=check_period_method(period_method, p),
+                           channels=channels)  # fmt: skip
+
+
+def _segment_motion(
+    motion: Motion,
+    *,
+    alpha: float,
+    n_periods: int | None,
+    period_range: tuple[float, float],
+    method: str,
+    channels: str | Sequence[str] = "default",
+) -> Segmentation:
+    """:func:`segment` with its settings already checked (the motion's data is checked
+    here: the channels, their values and the frame count)."""
     names = select_channels(motion.channels, channels)
     idx = [motion.channel_index(nm) for nm in names]
     values = check_finite(motion.values[:, idx], name=f"motion {motion.name!r} values")
@@ -483,7 +497,7 @@ def segment(
             f"motion {motion.name!r} has {values.shape[0]} frame(s); a segmentation needs more"
         )
     return _segment(unwrap_rotations(values, names), names, fps=motion.fps, alpha=alpha,
-                    n_periods=p, period_range=(lo_s, hi_s), method=method)  # fmt: skip
+                    n_periods=n_periods, period_range=period_range, method=method)  # fmt: skip
 
 
 def estimate_period_count(
