@@ -27,10 +27,10 @@ from ..errors import NotPeriodicError, ParameterError
 from ..units import (
     MAX_BPM,
     MIN_BPM,
-    check_between,
+    as_float,
     check_finite,
     check_fps,
-    check_range,
+    check_interval,
     frames_to_time,
     time_to_frames,
 )
@@ -583,12 +583,11 @@ def period_range_from_beat(
     >>> period_range_from_beat(0.5)
     (0.5, 4.0)
     """
-    hint = "a beat period in seconds is 60 / BPM; is it a tempo in BPM?"
-    bp = check_between(beat_period, name="beat_period", unit="s", low=60.0 / MAX_BPM,
-                       high=60.0 / MIN_BPM, closed="both", hint=hint)  # fmt: skip
-    try:
-        b_lo, b_hi = beats
-    except (TypeError, ValueError):
-        raise ParameterError(f"beats={beats!r} must be two numbers (fewest, most)") from None
-    b_lo, b_hi = check_range(b_lo, b_hi, name="beats", unit="beats")
+    bp = as_float(beat_period, name="beat_period", unit="s", text=True)
+    if not 60.0 / MAX_BPM <= bp <= 60.0 / MIN_BPM:
+        raise ParameterError(
+            f"beat_period={beat_period!r} must be in [{60.0 / MAX_BPM:g}, {60.0 / MIN_BPM:g}] "
+            "[s] (a beat period in seconds is 60 / BPM; is it a tempo in BPM?)"
+        )
+    b_lo, b_hi = check_interval(beats, name="beats", unit="beats")
     return b_lo * bp, b_hi * bp
