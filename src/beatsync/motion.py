@@ -449,24 +449,28 @@ def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
     bounds the length); that sum, times 2 sqrt(3) so that every coordinate of a
     position and of a difference of two stays finite, must be a finite float.
     """
-    reach: list[float] = []
-    largest = (0.0, "")
+    joints = skeleton.joints
+    with np.errstate(over="ignore"):  # an overflow is inf: refused below
+        sizes = np.abs([j.offset for j in joints]).sum(axis=1).tolist()
+    biggest = int(np.argmax(sizes))
+    largest = (sizes[biggest], f"OFFSET of joint {joints[biggest].name!r}")
     col = 0
-    for joint in skeleton.joints:
-        size = sum(abs(float(v)) for v in joint.offset)  # Python floats: inf, no warning
-        if size > largest[0]:
-            largest = (size, f"OFFSET of joint {joint.name!r} ({' '.join(map(str, joint.offset))})")
-        for c in joint.channels:
+    for i, joint in enumerate(joints):
+        for k, c in enumerate(joint.channels):
             if c in _POS_DOFS:
-                big = float(np.fmax.reduce(np.abs(values[:, col]), initial=0.0))
+                big = float(np.fmax.reduce(np.abs(values[:, col + k]), initial=0.0))
                 if big > largest[0]:
                     largest = (big, f"channel {joint.name}_{c} value {big:g}")
-                size += big
-            col += 1
-        reach.append(size + (reach[joint.parent] if joint.parent >= 0 else 0.0))
-    if not math.isfinite(2 * math.sqrt(3) * max(reach, default=0.0)):
+                sizes[i] += big
+        col += len(joint.channels)
+        if joint.parent >= 0:
+            sizes[i] += sizes[joint.parent]  # parents come first: now the chain's sum
+    if not math.isfinite(2 * math.sqrt(3) * max(sizes, default=0.0)):
+        what = largest[1]
+        if what.startswith("OFFSET"):
+            what += f" ({' '.join(map(str, joints[biggest].offset))})"
         raise ParameterError(
-            f"{largest[1]} is too large: forward kinematics would overflow float64 (joint "
+            f"{what} is too large: forward kinematics would overflow float64 (joint "
             "positions beyond 1e308); a corrupt number or a wrong unit?"
         )
 
