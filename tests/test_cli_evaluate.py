@@ -467,7 +467,7 @@ def test_empty_audio_folder(dataset, tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
     (empty / "notes.txt").write_text("not audio")
-    _refused(_bad(tmp_path, dataset, audio=empty), "holds no audio file")
+    _refused(_bad(tmp_path, dataset, audio=empty), "empty' holds no audio file")
     assert not (tmp_path / "results").exists()
 
 
@@ -485,7 +485,7 @@ def test_no_audio_has_an_annotation(dataset, tmp_path):
 
 
 def test_missing_folder(dataset, tmp_path):
-    _refused(_bad(tmp_path, dataset, audio=tmp_path / "nowhere"), "audio folder .* does not exist")
+    _refused(_bad(tmp_path, dataset, audio=tmp_path / "nowhere"), "nowhere' does not exist")
 
 
 @pytest.mark.parametrize(
@@ -617,18 +617,24 @@ def test_output_folder_is_a_file(dataset, tmp_path):
 @pytest.mark.parametrize(
     "extra, match",
     [
-        (["--workers", "0"], "whole number of workers >= 1"),
-        (["--workers", "-1"], "whole number of workers >= 1"),
-        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "give one or the other"),
-        (["--scheduler", "tcp://127.0.0.1:9"], "could not connect to the Dask scheduler"),
-        (["--scheduler", "not-an-address"], "not a Dask scheduler address"),
-        (["--min-beat-time", "-5"], "min-beat-time=-5.0 must be a finite number >= 0"),
-        (["--min-bpm", "120", "--max-bpm", "90"], "--min-bpm 120 must be smaller than --max-bpm"),
-        (["--max-bpm", "30"], "--max-bpm 30 is below psf's default --min-bpm 40: give --min-bpm"),
-        (["--method", "librosa", "--min-bpm", "330", "--max-bpm", "400"], "above 320 BPM"),
-        (["--min-bpm", "0.5"], "outside the plausible range 20-400 BPM"),
-        (["--method", "essentia-degara", "--min-bpm", "30"], "whole number of BPM from 40"),
-        (["--method", "essentia-degara", "--min-bpm", "90", "--max-bpm", "100"], "at least 20"),
+        (["--workers", "0"], "--workers=0"),
+        (["--workers", "-1"], "--workers=-1"),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "--workers 2.*--scheduler"),
+        (["--scheduler", "tcp://127.0.0.1:9"], "'tcp://127.0.0.1:9'"),
+        (["--scheduler", "not-an-address"], "'not-an-address'"),
+        (["--min-beat-time", "-5"], "--min-beat-time=-5"),
+        (["--min-bpm", "120", "--max-bpm", "90"], "--min-bpm 120 .*--max-bpm 90"),
+        (["--max-bpm", "30"], "--max-bpm 30 .*--min-bpm 40"),
+        (
+            ["--method", "librosa", "--min-bpm", "330", "--max-bpm", "400"],
+            "--min-bpm 330: .*320 BPM",
+        ),
+        (["--min-bpm", "0.5"], "--min-bpm=0.5 .*20-400 BPM"),
+        (["--method", "essentia-degara", "--min-bpm", "30"], "--min-bpm 30: .*40 to 180"),
+        (
+            ["--method", "essentia-degara", "--min-bpm", "90", "--max-bpm", "100"],
+            "--min-bpm 90 .*20 BPM.*--max-bpm 100",
+        ),
     ],
 )
 def test_bad_options(dataset, tmp_path, monkeypatch, extra, match):

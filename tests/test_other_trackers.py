@@ -182,19 +182,19 @@ def test_tempo_range_bounds_equal_to_the_default_are_none():
 @pytest.mark.parametrize(
     "name, lo, hi, match",
     [
-        ("psf", 120, 90, "min_bpm 120 must be smaller than max_bpm 90$"),
-        ("psf", None, 30, "max_bpm 30; max_bpm 30 is below psf's default min_bpm 40: give min"),
-        ("librosa", 300, None, "min_bpm 300 is above librosa's default max_bpm 240: give max_bpm"),
-        ("librosa", 330, 400, "librosa's beat tracker does not search above 320 BPM"),
-        ("psf", float("nan"), None, "not a finite number"),
-        ("librosa", 500, None, "outside the plausible range 20-400 BPM"),
-        ("essentia-degara", 30, None, "from 40 to 180 .*; to search outside them, use psf"),
-        ("essentia-degara", 75.5, None, "whole number of BPM from 40 to 180 .*; round it to 76"),
-        ("essentia-degara", 39.6, None, "from 40 to 180 .*; round it to 40$"),
-        ("essentia-degara", None, 250.4, "from 60 to 250 .*; round it to 250$"),
-        ("essentia-multifeature", None, 260, "whole number of BPM from 60 to 250"),
-        ("essentia-degara", 100, 110, "at least 20 BPM below max_bpm 110"),
-        ("essentia-degara", 190, None, "from 40 to 180"),
+        ("psf", 120, 90, r"min_bpm 120\b.*max_bpm 90$"),
+        ("psf", None, 30, r"max_bpm 30\b.*default min_bpm 40\b"),
+        ("librosa", 300, None, r"min_bpm 300\b.*default max_bpm 240\b"),
+        ("librosa", 330, 400, r"min_bpm 330\b.*320 BPM"),
+        ("psf", float("nan"), None, "min_bpm=nan"),
+        ("librosa", 500, None, r"min_bpm=500\b.*20-400 BPM"),
+        ("essentia-degara", 30, None, r"min_bpm 30\b.*40 to 180.*psf"),
+        ("essentia-degara", 75.5, None, r"min_bpm 75\.5\b.*40 to 180.*76$"),
+        ("essentia-degara", 39.6, None, r"min_bpm 39\.6\b.*40 to 180.* 40$"),
+        ("essentia-degara", None, 250.4, r"max_bpm 250\.4\b.*60 to 250.* 250$"),
+        ("essentia-multifeature", None, 260, r"max_bpm 260\b.*60 to 250"),
+        ("essentia-degara", 100, 110, r"min_bpm 100\b.*20 BPM.*max_bpm 110$"),
+        ("essentia-degara", 190, None, r"min_bpm 190\b.*40 to 180"),
     ],
 )
 def test_tempo_range_a_method_does_not_take_is_refused(name, lo, hi, match):
@@ -243,7 +243,7 @@ def test_resample_audio_gives_librosa_resample_samples(orig, target):
 
 
 def test_unknown_method():
-    with pytest.raises(ParameterError, match="unknown beat-tracking method 'madmom'"):
+    with pytest.raises(ParameterError, match="'madmom'"):
         trackers.get("madmom")
 
 
@@ -259,14 +259,14 @@ def test_missing_optional_package_says_how_to_install(monkeypatch):
 @pytest.mark.parametrize(
     "y, sr, match",
     [
-        (np.zeros(SR * 5, dtype=np.float32), SR, "silent"),
+        (np.zeros(SR * 5, dtype=np.float32), SR, r"peak below 1e-07"),
         # a DC offset: ours made up one beat at the end, essentia's sixteen
         (np.full(SR * 10, 0.5, dtype=np.float32), SR, r"constant at 0\.5 \(a DC offset"),
-        (np.array([], dtype=np.float32), SR, "empty|no samples"),
+        (np.array([], dtype=np.float32), SR, "zero samples"),
         # librosa returned one beat for 0.5 s, essentia's none
         (np.random.default_rng(0).standard_normal(SR // 2), SR, r"only 0\.500 s long"),
-        (np.full(SR * 5, np.nan, dtype=np.float32), SR, "NaN|finite"),
-        (np.ones(SR * 5, dtype=np.float32), 0, "sr"),
+        (np.full(SR * 5, np.nan, dtype=np.float32), SR, "110250 NaN"),
+        (np.ones(SR * 5, dtype=np.float32), 0, "sr=0"),
     ],
 )
 def test_bad_audio_refused_for_every_method(y, sr, match):
@@ -276,7 +276,7 @@ def test_bad_audio_refused_for_every_method(y, sr, match):
 
 
 def test_prepare_checks_the_name_and_compiles_only_for_librosa(monkeypatch):
-    with pytest.raises(ParameterError, match="unknown beat-tracking method"):
+    with pytest.raises(ParameterError, match="'madmom'"):
         trackers.prepare("madmom")
     calls = []
     librosa = pytest.importorskip("librosa")
