@@ -80,10 +80,10 @@ Documented rules (choices the paper leaves open)
   of the music). A range wider than a factor 5 is searched in tiers of a factor 5,
   shortest first (:func:`.period.period_tiers`); the first tier whose optimum passes
   the periodicity test gives the period, the shortest repeating cycle (otherwise the
-  energy estimate prefers multiples of a step: CMU salsa 61_04 searched over
-  0.25-6 s at once gave 2.9 s, three steps). The wide range is not the default
-  because the periodicity test accepts the CMU 005_02 pirouette in the long tier
-  (4 x 1.66 s). Long periods stay within memory through the decimated search.
+  energy estimate prefers multiples of a step: a salsa clip searched over the whole
+  range at once comes out as three steps). The wide range is not the default because
+  the periodicity test accepts a non-periodic pirouette in the long tier. Long
+  periods stay within memory through the decimated search.
 - Clip length: a clip shorter than ``MIN_CLIP_PERIODS`` (3) of the shortest period
   of the range is refused first. With the count estimated, a clip shorter than 3 of
   its own estimated period (the optimum then has a single pair of consecutive periods)
