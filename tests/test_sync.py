@@ -695,3 +695,21 @@ def test_speed_warning_names_a_tempo_that_fits():
     with pytest.warns(BeatsyncWarning, match=r"within x0.8-x1.25 .* only \d+% .* about \d+ BPM"):
         res = synchronize(m, None, np.array([0.5, 3.5, 6.5]), mode="beats")
     assert res.report["speed_warning"]
+
+
+def test_dance_meter_puts_the_dance_bars_on_bar_lines():
+    # the real waltz dancer, told its meter (3 motion beats a bar), on a 3/4 song
+    from beatsync import datasets
+
+    dancer = datasets.load_dance_pair("DANCE_W_10").motion
+    beats = np.arange(0.3, 40.0, 60.0 / 87.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        res = synchronize(dancer, None, beats, mode="beats", fill="loop", beats_per_bar=3,
+                          dance_beats_per_period=3)  # fmt: skip
+    r = res.report
+    assert r["phrases_on_bars"] >= 0.9
+    assert r["playback_speed"]["instantaneous"]["in_band"] >= 0.95
+    bar = 3 * 60.0 / 87.0
+    on_bar = np.abs(((np.asarray(r["target_beats_s"]) - beats[0]) / bar + 0.5) % 1.0 - 0.5) < 1e-6
+    assert on_bar.mean() > 1.0 / 3.0 + 0.1  # more than the share of beats that are bar lines

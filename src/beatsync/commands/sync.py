@@ -422,6 +422,8 @@ def _placement_notes(r: dict[str, Any]) -> str:
         out += f"; {r['n_merged_intervals']} merged with a neighbour"
     if r["n_half_beat_landings"]:
         out += f"; {r['n_half_beat_landings']} landing on a half beat"
+    if r.get("phrases_on_bars") is not None:
+        out += f"; {r['phrases_on_bars']:.0%} of the dance bars start on a bar line"
     return out
 
 

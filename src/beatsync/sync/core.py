@@ -73,7 +73,17 @@ class SyncResult:
         ``boundaries_s``, ``residual_ms`` (one per boundary),
         ``residual_nearest_frame_ms``, ``max_abs_residual_ms``,
         ``max_abs_residual_frames``, ``lead_in_hold_frames``, ``n_scaled_periods``,
-        ``covered_s`` (music time span the dance covers).
+        ``covered_s`` (music time span the dance covers); measured on the result
+        (:mod:`beatsync.sync.quality`): ``beats_per_motion_beat_used`` (count -> number
+        of intervals, halves allowed), ``n_merged_intervals``,
+        ``n_half_beat_landings``, ``phrases_on_bars`` (share of the dance bars, given
+        ``dance_beats_per_period``, that start on a bar line), ``playback_speed``
+        (``instantaneous`` and ``per_interval``: min, median, max, ``in_band`` share
+        of output time; ``band``; ``held_lead_in_s``), ``kinematics`` (p99 and peak
+        joint speed, p99 acceleration of input and output, and their ratios; None
+        without joint positions), ``loop`` (span, blend, turn per pass, pose
+        distance) and ``joins`` (music time and peak joint speed of each),
+        ``speed_warning``.
     warp : TimeWarp
         The warp itself (for plots).
     """

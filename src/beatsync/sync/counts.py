@@ -93,6 +93,9 @@ class CountPlan:
         Steps that cover two intervals.
     n_half : int
         Events landing between two beats.
+    phrases_on_bars : float or None
+        Share of the placed phrase starts (dance bars) on a bar line of the music;
+        None without both meters.
     cost : float
     """
 
@@ -103,6 +106,7 @@ class CountPlan:
     n_merged: int
     n_half: int
     cost: float
+    phrases_on_bars: float | None = None
 
 
 def _speed_cost(ls: np.ndarray, dur: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -307,4 +311,7 @@ def plan_counts(
         n_merged=int(np.count_nonzero(np.diff(ev_a) == 2)),
         n_half=int(np.count_nonzero(gk_a % 2 == 1)),
         cost=total,
+        phrases_on_bars=(
+            float(np.mean(bar_ok[gk_a[phrase[ev_a]]])) if bar and phrase[ev_a].any() else None
+        ),
     )

@@ -78,6 +78,7 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
         "beats": placed.beats,
         "n_merged": placed.n_merged,
         "n_half_beat": placed.n_half,
+        "phrases_on_bars": placed.phrases_on_bars,
     }
     return looped, used, targets, end, info
 

@@ -120,6 +120,7 @@ def report_entries(motion, out_motion, src_times, warp, used, targets, looped, p
         "beats_per_motion_beat_used": {f"{c:g}": int(k) for c, k in zip(counts, n, strict=True)},
         "n_merged_intervals": int(placed["n_merged"]),
         "n_half_beat_landings": int(placed["n_half_beat"]),
+        "phrases_on_bars": placed.get("phrases_on_bars"),
         "playback_speed": speed_figures(
             src_times, out_fps, (float(warp.tgt[0]), float(warp.tgt[-1])), used, targets
         ),
