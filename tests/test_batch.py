@@ -175,8 +175,9 @@ def test_batch_defaults_are_those_of_sync():
     assert inspect.signature(sync_grid).parameters["mode"].default == "auto"
 
 
-def test_grid_names_one_folder_per_take_by_its_folder(tmp_path):
-    # a dataset laid out as DANCE_C_4/skeletons.json, DANCE_R_3/skeletons.json, ...
+def _takes(tmp_path):
+    """Two real dancers laid out one folder per take (DANCE_C_4/skeletons.json, ...) and
+    a 10 s song."""
     clips = []
     for take in ("DANCE_C_4", "DANCE_R_3"):
         (tmp_path / take).mkdir()
@@ -189,12 +190,27 @@ def test_grid_names_one_folder_per_take_by_its_folder(tmp_path):
     )  # fmt: skip
     out = tmp_path / "out"
     out.mkdir()
+    return clips, song, out
+
+
+def test_grid_names_one_folder_per_take_by_its_folder(tmp_path):
+    clips, song, out = _takes(tmp_path)
     table = sync_grid(clips, [song], out, processes=False, n_workers=1, fps=25.0)
     assert sorted(table["clip"]) == ["DANCE_C_4", "DANCE_R_3"]
     assert (table["status"] == "ok").all(), table["error"].tolist()
     assert (table["mode"] == "beats").all()  # defaults of sync: auto falls back to motion beats
     for take in ("DANCE_C_4", "DANCE_R_3"):
         assert (out / f"{take}__song.json").is_file()
+
+
+def test_batch_cli_takes_one_folder_per_take(tmp_path, scheduler, capsys):
+    clips, song, out = _takes(tmp_path)
+    argv = ["batch", "--clips", *map(str, clips), "--songs", str(song), "--out-dir", str(out),
+            "--fps", "25", "--scheduler", scheduler]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in out.glob("*.json")) == [
+        "DANCE_C_4__song.json", "DANCE_R_3__song.json"
+    ]  # fmt: skip
 
 
 def _batch_args(inputs, out, *extra):
