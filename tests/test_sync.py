@@ -713,3 +713,39 @@ def test_dance_meter_puts_the_dance_bars_on_bar_lines():
     bar = 3 * 60.0 / 87.0
     on_bar = np.abs(((np.asarray(r["target_beats_s"]) - beats[0]) / bar + 0.5) % 1.0 - 0.5) < 1e-6
     assert on_bar.mean() > 1.0 / 3.0 + 0.1  # more than the share of beats that are bar lines
+
+
+def test_loop_of_a_turning_skeleton_carries_its_heading_on():
+    # the real salsa step (BVH) danced while turning 120 deg over the clip: each pass of
+    # the loop starts facing where the previous one ended, without a turn back at a join
+    from scipy.spatial.transform import Rotation
+
+    from beatsync import datasets
+    from beatsync.motion_beats import motion_positions
+    from beatsync.rotations import euler_to_rotation, rotation_to_euler
+
+    real = datasets.load_salsa("60_01")
+    step = real.values[60:120].copy()
+    step[:, :3] = step[0, :3]
+    values = np.tile(step, (5, 1))
+    yaw = np.linspace(0.0, np.deg2rad(120.0), values.shape[0])
+    root = real.skeleton.joints[0].name
+    idx, order = next((list(i), o) for j, i, o in real.rotation_triples() if j == root)
+    turned = Rotation.from_euler("y", yaw[:, None]) * euler_to_rotation(values[:, idx], order)
+    values[:, idx] = rotation_to_euler(turned, order, reference=values[:, idx])
+    dancer = real.with_values(values)
+    beats = np.arange(0.3, 16.0, 0.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        res = synchronize(dancer, None, beats, mode="beats", fill="loop")
+    r = res.report
+    assert r["joins"] and abs(r["loop"]["turn_deg"]) > 30.0
+    pos = motion_positions(res.motion)
+    names = [j.name for j in dancer.skeleton.joints]
+    hips = pos[:, names.index("lButtock")] - pos[:, names.index("rButtock")]
+    heading = np.degrees(np.unwrap(np.arctan2(hips[:, 0], hips[:, 2])))
+    assert np.abs(np.diff(heading)).max() < 10.0  # no turn back at a join (a reset: 48 deg)
+    # the heading goes on turning: about 24 deg per second, as in the clip
+    assert abs(heading[-1] - heading[0]) > 0.8 * 24.0 * res.motion.duration
+    own = np.linalg.norm(np.diff(motion_positions(dancer), axis=0), axis=-1).max()
+    assert np.linalg.norm(np.diff(pos, axis=0), axis=-1).max() <= 1.10 * own

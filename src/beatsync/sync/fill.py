@@ -28,9 +28,9 @@ Aligned and blended joins
     (``e_a + d``, moved by ``M^r``) with a raised-cosine weight, whose derivative
     vanishes at both ends of the window: both motions carry their own velocity, so
     the velocity is continuous and the blend adds only ``w'`` times the (small)
-    remaining pose difference. Rotation channels (BVH) are slerped and only translated
-    (a turn is not carried: the root's rotation channels are left as they are);
-    joint positions are rotated and translated, then blended linearly.
+    remaining pose difference. A skeleton's root is turned (its rotation channels and
+    its floor position) and moved; joint positions are rotated and translated. Rotation
+    channels are blended by slerp, positions linearly.
 
 Data contract: times in seconds of the clip (``e``) or of the looped timeline
 (``t``); positions ``(frames, joints, 3)`` with z up (position-only motion) or the
@@ -43,8 +43,9 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from ..rotations import blend_values, sample_motion
+from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
 
 __all__ = ["LOOP_BLEND_S", "MIN_SPAN", "LoopedClip", "choose_loop", "loop_events", "with_center"]
 
@@ -74,11 +75,11 @@ class LoopedClip:
     angle : float [rad]
         Rotation about the vertical axis from one pass to the next.
     shift : np.ndarray [shape=(2,)] or None
-        Translation on the floor from one pass to the next (None: no positions).
+        Translation on the floor from one pass to the next, on the floor axes of
+        :func:`beatsync.graph.distance.ground_axes` (x, y for joint positions; z, x
+        for a skeleton's root); None: no positions.
     distance : float
         Pose distance at the join (motion-graph distance, position unit).
-    floor : tuple of int
-        Value layout: the floor axes of the positions.
     """
 
     events: np.ndarray
@@ -160,16 +161,32 @@ class LoopedClip:
             pos = motion.values.reshape(motion.n_frames, -1, 3)
             return self.sample_positions(pos, motion.fps, t).reshape(len(t), -1)
         a, b, w, ra, rb = self._locate(t)
-        cols = _root_floor_columns(motion)
-        values = sample_motion(motion, a)
-        if cols is not None and self.shift is not None:
-            values[:, cols] += self._moves(ra)[1]
+        values = self._move_root(motion, sample_motion(motion, a), ra)
         blend = w > 0
         if blend.any():
-            vb = sample_motion(motion, b[blend])
-            if cols is not None and self.shift is not None:
-                vb[:, cols] += self._moves(rb[blend])[1]
+            vb = self._move_root(motion, sample_motion(motion, b[blend]), rb[blend])
             values[blend] = blend_values(motion, values[blend], vb, w[blend])
+        return values
+
+    def _move_root(self, motion: object, values: np.ndarray, reps: np.ndarray) -> np.ndarray:
+        """Skeleton motion: the root turned about the vertical (y) axis and moved on the
+        floor by ``M^r`` (its position and its rotation channels)."""
+        cols = _root_floor_columns(motion)
+        if cols is None or self.shift is None:
+            return values
+        ang, off = self._moves(reps)
+        if np.any(ang):
+            zx = values[:, cols]
+            c, s = np.cos(ang), np.sin(ang)
+            values[:, cols[0]] = c * zx[:, 0] - s * zx[:, 1]
+            values[:, cols[1]] = s * zx[:, 0] + c * zx[:, 1]
+            triple = _root_rotation(motion)
+            if triple is not None:
+                idx, order = triple
+                euler = values[:, idx]
+                turned = Rotation.from_euler("y", ang[:, None]) * euler_to_rotation(euler, order)
+                values[:, idx] = rotation_to_euler(turned, order, reference=euler)
+        values[:, cols] += off
         return values
 
 
@@ -194,15 +211,25 @@ def _move(p: np.ndarray, ang: np.ndarray, off: np.ndarray) -> np.ndarray:
 
 
 def _root_floor_columns(motion: object) -> np.ndarray | None:
-    """The skeleton root's two horizontal position channels (y up), or None."""
+    """The skeleton root's two horizontal position channels (y up), in the order of
+    :func:`beatsync.graph.distance.ground_axes` (z, x), or None."""
     skeleton = getattr(motion, "skeleton", None)
     if skeleton is None:
         return None
     root = skeleton.joints[0].name
-    names = (f"{root}_Xposition", f"{root}_Zposition")
+    names = (f"{root}_Zposition", f"{root}_Xposition")
     if not all(n in motion.channels for n in names):
         return None
     return np.array([motion.channels.index(n) for n in names])
+
+
+def _root_rotation(motion: object) -> tuple[list[int], str] | None:
+    """The skeleton root's rotation channels and their Euler order, or None."""
+    root = motion.skeleton.joints[0].name
+    for joint, idx, order in motion.rotation_triples():
+        if joint == root:
+            return list(idx), order
+    return None
 
 
 def _positions(motion: object) -> tuple[np.ndarray, int] | None:
@@ -262,24 +289,21 @@ def choose_loop(
     pick = best[np.argmax((jj - ii).ravel()[best])]
     ia, ib = np.unravel_index(pick, score.shape)
     a, b = int(idx[ia]), int(idx[ib])
+    # the floor rotation (about the vertical, in the plane of ground_axes: R_y for y up)
+    # and translation that carry the clouds at e_a onto those at e_b
     g0, g1 = ground_axes(up)
     src = clouds[ia][:, [g0, g1]]
     dst = clouds[ib][:, [g0, g1]]
     ms, md = src.mean(axis=0), dst.mean(axis=0)
-    if up == 2:  # joint positions: turn and translate
-        ps, pd = src - ms, dst - md
-        angle = float(
-            np.arctan2(
-                np.sum(ps[:, 0] * pd[:, 1] - ps[:, 1] * pd[:, 0]),
-                np.sum(ps[:, 0] * pd[:, 0] + ps[:, 1] * pd[:, 1]),
-            )
+    ps, pd = src - ms, dst - md
+    angle = float(
+        np.arctan2(
+            np.sum(ps[:, 0] * pd[:, 1] - ps[:, 1] * pd[:, 0]),
+            np.sum(ps[:, 0] * pd[:, 0] + ps[:, 1] * pd[:, 1]),
         )
-        c, s = np.cos(angle), np.sin(angle)
-        shift = md - np.array([c * ms[0] - s * ms[1], s * ms[0] + c * ms[1]])
-    else:  # rotation channels: translate the root only (order X, Z of its channels)
-        angle = 0.0
-        d = md - ms  # (g0, g1) = (z, x) for y up
-        shift = np.array([d[1], d[0]])
+    )
+    c, s = np.cos(angle), np.sin(angle)
+    shift = md - np.array([c * ms[0] - s * ms[1], s * ms[0] + c * ms[1]])
     return a, b, angle, shift, float(score.flat[pick]), float(join)
 
 
