@@ -14,12 +14,12 @@ def interval_intensity(positions, beat_frames, fps):
     vel = np.gradient(positions, axis=0) * fps
     energy = 0.5 * np.mean(np.sum(vel**2, axis=2), axis=1)
     bf = np.asarray(beat_frames)
-    return np.array([energy[a:b].mean() for a, b in zip(bf[:-1], bf[1:])])
+    return np.array([energy[a:b].mean() for a, b in zip(bf[:-1], bf[1:], strict=True)])
 
 
 def music_z(y, sr, beats):
     # RMS in dB of every interval between successive beats, z-scored over the song
     idx = np.round(np.asarray(beats) * sr).astype(int)
-    rms = np.array([np.sqrt(np.mean(y[a:b] ** 2)) for a, b in zip(idx[:-1], idx[1:])])
+    rms = np.array([np.sqrt(np.mean(y[a:b] ** 2)) for a, b in zip(idx[:-1], idx[1:], strict=True)])
     level = 20 * np.log10(np.maximum(rms, 1e-5))
     return (level - level.mean()) / level.std()

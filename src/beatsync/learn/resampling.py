@@ -73,8 +73,8 @@ def _case() -> tuple[np.ndarray, np.ndarray]:
 @exercise("resampling.landing_beats")
 def _landing_beats(answer: Any) -> str | None:
     """``landing_beats(beats, n_periods, m, first_beat)``: the beat of every boundary."""
-    from ..synth.motion import periodic_motion
     from ..sync import synchronize
+    from ..synth.motion import periodic_motion
 
     syn = periodic_motion(n_frames=301, fps=30.0, n_periods=10, seed=3, snr_db=None)
     _, beats = _case()
