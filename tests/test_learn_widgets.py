@@ -1,6 +1,8 @@
 """beatsync.learn.widgets: a live slider whose states are also precomputed for a static page."""
 
 import re
+import shutil
+import subprocess
 
 import matplotlib
 
@@ -92,3 +94,29 @@ def test_bad_sliders_raise(sliders, match):
 def test_update_must_return_a_figure():
     with pytest.raises(ParameterError, match="returned int"):
         explore(lambda a: 3, a=[1]).render(a=1)
+
+
+PROBE = """<script>
+var r = document.querySelector('.beatsync-explore');
+var ins = r.querySelectorAll('input[type=range]');
+ins[0].value = 1; ins[0].dispatchEvent(new Event('input'));
+ins[1].value = 2; ins[1].dispatchEvent(new Event('input'));
+var shown = [].filter.call(r.querySelectorAll('div[data-state]'),
+    function (d) { return d.style.display !== 'none'; });
+document.title = 'SHOWN=' + shown.map(function (d) { return d.dataset.state; }).join(',')
+    + ' LABELS=' + [].map.call(ins, function (i) { return i.nextElementSibling.textContent; });
+</script>"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")
+def test_static_slider_swaps_the_figure_in_a_browser(view, tmp_path):
+    page = tmp_path / "page.html"
+    page.write_text(
+        f"<html><head><title>-</title></head><body>{view.to_html()}{PROBE}</body></html>"
+    )
+    dom = subprocess.run(
+        ["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom", page.as_uri()],
+        capture_output=True, text=True, timeout=120, check=True,
+    ).stdout  # fmt: skip
+    assert "<title>SHOWN=1-2 LABELS=2,5</title>" in dom
