@@ -101,7 +101,7 @@ notebooks: setup
 # brings the lab extension its sliders need.
 lab:
 	@$(MAKE) --no-print-directory setup EXTRAS="$(EXTRAS) $(SITE_EXTRAS)"
-	$(BIN)/jupyter lab --ServerApp.root_dir=notebooks
+	$(BIN)/jupyter lab --ServerApp.root_dir=notebooks $(if $(filter 0,$(shell id -u)),--allow-root)
 
 # The site (docs/conf.py says how the notebooks get in); the committed notebooks' outputs
 # are shown as they are, never executed here.
@@ -112,7 +112,7 @@ docs:
 # Every page of the site and a widget in JupyterLab, in headless Chromium (.ci/run
 # installs Debian's chromium where it is missing).
 test-browser: docs
-	BEATSYNC_CHROMIUM=$(CHROMIUM) $(BIN)/python -m pytest $(PYTEST_ARGS) -p no:cacheprovider tests_browser
+	BEATSYNC_CHROMIUM=$(CHROMIUM) $(BIN)/python -m pytest $(PYTEST_ARGS) -p no:cacheprovider -n 0 tests_browser
 
 FORCE:
 
