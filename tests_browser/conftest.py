@@ -10,10 +10,13 @@ blocked and recorded, and fails the test that caused it.
 
 from __future__ import annotations
 
+import functools
 import os
 import subprocess
 import sys
+import threading
 from dataclasses import dataclass, field
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -127,13 +130,42 @@ def site() -> Path:
     return SITE
 
 
+class _QuietHandler(SimpleHTTPRequestHandler):
+    def log_message(self, format, *args) -> None:  # noqa: A002 (the base class's name)
+        pass
+
+
+@pytest.fixture(scope="session")
+def served_site(site):
+    """The built site served over HTTP on a free loopback port: its base URL."""
+    handler = functools.partial(_QuietHandler, directory=str(site))
+    server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_address[1]}/"
+    server.shutdown()
+    server.server_close()
+    thread.join()
+
+
 @pytest.fixture(scope="session")
 def fixture_site(tmp_path_factory) -> Path:
     """tests_browser/fixtures/site built with the site's own settings (docs/conf.py)."""
     out = tmp_path_factory.mktemp("fixture-site")
     build = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-b", "html", "-W", "-q", "-d", str(out / "doctrees"),
-         str(FIXTURES / "site"), str(out / "html")],
+        [
+            sys.executable,
+            "-m",
+            "sphinx",
+            "-b",
+            "html",
+            "-W",
+            "-q",
+            "-d",
+            str(out / "doctrees"),
+            str(FIXTURES / "site"),
+            str(out / "html"),
+        ],
         capture_output=True,
         text=True,
     )

@@ -32,22 +32,23 @@ SLIDER_PAGES = _pages_with(r"<input[^>]*type=[\"']?range")
 FIXTURE_PAGES = ["index.html", "widgets.html"]
 
 
-def _open(browser, path: Path):
-    """Load a page, wait until the network is idle (MathJax typeset where there is math)."""
+def _open(browser, path: Path | str):
+    """Load a page (a file or a URL), wait until the network is idle and MathJax has
+    typeset the page's math."""
     page = browser.new_page()
     watch = Watch().attach(page)
-    page.goto(path.as_uri(), wait_until="load")
+    page.goto(path if isinstance(path, str) else path.as_uri(), wait_until="load")
     page.wait_for_load_state("networkidle")
     if page.locator("div.math, span.math").count():
         page.wait_for_selector("mjx-container", state="attached", timeout=20_000)
     return page, watch
 
 
-def _check_page(browser, path: Path) -> None:
+def _check_page(browser, path: Path | str) -> None:
     page, watch = _open(browser, path)
     try:
-        assert page.title() and len(page.inner_text("body")) > 100, f"{path.name}: empty page"
-        assert watch.problems() == {}, f"{path.name}: {watch.problems()}"
+        assert page.title() and len(page.inner_text("body")) > 100, f"{path}: empty page"
+        assert watch.problems() == {}, f"{path}: {watch.problems()}"
     finally:
         page.close()
 
@@ -62,6 +63,11 @@ def test_the_site_has_its_pages():
 @pytest.mark.parametrize("page", PAGES)
 def test_page_loads_offline_without_errors(browser, site, page):
     _check_page(browser, site / page)
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_served_page_loads_offline_without_errors(browser, served_site, page):
+    _check_page(browser, served_site + page)
 
 
 @pytest.mark.parametrize("page", FIXTURE_PAGES)
