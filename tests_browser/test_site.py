@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import SITE, Watch
+from conftest import ROOT, SITE, Watch
 
 #: every HTML page of the site (not the assets' own files)
 PAGES = sorted(
@@ -58,6 +58,33 @@ def test_the_site_has_its_pages():
     for page in ("install.html", "cli.html", "api.html"):
         assert page in PAGES
     assert any(p.startswith("notebooks/paper_") for p in PAGES)
+
+
+def test_every_notebook_has_its_page():
+    notebooks = sorted(ROOT.glob("notebooks/*.ipynb")) + sorted(
+        ROOT.glob("notebooks/tutorials/*.ipynb")
+    )
+    assert notebooks
+    for notebook in notebooks:
+        page = notebook.relative_to(ROOT).with_suffix(".html").as_posix()
+        assert page in PAGES, page
+
+
+def test_references_cover_every_subcommand_and_public_name():
+    import importlib
+
+    from beatsync.commands import COMMAND_MODULES
+
+    cli = (SITE / "cli.html").read_text()
+    for command in COMMAND_MODULES:
+        assert f'id="beatsync-{command}"' in cli, command
+    api = (SITE / "api.html").read_text()
+    for module in ("segment", "beats", "sync", "graph", "evaluate", "io", "learn"):
+        package = importlib.import_module(f"beatsync.{module}")
+        for name in package.__all__:
+            if callable(getattr(package, name)):  # functions and classes (constants: their
+                # doc comment is in the submodule that defines them)
+                assert f'id="beatsync.{module}.{name}"' in api, f"beatsync.{module}.{name}"
 
 
 @pytest.mark.parametrize("page", PAGES)
