@@ -6,7 +6,8 @@ nbval and JupyterLab use them there. Sphinx reads only files under its source fo
 so at the start of every build they are copied into ``docs/notebooks/`` (ignored by
 git). A copy is written only when the notebook differs from it, with the notebook's
 own modification time, so that an unchanged notebook is not read again by an
-incremental build; a copy whose notebook is gone is removed.
+incremental build; a copy whose notebook is gone is removed, and so is its page in
+the built site (Sphinx leaves the pages of removed documents behind).
 
 :func:`cli_parser` is the program's parser with its help texts escaped for
 reStructuredText, which sphinx-argparse parses them as: the help is plain text
@@ -111,7 +112,17 @@ def _on_config_inited(app: Sphinx, config: Config) -> None:
     copy_notebooks(Path(app.srcdir))
 
 
+def _on_build_finished(app: Sphinx, exc: Exception | None) -> None:
+    if exc is not None or app.builder.format != "html":
+        return
+    out = Path(app.outdir)
+    for page in (out / "notebooks").rglob("*.html"):
+        if page.relative_to(out).with_suffix("").as_posix() not in app.env.found_docs:
+            page.unlink()
+
+
 def setup(app: Sphinx) -> dict[str, object]:
     app.connect("config-inited", _on_config_inited)
+    app.connect("build-finished", _on_build_finished)
     app.add_directive("globtoctree", GlobTocTree)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
