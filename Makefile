@@ -57,7 +57,7 @@ $(UV):
 # (PYTHONDONTWRITEBYTECODE, read-only installs): 9 s instead of 3 s per import.
 # Then librosa's numba functions are compiled into their on-disk cache by one process:
 # the parallel test workers and notebook kernels compiling them at once can pair cache
-# files written by different processes and crash (numba issue 10128; beatsync.peers.prepare).
+# files written by different processes and crash (numba issue 10128; beatsync.other_trackers.prepare).
 # The stamp holds the extras it was installed with: other extras (`make setup EXTRAS=...`,
 # `make lab`) sync .venv again.
 ifneq ($(strip $(file < $(STAMP))),$(strip $(EXTRAS)))
@@ -65,7 +65,7 @@ $(STAMP): FORCE
 endif
 $(STAMP): uv.lock pyproject.toml | $(UV)
 	$(UV) sync --locked --compile-bytecode --python $(PYTHON) $(EXTRAS)
-	$(BIN)/python -c "from beatsync import peers; peers.prepare('librosa')"
+	$(BIN)/python -c "from beatsync import other_trackers; other_trackers.prepare('librosa')"
 	@echo '$(strip $(EXTRAS))' > $(STAMP)
 
 setup: $(STAMP)
