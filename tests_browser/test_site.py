@@ -158,9 +158,13 @@ def _sliders_change_their_figures(browser, path: Path) -> int:
         count = sliders.count()
         for i in range(count):
             slider = sliders.nth(i)
-            # the images of the output the slider is in (its cell output, else its parent)
+            # the images shown in the output the slider is in (its cell output, else the
+            # slider's grandparent): a new src, or another image shown, is a new figure
             srcs = """s => [...(s.closest('.cell_output, .output') || s.parentElement.parentElement)
-                            .querySelectorAll('img')].map(i => i.src)"""
+                            .querySelectorAll('img')]
+                       .filter(i => i.offsetParent !== null
+                                    && getComputedStyle(i).visibility !== 'hidden')
+                       .map(i => i.src)"""
             before = slider.evaluate(srcs)
             assert before, f"{path.name}: slider {i} has no figure beside it"
             at_max = slider.evaluate("s => s.value === s.max")
