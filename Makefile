@@ -41,7 +41,7 @@ help:
 	@echo "make lock        re-resolve the newest allowed versions into uv.lock (and environment.yml)"
 	@echo "make bench       run the benchmarks into benchmarks/RESULTS.md"
 	@echo "make notebooks   re-execute the committed notebooks with params/ci.yaml"
-	@echo "make lint        ruff on src/ tests/ benchmarks/"
+	@echo "make lint        ruff on src/ tests/ tests_browser/ benchmarks/ and the site's Python"
 	@echo "make lab         install the lab extra from uv.lock and open JupyterLab at notebooks/"
 	@echo "make docs        build the static site into docs/_build/html (open docs/_build/html/index.html)"
 	@echo "make test-browser  build the site, then test it and JupyterLab in headless Chromium"
@@ -117,7 +117,7 @@ test-browser: docs
 FORCE:
 
 lint: setup
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests tests_browser benchmarks docs/_ext docs/conf.py
 
 clean:
 	rm -rf $(VENV) $(UV_DIR) .pytest_cache results/ci docs/_build docs/notebooks
