@@ -868,7 +868,7 @@ def main() -> int:
         "scaled, the metrical model's salience does not peak at the labelled level of "
         "either (labelled minus half-note level -0.10 at 180 BPM, labelled minus "
         "eighth-note level -0.02 at 90 BPM), and no single tactus prior taps both at their "
-        "level (the `beatsync.beats.metrical` docstring lists what was measured). With the "
+        "level (`docs/tuning.md` lists what was measured). With the "
         "cue, the items under F 0.95 are the click track at 180 BPM with noise (seed 0) "
         "and the drums at 60 BPM with drift (seeds 0 and 2). Between and above the set's "
         "tempi (the fast-tempi table), clean click tracks at 160 and 170 BPM are tapped "
