@@ -49,7 +49,7 @@ $(UV):
 # files written by different processes and crash (numba issue 10128; beatsync.peers.prepare).
 $(STAMP): uv.lock pyproject.toml | $(UV)
 	$(UV) sync --locked --compile-bytecode --python $(PYTHON) $(EXTRAS)
-	$(BIN)/python -c "from beatsync import peers; peers.prepare('librosa')"
+	$(BIN)/python -c "from beatsync import other_trackers; other_trackers.prepare('librosa')"
 	@touch $(STAMP)
 
 setup: $(STAMP)

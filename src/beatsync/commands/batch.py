@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, add_mode, add_period_range, emit
-from ._tempo import add_tempo_range, tempo_options
+from ._common import (
+    add_mode,
+    add_output_flags,
+    add_period_range,
+    add_tempo_range,
+    emit,
+    tempo_options,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -46,7 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
     )
     p.add_argument("--summary", default=None, help="summary CSV (default OUT_DIR/summary.csv)")
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 

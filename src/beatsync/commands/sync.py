@@ -28,13 +28,14 @@ from ._common import (
     Feedback,
     Outputs,
     add_mode,
+    add_music_beat_options,
     add_output_flags,
     add_position_options,
     emit,
     feedback,
     position_options,
+    tempo_options,
 )
-from ._tempo import add_music_beat_options, tempo_options
 
 __all__ = ["register", "run"]
 

@@ -9,10 +9,10 @@ import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..units import (
+    as_int,
+    check_interval,
     check_motion_fps,
-    check_range,
     check_times,
-    check_whole,
     frames_to_time,
     time_to_frames,
 )
@@ -150,14 +150,14 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
         Bad settings (``alpha``, ``period_range``), or a dancer whose joints do not move.
     """
     from ..motion import segmentation_view
-    from ..segment import segment
     from ..segment.checks import check_alpha, check_period_range
-    from ..segment.core import PeriodicityRefused
+    from ..segment.core import PeriodicityRefused, _segment_motion
 
     alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
     period_range = check_period_range(period_range)
     try:
-        seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
+        seg = _segment_motion(segmentation_view(motion), alpha=alpha, n_periods=None,
+                              period_range=period_range, method="energy")  # fmt: skip
     except PeriodicityRefused as exc:
         # the channels are segmentation_view's here (sync and batch have no --channels)
         raise NotPeriodicError(exc.advised(PERIODS_ADVICE)) from None
@@ -347,7 +347,7 @@ def synchronize(
             f"the music has {beats.size} detectable beat(s); at least 2 are needed "
             "(is it silent or without rhythm? give the tempo with bpm / --bpm)"
         )
-    first_beat = check_whole(first_beat, name="first_beat")
+    first_beat = as_int(first_beat, name="first_beat", minimum=0)
     if first_beat >= beats.size:
         raise ParameterError(
             f"first_beat={first_beat} but the music has only {beats.size} beats (indices from 0)"
@@ -355,17 +355,13 @@ def synchronize(
     override = (
         None
         if beats_per_period is None
-        else check_whole(beats_per_period, name="beats_per_period", minimum=1)
+        else as_int(beats_per_period, name="beats_per_period", minimum=1)
     )
-    bar = (
-        None
-        if beats_per_bar is None
-        else check_whole(beats_per_bar, name="beats_per_bar", minimum=1)
-    )
+    bar = None if beats_per_bar is None else as_int(beats_per_bar, name="beats_per_bar", minimum=1)
     dance = (
         None
         if dance_beats_per_period is None
-        else check_whole(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
+        else as_int(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
     )
     try:
         phase_offset = float(phase_offset)
@@ -393,13 +389,7 @@ def synchronize(
     elif period_range is None:
         period_range = (PERIOD_BEATS[0] * beat_period, PERIOD_BEATS[1] * beat_period)
     else:
-        try:
-            lo, hi = period_range
-        except (TypeError, ValueError):
-            raise ParameterError(
-                f"period_range={period_range!r} must be (shortest, longest) [s]"
-            ) from None
-        period_range = check_range(lo, hi, name="period_range", unit="s")
+        period_range = check_interval(period_range, name="period_range", unit="s")
     duration = float(frames_to_time(n_frames - 1, fps=fps))  # sample_motion clips here
 
     events, used_mode, note = _events(
