@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from beatsync import datasets, io
-from beatsync.batch import prepare_clip, sync_grid
+from beatsync.sync_grid import prepare_clip, sync_grid
 from beatsync.cli import main
 from beatsync.errors import NotPeriodicError, ParameterError
 from beatsync.synth.audio import beat_times, click_track

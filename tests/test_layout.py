@@ -19,12 +19,12 @@ MAX_LINES = 700
 #: top-level part of the package -> its layer (higher imports lower only)
 LAYER = {
     "errors": 0,
-    "units": 0,
+    "validation": 0,
     "io": 1,
     "motion": 1,
     "rotations": 1,
     "quaternions": 0,
-    "resampling": 0,
+    "audio_resampling": 0,
     "joints": 1,
     "segment": 2,
     "beats": 2,
@@ -40,7 +40,7 @@ LAYER = {
     "learn": 6,
     "datasets": 5,
     "cluster": 5,
-    "batch": 6,
+    "sync_grid": 6,
     "runner": 6,
     "commands": 7,
     "cli": 8,

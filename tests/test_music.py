@@ -119,7 +119,7 @@ def test_too_short_music_is_refused():
 
 def test_beat_samples_go_through_units(monkeypatch):
     import beatsync.music as music
-    from beatsync import units
+    from beatsync import validation as units
 
     calls = []
 

@@ -12,7 +12,7 @@ Stages (one module each; the layers are in the README):
 - :mod:`beatsync.graph` composes dances over weighted motion graphs (paper B).
 - :mod:`beatsync.evaluate` scores beat tracking and dance-music alignment.
 
-Event times are seconds everywhere (see :mod:`beatsync.units`).
+Event times are seconds everywhere (see :mod:`beatsync.validation`).
 """
 
 from .errors import BeatsyncWarning, NotPeriodicError, ParameterError

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ParameterError
-from .units import check_finite, check_fps
+from .validation import check_finite, check_fps
 
 __all__ = ["check_bones", "infer_bones", "bone_lengths", "fill_joint_gaps"]
 

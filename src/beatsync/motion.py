@@ -34,7 +34,7 @@ import numpy as np
 from .errors import ParameterError
 from .joints import bone_lengths, check_bones, fill_joint_gaps, infer_bones
 from .quaternions import quat_from_euler, quat_multiply, quat_rotate
-from .units import check_finite, check_fps
+from .validation import check_finite, check_fps
 
 __all__ = [
     "Joint",

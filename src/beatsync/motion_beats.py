@@ -44,7 +44,7 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.signal import find_peaks
 
 from .errors import ParameterError, warn
-from .units import check_finite, check_fps, check_times, frames_to_time, time_to_frames
+from .validation import check_finite, check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "kinematic_beats",
@@ -429,7 +429,7 @@ def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.nd
         if not np.all(np.equal(np.mod(bf, 1), 0)):
             raise ParameterError(
                 "beat_frames must be integer frame indices; convert seconds with "
-                "beatsync.units.time_to_frames"
+                "beatsync.validation.time_to_frames"
             )
     bf = bf.astype(np.int64)
     if bf.size < 2:
@@ -523,7 +523,7 @@ def motion_tempo(
     >>> motion_tempo([0.0, 0.5, 1.0, 2.0, 2.5])  # one missed beat
     120.0
     """
-    from .units import check_range
+    from .validation import check_range
 
     lo, hi = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="BPM")
     tol = float(tolerance)

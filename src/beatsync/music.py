@@ -26,7 +26,7 @@ import numpy as np
 from .beats import check_audio, track_beats
 from .errors import ParameterError
 from .motion_beats import zscore
-from .units import check_bpm, check_times, time_to_frames
+from .validation import check_bpm, check_times, time_to_frames
 
 __all__ = [
     "beat_rms_db",
@@ -89,7 +89,7 @@ def track_music_beats(
         Mono audio.
     sr : float > 0 [Hz]
     bpm : float, optional [bpm]
-        Known tempo (20-400 BPM, :func:`beatsync.units.check_bpm`).
+        Known tempo (20-400 BPM, :func:`beatsync.validation.check_bpm`).
     method : {"psf", "librosa"}
     min_bpm, max_bpm : float, optional [bpm]
         Tempo range searched (default: :func:`beatsync.beats.track_beats`'s).

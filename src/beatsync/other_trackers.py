@@ -273,7 +273,7 @@ def check_tempo_range(
         than 20 BPM); the message names the option and the default it was set against.
     """
     from .beats.tracker import LIBROSA_MAX_TEMPO
-    from .units import check_bpm
+    from .validation import check_bpm
 
     tracker = TRACKERS.get(name)
     if tracker is None:

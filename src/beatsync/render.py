@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ParameterError, warn
-from .units import (
+from .validation import (
     check_fps,
     check_motion_fps,
     check_positive,

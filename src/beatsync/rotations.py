@@ -20,7 +20,7 @@ from scipy.spatial.transform import Rotation
 from .errors import ParameterError
 from .motion import Motion
 from .quaternions import quat_from_euler
-from .units import check_finite, time_to_frames
+from .validation import check_finite, time_to_frames
 
 __all__ = [
     "euler_to_rotation",

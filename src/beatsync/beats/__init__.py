@@ -27,7 +27,7 @@ The front-end parameters (window, hop, FFT size, band edges) are not published i
 paper; the defaults are swept in ``notebooks/paper_a_sec4_beat_tracking.ipynb``.
 """
 
-from ..units import check_bpm
+from ..validation import check_bpm
 from .onset import FRONTEND_DEFAULTS, FrontEnd, OnsetSignal, onset_strength_psf, phase_slope
 from .tracker import (
     MIN_DURATION_S,

@@ -103,7 +103,7 @@ def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.nd
     import scipy.fft  # noqa: PLC0415 (batched real FFTs)
 
     if sr > CUE_SR:  # float32 out; no float64 copy of a long full-rate recording
-        from ..resampling import resample  # noqa: PLC0415
+        from ..audio_resampling import resample  # noqa: PLC0415
 
         y = resample(y, sr, CUE_SR, int(round(y.size * CUE_SR / sr)), keep_level=False)
         sr = CUE_SR

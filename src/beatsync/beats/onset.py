@@ -33,8 +33,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..resampling import resample
-from ..units import (
+from ..audio_resampling import resample
+from ..validation import (
     check_audio,
     check_positive,
     check_sample_rate,
@@ -107,7 +107,7 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     Raises
     ------
     ParameterError
-        An implausible sample rate (:func:`beatsync.units.check_sample_rate`), an
+        An implausible sample rate (:func:`beatsync.validation.check_sample_rate`), an
         unknown key, non-positive window or hop, a hop over half the window, an FFT
         shorter than the window, band edges that do not increase, or given band edges
         with a band that holds no FFT bin at the analysis rate (above its Nyquist

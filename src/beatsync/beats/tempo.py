@@ -16,7 +16,7 @@ import functools
 
 import numpy as np
 
-from ..units import frames_to_time, time_to_frames
+from ..validation import frames_to_time, time_to_frames
 
 __all__ = [
     "analysis_windows",

@@ -1,6 +1,6 @@
 """The public beat tracker: :func:`track_beats` and its result :class:`BeatTrack`.
 
-Validation happens here, once (:mod:`beatsync.units` helpers); the stage modules
+Validation happens here, once (:mod:`beatsync.validation` helpers); the stage modules
 (:mod:`.onset`, :mod:`.tempo`, :mod:`.phase`, :mod:`.metrical`) trust their inputs.
 
 The no-clear-pulse warning compares the resonator salience along the decoded tempo
@@ -21,8 +21,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..errors import ParameterError, warn
-from ..units import check_audio as _units_check_audio
-from ..units import (
+from ..validation import check_audio as _units_check_audio
+from ..validation import (
     check_bpm,
     check_positive,
     check_range,
@@ -124,7 +124,7 @@ class BeatTrack:
 def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndarray, float]:
     """Validate mono audio for the tracker; return ``(y float64, sr float)``.
 
-    :func:`beatsync.units.check_audio` with the silence threshold :data:`SILENCE_PEAK`
+    :func:`beatsync.validation.check_audio` with the silence threshold :data:`SILENCE_PEAK`
     (``allow_silent=True``: no silence check, e.g. to measure a level).
 
     Raises

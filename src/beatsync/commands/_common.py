@@ -175,7 +175,7 @@ def tempo_options(args: argparse.Namespace) -> dict[str, float]:
         searched), a tempo outside 20-400 BPM, or ``--min-bpm`` not below ``--max-bpm``.
     """
     from ..beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM  # noqa: PLC0415 (numpy)
-    from ..units import check_bpm  # noqa: PLC0415
+    from ..validation import check_bpm  # noqa: PLC0415
 
     beats = getattr(args, "beats", None)
     if beats is not None and args.bpm is not None:

@@ -61,7 +61,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
 
     from .. import io
-    from ..batch import item_names, output_suffixes, sync_grid
+    from ..sync_grid import item_names, output_suffixes, sync_grid
     from ..cluster import check_cluster_options
     from ..errors import ParameterError
     from ..io import check_input_file

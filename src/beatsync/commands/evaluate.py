@@ -99,7 +99,7 @@ def run_beats(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..evaluate.beats import EMPTY_REFERENCE_TEXT
     from ..study.beat_dataset import RESULT_FILES, evaluate_dataset, find_tracks
-    from ..units import check_positive
+    from ..validation import check_positive
     from ._common import Interrupted, check_output, feedback, interrupted_by
 
     fb = feedback(args)

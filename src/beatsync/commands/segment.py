@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..motion import is_marker_motion, segmentation_view
     from ..segment import period_range_from_beat, segment
-    from ..units import check_bpm, time_to_frames
+    from ..validation import check_bpm, time_to_frames
 
     period_range = tuple(args.period_range)
     if args.bpm is not None:

@@ -194,7 +194,7 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
         if inp is not None and not Path(inp).is_file():
             raise ParameterError(f"{what} file {inp!r} does not exist")
     if args.video:
-        from ..units import check_motion_fps
+        from ..validation import check_motion_fps
 
         check_motion_fps(args.video_fps, name="--video-fps")  # before minutes of work
     outs = Outputs(inputs=(args.motion, args.audio, args.beats))
@@ -255,7 +255,7 @@ def _pipeline(
     with fb.step("finding beats"):
         t0 = time.perf_counter()
         if args.beats is not None:
-            from ..units import check_times
+            from ..validation import check_times
 
             # beats after the music's end are a unit mistake (ms, frames), and would make
             # the dance run on for hours: refused before any work

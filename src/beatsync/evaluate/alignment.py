@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, warn
-from ..units import beat_phase, check_fps, check_times, frames_to_time, time_to_frames
+from ..validation import beat_phase, check_fps, check_times, frames_to_time, time_to_frames
 
 __all__ = [
     "validate",

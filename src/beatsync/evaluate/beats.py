@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, warn
-from ..units import MIN_BPM, check_positive, check_times
+from ..validation import MIN_BPM, check_positive, check_times
 
 __all__ = [
     "EMPTY_REFERENCE_TEXT",
@@ -47,7 +47,7 @@ __all__ = [
 ]
 
 #: Beat sequences whose median interval exceeds this [s] are refused (not seconds):
-#: 3 s, the beat period at :data:`beatsync.units.MIN_BPM` (20 BPM), the slowest
+#: 3 s, the beat period at :data:`beatsync.validation.MIN_BPM` (20 BPM), the slowest
 #: tempo the tracker considers.
 MAX_BEAT_INTERVAL = 60.0 / MIN_BPM
 
@@ -81,7 +81,7 @@ def diagnose_times(times: np.ndarray) -> str | None:
     Parameters
     ----------
     times : np.ndarray [shape=(n,)]
-        Finite, increasing values (already checked by :func:`beatsync.units.check_times`).
+        Finite, increasing values (already checked by :func:`beatsync.validation.check_times`).
 
     Returns
     -------

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, silenced, warn
-from ..units import time_to_frames
+from ..validation import time_to_frames
 from .alignment import alignment_scores
 
 __all__ = [

@@ -11,7 +11,7 @@ synchronization". Modules:
 - :mod:`~beatsync.graph.search`: the DP over the music's beats (and the dispatcher);
   :mod:`~beatsync.graph.baselines`: the multi-stage search and the random walk;
   :mod:`~beatsync.graph.objective`: their shared objective, result and checks.
-- :mod:`~beatsync.graph.warp`: the chosen intervals time-warped onto the music and
+- :mod:`~beatsync.graph.synthesis`: the chosen intervals time-warped onto the music and
   blended at transitions.
 - :mod:`~beatsync.graph.plausibility`: root and joint rotation speeds against the
   library's.
@@ -48,7 +48,7 @@ from .search import (
     random_walk,
     search,
 )
-from .warp import SynthesisResult, beat_warp, synthesize
+from .synthesis import SynthesisResult, beat_warp, synthesize
 
 __all__ = [
     "WEIGHT_RULES",

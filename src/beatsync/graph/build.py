@@ -58,7 +58,7 @@ import numpy as np
 
 from ..errors import ParameterError, silenced, warn
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
-from ..units import check_fps, check_positive, check_times, frames_to_time, time_to_frames
+from ..validation import check_fps, check_positive, check_times, frames_to_time, time_to_frames
 from .distance import aligned_distance_matrix, point_clouds, typical_speed
 
 __all__ = [

@@ -47,14 +47,14 @@ def graph_source_hash() -> str:
     :mod:`beatsync.graph.build` and :mod:`beatsync.motion_beats` (beat frames,
     intensities, distances) and the foundation they rest on: BVH reading
     (:mod:`beatsync.io.bvh`), forward kinematics (:mod:`beatsync.motion`) and
-    :mod:`beatsync.units`.
+    :mod:`beatsync.validation`.
     """
-    from .. import motion, motion_beats, units
+    from .. import motion, motion_beats, validation
     from ..io import bvh, sha256_file
     from . import build
 
     h = hashlib.sha256()
-    for module in (build, motion_beats, bvh, motion, units):
+    for module in (build, motion_beats, bvh, motion, validation):
         h.update(sha256_file(Path(str(module.__file__))).encode())
     return h.hexdigest()
 

@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import ParameterError, silenced, warn
 from ..motion import Motion
 from ..motion_beats import zscore
-from ..units import check_finite, check_fps, check_times
+from ..validation import check_finite, check_fps, check_times
 from .baselines import check_conventional_options, conventional_core, random_core
 from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
@@ -37,7 +37,7 @@ from .timescale import (
     music_grid,
     plan_tempo,
 )
-from .warp import SynthesisResult, synthesize_core
+from .synthesis import SynthesisResult, synthesize_core
 
 __all__ = ["Composition", "compose", "compose_music", "check_music_beats"]
 
@@ -175,7 +175,7 @@ def compose(
     seed : int
         Random walk seed.
     warp : {"pchip", "linear"}
-        Time warp inside runs (see :func:`beatsync.graph.warp.synthesize`).
+        Time warp inside runs (see :func:`beatsync.graph.synthesis.synthesize`).
     scale_bound : (float, float) or None
         Bound on every interval's time-scale factor (music / natural duration),
         enforced by every method; ``None``: unbounded (paper B as written).

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_finite
+from ..validation import check_finite
 from .build import WeightedMotionGraph
 from .timescale import check_scale_bound
 

@@ -42,7 +42,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion_beats import motion_tempo
-from ..units import check_range
+from ..validation import check_range
 
 __all__ = [
     "DEFAULT_SCALE_BOUND",

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..joints import fill_joint_gaps
 from ..motion import Motion
-from ..units import check_positive
+from ..validation import check_positive
 from ._files import (
     append_jsonl,
     atomic_write,

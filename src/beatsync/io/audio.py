@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, warn
-from ..resampling import resample
-from ..units import as_float, check_audio, check_finite, check_sample_rate, check_times
+from ..audio_resampling import resample
+from ..validation import as_float, check_audio, check_finite, check_sample_rate, check_times
 from ._files import atomic_write, check_input_file
 
 #: libsndfile's format for each suffix it reads (soundfile >= 0.12 with libsndfile >= 1.1

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..units import as_float, as_int, check_finite, check_fps
+from ..validation import as_float, as_int, check_finite, check_fps
 from ._files import atomic_write, check_input_file
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNELS"]

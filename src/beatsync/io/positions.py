@@ -43,7 +43,7 @@ from ..motion import (
     PositionInfo,
     fill_joint_gaps,
 )
-from ..units import check_fps, check_positive
+from ..validation import check_fps, check_positive
 from ._files import atomic_write, check_input_file
 
 __all__ = [

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from ..units import as_float, as_float_array, check_finite, check_fps
+from ..validation import as_float, as_float_array, check_finite, check_fps
 from ._files import atomic_write, check_input_file, write_csv
 
 

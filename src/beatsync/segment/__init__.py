@@ -12,7 +12,7 @@ Data contract
   increasing times [s] within ``[0, (n_frames - 1) / fps]``: start of the first full
   period ... end of the last (lead-in and tail shorter than a period are left out).
   Frames are used only inside this package; conversion goes through
-  :func:`beatsync.units.frames_to_time`.
+  :func:`beatsync.validation.frames_to_time`.
 
 Modules
 -------

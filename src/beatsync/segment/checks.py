@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import as_float, as_float_array, as_int, check_finite, check_interval
+from ..validation import as_float, as_float_array, as_int, check_finite, check_interval
 from .period import PERIOD_METHODS
 
 __all__ = [

@@ -7,7 +7,7 @@ Data contract
   channels in degrees. Periods and ranges in seconds.
 - Output: :class:`Segmentation`, whose ``boundaries`` are ``n_periods + 1`` strictly
   increasing times [s] within ``[0, (n_frames - 1) / fps]``. Frames are used only
-  inside the package; conversion goes through :func:`beatsync.units.frames_to_time`.
+  inside the package; conversion goes through :func:`beatsync.validation.frames_to_time`.
 
 Every argument is validated here, once, cheapest first (numbers, then the values,
 then what the data allow: constant channels, clip length, whether the count fits);
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError
-from ..units import (
+from ..validation import (
     MAX_BPM,
     MIN_BPM,
     as_float,

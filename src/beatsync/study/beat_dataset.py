@@ -46,7 +46,7 @@ from ..evaluate.beats import (
     not_seconds_detail,
     tempo_octave,
 )
-from ..units import MAX_BPM
+from ..validation import MAX_BPM
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -565,7 +565,7 @@ def evaluate_dataset(
         an unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
     """
     from ..cluster import check_cluster_options, dask_client
-    from ..units import check_positive
+    from ..validation import check_positive
 
     other_trackers.get(method)
     mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
@@ -697,7 +697,7 @@ def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> No
     import soundfile as sf
 
     from ..beats.tracker import librosa_tempo_prior
-    from ..units import check_sample_rate
+    from ..validation import check_sample_rate
 
     first: dict[float, str] = {}
     for t in tracks:

@@ -31,7 +31,7 @@ from ..segment.channels import nonconstant_channels, standardise
 from ..segment.checks import check_period_range, check_values
 from ..segment.period import estimate_period, estimation_band, uniform_frames
 from ..synth.motion import SyntheticMotion, periodic_motion
-from ..units import check_finite, check_fps, frames_to_time, time_to_frames
+from ..validation import check_finite, check_fps, frames_to_time, time_to_frames
 
 __all__ = [
     "SegmentationClips",

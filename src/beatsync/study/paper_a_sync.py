@@ -38,7 +38,7 @@ from ..evaluate.alignment import (
 )
 from ..motion import Motion
 from ..motion_beats import kinematic_beats
-from ..units import check_positive, frames_to_time, time_to_frames
+from ..validation import check_positive, frames_to_time, time_to_frames
 from .artifacts import write_artifacts
 
 __all__ = [
@@ -373,7 +373,7 @@ def evaluate_sync(
         :class:`~beatsync.sync.SyncResult`).
     """
     from ..sync import synchronize
-    from ..units import check_times
+    from ..validation import check_times
 
     yb = check_times(beats, name="beats")
     n_periods = None

@@ -521,7 +521,7 @@ def composition_proxies(
     """
     from ..evaluate.composition import foot_joints, quality_proxies
     from ..motion_beats import beat_interval_intensity, kinematic_beats, motion_positions
-    from ..units import frames_to_time
+    from ..validation import frames_to_time
 
     m = comp.motion
     beats = comp.music_beats
@@ -620,7 +620,7 @@ def plot_intensity(comp: Any) -> Any:
     import matplotlib.pyplot as plt
 
     from ..motion_beats import beat_interval_intensity
-    from ..units import frames_to_time
+    from ..validation import frames_to_time
 
     m = comp.motion
     last = float(frames_to_time(m.n_frames - 1, fps=m.fps))

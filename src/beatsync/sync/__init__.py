@@ -17,7 +17,7 @@ Data contract
   start. Frames before the first warped frame hold the first pose.
 - Rates are dimensionless: ``rate = target duration / source duration`` (> 1 slows
   the dance down). The report's ``tempo_ratio`` is its inverse, the playback speed.
-- All frame/second conversion goes through :mod:`beatsync.units`.
+- All frame/second conversion goes through :mod:`beatsync.validation`.
 
 Method (what the paper leaves open, and our choices)
 ----------------------------------------------------

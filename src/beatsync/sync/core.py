@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
-from ..units import (
+from ..validation import (
     as_int,
     check_interval,
     check_motion_fps,
@@ -387,7 +387,7 @@ def synchronize(
             "land='accents' measures the phase offset itself; do not also give phase_offset"
         )
     if delta is not None:
-        from ..units import check_positive
+        from ..validation import check_positive
 
         delta = check_positive(delta, name="delta", unit="s")
     beat_period = float(np.median(np.diff(beats)))

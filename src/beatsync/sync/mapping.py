@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import as_int, beat_phase, check_positive, check_times
+from ..validation import as_int, beat_phase, check_positive, check_times
 
 __all__ = [
     "BeatCount",

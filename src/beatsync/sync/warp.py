@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import check_positive, check_times
+from ..validation import check_positive, check_times
 
 __all__ = ["TimeWarp", "blended_rate", "correction_bump", "integrate_warp", "time_warp"]
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import (
+from ..validation import (
     check_bpm,
     check_positive,
     check_times,

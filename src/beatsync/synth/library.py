@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..units import check_fps, check_positive, frames_to_time, time_to_frames
+from ..validation import check_fps, check_positive, frames_to_time, time_to_frames
 
 __all__ = ["dance_skeleton", "synthetic_dance", "synthetic_library"]
 

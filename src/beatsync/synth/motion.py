@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Motion
-from ..units import check_fps, frames_to_time
+from ..validation import check_fps, frames_to_time
 
 __all__ = ["SyntheticMotion", "periodic_motion"]
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from beatsync.errors import ParameterError
-from beatsync.units import (
+from beatsync.validation import (
     MAX_BPM,
     MIN_BPM,
     as_float,
@@ -317,14 +317,14 @@ def test_check_helpers_accept_numbers_written_as_text():
     ],
 )
 def test_check_interval_refuses(pair, match):
-    from beatsync.units import check_interval
+    from beatsync.validation import check_interval
 
     with pytest.raises(ParameterError, match=match):
         check_interval(pair, name="period_range", unit="s")
 
 
 def test_check_interval_accepts_arrays_and_lists():
-    from beatsync.units import check_interval
+    from beatsync.validation import check_interval
 
     assert check_interval(np.array([0.5, 2.0]), name="r", unit="s") == (0.5, 2.0)
     assert check_interval([1, 3], name="r", unit="s") == (1.0, 3.0)

@@ -1,4 +1,6 @@
-"""Time bases and every validation helper of beatsync (the lowest layer but ``errors``).
+"""Validation of every input of beatsync, and its one frames/seconds conversion.
+
+The lowest layer but ``errors``.
 
 Every public entry of the package checks its inputs here, once; private functions
 trust them. The ``check_*`` helpers accept a number written as text (``"2.5"``, as

@@ -47,7 +47,7 @@ from ..rotations import (
     rotation_to_euler,
     sample_motion,
 )
-from ..units import check_fps, check_times, frames_to_time, time_to_frames
+from ..validation import check_fps, check_times, frames_to_time, time_to_frames
 from .build import WeightedMotionGraph
 from .distance import ground_axes
 
