@@ -271,3 +271,22 @@ def test_cli_check_in_place_and_quiet(nbdir, tmp_path, capsys):
     assert capsys.readouterr() == ("", "")
     assert "42\n" in _outputs(nbdir / "tiny.ipynb")  # the notebook itself, executed
     assert sorted(x.name for x in nbdir.iterdir()) == ["tiny.ipynb"]  # and no manifest
+
+
+def test_a_relative_results_folder_is_found_from_the_notebooks_whatever_the_cwd(
+    tmp_path, monkeypatch
+):
+    # papermill notebooks/X.ipynb from the repository root wrote "../results" outside it
+    from beatsync.study.artifacts import results_folder
+
+    root = Path(__file__).resolve().parents[1]
+    for cwd in (root, root / "notebooks", root / "src" / "beatsync", tmp_path):
+        monkeypatch.chdir(cwd)
+        assert results_folder("../results/ci") == root / "results" / "ci", cwd
+    assert results_folder(tmp_path / "r") == tmp_path / "r"  # absolute: as given
+    # another clone found from the current folder, before the package's own
+    other = tmp_path / "clone"
+    (other / "notebooks").mkdir(parents=True)
+    (other / "pyproject.toml").write_text("")
+    monkeypatch.chdir(other / "notebooks")
+    assert results_folder("../results") == other / "results"
