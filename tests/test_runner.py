@@ -290,3 +290,9 @@ def test_a_relative_results_folder_is_found_from_the_notebooks_whatever_the_cwd(
     (other / "pyproject.toml").write_text("")
     monkeypatch.chdir(other / "notebooks")
     assert results_folder("../results") == other / "results"
+
+
+def test_a_file_that_is_not_a_notebook_is_refused_by_name(nbdir):
+    (nbdir / "broken.ipynb").write_text("{not json")
+    with pytest.raises(ParameterError, match="cannot read notebook '.*broken.ipynb'"):
+        check_params({"tiny": {}, "broken": {}}, nbdir)

@@ -91,12 +91,15 @@ def check_params(
             f"notebooks {unlisted} are not listed in the parameter file; add them "
             "(with an empty mapping if they need no parameters)"
         )
-    if only and sorted(set(only) - set(present)):
-        unknown = sorted(set(only) - set(present))
+    unknown = sorted(set(only or ()) - set(present))
+    if unknown:
         raise ParameterError(f"unknown notebook(s) {unknown}; choose from {sorted(present)}")
     names = [n for n in params if not only or n in only]
     for name in names:
-        declared = pm.inspect_notebook(str(present[name]))
+        try:
+            declared = pm.inspect_notebook(str(present[name]))
+        except Exception as exc:  # not a notebook (JSON, nbformat)
+            raise ParameterError(f"cannot read notebook {str(present[name])!r}: {exc}") from None
         extra = sorted(set(params[name]) - set(declared))
         if extra:
             raise ParameterError(
