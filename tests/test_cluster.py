@@ -143,13 +143,16 @@ def _worker_state(dask_worker):
     )
 
 
-def test_local_worker_processes_run_with_our_settings_and_ignore_ctrl_c():
+def test_local_worker_processes_run_with_our_settings_and_ignore_ctrl_c(monkeypatch):
     """Dask's MALLOC_TRIM_THRESHOLD_ slows beat tracking; the dashboard's periodic work
     competes with it; a Ctrl-C to the process group printed a traceback per worker. A
     key the user sets keeps the user's value, and this process keeps its settings."""
     import dask
     import distributed  # noqa: F401 (its defaults loaded)
 
+    # a nanny of Dask's defaults started earlier in this process (another test) left
+    # the variable in os.environ, which every later worker process inherits
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
     keys = [*cluster.LOCAL_CLUSTER_CONFIG, "distributed.nanny.pre-spawn-environ"]
     with dask.config.set({"distributed.admin.tick.interval": "500ms"}):  # the user's
         before = {key: dask.config.get(key) for key in keys}
