@@ -11,6 +11,14 @@ UV_VERSION  = 0.13.8
 UV_DIR      = .uv
 UV          = $(UV_DIR)/bin/uv
 EXTRAS     ?= --extra test --extra dev --extra peers
+# `make lab`, `make docs` and `make test-browser` add these (one set for the three, so
+# that going from one to another does not re-sync .venv)
+SITE_EXTRAS = --extra lab --extra docs --extra browser
+# the site's build (docs/_build keeps the doctrees, so that a rebuild reads only what
+# changed); warnings are errors
+SPHINXOPTS ?= -W --keep-going
+# Debian's chromium, driven by playwright in the browser tests (never a browser of its own)
+CHROMIUM   ?= /usr/bin/chromium
 PARAMS     ?= params/paper.yaml
 # Pass e.g. PYTEST_ARGS="-x -q" to change pytest's options.
 PYTEST_ARGS ?= -q
@@ -25,7 +33,7 @@ DOCTEST     = --doctest-modules src/beatsync
 export UV_PYTHON_DOWNLOADS = never
 export UV_PROJECT_ENVIRONMENT = $(VENV)
 
-.PHONY: setup lock reproduce test test-unit test-notebooks bench notebooks lint clean help
+.PHONY: setup lock reproduce test test-unit test-notebooks test-browser bench notebooks lint lab docs clean help FORCE
 
 help:
 	@echo "make reproduce   set up .venv from uv.lock and run the whole study into results/"
@@ -33,7 +41,10 @@ help:
 	@echo "make lock        re-resolve the newest allowed versions into uv.lock (and environment.yml)"
 	@echo "make bench       run the benchmarks into benchmarks/RESULTS.md"
 	@echo "make notebooks   re-execute the committed notebooks with params/ci.yaml"
-	@echo "make lint        ruff on src/ tests/ benchmarks/"
+	@echo "make lint        ruff on src/ tests/ tests_browser/ benchmarks/ and the site's Python"
+	@echo "make lab         install the lab extra from uv.lock and open JupyterLab at notebooks/"
+	@echo "make docs        build the static site into docs/_build/html (open docs/_build/html/index.html)"
+	@echo "make test-browser  build the site, then test it and JupyterLab in headless Chromium"
 
 $(UV):
 	@$(PYTHON) -c 'import sys; assert sys.version_info[:2] == (3, 11), "beatsync is locked for Python 3.11, found " + sys.version' 
@@ -46,11 +57,16 @@ $(UV):
 # (PYTHONDONTWRITEBYTECODE, read-only installs): 9 s instead of 3 s per import.
 # Then librosa's numba functions are compiled into their on-disk cache by one process:
 # the parallel test workers and notebook kernels compiling them at once can pair cache
-# files written by different processes and crash (numba issue 10128; beatsync.peers.prepare).
+# files written by different processes and crash (numba issue 10128; beatsync.other_trackers.prepare).
+# The stamp holds the extras it was installed with: other extras (`make setup EXTRAS=...`,
+# `make lab`) sync .venv again.
+ifneq ($(strip $(file < $(STAMP))),$(strip $(EXTRAS)))
+$(STAMP): FORCE
+endif
 $(STAMP): uv.lock pyproject.toml | $(UV)
 	$(UV) sync --locked --compile-bytecode --python $(PYTHON) $(EXTRAS)
-	$(BIN)/python -c "from beatsync import peers; peers.prepare('librosa')"
-	@touch $(STAMP)
+	$(BIN)/python -c "from beatsync import other_trackers; other_trackers.prepare('librosa')"
+	@echo '$(strip $(EXTRAS))' > $(STAMP)
 
 setup: $(STAMP)
 
@@ -81,8 +97,27 @@ bench: setup
 notebooks: setup
 	$(BIN)/beatsync reproduce --params params/ci.yaml --in-place
 
+# JupyterLab at notebooks/ (the tutorials are in notebooks/tutorials/); ipywidgets 8
+# brings the lab extension its sliders need.
+lab:
+	@$(MAKE) --no-print-directory setup EXTRAS="$(EXTRAS) $(SITE_EXTRAS)"
+	$(BIN)/jupyter lab --ServerApp.root_dir=notebooks $(if $(filter 0,$(shell id -u)),--allow-root)
+
+# The site (docs/conf.py says how the notebooks get in); the committed notebooks' outputs
+# are shown as they are, never executed here.
+docs:
+	@$(MAKE) --no-print-directory setup EXTRAS="$(EXTRAS) $(SITE_EXTRAS)"
+	$(BIN)/sphinx-build -M html docs docs/_build $(SPHINXOPTS)
+
+# Every page of the site and a widget in JupyterLab, in headless Chromium (.ci/run
+# installs Debian's chromium where it is missing).
+test-browser: docs
+	BEATSYNC_CHROMIUM=$(CHROMIUM) $(BIN)/python -m pytest $(PYTEST_ARGS) -p no:cacheprovider -n 0 tests_browser
+
+FORCE:
+
 lint: setup
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests tests_browser benchmarks docs/_ext docs/conf.py
 
 clean:
-	rm -rf $(VENV) $(UV_DIR) .pytest_cache results/ci
+	rm -rf $(VENV) $(UV_DIR) .pytest_cache results/ci docs/_build docs/notebooks

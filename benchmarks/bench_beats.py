@@ -267,8 +267,8 @@ def excerpt_rows(
     excerpts on which our tracker warned (no clear pulse).
     """
     from beatsync import datasets
-    from beatsync.evaluate.beats import evaluate_beats, median_tempo
-    from beatsync.peers import track
+    from beatsync.evaluate.beats import evaluate, median_tempo
+    from beatsync.other_trackers import track
 
     rows = []
     for name in datasets.REAL_DEV_ITEMS:
@@ -291,7 +291,7 @@ def excerpt_rows(
                     r = ref[(ref >= start) & (ref < start + cut)] - start
                     est, w = _with_pulse_warning(track, method, seg, sr)
                     warned += w
-                    s = evaluate_beats(r, est, min_beat_time=min_beat_time)
+                    s = evaluate(r, est, min_beat_time=min_beat_time)
                     f.append(s["F-measure"])
                     cml.append(s["Correct Metric Level Total"])
                     tempi.append(median_tempo(est))
@@ -347,7 +347,7 @@ def dance_song_rows() -> list[dict]:
     """
     from beatsync import datasets
     from beatsync.beats import track_beats
-    from beatsync.evaluate.beats import evaluate_beats, median_tempo
+    from beatsync.evaluate.beats import evaluate, median_tempo
 
     rows = []
     for name in datasets.DANCE_PAIRS:
@@ -363,7 +363,7 @@ def dance_song_rows() -> list[dict]:
                 bt, w = _with_pulse_warning(track_beats, seg, sr)
                 ref = whole.beats[(whole.beats >= start) & (whole.beats < start + length)]
                 ref = ref - start
-                f.append(evaluate_beats(ref, bt.beats, min_beat_time=5.0)["F-measure"])
+                f.append(evaluate(ref, bt.beats, min_beat_time=5.0)["F-measure"])
                 warned.append(w)
                 tempi.append(median_tempo(bt.beats))
                 if f[-1] < DANCE_AGREE_F:
@@ -397,9 +397,9 @@ def dance_song_rows() -> list[dict]:
 
 def _agrees(ref: np.ndarray, beats: np.ndarray) -> bool:
     """Whether ``beats`` agree with ``ref`` (F >= :data:`DANCE_AGREE_F`, scored after 5 s)."""
-    from beatsync.evaluate.beats import evaluate_beats
+    from beatsync.evaluate.beats import evaluate
 
-    return evaluate_beats(ref, beats, min_beat_time=5.0)["F-measure"] >= DANCE_AGREE_F
+    return evaluate(ref, beats, min_beat_time=5.0)["F-measure"] >= DANCE_AGREE_F
 
 
 def madmom_rows() -> list[dict]:
@@ -410,7 +410,7 @@ def madmom_rows() -> list[dict]:
     """
     from beatsync import datasets
     from beatsync.beats import track_beats
-    from beatsync.evaluate.beats import evaluate_beats, median_tempo
+    from beatsync.evaluate.beats import evaluate, median_tempo
 
     y, sr, ref = datasets.load_madmom_sample()[:3]
     tempo = median_tempo(ref)
@@ -425,7 +425,7 @@ def madmom_rows() -> list[dict]:
     rows = []
     for what, kwargs in told.items():
         bt, warned = _with_pulse_warning(track_beats, y, sr, **kwargs)
-        s = evaluate_beats(ref, bt.beats, min_beat_time=0.0)
+        s = evaluate(ref, bt.beats, min_beat_time=0.0)
         rows.append(
             {
                 "told": what,
@@ -495,7 +495,7 @@ def level_rows(methods: list[str]) -> list[dict]:
     nothing else: no metrical level other than the clicks' own is in the signal. Each
     tracker's tempo is its beats' median interval, at the labelled tempo when within 8 %.
     """
-    from beatsync import peers
+    from beatsync import other_trackers
     from beatsync.evaluate.beats import octave_relation
     from beatsync.synth.audio import make_beat_test_set
 
@@ -508,7 +508,7 @@ def level_rows(methods: list[str]) -> list[dict]:
         for method in methods:
             off = []
             for it in items:
-                beats = _with_pulse_warning(peers.track, method, it.y, it.sr)[0]
+                beats = _with_pulse_warning(other_trackers.track, method, it.y, it.sr)[0]
                 tempo = 60.0 / float(np.median(np.diff(beats))) if beats.size > 1 else 0.0
                 if octave_relation(tempo, it.bpm) != "correct":
                     off.append(f"{it.bpm:g}@{tempo:.0f}")
@@ -868,7 +868,7 @@ def main() -> int:
         "scaled, the metrical model's salience does not peak at the labelled level of "
         "either (labelled minus half-note level -0.10 at 180 BPM, labelled minus "
         "eighth-note level -0.02 at 90 BPM), and no single tactus prior taps both at their "
-        "level (the `beatsync.beats.metrical` docstring lists what was measured). With the "
+        "level (`docs/tuning.md` lists what was measured). With the "
         "cue, the items under F 0.95 are the click track at 180 BPM with noise (seed 0) "
         "and the drums at 60 BPM with drift (seeds 0 and 2). Between and above the set's "
         "tempi (the fast-tempi table), clean click tracks at 160 and 170 BPM are tapped "

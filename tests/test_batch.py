@@ -36,7 +36,8 @@ def inputs(tmp_path_factory):
 
 def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
     _, clips, songs = inputs
-    table = sync_grid(clips, songs, tmp_path, processes=False, n_workers=2, fps=60.0)
+    table = sync_grid(clips, songs, tmp_path, processes=False, n_workers=2, fps=60.0,
+                      mode="periods")  # fmt: skip
     assert len(table) == 4
     ok = table[table["status"] == "ok"]
     assert sorted(ok["clip"]) == ["salsa", "salsa"]
@@ -154,13 +155,62 @@ def test_batch_refuses_to_overwrite_inputs(inputs, tmp_path):
 
 def test_batch_refuses_duplicate_song_names(inputs, tmp_path):
     d, clips, songs = inputs
-    (tmp_path / "a").mkdir()
-    (tmp_path / "b").mkdir()
-    twins = [tmp_path / "a" / "song.wav", tmp_path / "b" / "song.wav"]
-    for t in twins:
+    twins = [tmp_path / "a" / "take" / "song.wav", tmp_path / "b" / "take" / "song.wav"]
+    for t in twins:  # the same file name in folders of the same name: nothing tells them apart
+        t.parent.mkdir(parents=True)
         t.write_bytes(songs[0].read_bytes())
-    with pytest.raises(ParameterError, match="song file names must differ"):
+    with pytest.raises(ParameterError, match=r"song names must differ.*\['take'\]"):
         sync_grid(clips[:1], twins, tmp_path)
+
+
+def test_batch_defaults_are_those_of_sync():
+    import inspect
+
+    from beatsync.cli import build_parser
+
+    parser = build_parser()
+    batch = parser.parse_args(["batch", "--clips", "a.bvh", "--songs", "s.wav", "--out-dir", "o"])
+    sync = parser.parse_args(["sync", "a.bvh", "s.wav", "-o", "o.bvh"])
+    assert batch.mode == sync.mode == "auto"
+    assert inspect.signature(sync_grid).parameters["mode"].default == "auto"
+
+
+def _takes(tmp_path):
+    """Two real dancers laid out one folder per take (DANCE_C_4/skeletons.json, ...) and
+    a 10 s song."""
+    clips = []
+    for take in ("DANCE_C_4", "DANCE_R_3"):
+        (tmp_path / take).mkdir()
+        clips.append(tmp_path / take / "skeletons.json")
+        src = datasets.path(f"motion/dance_with_melody/{take}/skeletons.json")
+        clips[-1].write_bytes(src.read_bytes())
+    song = io.write_audio(
+        tmp_path / "song.wav",
+        click_track(beat_times(100, duration=10.0, start=0.5), sr=SR, duration=10.0), SR,
+    )  # fmt: skip
+    out = tmp_path / "out"
+    out.mkdir()
+    return clips, song, out
+
+
+def test_grid_names_one_folder_per_take_by_its_folder(tmp_path):
+    clips, song, out = _takes(tmp_path)
+    table = sync_grid(clips, [song], out, processes=False, n_workers=1, fps=25.0)
+    assert sorted(table["clip"]) == ["DANCE_C_4", "DANCE_R_3"]
+    assert (table["status"] == "ok").all(), table["error"].tolist()
+    assert (table["mode"] == "beats").all()  # defaults of sync: auto falls back to motion beats
+    for take in ("DANCE_C_4", "DANCE_R_3"):
+        assert (out / f"{take}__song.json").is_file()
+
+
+def test_batch_cli_takes_one_folder_per_take(tmp_path, scheduler, capsys):
+    clips, song, out = _takes(tmp_path)
+    argv = ["batch", "--clips", *map(str, clips), "--songs", str(song), "--out-dir", str(out),
+            "--fps", "25", "--scheduler", scheduler]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in out.glob("*.json")) == [
+        "DANCE_C_4__song.json", "DANCE_R_3__song.json"
+    ]  # fmt: skip
 
 
 def _batch_args(inputs, out, *extra):
@@ -281,7 +331,8 @@ def test_batch_text_gives_a_line_per_pair_and_its_note_or_error(inputs, schedule
     # as one table, the notes of real dancers made lines of several hundred characters
     _, clips, songs = inputs
     argv = ["batch", "--clips", *map(str, clips), "--songs", str(songs[0]), "--out-dir",
-            str(tmp_path), "--fps", "60", "--scheduler", scheduler]  # fmt: skip
+            str(tmp_path), "--fps", "60", "--scheduler", scheduler,
+            "--mode", "periods"]  # fmt: skip
     assert main(argv) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("salsa x click100: periods, ")

@@ -222,12 +222,12 @@ async def _slow_prepare(name, dask_worker=None):
 
 def test_workers_are_prepared_one_at_a_time_for_librosa(monkeypatch):
     # a fresh install's workers compiling librosa's numba cache together can crash
-    from beatsync import peers
+    from beatsync import other_trackers
     from beatsync.cluster import dask_client
     from beatsync.study.beat_dataset import _prepare_workers
 
     _PREPARED.clear()
-    monkeypatch.setattr(peers, "prepare", _slow_prepare)
+    monkeypatch.setattr(other_trackers, "prepare", _slow_prepare)
     with dask_client(n_workers=2, processes=False) as client:
         _prepare_workers(client, "psf")
         assert _PREPARED == []

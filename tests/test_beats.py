@@ -17,7 +17,7 @@ from beatsync.beats import (
 )
 from beatsync.beats.phase import band_phase_weights
 from beatsync.errors import BeatsyncWarning, ParameterError
-from beatsync.evaluate.beats import evaluate_beats
+from beatsync.evaluate.beats import evaluate
 from beatsync.synth.audio import (
     METERS,
     beat_times,
@@ -31,7 +31,7 @@ SR = 22050
 
 
 def _score(ref, est):
-    return evaluate_beats(ref, est, min_beat_time=0.0)
+    return evaluate(ref, est, min_beat_time=0.0)
 
 
 def test_phase_slope_crosses_zero_at_impulse():
@@ -269,7 +269,7 @@ def test_real_excerpts_on_the_beat_not_the_off_beat(name, start, length):
     y = y[int(start * sr) : int((start + length) * sr)]
     ref = ref[(ref >= start) & (ref < start + length)] - start
     # mir_eval's default skips the first 5 s, which a 7-10 s clip cannot spare
-    s = evaluate_beats(ref, track_beats(y, sr).beats, min_beat_time=5.0 if length > 10 else 0.0)
+    s = evaluate(ref, track_beats(y, sr).beats, min_beat_time=5.0 if length > 10 else 0.0)
     assert s["F-measure"] >= LOWER_F.get((name, start, length), 0.95)
     assert s["Correct Metric Level Total"] >= 0.90
 
@@ -320,7 +320,7 @@ def test_band_phase_weights_favour_the_band_locked_to_the_beat():
 def test_real_recordings_at_the_annotated_level(name, meter):
     y, sr, ref = datasets.load_real_dev(name)
     bt = track_beats(y, sr)
-    s = evaluate_beats(ref, bt.beats, min_beat_time=5.0)  # mir_eval default: after 5 s
+    s = evaluate(ref, bt.beats, min_beat_time=5.0)  # mir_eval default: after 5 s
     assert s["F-measure"] >= 0.95
     assert s["Correct Metric Level Total"] >= 0.90
     assert bt.beats_per_bar == meter

@@ -12,7 +12,7 @@ from beatsync.beats.drums import (
 )
 from beatsync.beats.tempo import analysis_windows
 from beatsync.errors import ParameterError
-from beatsync.evaluate.beats import evaluate_beats
+from beatsync.evaluate.beats import evaluate
 from beatsync.synth.audio import beat_times, click_track, drum_pattern, make_beat_test_set
 
 SR = 22050
@@ -116,7 +116,7 @@ def test_drum_pattern_at_the_edges_is_tapped_at_its_beat(bpm, without):
     (item,) = make_beat_test_set(bpms=[bpm], kinds=["drums"], groups=["clean"], seed=1)
     bt = track_beats(item.y, item.sr)
     assert bt.tempo == pytest.approx(bpm, rel=0.03)
-    assert evaluate_beats(item.beats, bt.beats, min_beat_time=0.0)["F-measure"] >= 0.95
+    assert evaluate(item.beats, bt.beats, min_beat_time=0.0)["F-measure"] >= 0.95
     # the metrical model alone (a known gap it leaves): the tactus prior puts both an
     # octave towards 110 BPM
     alone = track_beats(item.y, item.sr, drum_weight=0)
@@ -127,7 +127,7 @@ def test_tempo_change_of_drums_keeps_the_level():
     # 120 -> 160 BPM halfway: the second half was tapped at 80 BPM
     (item,) = make_beat_test_set(bpms=[120], kinds=["drums"], groups=["change"], seed=0)
     bt = track_beats(item.y, item.sr)
-    s = evaluate_beats(item.beats, bt.beats, min_beat_time=0.0)
+    s = evaluate(item.beats, bt.beats, min_beat_time=0.0)
     assert s["F-measure"] >= 0.95
     assert bt.tempo_curve[-1] == pytest.approx(160, rel=0.03)
 

@@ -169,6 +169,19 @@ def reference_parse(data: bytes) -> RefBvh:
         raise Refused("non-finite values")
     if 1.0 / ref.frame_time < 1.0:
         raise Refused("frame rate below 1 Hz")
+    # forward kinematics must not overflow: along each chain, the offsets' and the
+    # translations' |x| + |y| + |z| summed (a bound on the distance from the origin),
+    # times 2 sqrt(3) (a coordinate of a difference of two positions), is finite
+    col, reach = 0, []
+    for i, chans in enumerate(ref.channels):
+        size = sum(abs(v) for v in ref.offsets[i])
+        for c in chans or ():
+            if c.endswith("position"):
+                size += max(abs(float(v)) for v in ref.values[:, col])
+            col += 1
+        reach.append(size + (reach[ref.parents[i]] if ref.parents[i] >= 0 else 0.0))
+    if not math.isfinite(2 * math.sqrt(3) * max(reach)):
+        raise Refused("forward kinematics overflows")
     return ref
 
 
@@ -194,6 +207,8 @@ _TOKENS = [
     "inf",
     "-inf",
     "1e400",
+    "1e308",
+    "-2e307",
     "",
     "1.2.3",
     "-0",
@@ -349,3 +364,30 @@ def test_fuzzed_bvh_refused_or_equal_to_reference(tmp_path):
 @pytest.mark.parametrize("k", [0, 1])
 def test_mutations_are_seeded(k):
     assert _cases()[k] == _cases()[k]
+
+
+@pytest.mark.parametrize(
+    "old, new, named",
+    [
+        ("OFFSET", "OFFSET 1e308 0 0", "1e+308"),  # one huge bone offset
+        (None, "1e308", "Xposition value 1e+308"),  # a huge root translation in a frame
+    ],
+)
+def test_an_overflowing_offset_or_translation_is_refused_by_both(tmp_path, old, new, named):
+    text = _base_text()
+    if old is None:  # the first frame's first value (the root's Xposition)
+        head, _, frames = text.partition("Frame Time:")
+        time_line, first, *rest = frames.split("\n")
+        text = "\n".join(
+            [head + "Frame Time:" + time_line, first.replace(first.split()[0], new, 1), *rest]
+        )
+    else:
+        first = text.index(old, text.index("JOINT"))
+        end = text.index("\n", first)
+        text = text[:first] + new + text[end:]
+    with pytest.raises(Refused, match="overflows"):
+        reference_parse(text.encode())
+    path = tmp_path / "huge.bvh"
+    path.write_text(text)
+    with pytest.raises(ParameterError, match=re.escape(named)):
+        io.read_bvh(path)

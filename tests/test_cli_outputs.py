@@ -22,7 +22,6 @@ from beatsync import datasets, io
 from beatsync.cli import build_parser, main
 from beatsync.commands import COMMAND_HELP, COMMAND_MODULES
 from beatsync.commands._common import Feedback, Outputs
-from beatsync.errors import ParameterError
 from beatsync.synth.audio import beat_times, click_track
 
 SR = 22050
@@ -258,26 +257,6 @@ def test_outputs_keep_an_existing_files_mode(tmp_path):
         outs.add(a)
         outs.path(a).write_text("new")
     assert a.read_text() == "new" and a.stat().st_mode & 0o777 == 0o640
-
-
-def test_outputs_refuse_undeclared_and_unwritten_files(tmp_path):
-    outs = Outputs()
-    with pytest.raises(RuntimeError, match="not declared"):
-        outs.path(tmp_path / "x.txt")
-    with pytest.raises(RuntimeError, match="declared but not written"):
-        with Outputs() as outs:
-            outs.add(tmp_path / "y.txt")
-            outs.path(tmp_path / "y.txt")
-    assert _listing(tmp_path) == []
-
-
-def test_outputs_refuse_an_input_named_later(tmp_path):
-    out = tmp_path / "o.bvh"
-    out.write_text("x")
-    outs = Outputs()
-    outs.add(out, option="-o")
-    with pytest.raises(ParameterError, match="-o .* same file as the input"):
-        outs.add_inputs(out)
 
 
 def _notebook(path: Path, body: str) -> None:

@@ -290,7 +290,9 @@ def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
     assert r["fill"] == "loop" and r["output_duration_s"] >= beats[-1] - 1 / 25
     assert r["max_abs_residual_frames"] <= 1.0
     assert result["beats_per_bar"] == 3 and r["meter_fit"] is not False
-    assert r["beats_per_period"] in (1, 3, 6, 9)  # never 4 or 5 on a 3/4 song
+    # the counts follow the dancer's speed, not the song's meter alone (a waltz step of
+    # 2 beats where 2 fit); the output plays within x0.8-1.25 of the dancer's speed
+    assert r["playback_speed"]["instantaneous"]["in_band"] >= 0.95
     back = io.read_motion(out, fps=25)
     assert back.is_positional and back.n_frames == r["output_frames"]
     src = io.read_motion(d / "dancer.json", fps=25)
@@ -304,3 +306,24 @@ def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
     lo, hi = lengths(src).min(axis=0), lengths(src).max(axis=0)
     got = lengths(back)
     assert np.all(got >= 0.99 * lo) and np.all(got <= 1.01 * hi)
+
+
+def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, capsys):
+    d, _, beats = inputs  # 12 s of a real waltz dancer (JSON: skeletons relative to center)
+    out, rep = tmp_path / "out.json", tmp_path / "report.json"
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(out), "--fps", "25",
+            "--beats", str(d / "song.beats"), "--report", str(rep)]  # fmt: skip
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    src, got = json.loads((d / "dancer.json").read_text()), json.loads(out.read_text())
+    # the joints keep their place relative to the dataset's root track: the joints'
+    # centroid (what replaced it) would put their mean on it in every frame
+    off_in = np.linalg.norm(np.asarray(src["skeletons"]).mean(axis=1), axis=1)  # [cm]
+    off_out = np.linalg.norm(np.asarray(got["skeletons"]).mean(axis=1), axis=1)
+    assert np.median(off_in) > 1.0
+    assert np.median(off_out) == pytest.approx(np.median(off_in), rel=0.25)
+    r = json.loads(rep.read_text())["report"]
+    assert len(r["boundaries_s"]) == len(r["target_beats_s"]) == r["periods_used"] + 1
+    assert sum(r["beats_per_motion_beat_used"].values()) == r["periods_used"]
+    assert r["joins"] and all(j["peak_joint_speed"] > 0 for j in r["joins"])
+    assert "beats    per motion beat used: " in stdout and "% of the output within" in stdout

@@ -1,9 +1,8 @@
-"""Tests of the beat metrics on arrays (beatsync.evaluate.beats) and the study tables."""
+"""Tests of the beat metrics on arrays (beatsync.evaluate.beats)."""
 
 import warnings
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from beatsync.errors import BeatsyncWarning, ParameterError
@@ -14,18 +13,16 @@ from beatsync.evaluate.beats import (
     count_other_tempo,
     diagnose_times,
     evaluate,
-    evaluate_beats,
     octave_relation,
     tempo_octave,
     validate,
 )
-from beatsync.study.beat_evaluation import summarize_scores
 
 REF = np.arange(0.5, 20.0, 0.5)
 
 
 def test_perfect_estimate_scores_one():
-    s = evaluate_beats(REF, REF, min_beat_time=0.0)
+    s = evaluate(REF, REF, min_beat_time=0.0)
     assert set(s) == set(METRICS)
     for k in METRICS:
         if k != "Information gain":
@@ -35,7 +32,7 @@ def test_perfect_estimate_scores_one():
 
 def test_double_tempo_is_any_level_only():
     est = np.arange(0.5, 20.0, 0.25)
-    s = evaluate_beats(REF, est, min_beat_time=0.0)
+    s = evaluate(REF, est, min_beat_time=0.0)
     assert s["Correct Metric Level Total"] == 0.0
     assert s["Any Metric Level Total"] > 0.9
     assert s["F-measure"] == pytest.approx(2 / 3, abs=0.01)
@@ -44,19 +41,19 @@ def test_double_tempo_is_any_level_only():
 def test_min_beat_time_is_applied():
     est = REF.copy()
     est[:4] += 0.2  # wrong only in the first 2 s
-    assert evaluate_beats(REF, est, min_beat_time=0.0)["F-measure"] < 1.0
-    assert evaluate_beats(REF, est, min_beat_time=2.3)["F-measure"] == pytest.approx(1.0)
+    assert evaluate(REF, est, min_beat_time=0.0)["F-measure"] < 1.0
+    assert evaluate(REF, est, min_beat_time=2.3)["F-measure"] == pytest.approx(1.0)
 
 
 def test_min_beat_time_required():
     with pytest.raises(TypeError):
-        evaluate_beats(REF, REF)  # type: ignore[call-arg]
+        evaluate(REF, REF)  # type: ignore[call-arg]
 
 
 def test_empty_estimate_warns_zero():
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
-        s = evaluate_beats(REF, np.array([]), min_beat_time=0.0)
+        s = evaluate(REF, np.array([]), min_beat_time=0.0)
     assert all(v == 0.0 for v in s.values())
     assert any(issubclass(w.category, BeatsyncWarning) for w in rec)
 
@@ -77,7 +74,7 @@ def test_empty_estimate_warns_zero():
 )
 def test_bad_input_raises(ref, est, mbt):
     with pytest.raises(ParameterError):
-        evaluate_beats(ref, est, min_beat_time=mbt)
+        evaluate(ref, est, min_beat_time=mbt)
 
 
 @pytest.mark.parametrize(
@@ -109,10 +106,6 @@ def test_diagnose_accepts_seconds():
     assert diagnose_times(np.array([1.0, 9.0])) is None
 
 
-def test_evaluate_is_the_old_name():
-    assert evaluate_beats is evaluate
-
-
 def test_tempo_octave_from_beats():
     out = tempo_octave(REF, np.arange(0.5, 20.0, 0.25))
     assert out["tempo_ref"] == pytest.approx(120.0)
@@ -137,7 +130,9 @@ def test_evaluate_never_runs_a_tracker():
     imported = {
         (node.module or "") for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
     } | {a.name for node in ast.walk(tree) if isinstance(node, ast.Import) for a in node.names}
-    assert not {m for m in imported if m.lstrip(".").split(".")[0] in ("beats", "peers", "study")}
+    assert not {
+        m for m in imported if m.lstrip(".").split(".")[0] in ("beats", "other_trackers", "study")
+    }
 
 
 @pytest.mark.parametrize(
@@ -154,46 +149,6 @@ def test_evaluate_never_runs_a_tracker():
 )
 def test_octave_relation(est, ref, name):
     assert octave_relation(est, ref) == name
-
-
-def _toy_scores():
-    rows = []
-    for method, octaves, f in (
-        ("psf", ["correct", "double", "half", "other"], [1.0, 0.6, 0.6, 0.2]),
-        ("librosa", ["correct", "correct", "triple", "correct"], [0.9, 0.9, 0.5, 0.9]),
-    ):
-        for i, (o, fi) in enumerate(zip(octaves, f, strict=True)):
-            rows.append(
-                {
-                    "item": f"x{i}",
-                    "group": "ab"[i % 2],
-                    "method": method,
-                    "octave": o,
-                    "F-measure": fi,
-                }
-            )
-    return pd.DataFrame(rows)
-
-
-def test_summarize_scores_overall_and_by_group():
-    sc = _toy_scores()
-    overall = summarize_scores(sc, by=None, metrics=["F-measure"])
-    assert list(overall.index) == ["psf", "librosa"]
-    assert overall.loc["psf", "octave errors"] == 2  # double + half
-    assert overall.loc["psf", "other tempo"] == 1
-    assert overall.loc["librosa", "octave errors"] == 1  # triple
-    assert overall.loc["psf", "n"] == 4
-    assert overall.loc["psf", "F-measure"] == pytest.approx(0.6)
-    per = summarize_scores(sc, by="group", metrics=["F-measure"])
-    assert per.loc[("a", "psf"), "octave errors"] == 1  # half (x2)
-    assert per.loc[("b", "psf"), "octave errors"] == 1  # double (x1)
-    assert per.loc[("b", "psf"), "other tempo"] == 1
-    assert per["n"].sum() == len(sc)
-
-
-def test_summarize_scores_missing_column():
-    with pytest.raises(ParameterError, match="no column"):
-        summarize_scores(_toy_scores(), by="kind", metrics=["F-measure"])
 
 
 def test_mir_eval_time_limit_is_mir_evals():

@@ -273,7 +273,7 @@ def test_a_file_cut_short_is_refused_naming_both_lengths(tmp_path, fmt, suffix):
     assert io.read_audio(whole)[0].size == pytest.approx(y.size, rel=0.01)
     cut = tmp_path / f"cut{suffix}"
     cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 4])
-    with pytest.raises(ParameterError, match=r"is cut short: its header announces 15\.0"):
+    with pytest.raises(ParameterError, match=r"cut short.*15\.0"):
         io.read_audio(cut)
 
 
@@ -305,7 +305,7 @@ def test_an_ogg_file_cut_short_is_refused(tmp_path):
     for name, size in (("mid_page", len(data) // 3), ("page_boundary", pages[len(pages) // 2])):
         cut = tmp_path / f"{name}.ogg"
         cut.write_bytes(data[:size])
-        with pytest.raises(ParameterError, match=r"cut short: its Ogg stream stops without"):
+        with pytest.raises(ParameterError, match=r"cut short.*Ogg"):
             io.read_audio(cut)
     # bytes after the last page (a tag some tools append) are not a truncation
     trailing = tmp_path / "trailing.ogg"
@@ -330,7 +330,7 @@ def test_the_mp3_decoders_own_messages_become_a_warning(tmp_path, capfd):
     # libmpg123 printed "Warning: Xing stream size off..." to the process's stderr,
     # beside (and with --json, inside) the command's own output
     cut = _mp3_cut(tmp_path, 0.985)  # short by less than the cut-short check refuses
-    with pytest.warns(BeatsyncWarning, match=r"the MP3 decoder \(libmpg123\) reported on"):
+    with pytest.warns(BeatsyncWarning, match="libmpg123"):
         y, sr = io.read_audio(cut)
     assert y.size > 9 * sr
     assert "Xing" not in capfd.readouterr().err
@@ -415,7 +415,7 @@ def test_beats_files(tmp_path):
     with pytest.raises(ParameterError, match="increasing"):
         io.read_beats(tmp_path / "bad.beats")
     (tmp_path / "ms.beats").write_text("abc\n")
-    with pytest.raises(ParameterError, match=r"line 1: 'abc' is not a number; a beat file"):
+    with pytest.raises(ParameterError, match=r"line 1: 'abc'"):
         io.read_beats(tmp_path / "ms.beats")
     with pytest.raises(ParameterError, match="increasing"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
@@ -458,7 +458,7 @@ def _wav_with_header_rate(tmp_path: Path, rate: int) -> Path:
 
 def test_wav_with_sample_rate_zero_refused(tmp_path):
     p = _wav_with_header_rate(tmp_path, 0)
-    with pytest.raises(ParameterError, match=r"broken header: sample rate=0 must be a finite"):
+    with pytest.raises(ParameterError, match=r"broken header: sample rate=0"):
         io.read_audio(p)
 
 
@@ -482,7 +482,7 @@ def test_read_and_write_audio_bad_sr(tmp_path, sr, match):
 def test_npz_renamed_npy_refused(tmp_path):
     np.savez(tmp_path / "m.npz", values=np.zeros((5, 2)))
     p = (tmp_path / "m.npz").rename(tmp_path / "m.npy")
-    with pytest.raises(ParameterError, match=r"is an \.npz archive .*not a \.npy array"):
+    with pytest.raises(ParameterError, match=r"\.npz archive"):
         io.read_motion(p, fps=25)
 
 
@@ -520,10 +520,10 @@ def test_mat_struct_without_freq_refused(tmp_path):
 
     rec = {"data": np.zeros((10, 3)), "markerName": np.array(["Head"], dtype=object)}
     scipy.io.savemat(tmp_path / "m.mat", {"rec": rec})
-    with pytest.raises(ParameterError, match=r"recording 'rec' has no 'freq' field"):
+    with pytest.raises(ParameterError, match=r"'rec'.*'freq'"):
         io.read_mocap_mat(tmp_path / "m.mat")
     scipy.io.savemat(tmp_path / "m0.mat", {"rec": {**rec, "freq": 0.0}})
-    with pytest.raises(ParameterError, match=r"freq=0.0 must be a finite frame rate"):
+    with pytest.raises(ParameterError, match=r"freq=0\.0"):
         io.read_mocap_mat(tmp_path / "m0.mat")
     scipy.io.savemat(tmp_path / "ok.mat", {"rec": {**rec, "freq": 100.0}})
     assert io.read_mocap_mat(tmp_path / "ok.mat").fps == 100.0
@@ -559,14 +559,14 @@ _FRAME2 = "0 1 0 0 0 0 0 20 0"
             "CHANNELS 3 Zrotation Zrotation",
             r"line 9: channel Zrotation listed twice in joint 'knee'",
         ),
-        ("  OFFSET 0 -1 0\n  CHANNELS", "  CHANNELS", r"line 6: joint 'knee' has no OFFSET line"),
-        ("   OFFSET 0 -1 0\n  }", "  }", r"line 10: End Site of 'knee' has no OFFSET line"),
+        ("  OFFSET 0 -1 0\n  CHANNELS", "  CHANNELS", r"line 6: joint 'knee'.*OFFSET"),
+        ("   OFFSET 0 -1 0\n  }", "  }", r"line 10: End Site of 'knee'.*OFFSET"),
         (
             " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n",
             "",
             r"line 2: joint 'hip' has no CHANNELS line",
         ),
-        ("JOINT knee", "JOINT hip", r"line 6: duplicate joint name 'hip' \(first on line 2\)"),
+        ("JOINT knee", "JOINT hip", r"line 6: duplicate .*'hip'.*line 2"),
         (
             "OFFSET 0 -1 0\n  CHANNELS",
             "OFFSET 0 -1 0 7\n  CHANNELS",
@@ -591,10 +591,10 @@ _FRAME2 = "0 1 0 0 0 0 0 20 0"
         (_FRAME2, "0 1 0 0 0 0 0 \u0662 0", r"line 20: non-numeric value"),
         ("Frames: 2", "Frames: 2.5", r"line 17: Frames=.2.5. must be a whole number"),
         ("Frames: 2", "Frames: -1", r"line 17: Frames=.-1. must be an integer >= 0"),
-        ("Frame Time: 0.04", "Frame Time 0.04", r"line 18: expected 'Frame Time: <value>'"),
+        ("Frame Time: 0.04", "Frame Time 0.04", r"line 18: .*'Frame Time"),
         ("Frames: 2", "Frames: 1000000000000", r"declares 1000000000000 frames but has 2"),
-        ("MOTION", "MOTION extra", r"line 16: unexpected 'extra' after MOTION"),
-        ("  End Site", "  End Sight", r"line 10: expected 'End Site', got 'End Sight'"),
+        ("MOTION", "MOTION extra", r"line 16: .*'extra'"),
+        ("  End Site", "  End Sight", r"line 10: .*'End Sight'"),
     ],
 )
 def test_bvh_malformed_with_line_numbers(tmp_path, old, new, match):
@@ -672,9 +672,7 @@ def test_bvh_duplicate_joint_names_refused_in_linear_time(tmp_path):
     dup.write_text(_sibling_bvh(5000, same_name=True))
 
     def read_dup():
-        with pytest.raises(
-            ParameterError, match=r"line 15: duplicate joint name 'j' \(first on line 6\)"
-        ):
+        with pytest.raises(ParameterError, match=r"line 15: duplicate .*'j'.*line 6"):
             io.read_bvh(dup)
 
     # refusing 5,000 same-named siblings costs no more than reading 5,000 distinct ones
@@ -757,7 +755,7 @@ def test_write_json_bad_float_digits(tmp_path, digits, match):
 def test_npy_renamed_npz_refused(tmp_path):
     np.save(tmp_path / "a.npy", np.zeros((3, 2)))
     p = (tmp_path / "a.npy").rename(tmp_path / "a.npz")
-    with pytest.raises(ParameterError, match=r"is a single \.npy array, not an \.npz archive"):
+    with pytest.raises(ParameterError, match=r"\.npy array"):
         io.read_npz(p)
     (tmp_path / "t.npz").write_bytes(b"PK\x03\x04 broken zip")
     with pytest.raises(ParameterError, match=r"cannot read .* as an \.npz archive"):
@@ -768,7 +766,7 @@ def test_mat_without_marker_struct_refused(tmp_path):
     import scipy.io
 
     scipy.io.savemat(tmp_path / "m.mat", {"rec": {"data": np.zeros((10, 3)), "freq": 100.0}})
-    with pytest.raises(ParameterError, match=r"no MoCap Toolbox marker recording .*\['rec'\]"):
+    with pytest.raises(ParameterError, match=r"\['rec'\]"):
         io.read_mocap_mat(tmp_path / "m.mat")
 
 

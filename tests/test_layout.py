@@ -31,7 +31,7 @@ LAYER = {
     "motion_beats": 2,
     "music": 2,
     "graph": 2,
-    "peers": 2,
+    "other_trackers": 2,
     "evaluate": 3,
     "synth": 3,
     "render": 4,

@@ -124,7 +124,7 @@ def test_is_positional_false_for_bvh_tables_and_partial_triples(chain_motion):
 
 
 def test_position_info_refused_on_other_channels():
-    with pytest.raises(ParameterError, match="only for position-only motion"):
+    with pytest.raises(ParameterError, match="position-only"):
         Motion(np.zeros((3, 2)), 30.0, ("a", "b"), position_info=PositionInfo())
 
 
@@ -132,8 +132,8 @@ def test_position_info_refused_on_other_channels():
     ("bones", "match"),
     [
         ([[0, 1, 2]], r"shape \(n_bones, 2\)"),
-        ([[0, 5]], r"joint 5 but the motion has joints 0\.\.4"),
-        ([[2, 2]], "joins a joint to itself"),
+        ([[0, 5]], r"joint 5 .*0\.\.4"),
+        ([[2, 2]], "itself"),
         ([[0.5, 1]], "integer joint indices"),
     ],
 )
@@ -156,7 +156,7 @@ def test_fill_joint_gaps_short_filled_long_refused():
     np.testing.assert_allclose(filled[50:53, 2], pos[50:53, 2], atol=0.05)
     long = pos.copy()
     long[50:70, 3, 1] = np.nan  # 20 frames = 0.8 s
-    with pytest.raises(ParameterError, match=r"'j3' is missing \(NaN\) for 20 frames"):
+    with pytest.raises(ParameterError, match=r"'j3' .*20 frames"):
         fill_joint_gaps(long, 25.0, max_gap=0.25, joint_names=["j0", "j1", "j2", "j3", "j4"])
 
 

@@ -185,3 +185,56 @@ def test_write_video_progress_callable_and_interruption_leaves_no_ffmpeg(tmp_pat
     render.write_video(_motion(), tmp_path / "v.mp4", size=(64, 64),
                        progress=lambda d, t: done.append((d, t)))
     assert done[-1] == (done[-1][1], done[-1][1]) and len(done) == done[-1][1]
+
+
+def _frames(path, size):
+    import imageio_ffmpeg
+
+    gen = imageio_ffmpeg.read_frames(str(path))
+    meta = next(gen)
+    assert tuple(meta["size"]) == size
+    return [np.frombuffer(f, np.uint8).reshape(size[1], size[0], 3) for f in gen]
+
+
+def _walker(n: int = 100, fps: float = 25.0, metres: float = 6.0) -> Motion:
+    """A 1.7 m stick figure (z up, 5 joints) that walks ``metres`` along x."""
+    base = np.array([[0, 0, 1.0], [0, 0, 1.45], [0, 0, 1.7], [0.1, 0, 0], [-0.1, 0, 0]])
+    pos = np.repeat(base[None], n, axis=0)
+    pos[:, :, 0] += np.linspace(0, metres, n)[:, None]
+    names = tuple(f"{j}_{a}" for j in ("hip", "neck", "head", "lfoot", "rfoot") for a in "xyz")
+    return Motion(pos.reshape(n, -1), fps, names, None, "walker")
+
+
+def _figure_box(frame: np.ndarray) -> tuple[float, float, float]:
+    """Centre x, top and bottom rows of the figure's pixels (dark or red)."""
+    r, g, b = (frame[..., c].astype(int) for c in range(3))
+    body = ((r < 120) & (b > r)) | ((r > 170) & (g < 90) & (b < 90))
+    body[-40:] = False  # the beat ruler
+    body[:30] = False  # the caption and the beat dot
+    ys, xs = np.nonzero(body)
+    return float(xs.mean()), float(ys.min()), float(ys.max())
+
+
+@pytest.mark.skipif(render.find_ffmpeg() is None, reason="no ffmpeg")
+def test_write_video_default_is_640x480_and_the_camera_follows_the_dancer(tmp_path):
+    out = render.write_video(_walker(), tmp_path / "v.mp4", up="z")
+    frames = _frames(out, (640, 480))
+    first, last = _figure_box(frames[5]), _figure_box(frames[-5])
+    # a 6 m walk: the figure stays near the middle of the frame, and fills a good part of it
+    for x, top, bottom in (first, last):
+        assert 160 < x < 480
+        assert bottom - top > 0.4 * 480
+
+
+@pytest.mark.skipif(render.find_ffmpeg() is None, reason="no ffmpeg")
+def test_write_video_marks_the_beat_in_red(tmp_path):
+    out = render.write_video(_walker(50), tmp_path / "v.mp4", up="z", beats=[1.0])
+    frames = _frames(out, (640, 480))
+    red = [int(((f[..., 0] > 170) & (f[..., 1] < 90) & (f[..., 2] < 90)).sum()) for f in frames]
+    assert red[25] > 50 * max(red[10], 1) and red[25] > 500  # lit on the beat at 1.0 s only
+
+
+def test_write_video_bad_elevation(tmp_path):
+    with pytest.raises(ParameterError, match="elevation=95"):
+        render.write_video(_motion(), tmp_path / "v.mp4", elevation=95)
+    assert list(tmp_path.iterdir()) == []

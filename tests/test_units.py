@@ -11,7 +11,6 @@ from beatsync.units import (
     as_float_array,
     as_int,
     check_audio,
-    check_between,
     check_bpm,
     check_finite,
     check_fps,
@@ -103,13 +102,13 @@ def test_range():
 @pytest.mark.parametrize(
     "value, match",
     [
-        ("abc", r"delta='abc' is text, not a number \[s\]"),
-        ("0.5", r"delta='0.5' is text, not a number \[s\]; pass a number"),
-        (None, r"delta=None is not a number"),
-        (True, r"delta=True is a bool"),
+        ("abc", r"delta='abc'.*text"),
+        ("0.5", r"delta='0\.5'.*text"),
+        (None, r"delta=None.*not a number"),
+        (True, r"delta=True.*bool"),
         (np.array([0.5, 0.6]), r"single number \[s\], got an array of shape \(2,\)"),
-        ([0.5], r"single number \[s\], not a list"),
-        (np.nan, r"delta=nan must be a finite number \[s\]"),
+        ([0.5], r"delta=\[0\.5\].*list"),
+        (np.nan, r"delta=nan.*finite"),
         (np.inf, r"finite"),
         (1e999, r"finite"),
     ],
@@ -156,40 +155,13 @@ def test_check_positive_refuses(value, match):
 
 
 @pytest.mark.parametrize(
-    "value, closed, match",
-    [
-        (0.5, "neither", r"alpha=0.5 must be in \(0, 0.5\) \(a fraction"),
-        (0.0, "high", r"alpha=0.0 must be in \(0, 0.5\]"),
-        (10, "both", r"must be in \[0, 0.5\]"),
-        (np.nan, "both", "finite"),
-    ],
-)
-def test_check_between_refuses(value, closed, match):
-    with pytest.raises(ParameterError, match=match):
-        check_between(
-            value,
-            name="alpha",
-            unit="",
-            low=0,
-            high=0.5,
-            closed=closed,
-            hint="a fraction of the period, not a percentage",
-        )
-
-
-def test_check_between_accepts_closed_bounds():
-    assert check_between(0.5, name="a", unit="s", low=0, high=0.5, closed="high") == 0.5
-    assert check_between(0, name="a", unit="s", low=0, high=0.5, closed="low") == 0.0
-
-
-@pytest.mark.parametrize(
     "sr, match",
     [
-        (0, r"sr=0 must be a finite sample rate > 0 \[Hz\]"),
+        (0, r"sr=0 .*> 0"),
         (-22050, "> 0"),
         (np.nan, "> 0"),
-        ("fast", r"sr='fast' is not a number \[Hz\]"),
-        (44.1, r"not kHz; did you mean sr=44100\?"),
+        ("fast", r"sr='fast'.*not a number"),
+        (44.1, r"sr=44\.1 .*sr=44100"),
         (None, "not a number"),
     ],
 )
@@ -206,12 +178,12 @@ def test_check_sample_rate_accepts():
 @pytest.mark.parametrize(
     "bpm, match",
     [
-        (0.5, r"bpm=0.5 is outside the plausible range 20-400 BPM \(did you give a beat period"),
+        (0.5, r"bpm=0\.5 .*beat period"),
         (2.0, "beats per second"),
         (1000, "sub-beats"),
-        (0, r"bpm=0 .* \(a tempo is a positive number of beats per minute\)"),
+        (0, r"bpm=0 .*positive"),
         (-5, "a tempo is a positive number"),
-        (np.nan, r"bpm=nan is not a finite number; give a tempo in BPM from 20 to 400"),
+        (np.nan, r"bpm=nan .*finite"),
         (np.inf, "not a finite number"),
         ("inf", "not a finite number"),
         ("x", r"not a number \[bpm\]"),
@@ -251,12 +223,12 @@ _Y = np.full(2205, 0.1, dtype=np.float32)
             {},
             "1 NaN or infinite sample.*sample 7",
         ),
-        (_Y, 0, {}, r"sr=0 must be a finite sample rate"),
+        (_Y, 0, {}, r"sr=0 "),
         (_Y + 1j, 22050, {}, "complex"),
         (["a"] * 5, 22050, {}, "strings"),
-        (_Y, 22050, {"min_duration": 1.0}, r"only 0.100 s long \(2205 samples at sr=22050"),
+        (_Y, 22050, {"min_duration": 1.0}, r"0\.100 s .*2205 samples"),
         (_Y * 0, 22050, {"silence_peak": 1e-7}, "all silent"),
-        (_Y, 22050, {"silence_peak": 1e-7}, r"constant at 0\.1 \(a DC offset"),
+        (_Y, 22050, {"silence_peak": 1e-7}, r"constant at 0\.1 "),
         (_Y - 0.3, 22050, {"silence_peak": 1e-7}, r"constant at -0\.2"),
     ],
 )
@@ -337,7 +309,7 @@ def test_check_helpers_accept_numbers_written_as_text():
 @pytest.mark.parametrize(
     "pair, match",
     [
-        (0.5, r"period_range=0.5 must be two numbers \(lower, upper\) \[s\]"),
+        (0.5, r"period_range=0\.5 .*two numbers"),
         ((0.5, 1.0, 2.0), "two numbers"),
         ("ab", "two numbers"),
         ((2.0, 0.5), "reversed"),

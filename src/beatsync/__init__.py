@@ -1,6 +1,6 @@
 """beatsync: beat-synchronous dance animation.
 
-Stages (one module each; see ``DESIGN`` in the README):
+Stages (one module each; the layers are in the README):
 
 - :mod:`beatsync.io` reads and writes files (BVH, MoCap Toolbox ``.mat``, CSV/NPY
   joint-angle tables, audio, beat annotations). No other module reads files.

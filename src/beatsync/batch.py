@@ -6,10 +6,16 @@ once, and every (clip, song) pair is synchronised from those results. By default
 local cluster (one process per core) runs it; give ``scheduler`` (an address such as
 ``"tcp://10.0.0.5:8786"``) to use an existing cluster. A pair that fails on bad
 input (a clip that is not periodic, a song without beats) records the error message
-in its row instead of stopping the study. ``mode`` is that of
-:func:`beatsync.sync.synchronize`: paper A's periods (default), the dancer's own motion
-beats, or ``"auto"`` (periods when the clip is periodic, else its motion beats: what
-real dancers need); the clip is segmented once either way.
+in its row instead of stopping the study. Every pair is synchronised as ``beatsync
+sync`` does with its defaults: ``mode`` is that of :func:`beatsync.sync.synchronize`
+(``"auto"`` by default: periods when the clip is periodic, else its motion beats, what
+real dancers need; or paper A's periods, or the dancer's own motion beats), the dance
+is looped to the song's last beat (``fill="loop"``) and the song's meter estimated by
+the beat tracker is respected; the clip is segmented once either way.
+
+Items are named by their file name without suffix; when file names repeat (a dataset
+of one folder per take, ``DANCE_C_4/skeletons.json``, ``DANCE_R_3/skeletons.json``),
+by the folder that holds them (:func:`item_names`).
 
 Data contract: every time is in seconds; every output file is written atomically
 under ``out_dir`` as ``<clip>__<song>`` in the clip's own kind of file
@@ -27,7 +33,37 @@ from typing import Any
 
 from .errors import NotPeriodicError, ParameterError
 
-__all__ = ["sync_grid", "prepare_song", "prepare_clip", "sync_pair", "output_suffix"]
+__all__ = [
+    "item_names",
+    "sync_grid",
+    "prepare_song",
+    "prepare_clip",
+    "sync_pair",
+    "output_suffix",
+]
+
+
+def item_names(paths: Sequence[str | os.PathLike[str]], what: str) -> list[str]:
+    """Names of clips or songs in outputs (``<clip>__<song>``): the file name without
+    suffix, or the folder's name for files whose names repeat (one folder per take).
+
+    Raises
+    ------
+    ParameterError
+        Two items still share a name.
+    """
+    stems = [Path(p).stem for p in paths]
+    names = [
+        Path(p).resolve().parent.name if stems.count(st) > 1 else st
+        for p, st in zip(paths, stems, strict=True)
+    ]
+    dup = sorted({x for x in names if names.count(x) > 1})
+    if dup:
+        raise ParameterError(
+            f"{what} names must differ (outputs are named <clip>__<song>; repeated file "
+            f"names are told apart by their folder): {dup} appear more than once"
+        )
+    return names
 
 
 def output_suffix(motion: Any) -> str:
@@ -70,7 +106,13 @@ def prepare_song(
     y, sr = io.read_audio(path)
     told = {"min_bpm": min_bpm, "max_bpm": max_bpm}
     track = track_beats(y, sr, bpm=bpm, **{k: v for k, v in told.items() if v is not None})
-    return {"song": Path(path).stem, "beats": track.beats, "tempo_bpm": track.tempo}
+    bar = int(getattr(track, "beats_per_bar", 0) or 0)
+    return {
+        "song": Path(path).stem,
+        "beats": track.beats,
+        "tempo_bpm": track.tempo,
+        "beats_per_bar": bar if bar > 0 else None,
+    }
 
 
 def prepare_clip(
@@ -80,7 +122,7 @@ def prepare_clip(
     variable: str | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
-    mode: str = "periods",
+    mode: str = "auto",
 ) -> dict[str, Any]:
     """Read a motion clip and find its periods (a task of the graph).
 
@@ -134,11 +176,13 @@ def sync_pair(
             row.update(status="error", error=f"{what}: {value}")
             return row
     assert isinstance(clip, dict) and isinstance(song, dict)
+    # as `beatsync sync` with its defaults: looped to the song's last beat, its meter kept
+    kw = {"fill": "loop", "beats_per_bar": song.get("beats_per_bar")}
     try:
         if clip["boundaries"] is None:  # mode "beats", or "auto" on a clip that is not periodic
-            res = synchronize(clip["motion"], None, song["beats"], mode="beats")
+            res = synchronize(clip["motion"], None, song["beats"], mode="beats", **kw)
         else:
-            res = synchronize(clip["motion"], clip["boundaries"], song["beats"])
+            res = synchronize(clip["motion"], clip["boundaries"], song["beats"], **kw)
     except ParameterError as exc:
         row.update(status="error", error=str(exc))
         return row
@@ -158,6 +202,7 @@ def sync_pair(
         input_frames=rep.get("input_frames"),
         output_frames=rep.get("output_frames"),
         beats_per_period=rep.get("beats_per_period"),
+        speed_in_band=rep["playback_speed"]["per_interval"]["in_band"],
         max_abs_residual_ms=rep.get("max_abs_residual_ms"),
         error="",
     )
@@ -194,7 +239,7 @@ def sync_grid(
     max_bpm: float | None = None,
     period_range: tuple[float, float] = (0.25, 1.25),
     alpha: float = 0.1,
-    mode: str = "periods",
+    mode: str = "auto",
     progress: Callable[..., None] | None = None,
 ) -> Any:
     """Synchronise every clip with every song on Dask; return a table of reports.
@@ -226,10 +271,11 @@ def sync_grid(
         Known tempo of every song.
     min_bpm, max_bpm : float, optional [BPM]
         Tempo range searched in every song (default: :func:`beatsync.beats.track_beats`'s).
-    mode : {"periods", "beats", "auto"}
-        What lands on the beats: paper A's periods (a clip that is not periodic fails),
-        the clip's own motion beats, or periods when the clip is periodic and motion
-        beats otherwise (see :func:`beatsync.sync.synchronize`).
+    mode : {"auto", "periods", "beats"}
+        What lands on the beats (``beatsync sync``'s default ``"auto"``): periods when
+        the clip is periodic and motion beats otherwise, paper A's periods (a clip that
+        is not periodic fails), or the clip's own motion beats (see
+        :func:`beatsync.sync.synchronize`).
     progress : callable ``progress(done, total=None)``, optional
         Called as pairs finish (e.g. a command's progress bar).
 
@@ -274,19 +320,13 @@ def sync_grid(
     out = Path(out_dir)
     if not out.is_dir():
         raise ParameterError(f"output folder {str(out)!r} does not exist; create it first")
-    for what, paths in (("clip", clips), ("song", songs)):
-        stems = [Path(p).stem for p in paths]
-        dup = sorted({x for x in stems if stems.count(x) > 1})
-        if dup:
-            raise ParameterError(
-                f"{what} file names must differ without their folder and suffix "
-                f"(outputs are named <clip>__<song>): {dup} appear more than once"
-            )
+    clip_names = dict(zip(clips, item_names(clips, "clip"), strict=True))
+    song_names = dict(zip(songs, item_names(songs, "song"), strict=True))
     inputs = {Path(p).resolve() for p in clips + songs}
     for c in clips:
         for s in songs:
             for suffix in output_suffixes(c):
-                target = (out / f"{Path(c).stem}__{Path(s).stem}{suffix}").resolve()
+                target = (out / f"{clip_names[c]}__{song_names[s]}{suffix}").resolve()
                 if target in inputs:
                     raise ParameterError(
                         f"output {str(target)!r} would overwrite an input file; "
@@ -319,8 +359,8 @@ def sync_grid(
                 clip_f[c],
                 song_f[s],
                 str(out),
-                Path(c).stem,
-                Path(s).stem,
+                clip_names[c],
+                song_names[s],
                 pure=False,
             )
             for c in clips

@@ -9,7 +9,7 @@ still printed). Progress bars appear only when stderr is a terminal.
 
 Outputs are all-or-nothing: every output file of a command is checked before any
 work (an existing folder, a read-only file, an input file, a missing folder are
-refused), written to a hidden staging folder (``.beatsync-tmp-*``) next to it and
+refused), written beside it under a hidden temporary name (``.beatsync-tmp-*``) and
 renamed into place only when the whole command succeeded. An error, Ctrl-C or
 SIGTERM leaves every output path as it was.
 

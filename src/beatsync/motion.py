@@ -25,6 +25,7 @@ Data contract
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -211,8 +212,10 @@ class Motion:
                 f"motion has {values.shape[1]} value columns but {len(self.channels)} channel "
                 "names; is the array transposed (it must be time first: frames x channels)?"
             )
-        if self.skeleton is not None and self.skeleton.channel_names() != self.channels:
-            raise ParameterError("channel names do not match the skeleton's channels")
+        if self.skeleton is not None:
+            if self.skeleton.channel_names() != self.channels:
+                raise ParameterError("channel names do not match the skeleton's channels")
+            _check_reach(self.skeleton, values)
         info = self.position_info
         if info is not None:
             if not self.is_positional:
@@ -436,6 +439,40 @@ class Motion:
                 glob.append(quat_multiply(parent_rot, local))
         self._cache["positions"] = pos
         return pos
+
+
+def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
+    """Refuse offsets or translations so large that forward kinematics would overflow.
+
+    A joint's world position is at most the sum, along its chain, of the offsets and
+    translations (rotations keep lengths; each summed as ``|x| + |y| + |z|``, which
+    bounds the length); that sum, times 2 sqrt(3) so that every coordinate of a
+    position and of a difference of two stays finite, must be a finite float.
+    """
+    joints = skeleton.joints
+    with np.errstate(over="ignore"):  # an overflow is inf: refused below
+        sizes = np.abs([j.offset for j in joints]).sum(axis=1).tolist()
+    biggest = int(np.argmax(sizes))
+    largest = (sizes[biggest], f"OFFSET of joint {joints[biggest].name!r}")
+    col = 0
+    for i, joint in enumerate(joints):
+        for k, c in enumerate(joint.channels):
+            if c in _POS_DOFS:
+                big = float(np.fmax.reduce(np.abs(values[:, col + k]), initial=0.0))
+                if big > largest[0]:
+                    largest = (big, f"channel {joint.name}_{c} value {big:g}")
+                sizes[i] += big
+        col += len(joint.channels)
+        if joint.parent >= 0:
+            sizes[i] += sizes[joint.parent]  # parents come first: now the chain's sum
+    if not math.isfinite(2 * math.sqrt(3) * max(sizes, default=0.0)):
+        what = largest[1]
+        if what.startswith("OFFSET"):
+            what += f" ({' '.join(map(str, joints[biggest].offset))})"
+        raise ParameterError(
+            f"{what} is too large: forward kinematics would overflow float64 (joint "
+            "positions beyond 1e308); a corrupt number or a wrong unit?"
+        )
 
 
 def fill_gaps(motion: Motion) -> Motion:

@@ -4,8 +4,9 @@
   poses that fall on a music beat drawn in colour (paper A, Figure 3).
 - :func:`plot_beat_timeline`: mean joint speed over time with music beats, kinematic
   beats and period boundaries.
-- :func:`write_video`: an MP4 of the stick figure with the music as soundtrack, made
-  by piping matplotlib frames to ffmpeg (the binary bundled with ``imageio-ffmpeg``,
+- :func:`write_video`: an MP4 of the dancer seen in perspective by a camera that
+  follows them over a floor, the beats marked, with the music as soundtrack: Pillow
+  draws each frame and pipes it to ffmpeg (the binary bundled with ``imageio-ffmpeg``,
   or one on ``PATH``). Without ffmpeg it writes an animated GIF and the music as a
   WAV next to it, and says so with a :class:`~beatsync.errors.BeatsyncWarning`.
 
@@ -13,7 +14,8 @@ Data contract
 -------------
 - Poses come from forward kinematics (:meth:`beatsync.motion.Motion.positions`) for
   skeletal motion, or from ``<marker>_x/_y/_z`` channels for marker tables
-  (:func:`beatsync.motion_beats.motion_positions`); drawn in an orthographic view.
+  (:func:`beatsync.motion_beats.motion_positions`); figures use an orthographic
+  view, videos a perspective one.
   BVH skeletons are y-up, marker data (MoCap Toolbox) z-up; ``up=`` overrides.
 - Times and beats are seconds in the motion's timeline (frame ``k`` at ``k / fps``).
 - Audio is mono float ``y`` with its sample rate ``sr`` [Hz], starting at the motion's
@@ -337,79 +339,184 @@ def find_ffmpeg() -> str | None:
     return shutil.which("ffmpeg")
 
 
-class _FrameRenderer:
-    """Draws one stick-figure frame at a time into an RGB buffer (Agg, no GUI)."""
+class _Stage:
+    """Draws the dancer in perspective, one frame at a time, into an RGB buffer.
 
-    def __init__(self, xy: np.ndarray, bones: np.ndarray, size: tuple[int, int], title: str):
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.collections import LineCollection
-        from matplotlib.figure import Figure
+    The camera looks at the dancer from ``azimuth`` degrees about the vertical axis
+    and ``elevation`` degrees above the floor, and follows the dancer: it aims at the
+    joints' horizontal centroid smoothed over a second, so steps move the figure over a
+    floor grid that stays put in the world. The dancer's height (the 95th percentile
+    of the per-frame vertical extent) sets the distance, so the figure fills about
+    two thirds of the frame whatever the units. Bones are drawn far to near, with
+    their shadows on the floor; on a beat the figure turns red, a dot lights, and the
+    beat ruler at the bottom (beats within two seconds of now, scrolling past a
+    playhead) shows where the beats fall. Pillow draws every frame: no GUI toolkit,
+    about a millisecond per frame.
+    """
+
+    def __init__(
+        self,
+        pos: np.ndarray,
+        bones: np.ndarray,
+        names: list[str],
+        *,
+        up: int,
+        azimuth: float,
+        elevation: float,
+        fps: float,
+        size: tuple[int, int],
+        title: str,
+    ):
+        from PIL import Image, ImageDraw, ImageFont
+        from scipy.ndimage import gaussian_filter1d
 
         w, h = size
-        dpi = 100
-        self.fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi)
-        self.canvas = FigureCanvasAgg(self.fig)
-        ax = self.fig.add_axes((0.02, 0.02, 0.96, 0.9))
-        lo = xy.reshape(-1, 2).min(axis=0)
-        hi = xy.reshape(-1, 2).max(axis=0)
-        pad = 0.08 * float(max(hi - lo))
-        cx, cy = (lo + hi) / 2
-        half = 0.5 * max((hi - lo)[0] * h / w, (hi - lo)[1]) + pad
-        ax.set_xlim(cx - half * w / h, cx + half * w / h)
-        ax.set_ylim(cy - half, cy + half)
-        ax.set_aspect("equal")
-        ax.axis("off")
-        ax.axhline(lo[1], color="0.8", lw=1)
-        self.bones = bones
-        if len(bones):
-            self.artist = LineCollection([], colors=_POSE_COLOR, linewidths=2)
-            ax.add_collection(self.artist)
-        else:
-            (self.artist,) = ax.plot([], [], "o", ms=3, color=_POSE_COLOR)
-        self.dot = ax.text(
-            0.95,
-            0.95,
-            "\u25cf",
-            transform=ax.transAxes,
-            ha="right",
-            va="top",
-            fontsize=22,
-            color=_BEAT_COLOR,
-            visible=False,
-        )
-        self.text = self.fig.text(0.02, 0.97, title, ha="left", va="top", fontsize=8)
-        self.title = title
-        self.size = (w, h)
+        self.size, self.title, self.bones = size, title, bones
+        # world -> (h1, h2, up) with the vertical last: a right-handed frame
+        order = [(up + 1) % 3, (up + 2) % 3, up]
+        p = pos[..., order]
+        self.floor = float(np.percentile(p[..., 2].min(axis=1), 1))
+        height = float(np.percentile(np.ptp(p[..., 2], axis=1), 95)) or 1.0
+        # the camera's target: the joints' centroid's horizontal track, smoothed over a
+        # second so that the view does not shake with the hips
+        track = gaussian_filter1d(p.mean(axis=1)[:, :2], sigma=fps, axis=0, mode="nearest")
+        a, e = np.deg2rad(azimuth), np.deg2rad(elevation)
+        # at azimuth 0 the image's horizontal axis is h2, as in :func:`project`
+        right = np.array([-np.sin(a), np.cos(a), 0.0])
+        back = np.array([np.cos(a), np.sin(a), 0.0])  # from the dancer towards the camera
+        fwd = -(np.cos(e) * back) - np.sin(e) * np.array([0.0, 0.0, 1.0])
+        cam_up = np.cross(right, fwd)
+        self.f = 0.5 * h / np.tan(np.deg2rad(20.0))  # 40 degrees vertical field of view
+        dist = self.f * height / (0.7 * h)
+        target = np.column_stack([track, np.full(len(track), self.floor + 0.5 * height)])
+        self.eye = target - dist * fwd
+        self.basis = np.stack([right, cam_up, fwd])  # rows: camera x, y, depth
+        self.centre = np.array([w / 2.0, h / 2.0])
+        self.joints = self._screen(p)
+        shadow = p.copy()
+        shadow[..., 2] = self.floor
+        self.shadow = self._screen(shadow)
+        self.thick = 0.045 * height
+        self.head = _head_joint(p, bones, names)
+        self.height = height
+        self.grid = self._grid_segments(track, height)
+        self.draw_module, self.image_module = ImageDraw, Image
+        self.font = ImageFont.load_default(size=max(11, h // 32))
+        # sky above the horizon, floor below: the same for every frame
+        horizon = int(np.clip(self.centre[1] - self.f * np.tan(e), 0, h))
+        bg = Image.new("RGB", (w, h), (226, 232, 240))
+        ImageDraw.Draw(bg).rectangle((0, horizon, w, h), fill=(206, 203, 196))
+        self.background = bg
 
-    def draw(self, pose: np.ndarray, t: float, beat: bool) -> bytes:
-        color = _BEAT_COLOR if beat else _POSE_COLOR
-        if len(self.bones):
-            self.artist.set_segments(pose[self.bones])
-            self.artist.set_color(color)
-        else:
-            self.artist.set_data(pose[:, 0], pose[:, 1])
-            self.artist.set_color(color)
-        self.dot.set_visible(beat)
-        self.text.set_text(f"{self.title}  t = {t:5.2f} s")
-        self.canvas.draw()
-        buf = np.asarray(self.canvas.buffer_rgba())[..., :3]
-        return np.ascontiguousarray(buf).tobytes()
+    def _screen(self, p: np.ndarray, eye: np.ndarray | None = None) -> np.ndarray:
+        """(x, y, depth) in pixels of points ``p`` [shape=(n_frames, k, 3)]."""
+        eye = self.eye if eye is None else eye
+        c = (p - eye[:, None, :]) @ self.basis.T
+        z = np.maximum(c[..., 2], 1e-6)
+        x = self.centre[0] + self.f * c[..., 0] / z
+        y = self.centre[1] - self.f * c[..., 1] / z
+        return np.stack([x, y, c[..., 2]], axis=-1)
+
+    def _grid_segments(self, track: np.ndarray, height: float) -> np.ndarray:
+        """Screen segments [shape=(n_frames, n_lines, 4)] of the floor grid, NaN where
+        a line lies behind the camera. Lines every ``height / 2``, around the dancer."""
+        step = 0.5 * height
+        c0 = np.round(np.median(track, axis=0) / step) * step
+        reach = np.ptp(track, axis=0).max() / 2 + 4 * height
+        ticks = np.arange(-reach, reach + step / 2, step)
+        lines = []
+        for u in ticks:
+            lines.append(((c0[0] + u, c0[1] - reach), (c0[0] + u, c0[1] + reach)))
+            lines.append(((c0[0] - reach, c0[1] + u), (c0[0] + reach, c0[1] + u)))
+        ends = np.asarray(lines, dtype=np.float64)  # (n_lines, 2, 2)
+        ends = np.concatenate([ends, np.full(ends.shape[:2] + (1,), self.floor)], axis=-1)
+        # clip each line to the part in front of the camera (depth >= near), per frame
+        cam = (ends[None, :, :, :] - self.eye[:, None, None, :]) @ self.basis.T
+        near = 0.3 * height
+        d0, d1 = cam[..., 0, 2], cam[..., 1, 2]
+        s0 = np.clip((near - d0) / np.where(d1 != d0, d1 - d0, 1e-12), 0, 1)
+        s1 = np.clip((near - d1) / np.where(d0 != d1, d0 - d1, 1e-12), 0, 1)
+        span = cam[..., 1, :] - cam[..., 0, :]
+        a = cam[..., 0, :] + np.where(d0 < near, s0, 0)[..., None] * span
+        b = cam[..., 1, :] - np.where(d1 < near, s1, 0)[..., None] * span
+        seg = np.empty(cam.shape[:2] + (4,))
+        for k, q in enumerate((a, b)):
+            z = np.maximum(q[..., 2], 1e-6)
+            seg[..., 2 * k] = self.centre[0] + self.f * q[..., 0] / z
+            seg[..., 2 * k + 1] = self.centre[1] - self.f * q[..., 1] / z
+        w, h = 2 * self.centre
+        behind = (d0 < near) & (d1 < near)
+        outside = ((seg[..., 0] < 0) & (seg[..., 2] < 0)) | ((seg[..., 0] > w) & (seg[..., 2] > w))
+        outside |= (seg[..., 1] > h) & (seg[..., 3] > h)
+        seg[behind | outside] = np.nan
+        return seg
+
+    def draw(self, k: int, t: float, beat: bool, ruler: np.ndarray) -> bytes:
+        """Frame ``k`` at time ``t`` [s]; ``ruler``: beats within 2 s of ``t`` [s]."""
+        im = self.background.copy()
+        d = self.draw_module.Draw(im)
+        w, h = self.size
+        for x0, y0, x1, y1 in self.grid[k]:
+            if x0 == x0:  # not NaN
+                d.line((x0, y0, x1, y1), fill=(178, 174, 166), width=1)
+        z = self.joints[k, :, 2]
+        width = np.maximum(self.f * self.thick / np.maximum(z, 1e-6), 2.0)
+        sh = self.shadow[k]
+        for i, j in self.bones:
+            d.line(
+                (sh[i, 0], sh[i, 1], sh[j, 0], sh[j, 1]),
+                fill=(160, 156, 150),
+                width=int(width[i] * 0.8),
+            )
+        base = np.array((214, 39, 40) if beat else (40, 52, 82), dtype=np.float64)
+        # farther bones fade towards the floor's colour: depth at a glance
+        depth = (z - z.min()) / max(float(np.ptp(z)), 1e-9)
+        fade = 0.45 * depth[:, None] * (np.array([206.0, 203.0, 196.0]) - base)
+        tone = [tuple(int(c) for c in base + fade[n]) for n in range(len(z))]
+        colour = tuple(int(c) for c in base)
+        far = (
+            np.argsort(-(z[self.bones[:, 0]] + z[self.bones[:, 1]]))
+            if len(self.bones)
+            else np.zeros(0, dtype=int)
+        )
+        q = self.joints[k]
+        for b in far:
+            i, j = self.bones[b]
+            n = i if z[i] > z[j] else j  # the bone's far end: its tone, its round cap
+            r = int(round(min(width[i], width[j])))
+            d.line((q[i, 0], q[i, 1], q[j, 0], q[j, 1]), fill=tone[n], width=r)
+            rad = r / 2
+            d.ellipse((q[n, 0] - rad, q[n, 1] - rad, q[n, 0] + rad, q[n, 1] + rad), fill=tone[n])
+        if not len(self.bones):
+            for x, y, depth in q:
+                rad = max(self.f * self.thick / max(depth, 1e-6) / 2, 1.5)
+                d.ellipse((x - rad, y - rad, x + rad, y + rad), fill=colour)
+        if self.head is not None:
+            rad = self.f * 0.055 * self.height / max(z[self.head], 1e-6)
+            x, y = q[self.head, :2]
+            d.ellipse((x - rad, y - rad, x + rad, y + rad), fill=tone[self.head])
+        # the beat ruler: 4 s of beats scrolling past the playhead in the middle
+        y = h - max(14, h // 24)
+        d.line((0, y, w, y), fill=(120, 120, 120), width=1)
+        for b in ruler:
+            x = w / 2 + (b - t) * w / 4
+            d.line((x, y - 6, x, y + 6), fill=(214, 39, 40), width=2)
+        d.line((w / 2, y - 10, w / 2, y + 10), fill=(30, 30, 30), width=2)
+        if beat:
+            r = max(8, h // 30)
+            d.ellipse((w - 3 * r, 1 * r, w - r, 3 * r), fill=(214, 39, 40))
+        d.text((8, 6), f"{self.title}   t = {t:5.2f} s", fill=(30, 30, 30), font=self.font)
+        return im.tobytes()
 
 
 def _video_frames(
-    motion: Any,
-    fps: float,
-    beats: np.ndarray | None,
-    up: str | None,
-    azimuth: float,
-    duration: float | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    motion: Any, fps: float, beats: np.ndarray | None, duration: float | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Output times [s], the motion frame shown at each, and whether a beat is lit."""
     last = (motion.n_frames - 1) / motion.fps if duration is None else duration - 1.0 / fps
     n_out = int(np.floor(max(last, 0.0) * fps + 1e-9)) + 1
     t = frames_to_time(np.arange(n_out), fps=fps)
     src = np.clip(time_to_frames(t, fps=motion.fps), 0, motion.n_frames - 1)
-    pos, bones = pose_positions(motion)
-    xy = project(pos[src], up=_up_axis(motion, up), azimuth=azimuth)
     # a beat lights up for 0.1 s (at least one frame)
     flash = max(0.1, 1.0 / fps)
     on = np.zeros(n_out, dtype=bool)
@@ -417,7 +524,7 @@ def _video_frames(
         idx = np.searchsorted(beats, t, side="right") - 1
         ok = idx >= 0
         on[ok] = (t[ok] - beats[idx[ok]]) < flash - 1e-9
-    return t, xy, bones, on
+    return t, src, on
 
 
 def write_video(
@@ -427,15 +534,19 @@ def write_video(
     audio: tuple[np.ndarray, int] | None = None,
     fps: float | None = None,
     beats: Any = None,
-    size: tuple[int, int] = (480, 360),
+    size: tuple[int, int] = (640, 480),
     up: str | None = None,
-    azimuth: float = 0.0,
+    azimuth: float = 30.0,
+    elevation: float = 12.0,
     title: str | None = None,
     ffmpeg: str | bool | None = None,
     progress: bool | Callable[[int, int], None] = False,
     duration: float | None = None,
 ) -> Path:
-    """Write a stick-figure video of ``motion``, with the music as soundtrack.
+    """Write a video of ``motion`` seen in perspective, with the music as soundtrack.
+
+    The camera follows the dancer over a floor grid; beats are marked (see
+    :class:`_Stage`).
 
     Parameters
     ----------
@@ -450,11 +561,17 @@ def write_video(
     fps : float > 0, optional [Hz]
         Video frame rate; default the motion's (frames are picked, not interpolated).
     beats : np.ndarray [s], optional
-        Music beats: the figure turns red and a dot lights for 0.1 s from each beat.
+        Music beats: the figure turns red and a dot lights for 0.1 s from each beat,
+        and a ruler at the bottom shows the beats scrolling past.
     size : (int, int) [px]
         Width and height (rounded to even numbers for H.264).
-    up, azimuth
-        As in :func:`plot_frames`.
+    up : {"x", "y", "z"}, optional
+        Vertical axis; default ``y`` for skeletons, ``z`` for markers.
+    azimuth : float [deg]
+        Camera position about the vertical axis (0: the side view of
+        :func:`plot_frames`).
+    elevation : float [deg], in [0, 80]
+        Camera height: the angle at which it looks down on the dancer.
     title : str, optional
         Text in the corner; default the motion's name.
     ffmpeg : str or bool, optional
@@ -502,8 +619,16 @@ def write_video(
             raise ParameterError(f"audio sample rate {sr!r} must be > 0 [Hz]")
         y_sr = (y, int(sr))
 
-    t, xy, bones, on = _video_frames(motion, fps, beats_arr, up, azimuth, duration)
-    renderer = _FrameRenderer(xy, bones, (w, h), motion.name if title is None else title)
+    if not 0.0 <= float(elevation) <= 80.0:
+        raise ParameterError(f"elevation={elevation!r} must be in [0, 80] degrees")
+    t, src, on = _video_frames(motion, fps, beats_arr, duration)
+    pos, bones = pose_positions(motion)
+    stage = _Stage(
+        pos[src], bones, list(getattr(motion, "joint_names", [])),
+        up=_up_axis(motion, up), azimuth=float(azimuth), elevation=float(elevation),
+        fps=fps, size=(w, h), title=motion.name if title is None else title,
+    )  # fmt: skip
+    ruler = _rulers(t, beats_arr)
     exe = find_ffmpeg() if ffmpeg is None else (ffmpeg or None)
     frames_iter: Any = range(len(t))
     if callable(progress):
@@ -515,7 +640,7 @@ def write_video(
     length = len(t) / fps
 
     if exe is None:
-        return _write_gif_fallback(dest, renderer, xy, t, on, fps, y_sr, length, frames_iter)
+        return _write_gif_fallback(dest, stage, t, on, ruler, fps, y_sr, length, frames_iter)
 
     with tempfile.TemporaryDirectory(dir=parent, prefix=".beatsync-video-") as tmp:
         tmp_video = Path(tmp) / ("out" + (dest.suffix or ".mp4"))
@@ -531,7 +656,8 @@ def write_video(
             n = min(y.size, int(np.ceil(length * sr)))
             wav = write_audio(Path(tmp) / "audio.wav", y[:n], sr)
             cmd += ["-i", str(wav)]
-        cmd += ["-c:v", "libx264", "-preset", "veryfast", "-crf", "23", "-pix_fmt", "yuv420p"]
+        cmd += ["-c:v", "libx264", "-preset", "superfast", "-tune", "animation",
+                "-crf", "23", "-pix_fmt", "yuv420p"]  # fmt: skip
         if y_sr is not None:
             cmd += ["-c:a", "aac", "-b:a", "128k"]
         cmd += ["-movflags", "+faststart", str(tmp_video)]
@@ -542,7 +668,7 @@ def write_video(
         assert proc.stdin is not None
         try:
             for k in frames_iter:
-                proc.stdin.write(renderer.draw(xy[k], float(t[k]), bool(on[k])))
+                proc.stdin.write(stage.draw(k, float(t[k]), bool(on[k]), ruler[k]))
             proc.stdin.close()
         except BrokenPipeError:
             pass
@@ -558,6 +684,27 @@ def write_video(
     return dest
 
 
+def _head_joint(p: np.ndarray, bones: np.ndarray, names: list[str]) -> int | None:
+    """The joint drawn as a head: one named so, else the highest joint (median over
+    frames, ``p`` z-up) if it ends a single bone; None if neither."""
+    named = [i for i, n in enumerate(names) if "head" in n.lower()]
+    if named:
+        return named[-1]
+    if not len(bones):
+        return None
+    top = int(np.argmax(np.median(p[..., 2], axis=0)))
+    return top if int(np.sum(bones == top)) == 1 else None
+
+
+def _rulers(t: np.ndarray, beats: np.ndarray | None) -> list[np.ndarray]:
+    """The beats within 2 s of each output time (the ruler at the bottom of a frame)."""
+    if beats is None or not len(beats):
+        return [np.zeros(0)] * len(t)
+    lo = np.searchsorted(beats, t - 2.0)
+    hi = np.searchsorted(beats, t + 2.0)
+    return [beats[a:b] for a, b in zip(lo, hi, strict=True)]
+
+
 def _reporting(frames: range, progress: Callable[[int, int], None]) -> Iterator[int]:
     """The frame indices, calling ``progress(done, total)`` after each one."""
     total = len(frames)
@@ -568,10 +715,10 @@ def _reporting(frames: range, progress: Callable[[int, int], None]) -> Iterator[
 
 def _write_gif_fallback(
     dest: Path,
-    renderer: _FrameRenderer,
-    xy: np.ndarray,
+    stage: _Stage,
     t: np.ndarray,
     on: np.ndarray,
+    ruler: list[np.ndarray],
     fps: float,
     y_sr: tuple[np.ndarray, int] | None,
     duration: float,
@@ -583,9 +730,9 @@ def _write_gif_fallback(
 
     gif = dest.with_suffix(".gif")
     wav = dest.with_suffix(".wav")
-    w, h = renderer.size
+    w, h = stage.size
     images = [
-        Image.frombytes("RGB", (w, h), renderer.draw(xy[k], float(t[k]), bool(on[k])))
+        Image.frombytes("RGB", (w, h), stage.draw(k, float(t[k]), bool(on[k]), ruler[k]))
         for k in frames_iter
     ]
     with atomic_write(gif, "wb") as fh:

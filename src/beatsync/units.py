@@ -11,7 +11,7 @@ fraction) and returns the value converted to its working type.
 Helpers
 -------
 - numbers: :func:`as_float`, :func:`as_int`, :func:`check_positive`,
-  :func:`check_between`, :func:`check_range`, :func:`check_interval` (one pair);
+  :func:`check_range`, :func:`check_interval` (one pair);
 - rates: :func:`check_fps` [Hz], :func:`check_sample_rate` [Hz], :func:`check_bpm`
   [bpm] (one range, :data:`MIN_BPM`-:data:`MAX_BPM`);
 - arrays: :func:`check_finite`, :func:`check_times` [s], :func:`check_audio`.
@@ -43,7 +43,6 @@ __all__ = [
     "check_finite",
     "check_range",
     "check_positive",
-    "check_between",
     "check_sample_rate",
     "check_bpm",
     "check_audio",
@@ -53,7 +52,6 @@ __all__ = [
     "MIN_PLAUSIBLE_SR",
     "MIN_BPM",
     "MAX_BPM",
-    "check_whole",
     "beat_phase",
     "MAX_MOTION_FPS",
     "check_motion_fps",
@@ -380,48 +378,6 @@ def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float
     return lo_f, hi_f
 
 
-def check_between(
-    value: Any,
-    *,
-    name: str,
-    unit: str,
-    low: float,
-    high: float,
-    closed: str = "neither",
-    hint: str = "",
-) -> float:
-    """Return ``value`` as a float after checking it is finite and between two bounds.
-
-    Parameters
-    ----------
-    low, high : float
-        The bounds, in ``unit``.
-    closed : {"neither", "low", "high", "both"}
-        Which bounds are allowed: ``"high"`` is ``(low, high]``.
-    hint : str
-        The likely mistake, appended to the message (e.g. ``"a fraction, not a
-        percentage"``).
-
-    Examples
-    --------
-    >>> check_between(0.1, name="alpha", unit="", low=0, high=0.5)
-    0.1
-    """
-    if closed not in ("neither", "low", "high", "both"):
-        raise ValueError(f"closed={closed!r} must be 'neither', 'low', 'high' or 'both'")
-    v = as_float(value, name=name, unit=unit, text=True)
-    low_ok = v >= low if closed in ("low", "both") else v > low
-    high_ok = v <= high if closed in ("high", "both") else v < high
-    if not (low_ok and high_ok):
-        left = "[" if closed in ("low", "both") else "("
-        right = "]" if closed in ("high", "both") else ")"
-        more = f" ({hint})" if hint else ""
-        raise ParameterError(
-            f"{name}={value!r} must be in {left}{low:g}, {high:g}{right}{_unit(unit)}{more}"
-        )
-    return v
-
-
 def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
     """Return an audio sample rate as a float after checking it is plausible [Hz].
 
@@ -562,14 +518,6 @@ def check_audio(
                 f"less than {silence_peak:g}): check the file and the recording chain"
             )
     return arr, sr_f
-
-
-def check_whole(value: Any, *, name: str, minimum: int = 0) -> int:
-    """Return ``value`` as an int >= ``minimum`` (``2.5`` beats is a mistake, not 2).
-
-    The same check as :func:`as_int`, with a lower bound that defaults to 0.
-    """
-    return as_int(value, name=name, minimum=minimum)
 
 
 def beat_phase(events: Any, beats: Any) -> np.ndarray:

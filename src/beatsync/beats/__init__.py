@@ -30,11 +30,9 @@ paper; the defaults are swept in ``notebooks/paper_a_sec4_beat_tracking.ipynb``.
 from ..units import check_bpm
 from .onset import FRONTEND_DEFAULTS, FrontEnd, OnsetSignal, onset_strength_psf, phase_slope
 from .tracker import (
-    MAX_SANE_BPM,
     MIN_DURATION_S,
     MIN_PATH_SALIENCE,
     MIN_PULSE_CLARITY,
-    MIN_SANE_BPM,
     SILENCE_PEAK,
     BeatTrack,
     beat_tempo,
@@ -57,8 +55,6 @@ __all__ = [
     "beat_tempo",
     "mix_clicks",
     "FRONTEND_DEFAULTS",
-    "MIN_SANE_BPM",
-    "MAX_SANE_BPM",
     "MIN_DURATION_S",
     "SILENCE_PEAK",
     "MIN_PATH_SALIENCE",

@@ -15,72 +15,32 @@ both an octave towards 110 BPM.
    bass drum's band, :data:`LOW_BAND_HZ`) and between 150 Hz and 5 kHz (the snare
    drum's, :data:`MID_BAND_HZ`), from an STFT with 93 ms windows (:data:`N_FFT_S`, at
    most 11.025 kHz) every 23 ms (:data:`HOP_S`); half-wave rectified differences
-   (energy that rises), interpolated to the onset signal's frame rate. A first version
-   with every onset frame (5.8 ms hops) and a 2-frame smoothing gave the same output of
-   ``bench_beats.py --accuracy-only`` at 2.6 times the cost (40 ms against 15 ms for a
-   minute of audio).
+   (energy that rises), interpolated to the onset signal's frame rate.
 2. **Alternation** (:func:`alternation_cue`): per window and period ``tau``, the
    normalised cross-correlations of the two envelopes at lags ``+tau`` and ``-tau``
    (a bass drum followed by a snare drum one period later, and the other way round),
    minus their normalised autocorrelations at ``tau`` (each drum repeating every
    period): ``A(tau) = (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``, each
    term over the whole window's norms (so ``A`` shrinks by up to ``1 - tau / L``, a
-   quarter at the longest period scored). On the synthetic rock pattern
-   (:func:`beatsync.synth.audio.drum_pattern`, 30 s, seeds 0-2) at 60, 120 and
-   180 BPM, ``A`` averages +0.63-0.68, +0.66-0.70 and +0.71-0.75 at the beat, -0.71 to
-   -0.76 at twice the beat (each drum repeats every period; 120 and 180 BPM) and -0.01
-   at half the beat; on click tracks it stays within +-0.015. Only periods with
-   :data:`MIN_CYCLES` cycles in the window are scored.
+   quarter at the longest period scored). A drum pattern gives ``A`` near +0.7 at its
+   beat and near -0.7 at twice the beat (each drum repeats every two beats); click
+   tracks give about 0. Only periods with :data:`MIN_CYCLES` cycles in the window are
+   scored.
 3. **Evidence, never counter-evidence**: ``max(A - NOISE_LEVEL, 0)``. Drums that do not
-   alternate are no evidence against a period (at the beat of the bundled songs ``A``
-   averages -0.29 for the cha-cha DANCE_C_4 and -0.07 to +0.06 for the others), and an
-   alternation no stronger than noise's is none for it (:data:`NOISE_LEVEL`).
+   alternate (a cha-cha's) are no evidence against a period, and an alternation no
+   stronger than noise's is none for it (:data:`NOISE_LEVEL`).
 4. **Weight** (:data:`DRUM_WEIGHT`): ``log_obs += DRUM_WEIGHT * max(A - NOISE_LEVEL, 0)``,
    added to the tactus observation of every window before the tempo HMM decodes it.
 
-Why a separate STFT. The front end's four bands (:mod:`.onset`, 23 ms windows, 43 Hz
-bins) put the synthetic bass drum and the snare drum's body in the same 0-250 Hz band;
-with its log-magnitude flux as the two envelopes (0-250 Hz and 250-1000 Hz), ``A`` of
-the rock pattern was within +-0.1 at every level. Why the energy and not its log: with
-the rise of ``log(1 + E / (c max E))``, the 60 BPM pattern's ``A`` at its beat was -0.09
-for ``c = 1e-4`` (40 dB: the snare's tail in the low band and the decays count as much
-as the attacks), +0.19 for ``1e-2`` and +0.56 for ``1`` (measured with the first
-version above); linear, it is +0.63-0.68.
+Why a separate STFT: the front end's four bands (:mod:`.onset`, 23 ms windows, 43 Hz
+bins) put a bass drum and a snare drum's body in the same 0-250 Hz band. Why the
+energy and not its log: on a log scale the decays and the snare's tail in the low band
+count as much as the attacks, and the alternation fades.
 
-What was chosen on what (a scratch sweep, 2026-11-29):
-
-- The bands and the window are a first choice (a bass drum's fundamental is
-  50-100 Hz, a snare drum's body about 200 Hz), not swept.
-- :data:`NOISE_LEVEL` on noise alone: over 140 white and brown noises of 2-30 s
-  (seeds 0-9), the largest ``A`` of a window over the period grid has a median of
-  0.12-0.14 and a 95th percentile of 0.16-0.20 for 5-30 s. Shorter windows reach more
-  (95th percentile 0.22-0.25 for 2-3 s): on a noise clip that short the cue can add a
-  little evidence for a fast period (up to ``DRUM_WEIGHT`` x 0.08). A known limit.
-- :data:`DRUM_WEIGHT` on the 30 s synthetic set (seeds 0-2): every weight from 3 to 12
-  meets the three synthetic targets on every seed; 2 does not (AMLt 0.974 and 0.976 on
-  seeds 0 and 1); from 8, the clean drum pattern at 210 and 230 BPM is tapped at a third
-  of its tempo. 4 is about the geometric middle of 3 and 6.
-- The bundled real recordings were only scored, and the cue is silent on them: over
-  the tempo windows of the seven (Hainsworth 001, the Ballroom waltz, the madmom sample,
-  the four dancers' 28 s songs), it is 0 at every period but in 1 of the waltz's 25
-  windows (at most 0.012), where the synthetic drums at 180 BPM reach 0.5 in every
-  window. So it is untested on real music where it would fire (drums with a clear
-  backbeat): none with beat annotations is bundled. With these constants none of them
-  changed (``benchmarks/bench_beats.py --accuracy-only``: the whole recordings, their
-  15-30 s excerpts and 3-10 s clips, the dancers' songs and their clips, the madmom
-  sample). Without the noise level (``max(A, 0)``, weight 3), 3-7 s clips of the
-  Ballroom waltz were tapped at the eighth more often (5 s: mean F 0.926 to 0.895); with
-  ``A`` itself, negative values included (weight 2), the clips of DANCE_W_5 and
-  DANCE_W_10 also agreed less with their 28 s excerpts (mean F 0.771 to 0.739 and 0.741
-  to 0.732).
-
-Results (the synthetic set, 30 s, seeds 0-2; ``benchmarks/RESULTS.md``): clean F 1.000
-on every seed (0.966, 0.967 and 0.933 before), AMLt 0.997, 0.999 and 0.997 (0.962, 0.975
-and 0.963) and tempo-change F 0.993, 0.995 and 0.995 (0.943, 0.928 and 0.945). Left:
-the click track at 180 BPM with noise (seed 0) and the drums at 60 BPM with drift
-(seeds 0 and 2) tapped an octave off, and clean click tracks at 160, 170 and 190-240
-BPM tapped at half (clicks have no drums to alternate: the grid artifact of
-:mod:`beatsync.beats.metrical`).
+The bands and the window are a first choice (a bass drum's fundamental is 50-100 Hz,
+a snare drum's body about 200 Hz); :data:`NOISE_LEVEL` was set on noises and
+:data:`DRUM_WEIGHT` on the synthetic set. None of the bundled real recordings has drums
+that alternate, so the cue is silent on them. Calibrated: docs/tuning.md#drum-cue.
 """
 
 from __future__ import annotations

@@ -36,188 +36,25 @@ The paper's comb filters run on integer lags sample by sample; we take their
 steady-state energy per 8-s window.
 
 The spectrum of each window is zero-padded so that every resonator pass band (about
-0.074 Hz wide) spans :data:`BINS_PER_PASS_BAND` bins (:func:`resonator_fft_size`).
-Before, padded only to a power of two (0.084 Hz bins for 8 s windows), the salience
-was jagged over the period grid; every measurement below that does not say otherwise
-was made with that coarser sampling, and the fine sampling changed the synthetic set
-little (it fixed the 180 BPM click track with drift on every seed) while it lifted
-the short clips of the real recordings and put the madmom sample at its level (see
-below and ``benchmarks/RESULTS.md``).
+0.074 Hz wide) spans :data:`BINS_PER_PASS_BAND` bins (:func:`resonator_fft_size`);
+coarser, the salience is jagged over the period grid and short clips are tapped at
+the wrong level.
 
-Known limit of the per-window evaluation (measured, not yet fixed): the Hann-windowed
-8-s segment smears each spectral line over more than a resonator's pass band, so a
-perfectly periodic pattern gets a salience that falls with the period (per band about
-0.35, 0.30, 0.25 and 0.19 at 1, 2, 3 and 4 beats of the synthetic 3/4 pattern at
-90 BPM). The evidence alone therefore prefers the fastest pulse present, the tactus
-prior decides between levels an octave apart (without the drum cue, the synthetic drum
-pattern at 180 BPM is tapped at 90), and the bar of a slow 3/4 loses to two beats
-(meter 2 at 90 BPM).
-Running the resonators in time over the whole signal (as in the paper) reverses the
-bias (steady-state salience 3.23, 3.24 and 3.36 for 1, 2 and 3 beats of that pattern,
-summed over bands) at several times the cost; correcting the window bias analytically
-(dividing by each resonator's gain for a periodic input seen through the window)
-amplified the noise of the long periods on real music (meters of 5 to 8). Neither is
-used. The resonators run in time were measured in full on 2026-11-29 (a scratch run:
-fractional delays by linear interpolation, each band's accents minus their 8 s moving
-mean, the output energy over each 8 s window against the input's, the null left as it
-is): Hainsworth 001, the waltz and the madmom sample kept F 1.0 and their meters, but
-DANCE_C_4 went to 62.5 BPM (half its beat), and the synthetic set (30 s, seed 0) fell to
-clean F 0.762, AMLt 0.787 and tempo-change F 0.770 (0.966, 0.962, 0.943 with the
-windows): click tracks at 90-180 BPM were tapped at a half or a third of their tempo,
-since a converged comb at a multiple of the period passes every harmonic of the period
-too. The scratch implementation (numpy, block by block) took 16 times as long.
-
-Two more evaluations of the same resonators were measured and not used. The energy of
-a comb filter run over a zero-padded segment has a closed form in the segment's
-normalised autocorrelation ``rho``: ``r(tau) = (1 - alpha) sum_{d >= 1} alpha**(d-1)
-rho(d tau)``. (a) On a rectangular segment (the biased autocorrelation, each period
-searched within its grid cell) every bundled real recording keeps its level and
-meter and 3/4 at 90 BPM gets meter 3, but the synthetic set does not improve (seeds
-0-2: clean F 0.933, 0.933, 0.966; AMLt 0.961, 0.983, 0.973; tempo-change F 0.933,
-0.935, 0.957), 120 BPM items with swing or noise are tapped at 60 on every seed, and
-the madmom sample stays at 118 BPM. (b) With the unbiased autocorrelation (Hann
-segment divided by the window's own autocorrelation, lags up to half the window) no
-multiple of the beat is favoured any more: the madmom sample is tapped at its level
-(87.9 BPM, F 1.0) and the real recordings keep theirs for ``beta`` <= 5, but the
-tactus prior alone then picks between levels an octave apart, and the synthetic
-click tracks at 180 BPM are tapped at 90 (clean F 0.865-0.898). Either would also
-need the no-clear-pulse constants of :mod:`beatsync.beats.tracker` calibrated again
-(the salience scale changes).
-
-Why the synthetic drums were missed by the prior (measured on seed 0, before the drum
-cue of :mod:`beatsync.beats.drums`, which now taps them at their beat). The drum
-pattern at 90 and at 180 BPM is the same pattern, only scaled; any salience that does
-not depend on the tempo gives both the same evidence in beat units. A prior can tap
-both at their labelled level only if the evidence at the labelled level is higher than
-the mean of the levels either side of it. Ours is not. At 180 BPM, the labelled level
-minus the half-note level is -0.10 (``beta * s`` averaged over windows; -0.24 with the
-coarser spectral sampling). At 90 BPM, the labelled level minus the eighth-note level
-is -0.02 (-0.03). With the tatum and measure terms as well, the labelled level beats
-the half-note level at 180 BPM by 0.56 and loses to the eighth-note level at 90 BPM by
-0.68, while the tactus prior favours 90 over 180 BPM by 1.17: no prior of the period
-alone can get both. Every evaluation above shares this, because the kick and the snare
-fall in different bands and each band on its own repeats every two beats. So with a
-wider tactus prior (sigma 0.45 or 0.6) the clean 90 BPM pattern is tapped at 180 on
-every seed (0-2), and the 180 BPM pattern with drift or noise still at 90. Every
-experiment below was measured before :attr:`MeterModel.tatum_ratio_weights`, against
-the scores of that time (Hainsworth 001's 3 s and 5 s clips: mean F 0.416 and 0.654;
-now 0.508 and 0.789):
-
-- The band sum added as a fifth band changed no level. The band sum alone tapped
-  180 BPM clicks at 90.
-- Tukey windows (taper 0.25 and 0.5) in place of the Hann tapped the 150 BPM
-  pattern at 75.
-- The exact comb energy over rectangular windows, averaged over the multiples of
-  the period, tapped 90 and 120 BPM clicks at 45 and 60, and DANCE_C_4 at 62.5.
-- That same energy used only for clips that fit in one window did better on short
-  real clips, and worse on short synthetic ones. This was measured with the equal
-  phase weights of that time; the current phase weights alone score the waltz's 3 s
-  and 5 s clips 0.858 and 0.911. On the real clips, mean F went from
-  0.418 to 0.672 and from 0.633 to 0.785 on Hainsworth 001 at 3 s and 5 s, and from
-  0.625 to 0.724 and from 0.736 to 0.846 on the waltz. On 7 s synthetic clips it fell
-  from 0.956 to 0.869.
-- A jump distribution that decays with the log tempo ratio (Laplacian, scale 0.1
-  and 0.03) did not keep the level through a tempo change. The level is decided
-  window by window, and the cost of a single jump cannot outweigh that. On the
-  tempo-change drum items (seed 0), the decoded half beats the half at the other
-  level by 9-25 (log observation summed over ten windows): 120 BPM over 60 by 22,
-  80 over 160 by 25, 135 over 67.5 by 9. Nor would keeping the meter help: the best
-  measure is two beats on both sides of the decoded 120 -> 80 BPM switch.
-- A narrower ratio model (``ratio_sigma`` 0.15 instead of the paper's 0.3, so that a
-  tactus of three tatums counts against one of two or four) changed nothing on the
-  synthetic set or the madmom sample (119.8 BPM), lifted the 5 s clips of
-  Hainsworth 001 from mean F 0.654 to 0.751, and lowered those of the waltz
-  (5 s: 0.911 to 0.905; 7 s: 0.967 to 0.960). Mixed, and seen on two recordings only.
-- The decoded level was checked against the levels at 3/4 and 4/3 of it, each decoded
-  again within +-4 % of that tempo with its beats placed, and the beat sequence whose
-  beats fall on the strongest accents (mean accent at the beats over the mean accent)
-  was kept. Hainsworth 001's clips rose (3 s: mean F 0.416 to 0.788; 5 s: 0.654 to
-  0.893), but the waltz's fell (5 s: 0.911 to 0.721; 10 s: 0.992 to 0.852; its 15-30 s
-  excerpts: 0.993 to 0.940): a slower sequence that keeps to the downbeats scores
-  higher. With 2/3 and 3/2 of the level as well (+-8 %), the waltz's excerpts fell to
-  0.832. The synthetic set did not change. Not used.
-- A contrast of the folded accent was measured as evidence that could peak at the
-  beat (per window and period: the band-sum accent folded over the period, the most
-  that one phase exceeds the phase half a period later, over the mean accent). On the
-  synthetic drums it peaks at half the beat, where the empty sixteenth counts as a
-  weak off-beat, and of the seven bundled real recordings it peaks at the beat only
-  on DANCE_C_4 (elsewhere at 1/2, 3/4 or 3/2 of it). Not used.
-- Goto's (2001) drum-pattern cue was added to the tactus observation: the beat is the
-  interval between a bass drum and a snare drum that alternate. We scored it as the
-  low band and a higher band both concentrated at twice the period, in antiphase.
-  On our phase-slope onsets the low band is too dense to show the kick (the score,
-  averaged over windows, was 0.05 at most); weight 300 tapped DANCE_R_3 at 190. With the
-  energy of its own STFT's bands (30-150 Hz, 150 Hz-5 kHz) it is used (:mod:`.drums`).
-- Nor does a band's accent between the decoded beats tell a beat tapped at half its
-  tempo (2026-11-29, scratch run: per band, the strongest onset within 1/8 beat of
-  each beat and of each midpoint). Midpoints over beats: the 180 BPM drum pattern
-  tapped at 90 (seed 0) 1.17 in the low band, the drums at their level 0.09-0.39; but
-  at the annotated level the madmom sample 1.12-1.38 in every band, Hainsworth 001
-  1.13 and DANCE_R_3 1.26-1.27 in low bands. A doubling rule would double them too.
-- The tatum grid (1 % steps) misses the tactus periods (0.5 %); a periodic pulse's salience
-  falls ~40 % within 1 % of its period: clicks at 160, 170, 190-240 BPM are tapped at half.
-  Aligned grids fix 160-190 but tap 60 BPM drums at 120: not used (numbers: CHANGELOG).
-
-Why 10-20 s clips of the waltz DANCE_W_10 were tapped faster than its beat, measured
-before :attr:`MeterModel.tatum_ratio_weights` weighed a beat of three tatums half (the
-disagreeing clips at 85-116 BPM, median 107, against 87 BPM for the 28 s excerpt;
-``dance_song_rows`` in ``benchmarks/bench_beats.py``). Its first 20 s were tapped at
-110 BPM (now 87.5). Their terms were compared at 87 BPM and at 4/3 of it, 116 BPM, in a
-scratch decomposition of :func:`tactus_observation`. The measure is found right for both,
-about 2.07 s: three beats at 87 BPM, or four at 116 BPM. Both readings are consistent
-metrical trees, and a balance of small terms decides. Summed over the 13 windows:
-
-- the salience favours 87 BPM by 2.9, and the tatum term by 2.0;
-- the tactus prior favours 116 BPM by 3.4, and the measure term by 4.0. About 3 of
-  the 4.0 is the normalisation of ``P(measure | tactus)``, which is larger for a
-  shorter tactus.
-
-The ratio term is where the two readings differ: the faster one is a beat of three
-tatums. With that weighed half, DANCE_W_10 still has 9 disagreeing clips (median 105
-BPM). Given a range of +-15 % around the excerpt's tempo, 1 of them agrees (tapped at
-80-102 BPM, median 90): the salience near the beat is flat on them. Given the tempo
-itself, 4 of the 9 agree, and none of DANCE_W_5's 11, most of which are at its tempo on
-another phase (``dance_song_rows``). The no-clear-pulse warning of
-:mod:`beatsync.beats.tracker` names a known tempo as the way out.
-
-The whole songs (``benchmarks/whole_dance_songs.py``, on the songs of the development
-machine's shared data, which are not bundled) showed it most. The cha-cha and the rumba
-keep their excerpt's tempo in every window. With equal tatum-ratio weights, only 93 of
-197 windows of DANCE_W_5 and 56 of 239 of DANCE_W_10 did, 51 and 129 were at 4/3 of
-it, and DANCE_W_10 got 4 beats per bar; forced to one tempo (``time_varying=False``),
-DANCE_W_10 got 120.3 BPM. With ``w_3 = 0.5``: 189 of 197 and 147 of 239, none at 4/3,
-3 beats per bar for both; DANCE_W_10's other 92 windows are at 95-106 BPM and it still
-warns of no clear pulse. The peers do not settle those windows either: on 30 s cut at
-95-125 s, essentia's two trackers give 115 and 110 BPM and librosa 116 (ours alone:
-101); on 200-230 s essentia gives 86 and ours alone 121 (a scratch check, median beat
-intervals).
-
-The madmom sample (2.8 s, 88 BPM, 4 annotated beats) was tapped at 120 BPM, a pulse of
-three sixteenths, until the resonators' spectrum was sampled finely enough
-(:func:`resonator_fft_size`): with 0.34 Hz bins for a 2.8 s clip (n_fft 512 at 172
-frames/s) its salience at 88 BPM came out below the noise level (``s`` = -0.03 against
-0.14 at 120 BPM), which no correction of the window bias could lift. It is now tapped
-at 87.9 BPM (F 1.0) told nothing; neither librosa nor essentia's two trackers tap it at
-its level (117 and 175 BPM).
-
-The meter of the synthetic 3/4 pattern at 60-90 BPM is found as 1 or 2 beats (the
-measure term sees the bar through the same window bias). A beat-synchronous meter
-class was measured as a fix and not used (Gouyon & Herrera 2003, recurrence of
-beat-segment descriptors): triple if the normalised autocorrelation of per-beat
-features at a lag of 3 beats exceeds those at 2 and 4. On the synthetic meter grid
-(2/4, 3/4, 6/8 at 60-160 BPM, seeds 1 and 3) it names the class of every item tapped
-at its beat, which would lift the grid from 28 to 36 of 42. On the real recordings it
-does not hold: with the band accents at the beats, the Ballroom waltz and DANCE_W_5
-come out duple; with log-mel energies per beat, the Ballroom waltz and DANCE_W_10 do,
-and the lag-3 autocorrelation is within 0.2 of the larger of lags 2 and 4 on all six
-real items with a known meter, against about 1.4 on the synthetic ones (a scratch
-measurement). The metrical model names the meter of all six (Hainsworth 001, the
-cha-cha and the rumba 4; the three waltzes 3).
+Known limit of the per-window evaluation: the Hann-windowed 8-s segment smears each
+spectral line over more than a resonator's pass band, so a perfectly periodic pattern
+gets a salience that falls with the period. The evidence alone therefore prefers the
+fastest pulse present; the tactus prior (and, for drums, the cue of
+:mod:`beatsync.beats.drums`) decides between levels an octave apart, and the bar of a
+slow 3/4 can lose to two beats. The tatum and measure grids (1 % steps) are not
+aligned with the tactus grid (0.5 %), so fast click tracks (160 BPM and above) can be
+tapped at half. None of the alternatives tried (resonators run in time, closed-form
+comb energies, other windows, aligned grids, other priors) did better over both the
+synthetic set and the real recordings.
 
 The observation exponent ``beta``, the prior widths and the ratio weights are our
-choices (see :data:`METER_MODEL`): they were set on the synthetic test set, except the
-tatum ratio weight ``w_3``, chosen on the whole songs of two waltzes (see
-:class:`MeterModel`); the annotated recordings were only scored.
+choices (:data:`METER_MODEL`), set on the synthetic test set; the tatum ratio weight
+``w_3`` was chosen on the whole songs of two waltzes. Calibrated:
+docs/tuning.md#metrical-model.
 """
 
 from __future__ import annotations
@@ -256,21 +93,9 @@ class MeterModel:
         ``w_l`` of the ratio model for l = 1..9: measure / tactus.
     tatum_ratio_weights : tuple of float
         ``w_l`` for tactus / tatum. As ``ratio_weights`` but ``w_3 = 0.5``: a beat of
-        three tatums (compound meter) counts half, as the ratios 6 and 8 do. With equal
-        weights the whole waltz songs DANCE_W_5 and DANCE_W_10 were tapped at 4/3 of
-        their beat (a "beat" of three sixteenths, four to the bar) in 51 of 197 and 129
-        of 239 tempo windows; with ``w_3`` at 0.2, 0.5 or 0.7, in none, and at 0.8 in 95
-        of DANCE_W_10's (``benchmarks/whole_dance_songs.py``). Chosen on those two
-        songs. The scores of the annotated recordings and their excerpts stayed the
-        same. Of Hainsworth 001's 5-10 s clips, 13 moved from 130-135 to about
-        100 BPM, 12 onto the beat and one onto the off-beat (7 s at 48 s: F 0.30 to
-        0.0), none the other way (5 s: mean F 0.654 to 0.789). Of 204 synthetic items
-        (the 30 s set and the 20 s front-end sweep set, seeds 0-2 each), 4 moved to
-        another level and none the other way, all at the edges of the tempo range:
-        the 180 BPM click track with noise (30 s seed 0, 20 s seed 1) and the 180 BPM
-        drums with noise (20 s seed 1) to 90 BPM, the clean 60 BPM drums (20 s seed 1)
-        to 120 BPM. The 6/8 pattern at 140 BPM is tapped at its beat rather than at
-        half of it, but with 4 beats per bar rather than 2.
+        three tatums (compound meter) counts half, as the ratios 6 and 8 do, so that a
+        "beat" of three sixteenths, four to the bar, does not beat the waltz's own beat
+        (docs/tuning.md#tatum-ratio-weight).
     ratio_sigma : float
         Width of each Gaussian of the ratio model.
     beta : float
@@ -348,13 +173,9 @@ def resonator_salience(
 
     The product ``sum_k a(k) c(k)`` is taken in float32 (the weights are computed in
     float64 and stored in float32; each autocorrelation is first divided by its lag-0
-    value, so the salience stays independent of the accents' scale). Each band's
-    energy ratio is off by about 1e-7 of its range (1e-15 in float64); the product's
-    memory traffic and the cached weights halve (the whole tracker took 0.95 times
-    the time on the 2.8 s madmom sample and on a 32 s song, interleaved in one process
-    with the float64 code). It changed no beat, tempo, meter or warning of 75 items
-    (the bundled recordings, 18 clips of them and the 20 s synthetic set); saliences
-    moved by at most 9e-7.
+    value, so the salience stays independent of the accents' scale): each band's
+    energy ratio is off by about 1e-7 of its range, and the product's memory traffic
+    and the cached weights halve.
     """
     return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
 
@@ -385,8 +206,8 @@ def resonator_saliences(
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
     # the weights are cached for lags up to the next multiple of LAG_BUCKET: clips of
-    # other lengths under it share them (with the exact length as the key, every new
-    # clip length computed three grids again, about 0.2 s)
+    # other lengths under it share them (keyed by the exact length, every new clip
+    # length would compute three grids again)
     n_lags = min(n_fft, -(-length // LAG_BUCKET) * LAG_BUCKET)
     weights = [
         _resonator_lag_weights(
@@ -461,13 +282,9 @@ def resonator_fft_size(length: int, fps: float, half_time_s: float) -> int:
     ``ln 2 / (pi T0)`` wide around each multiple of ``1 / tau`` (0.074 Hz for the
     paper's 3 s, whatever the period). The window's spectrum is sampled at
     :data:`BINS_PER_PASS_BAND` bins per pass band at least (zero padding), else the
-    salience of a period depends on whether its pass bands happen to fall on a bin:
-    with bins ``fps / n_fft`` = 0.084 Hz apart (an 8 s window at 172 frames/s padded
-    only to a power of two) or 0.17 Hz (a 5 s clip), neighbouring periods on the 0.5 %
-    grid differed by up to 7 in log observation, and a clean 5 s click track at 120 BPM
-    was tapped at 60. Sampled twice as finely again (7 bins per pass band), the
-    bundled real recordings, their clips and the synthetic set kept every tempo and
-    score but that of one 3 s clip of the waltz.
+    salience of a period depends on whether its pass bands happen to fall on a bin,
+    and neighbouring periods of the grid get very different observations
+    (docs/tuning.md#spectral-sampling-of-the-resonators).
     """
     pass_band = np.log(2.0) / (np.pi * half_time_s)  # [Hz]
     need = max(length, 2, int(np.ceil(BINS_PER_PASS_BAND * fps / pass_band)))

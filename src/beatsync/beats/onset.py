@@ -16,18 +16,12 @@ paper; :data:`FRONTEND_DEFAULTS` are swept in
 ``notebooks/paper_a_sec4_beat_tracking.ipynb``. numpy and scipy only (no
 JIT compilation on the first call).
 
-Known limit (measured, not fixed): a steady tone has onsets. In the bands without the
-tone, its leakage from the positive and the negative frequency interferes, and the
-phase slope there crosses zero at a steady rate (about 37 times a second for 440 Hz).
-The flux at those crossings is small but not zero, and the tracker reads the
-periodic train as a pulse. Three gates were measured and not used. A floor on a
-band's energy relative to the frame's total does not separate the two: a tone's
-leakage into the next band is -3 to -59 dB within 200 Hz of a band edge, while the
-top band of DANCE_W_5 is below -50 dB in 35 % of its frames. A minimum energy rise
-at the crossing does not either: the tone's crossings rise by 0.3-0.7 dB, and 23-38 %
-of the onsets of the bundled real recordings rise by less than 1 dB. Nor does the
-density of onset strength: a tone gives 0.5-0.7 per second, but a click track at
--40 dB under the same tone gives 0.86, and it is tracked right (F 1.0).
+Known limit: a steady tone has onsets. In the bands without the tone, its leakage
+from the positive and the negative frequency interferes, and the phase slope there
+crosses zero at a steady rate; the flux at those crossings is small but not zero, and
+the tracker reads the periodic train as a pulse. No gate on band energy, energy rise
+or onset density separates it from the quiet onsets of real music
+(docs/tuning.md#front-end-phase-slope-onsets).
 """
 
 from __future__ import annotations
@@ -131,7 +125,7 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
 
 @functools.lru_cache(maxsize=16)
 def _default_frontend(sr: float, defaults: tuple) -> FrontEnd:
-    """The default front end at rate ``sr`` (cached: validating it took 0.1 ms a call)."""
+    """The default front end at rate ``sr`` (cached: every call would validate it again)."""
     return _frontend_settings({}, sr)
 
 
@@ -227,7 +221,7 @@ def _hann(n: int) -> np.ndarray:
 
 
 #: Frames per block of the front end: a block's spectra stay in cache, and no array of
-#: the whole song's spectra is allocated (1.3x faster than one pass over a 28 s song).
+#: the whole song's spectra is allocated.
 BLOCK_FRAMES = 256
 
 
@@ -313,8 +307,8 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
         m = np.sqrt(power)
         if mag is not None:
             mag[a:b] = m
-        # log(1 + 100 m): numpy's float32 log is vectorised, its log1p is not (6x
-        # slower); in float32 both are within 5e-7 of the exact value
+        # log(1 + 100 m): numpy's float32 log is vectorised, its log1p is not; in
+        # float32 both are within 5e-7 of the exact value
         logmag = np.float32(100.0) * m
         logmag += np.float32(1.0)
         np.log(logmag, out=logmag)
@@ -446,8 +440,8 @@ def onset_strength_psf(
 def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     """:func:`onset_strength_psf` on validated input (``y`` finite mono, not silent)."""
     if fe.analysis_sr != sr:
-        # soxr's high-quality filter (23 ms per minute of 44.1 kHz audio; an ideal low-pass
-        # by FFT over the whole signal took 140 ms), keeping round(n * ratio) samples
+        # soxr's high-quality filter (far cheaper than an ideal low-pass by FFT over the
+        # whole signal), keeping round(n * ratio) samples
         n_out = int(round(y.size * fe.analysis_sr / sr))
         # float32; a very loud signal comes back lowered by a power of two, which the
         # normalisation below removes

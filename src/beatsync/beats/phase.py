@@ -15,33 +15,13 @@ A band's weight averages its windows, weighted by its onset strength in each
 cancel it out. It does not use paper A's weights ``6 - c`` (eq. 7, which
 :attr:`OnsetSignal.envelope` keeps).
 
-On the two annotated real recordings the lowest band (0-250 Hz) holds about half of
-the onset strength. Yet its onsets fall evenly over the beat: 0.25 and 0.27 of its
-strength lie within an eighth of a beat of an annotated beat, as for onsets at random
-phases (0.25). The bands above 1 kHz have 0.34-0.51 there.
-
-- **Weighted 5:4:3:2**, that band pulled the phase onto the off-beat. Over excerpts of
-  15-30 s starting every 2.5 s (56 of Hainsworth 001, 16 of the Ballroom waltz), mean F
-  was 0.992 and 0.842, lowest 0.680 and 0.000.
-- **With equal weights** the long excerpts scored 0.998 and 0.998. The bass band's
-  random phases still decided short clips: about one clip of 7-10 s in ten was on the
-  off-beat.
-- **With concentration weights**, on clips of 5, 7 and 10 s starting every second, mean
-  F went from 0.633, 0.888 and 0.941 to 0.654, 0.948 and 0.984 on Hainsworth 001, and
-  from 0.736, 0.833 and 0.940 to 0.911, 0.967 and 0.992 on the waltz (the tatum ratio
-  weight of :class:`beatsync.beats.metrical.MeterModel` later lifted Hainsworth 001's
-  to 0.789, 0.957 and 0.999). The 15-30 s excerpts scored 0.998 and 0.993 (lowest
-  0.970 and 0.952), and both whole recordings scored F 1.000. The synthetic set
-  (seeds 0-2) is unchanged to within 0.002.
-- **Variants measured and not used.** One concentration over the whole signal scored
-  the same clips but the whole waltz at F 0.971, with one beat 95 ms off. Squared
-  concentrations were about the same. Subtracting the resultant expected from random
-  phases did worse on short clips (Hainsworth 001 at 10 s: 0.963).
-
-The weights need no constant and no annotation: they come from the audio and its
-decoded tempo. The choice was made on those two recordings only, which is a sanity
-check and not a benchmark (``benchmarks/bench_beats.py``, the excerpt and short-clip
-tables).
+Why not fixed weights: on real music the lowest band (0-250 Hz) holds about half of
+the onset strength, yet its onsets can fall at every phase of the beat (a bass line
+between the beats). Weighted ``6 - c`` it pulls the phase onto the off-beat; with
+equal weights it still decides short clips. Weighted by its concentration, a band
+counts as much as it follows the beat. The weights need no constant and no
+annotation: they come from the audio and its decoded tempo. The choice was made on
+the two annotated recordings (docs/tuning.md#band-phase-weights).
 """
 
 from __future__ import annotations

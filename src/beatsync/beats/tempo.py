@@ -190,7 +190,7 @@ def viterbi_banded(
     for t in range(1, n_steps):
         pad[reach : reach + n_states] = value
         # row j: the values of j's predecessors j - reach .. j + reach (a reduction over
-        # contiguous rows: 2x faster than over the columns of the transposed layout)
+        # contiguous rows, faster than over the columns of the transposed layout)
         scores = np.lib.stride_tricks.sliding_window_view(pad, 2 * reach + 1) + band
         k = np.argmax(scores, axis=1)
         best = scores[cols, k]

@@ -10,7 +10,7 @@ density, window lengths and the decoder's selection bias, so one ratio threshold
 serves 2 s clips and whole songs; a fixed salience threshold alone could not (a 5 s
 noise reaches the salience of the quietest real song). Its constants
 (:data:`MIN_PULSE_CLARITY`, :data:`MIN_PATH_SALIENCE`, :data:`CLEAR_PULSE`) were set on
-noises and the bundled real recordings (numbers beside them).
+noises and the bundled real recordings.
 """
 
 from __future__ import annotations
@@ -21,16 +21,14 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..errors import ParameterError, warn
+from ..units import check_audio as _units_check_audio
 from ..units import (
-    MAX_BPM,
-    MIN_BPM,
     check_bpm,
     check_positive,
     check_range,
     check_times,
     frames_to_time,
 )
-from ..units import check_audio as _units_check_audio
 from .drums import DRUM_WEIGHT, drum_cue
 from .filters import gaussian_smooth
 from .metrical import (
@@ -49,8 +47,6 @@ __all__ = [
     "Observation",
     "observe",
     "SILENCE_PEAK",
-    "MIN_SANE_BPM",
-    "MAX_SANE_BPM",
     "DEFAULT_MIN_BPM",
     "DEFAULT_MAX_BPM",
     "BeatTrack",
@@ -68,9 +64,6 @@ __all__ = [
 #: Tempo range [bpm] that :func:`track_beats` searches unless told otherwise.
 DEFAULT_MIN_BPM = 40.0
 DEFAULT_MAX_BPM = 240.0
-#: The plausible tempo range [bpm] (:data:`beatsync.units.MIN_BPM`, ``MAX_BPM``).
-MIN_SANE_BPM = MIN_BPM
-MAX_SANE_BPM = MAX_BPM
 #: Audio shorter than this is refused [s] (:func:`check_duration`): two beat periods
 #: at 80 BPM, three at 120 BPM. A shorter clip cannot show a pulse (two beat periods)
 #: at any but the fastest tempi, and the tracker would return a tempo made up by its
@@ -81,24 +74,13 @@ MIN_DURATION_S = 1.5
 #: Unless it reaches :data:`CLEAR_PULSE`, it is compared with the same measure on the
 #: audio's own onsets in random order (:func:`pulse_clarity_null`, the null); below
 #: ``MIN_PULSE_CLARITY`` times the null, or below :data:`MIN_PATH_SALIENCE`, a warning
-#: says the beats may be meaningless. Calibrated on 84 noises (white, 10 seeds, and
-#: brown, 2 seeds, at 2, 3, 5, 7, 10, 15 and 30 s) and the seven bundled real recordings
-#: (Hainsworth 001, the Ballroom waltz, the madmom sample and the four Dance-with-Melody
-#: songs; ``benchmarks/calibrate_pulse_clarity.py``). Since the resonators' spectrum is
-#: sampled at 3 bins per pass band
-#: (:func:`beatsync.beats.metrical.resonator_fft_size`): noises 0.00-2.53, but one 2 s
-#: white noise 3.32; real recordings 3.33 (the madmom sample) to 22.4; 2.9 is the
-#: geometric middle of 2.53 and 3.33. (With the coarser sampling before: noises
-#: 0.36-1.97, real 3.22-12.5, threshold 2.5.) With the drum cue of
-#: :mod:`beatsync.beats.drums` in the decoded path, the calibration prints the same
-#: table as without it.
+#: says the beats may be meaningless. Set between the ratios that noises and the
+#: bundled real recordings reach (docs/tuning.md#pulse-clarity).
 MIN_PULSE_CLARITY = 2.9
-#: Path salience below which the pulse is unclear whatever the null says: the one noise
-#: that passes the ratio (a 2 s white noise) has 0.054, the real recordings 0.11
-#: (DANCE_W_10) to 0.67; 0.08 is about the geometric middle of 0.054 and 0.11.
+#: Path salience below which the pulse is unclear whatever the null says (between a
+#: short noise that passes the ratio and the quietest real recording).
 MIN_PATH_SALIENCE = 0.08
-#: Path salience above which the pulse is clear without the null (noises reached 0.13,
-#: real recordings 0.11-0.67; with the coarser sampling before, noises of 2 s 0.61).
+#: Path salience above which the pulse is clear without the null (above every noise).
 CLEAR_PULSE = 0.7
 #: How the no-clear-pulse warning ends: what a user who knows the tempo can do.
 KNOWN_TEMPO_HINT = "if you know the tempo, give it with bpm= (--bpm) and only the phase is tracked"

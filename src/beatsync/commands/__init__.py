@@ -2,8 +2,7 @@
 
 Each module defines ``register(subparsers)``, which adds its parser and sets
 ``func=run``; ``run(args)`` checks the options and files (cheapest first, through
-:mod:`beatsync.commands._common`; the music options of the commands that track beats
-in :mod:`beatsync.commands._tempo`), calls the library, and prints a JSON-serialisable
+:mod:`beatsync.commands._common`), calls the library, and prints a JSON-serialisable
 ``dict`` or a human-readable text via :func:`beatsync.commands._common.emit`.
 
 The program imports only the module of the subcommand it runs: ``beatsync --help``

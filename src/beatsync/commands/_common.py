@@ -1,12 +1,10 @@
-"""What every subcommand shares: options, input and output checks, feedback, errors.
+"""What every subcommand shares: options, output checks, feedback, errors.
 
-Outputs are all-or-nothing per command (:class:`Outputs`): every output file is
-declared and checked before any work (a folder, a non-regular file, a read-only file,
-an input file, a missing or unwritable folder, two options naming one file are
-refused), written into a hidden staging folder next to its destination
-(``.beatsync-tmp-*``) and renamed into place only when the whole command succeeded.
-An error, Ctrl-C (SIGINT), SIGTERM or SIGHUP removes the staging folders, so nothing
-is left behind; the files that existed before keep their content.
+Outputs are all-or-nothing per command (:class:`Outputs`): each output is checked
+before any work, written beside its destination under a hidden temporary name
+(``.beatsync-tmp-<token>-<name>``) and renamed into place only when the whole command
+succeeded; an error, Ctrl-C (SIGINT), SIGTERM or SIGHUP removes the temporaries and
+leaves every destination as it was.
 
 Feedback goes to stderr (:class:`Feedback`): a tqdm bar per step a user waits for,
 only when stderr is a terminal, silenced by ``--quiet``; library code receives it as
@@ -33,32 +31,6 @@ from typing import Any, TextIO
 
 from ..errors import ParameterError
 
-__all__ = [
-    "EXIT_OK",
-    "EXIT_FAILED_ITEMS",
-    "EXIT_USAGE",
-    "EXIT_BAD_INPUT",
-    "EXIT_OS_ERROR",
-    "EXIT_INTERNAL",
-    "STAGING_PREFIX",
-    "ProgressCallback",
-    "Interrupted",
-    "Outputs",
-    "Feedback",
-    "add_output_flags",
-    "add_json_flag",
-    "add_period_range",
-    "add_mode",
-    "add_position_options",
-    "position_options",
-    "emit",
-    "feedback",
-    "check_output",
-    "signals_as_exceptions",
-    "interrupted_by",
-    "error_report",
-]
-
 EXIT_OK = 0
 EXIT_FAILED_ITEMS = 1  # ran, but no item done (batch, evaluate) or a checksum failed (data)
 EXIT_USAGE = 2  # argparse: unknown option, missing argument, wrong type
@@ -72,16 +44,10 @@ STAGING_PREFIX = ".beatsync-tmp-"
 ProgressCallback = Callable[..., None]
 """``progress(done, total=None)``: ``done`` of ``total`` units of a step are finished."""
 
-_CAUGHT_SIGNALS = tuple(
-    getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)
-)
-# Signals received while a command runs. The exception a signal raises can be lost
-# (Python code called back from C, e.g. soundfile's writer, swallows it), so the
-# record also stops Outputs.commit and makes the error that follows a report of it.
+_SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+# The signals received while a command runs. The exception a signal raises can be lost
+# (Python code called back from C swallows it): the record still stops the command.
 _RECEIVED: list[int] = []
-# Set when an Outputs transaction was rolled back: the error report can then say that
-# nothing was written (a command that writes incrementally, like evaluate, has none).
-_ROLLED_BACK: list[bool] = []
 
 
 # --------------------------------------------------------------------- options
@@ -101,9 +67,6 @@ def add_output_flags(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="no progress bars or progress lines on stderr (warnings and errors still shown)",
     )
-
-
-add_json_flag = add_output_flags  # the name the subcommands used before --quiet existed
 
 
 def add_mode(parser: argparse.ArgumentParser, *, default: str) -> None:
@@ -130,105 +93,6 @@ def add_period_range(parser: argparse.ArgumentParser) -> None:
         help="shortest and longest motion period searched [s] (default 0.25 1.25, the "
         "paper's range; real dance cycles can be longer)",
     )
-
-
-def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
-    """Print ``result`` as JSON if ``--json`` was given, else ``text``; return exit code 0."""
-    if getattr(args, "json", False):
-        from ..io import to_jsonable
-
-        json.dump(to_jsonable(result), sys.stdout, indent=2, allow_nan=False)
-        sys.stdout.write("\n")
-    else:
-        sys.stdout.write(text.rstrip("\n") + "\n")
-    return EXIT_OK
-
-
-# --------------------------------------------------------------------- outputs
-
-
-def _same_file(a: Path, b: Path) -> bool:
-    if a.resolve() == b.resolve():
-        return True
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
-def _writable_folder(folder: Path) -> bool:
-    return os.access(folder, os.W_OK | os.X_OK)
-
-
-def check_output(
-    path: str | os.PathLike[str],
-    *,
-    option: str = "output",
-    inputs: Iterable[str | os.PathLike[str] | None] = (),
-    suffixes: Iterable[str] | None = None,
-    text: str | None = None,
-) -> Path:
-    """Refuse an output path that cannot be written whole; return it as a ``Path``.
-
-    Refused, in this order: a wrong suffix (if ``suffixes`` are given), the suffix of an
-    audio, video or binary motion file for a text output (``text`` says what the file
-    holds, e.g. ``"beat times"``: writing it would replace such a file with text), an
-    existing folder, an existing file that is not a regular file (a device, a pipe), a
-    read-only file, the same file as one of ``inputs`` (also through links), a missing
-    or unwritable folder; an empty name, and a name ending in a path separator (a
-    folder's name; ``Path`` would drop the separator and write a file). Nothing is
-    touched on disk.
-    """
-    raw = os.fspath(path)
-    p = Path(path)
-    name = f"{option} {str(path)!r}"
-    if not raw:
-        raise ParameterError(f"{option} is an empty name; give a file name")
-    seps = tuple(x for x in (os.sep, os.altsep) if x)
-    ends_in_folder = raw.endswith(seps) or raw.endswith(tuple(s_ + "." for s_ in seps))
-    if ends_in_folder and not p.is_dir():
-        # Path() drops the slash: "out/" would be written as a file named "out"
-        raise ParameterError(
-            f"{name} ends in {raw.rstrip('.')[-1]!r}, which names a folder, but {option} "
-            f"is a file: drop it or add a file name (e.g. {str(p / 'output')!r})"
-        )
-    if suffixes is not None:
-        allowed = tuple(s.lower() for s in suffixes)
-        if p.suffix.lower() not in allowed:
-            raise ParameterError(f"{name} must end in {' or '.join(allowed)}")
-    if text is not None and p.suffix.lower() in _media_suffixes():
-        raise ParameterError(
-            f"{name} ends in {p.suffix}, the suffix of an audio, video or motion file, but "
-            f"{option} writes {text} as text: a mistaken option or argument? choose a text "
-            "file name (e.g. .txt)"
-        )
-    if p.is_dir():
-        example = p / ("output" + (p.suffix or next(iter(suffixes or ()), "")))
-        raise ParameterError(
-            f"{name} is an existing folder; give a file name (e.g. {str(example)!r})"
-        )
-    if p.exists():
-        st = p.stat()
-        if not stat.S_ISREG(st.st_mode):
-            raise ParameterError(f"{name} exists and is not a regular file; choose a file name")
-        if not st.st_mode & 0o222 or not os.access(p, os.W_OK):
-            raise ParameterError(
-                f"{name} is a read-only file; beatsync does not replace read-only files: "
-                "make it writable (chmod u+w) or choose another name"
-            )
-    for inp in inputs:
-        if inp is not None and _same_file(p, Path(inp)):
-            raise ParameterError(
-                f"{name} is the same file as the input {str(inp)!r}; beatsync never overwrites its "
-                "input: choose another output name"
-            )
-    from ..io import check_output_folder
-
-    try:
-        check_output_folder(p)
-    except ParameterError as exc:
-        raise ParameterError(f"{name}: {exc}") from None
-    return p
 
 
 def add_position_options(parser: argparse.ArgumentParser) -> None:
@@ -265,33 +129,186 @@ def position_options(args: argparse.Namespace) -> dict[str, Any]:
     return {"up": args.up, "units": args.units, "max_gap": args.max_gap}
 
 
+def add_music_beat_options(parser: argparse.ArgumentParser) -> None:
+    """``--beats FILE`` (known beat times: no tracking), ``--bpm`` (known tempo) and the
+    tempo range searched (:func:`add_tempo_range`)."""
+    parser.add_argument(
+        "--beats",
+        default=None,
+        metavar="FILE",
+        help="music beat times [s], one per line (first column): skip beat tracking",
+    )
+    parser.add_argument(
+        "--bpm",
+        type=float,
+        default=None,
+        help="known tempo of the music [BPM]: the tracker only finds the phase",
+    )
+    add_tempo_range(parser)
+
+
+def add_tempo_range(parser: argparse.ArgumentParser) -> None:
+    """``--min-bpm`` and ``--max-bpm``: the tempo range the beat tracker searches."""
+    parser.add_argument(
+        "--min-bpm",
+        type=float,
+        default=None,
+        help="slowest tempo the beat tracker considers [BPM] (default 40); with --max-bpm, "
+        "a range that keeps the tracker off a metrical level you know is wrong",
+    )
+    parser.add_argument(
+        "--max-bpm",
+        type=float,
+        default=None,
+        help="fastest tempo the beat tracker considers [BPM] (default 240)",
+    )
+
+
+def tempo_options(args: argparse.Namespace) -> dict[str, float]:
+    """The beat tracker's tempo keywords (``bpm``, ``min_bpm``, ``max_bpm``) from the
+    options, checked before any work and named as options in the errors.
+
+    Raises
+    ------
+    ParameterError
+        ``--beats`` with ``--bpm``, a range given with either (the tempo is then not
+        searched), a tempo outside 20-400 BPM, or ``--min-bpm`` not below ``--max-bpm``.
+    """
+    from ..beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM  # noqa: PLC0415 (numpy)
+    from ..units import check_bpm  # noqa: PLC0415
+
+    beats = getattr(args, "beats", None)
+    if beats is not None and args.bpm is not None:
+        raise ParameterError(
+            "--beats and --bpm conflict: give beat times (--beats FILE) or a tempo (--bpm), "
+            "not both"
+        )
+    bounds = (("--min-bpm", args.min_bpm), ("--max-bpm", args.max_bpm))
+    given = [name for name, value in bounds if value is not None]
+    fixed = "--beats" if beats is not None else "--bpm" if args.bpm is not None else None
+    if given and fixed is not None:
+        raise ParameterError(
+            f"{' and '.join(given)} {'bound' if len(given) == 2 else 'bounds'} the tempo that "
+            f"the beat tracker searches, and {fixed} means that it searches none: give one "
+            "or the other"
+        )
+    if args.bpm is not None:
+        return {"bpm": check_bpm(args.bpm, name="--bpm")}
+    lo = DEFAULT_MIN_BPM if args.min_bpm is None else check_bpm(args.min_bpm, name="--min-bpm")
+    hi = DEFAULT_MAX_BPM if args.max_bpm is None else check_bpm(args.max_bpm, name="--max-bpm")
+    if not lo < hi:
+        raise ParameterError(
+            f"--min-bpm {lo:g} must be smaller than --max-bpm {hi:g}"
+            + ("" if len(given) == 2 else " (the other bound is its default)")
+        )
+    return {"min_bpm": lo, "max_bpm": hi}
+
+
+def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
+    """Print ``result`` as JSON if ``--json`` was given, else ``text``; return exit code 0."""
+    if getattr(args, "json", False):
+        from ..io import to_jsonable
+
+        json.dump(to_jsonable(result), sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        sys.stdout.write(text.rstrip("\n") + "\n")
+    return EXIT_OK
+
+
+# --------------------------------------------------------------------- outputs
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    if a.resolve() == b.resolve():
+        return True
+    try:
+        return os.path.samefile(a, b)  # a hard link
+    except OSError:
+        return False
+
+
+_MEDIA_SUFFIXES = (".mp4", ".bvh", ".mat", ".npy", ".npz", ".c3d")
+
+
+def check_output(
+    path: str | os.PathLike[str],
+    *,
+    option: str = "output",
+    inputs: Iterable[str | os.PathLike[str] | None] = (),
+    suffixes: Iterable[str] | None = None,
+    text: str | None = None,
+) -> Path:
+    """Refuse an output path that cannot be written whole; return it as a ``Path``.
+
+    Refused: an empty name, a name ending in a path separator (``Path`` would drop it
+    and write a file), a wrong suffix (if ``suffixes`` are given), the suffix of an
+    audio, video or binary motion file for a text output (``text`` says what the file
+    holds, e.g. ``"beat times"``), an existing folder, a file that is not a regular
+    file, a read-only file, one of ``inputs`` (also through links), a missing or
+    unwritable folder. Nothing is touched on disk.
+    """
+    from ..io import AUDIO_SUFFIXES, SOUNDFILE_SUFFIXES, check_output_folder
+
+    raw = os.fspath(path)
+    p = Path(path)
+    name = f"{option} {raw!r}"
+    if not raw:
+        raise ParameterError(f"{option} is an empty name; give a file name")
+    seps = tuple(x for x in (os.sep, os.altsep) if x)
+    if raw.endswith((*seps, *(s + "." for s in seps))) and not p.is_dir():
+        raise ParameterError(
+            f"{name} ends in {raw.rstrip('.')[-1]!r}, which names a folder, but {option} "
+            f"is a file: drop it or add a file name (e.g. {str(p / 'output')!r})"
+        )
+    if suffixes is not None:
+        allowed = tuple(s.lower() for s in suffixes)
+        if p.suffix.lower() not in allowed:
+            raise ParameterError(f"{name} must end in {' or '.join(allowed)}")
+    media = {*AUDIO_SUFFIXES, *SOUNDFILE_SUFFIXES, *_MEDIA_SUFFIXES}
+    if text is not None and p.suffix.lower() in media:
+        raise ParameterError(
+            f"{name} ends in {p.suffix}, the suffix of an audio, video or motion file, but "
+            f"{option} writes {text} as text: a mistaken option or argument? choose a text "
+            "file name (e.g. .txt)"
+        )
+    if p.is_dir():
+        example = p / ("output" + (p.suffix or next(iter(suffixes or ()), "")))
+        raise ParameterError(
+            f"{name} is an existing folder; give a file name (e.g. {str(example)!r})"
+        )
+    if p.exists():
+        if not stat.S_ISREG(p.stat().st_mode):
+            raise ParameterError(f"{name} exists and is not a regular file; choose a file name")
+        if not p.stat().st_mode & 0o222 or not os.access(p, os.W_OK):
+            raise ParameterError(
+                f"{name} is a read-only file; beatsync does not replace read-only files: "
+                "make it writable (chmod u+w) or choose another name"
+            )
+    for inp in inputs:
+        if inp is not None and _same_file(p, Path(inp)):
+            raise ParameterError(
+                f"{name} is the same file as the input {str(inp)!r}; beatsync never "
+                "overwrites its input: choose another output name"
+            )
+    try:
+        check_output_folder(p)
+    except ParameterError as exc:
+        raise ParameterError(f"{name}: {exc}") from None
+    return p
+
+
 @contextlib.contextmanager
-def _signals_blocked() -> Iterator[None]:
-    """Hold SIGINT/SIGTERM/SIGHUP until the block ends (renames and clean-up finish)."""
-    sigs = set(_CAUGHT_SIGNALS)
+def _signals_held() -> Iterator[None]:
+    """Hold SIGINT/SIGTERM/SIGHUP until the block ends (renames and reports finish)."""
     if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, sigs)
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
     try:
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
-
-
-def _mkdtemp(folder: Path) -> Path:
-    import tempfile
-
-    return Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=folder))
-
-
-def _media_suffixes() -> frozenset[str]:
-    """Suffixes of the audio, video and binary motion files beatsync reads or writes."""
-    from ..io import AUDIO_SUFFIXES, SOUNDFILE_SUFFIXES
-
-    return frozenset(
-        {*AUDIO_SUFFIXES, *SOUNDFILE_SUFFIXES, ".mp4", ".bvh", ".mat", ".npy", ".npz", ".c3d"}
-    )
 
 
 class Outputs:
@@ -307,38 +324,22 @@ class Outputs:
             io.write_audio(outs.path(click), mix, sr)
         # here both files are in place, or (on any error or signal) neither was touched
 
-    :meth:`add` checks a path at once (:func:`check_output`, and no two outputs may
-    name one file). :meth:`path` gives the file to write instead: same name, in a
-    hidden staging folder ``.beatsync-tmp-*`` created in the destination's folder (so
-    that writers choosing a format by suffix, and temporary files of their own, work
-    unchanged and the final rename stays on one file system). On success the staged
-    files are renamed over their destinations, with signals held until the last rename;
-    on an exception (including KeyboardInterrupt and :class:`Interrupted`) the staging
-    folders are removed with everything in them.
+    :meth:`add` checks a path at once (:func:`check_output`; no two outputs may name
+    one file). :meth:`path` gives the file to write instead: beside the destination,
+    hidden, with the same suffix (writers choose their format by it), named with this
+    command's token. On success each is renamed over its destination (keeping an old
+    file's mode) with signals held; on an exception every file and folder whose name
+    carries the token is removed from the output folders.
     """
 
     def __init__(self, inputs: Iterable[str | os.PathLike[str] | None] = ()):
-        self._inputs: list[Path] = [Path(p) for p in inputs if p is not None]
-        self._declared: dict[Path, tuple[Path, str]] = {}  # resolved -> (path, option)
-        self._folders: dict[Path, str] = {}  # resolved output folders -> option
-        self._staging: dict[Path, Path] = {}  # destination folder -> staging folder
-        self._staged: dict[Path, Path] = {}  # destination -> staged file
-        self.committed: list[Path] = []
+        import secrets
 
-    # declaring -------------------------------------------------------------
-    def add_inputs(self, *paths: str | os.PathLike[str] | None) -> None:
-        """More input files (known only after parsing, e.g. the clips of a folder)."""
-        for p in paths:
-            if p is None:
-                continue
-            q = Path(p)
-            for out, option in self._declared.values():
-                if _same_file(out, q):
-                    raise ParameterError(
-                        f"{option} {str(out)!r} is the same file as the input {str(p)!r}; beatsync "
-                        "never overwrites its input: choose another output name"
-                    )
-            self._inputs.append(q)
+        self._tag = f"{STAGING_PREFIX}{secrets.token_hex(4)}"
+        self._inputs = [Path(p) for p in inputs if p is not None]
+        self._declared: dict[Path, tuple[Path, str]] = {}  # resolved -> (path, option)
+        self._staged: dict[Path, Path] = {}  # resolved destination -> temporary
+        self._folders: set[Path] = set()  # resolved folders that may hold temporaries
 
     def add(
         self,
@@ -357,128 +358,98 @@ class Outputs:
                 f"{option} and {other} both name {str(path)!r}; give each output its own file"
             )
         self._declared[key] = (p, option)
+        self._folders.add(key.parent)
         return p
 
     def add_folder(self, folder: str | os.PathLike[str], *, option: str) -> Path:
-        """Declare an existing, writable folder whose files :meth:`add` will declare."""
+        """Declare an existing, writable folder whose files :meth:`adopt` will declare."""
         d = Path(folder)
-        if not d.exists():
-            raise ParameterError(f"{option} {str(folder)!r} does not exist; create it first")
         if not d.is_dir():
-            raise ParameterError(f"{option} {str(folder)!r} is a file, not a folder")
-        if not _writable_folder(d):
+            why = "is a file, not a folder" if d.exists() else "does not exist; create it first"
+            raise ParameterError(f"{option} {str(folder)!r} {why}")
+        if not os.access(d, os.W_OK | os.X_OK):
             raise ParameterError(f"{option} {str(folder)!r} is not writable")
-        self._folders[d.resolve()] = option
+        self._folders.add(d.resolve())
         return d
 
-    # writing ---------------------------------------------------------------
     def path(self, final: str | os.PathLike[str]) -> Path:
-        """Where to write the declared output ``final`` (a staged file of the same name)."""
-        dest = Path(final)
-        key = dest.resolve()
-        if key not in self._declared:
-            raise RuntimeError(f"output {str(final)!r} was not declared before being written")
-        if key not in self._staged:
-            folder = key.parent
-            if folder not in self._staging:
-                self._staging[folder] = _mkdtemp(folder)
-            self._staged[key] = self._staging[folder] / key.name
-        return self._staged[key]
+        """Where to write the declared output ``final`` (a temporary beside it)."""
+        key = Path(final).resolve()
+        self._declared[key]  # noqa: B018 - a KeyError for an undeclared output (a bug)
+        return self._staged.setdefault(key, key.with_name(f"{self._tag}-{key.name}"))
 
     def staging_folder(self, folder: str | os.PathLike[str]) -> Path:
-        """A staging folder for a folder declared with :meth:`add_folder`.
+        """A temporary folder inside ``folder`` (declared with :meth:`add_folder`) for
+        files named by others (e.g. workers), taken in with :meth:`adopt`."""
+        stage = Path(folder).resolve() / self._tag
+        stage.mkdir(exist_ok=True)
+        return stage
 
-        Files written there are moved into ``folder`` by :meth:`adopt` + commit.
-        """
-        key = Path(folder).resolve()
-        if key not in self._folders:
-            raise RuntimeError(f"output folder {str(folder)!r} was not declared")
-        if key not in self._staging:
-            self._staging[key] = _mkdtemp(key)
-        return self._staging[key]
-
-    def final_path(self, staged: str | os.PathLike[str]) -> Path:
-        """The destination of a file written into a staging folder."""
-        s = Path(staged)
-        for folder, stage in self._staging.items():
-            if s.parent.resolve() == stage.resolve():
-                for dest, (out, _) in self._declared.items():
-                    if dest.parent == folder and dest.name == s.name:
-                        return out
-                return folder / s.name
-        raise RuntimeError(f"{str(staged)!r} is not in a staging folder of this command")
-
-    # finishing -------------------------------------------------------------
-    def commit(self) -> list[Path]:
-        """Rename every staged file into place; return the destinations written."""
-        with _signals_blocked():
-            if interrupted_by() is not None:  # a signal whose exception was swallowed
-                raise Interrupted(interrupted_by())  # type: ignore[arg-type]
-            moves = []
-            for key, staged in self._staged.items():
-                out, option = self._declared[key]
-                if not staged.is_file():
-                    raise RuntimeError(f"{option} {str(out)!r} was declared but not written")
-                check_output(out, option=option, inputs=self._inputs)  # changed meanwhile?
-                moves.append((staged, out))
-            for staged, out in moves:
-                with contextlib.suppress(FileNotFoundError):
-                    os.chmod(staged, out.stat().st_mode & 0o777)  # keep an old file's mode
-                os.replace(staged, out)
-                self.committed.append(out)
-            self._staged.clear()
-            self._remove_staging()
-        return list(self.committed)
-
-    def rollback(self) -> None:
-        """Remove every staged file and staging folder; destinations stay untouched."""
-        with _signals_blocked():
-            self._staged.clear()
-            self._remove_staging()
-            if self._declared:
-                _ROLLED_BACK.append(True)
-
-    def _remove_staging(self) -> None:
-        import shutil
-
-        for stage in self._staging.values():
-            for _ in range(3):  # a child process may still be finishing a file there
-                shutil.rmtree(stage, ignore_errors=True)
-                if not stage.exists():
-                    break
-                time.sleep(0.05)
-        self._staging.clear()
+    def adopt(self, staged: str | os.PathLike[str], *, option: str) -> Path:
+        """Take in a file written under a temporary name (see :meth:`path`) or into a
+        :meth:`staging_folder`: declared under its final name (refused if that is
+        another option's output) and renamed there on success."""
+        s = Path(staged).resolve()
+        folder = s.parent.parent if s.parent.name == self._tag else s.parent
+        dest = folder / s.name.removeprefix(f"{self._tag}-")
+        declared = self._declared.get(dest)
+        p = declared[0] if declared and declared[1] == option else self.add(dest, option=option)
+        self._staged[p.resolve()] = s
+        return p
 
     def forget(self, final: str | os.PathLike[str]) -> None:
-        """Withdraw a declared output (a writer chose another file, see :meth:`adopt`)."""
+        """Withdraw a declared output (a writer chose other files: :meth:`adopt` them)."""
         key = Path(final).resolve()
         self._staged.pop(key, None)
         self._declared.pop(key, None)
 
-    def adopt(self, staged: str | os.PathLike[str], *, option: str) -> Path:
-        """Declare a file found in a staging folder (e.g. named by a worker) and stage it."""
-        s = Path(staged)
-        dest = self.final_path(s)
-        declared = self._declared.get(dest.resolve())
-        # declared by this option: staged as it is; by another: add() refuses it (never
-        # overwritten); not declared yet: declared now
-        mine = declared is not None and declared[1] == option
-        p = dest if mine else self.add(dest, option=option)
-        self._staged[p.resolve()] = s
-        return p
+    def commit(self) -> list[Path]:
+        """Rename every written temporary into place; return the destinations."""
+        with _signals_held():
+            if _RECEIVED:  # a signal whose exception was swallowed
+                raise Interrupted(_RECEIVED[0])
+            done = []
+            for key, tmp in self._staged.items():
+                dest = self._declared[key][0]
+                with contextlib.suppress(FileNotFoundError):
+                    os.chmod(tmp, dest.stat().st_mode & 0o777)  # keep an old file's mode
+                os.replace(tmp, dest)
+                done.append(dest)
+            self._remove_temporaries()
+        return done
+
+    def rollback(self) -> None:
+        """Remove every temporary of this command; destinations stay untouched."""
+        with _signals_held():
+            self._remove_temporaries()
+
+    def _remove_temporaries(self) -> None:
+        import shutil
+
+        for folder in self._folders:
+            for p in folder.glob(f"*{self._tag}*"):  # also a writer's own temporaries
+                if p.is_dir() and not p.is_symlink():
+                    shutil.rmtree(p, ignore_errors=True)
+                else:
+                    p.unlink(missing_ok=True)
 
     def __enter__(self) -> Outputs:
         return self
 
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
-        if exc_type is None:
+        if exc is None:
             try:
                 self.commit()
-            except BaseException:
-                self.rollback()
+                return
+            except BaseException as failed:
+                self._roll_back(failed)
                 raise
-        else:
-            self.rollback()
+        self._roll_back(exc)
+
+    def _roll_back(self, exc: BaseException) -> None:
+        self.rollback()
+        if self._declared:
+            exc.nothing_written = True  # type: ignore[attr-defined]  # said in the report
 
 
 # -------------------------------------------------------------------- feedback
@@ -539,11 +510,8 @@ class Feedback:
             return
         from tqdm import tqdm
 
-        fmt = (
-            "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]"
-            if total
-            else "{desc}: [{elapsed}]"
-        )
+        counted = "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]"
+        fmt = counted if total else "{desc}: [{elapsed}]"
         bar = tqdm(total=total, desc=desc, file=self.stream, leave=False, bar_format=fmt)
         stop = threading.Event()
 
@@ -553,15 +521,11 @@ class Feedback:
 
         ticker = threading.Thread(target=tick, daemon=True)
         ticker.start()
-
         last = [0.0]
 
         def progress(done: float, total: float | None = None) -> None:
             if total is not None and total != bar.total:
-                bar.total = total
-                bar.bar_format = (
-                    "{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]"
-                )
+                bar.total, bar.bar_format = total, counted
             bar.n = done
             now = time.monotonic()
             if now - last[0] >= 0.1 or (bar.total and done >= bar.total):
@@ -598,13 +562,10 @@ class Interrupted(KeyboardInterrupt):
 
 @contextlib.contextmanager
 def signals_as_exceptions() -> Iterator[None]:
-    """Turn SIGINT, SIGTERM and SIGHUP into :class:`Interrupted` while the block runs.
-
-    So ``finally`` blocks and :class:`Outputs` clean up on every one of them, and each
-    signal is recorded (see :func:`interrupted_by`).
-    """
+    """Turn SIGINT, SIGTERM and SIGHUP into :class:`Interrupted` while the block runs
+    (so that ``finally`` blocks and :class:`Outputs` clean up), recording each one
+    (:func:`interrupted_by`)."""
     _RECEIVED.clear()
-    _ROLLED_BACK.clear()
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -613,14 +574,13 @@ def signals_as_exceptions() -> Iterator[None]:
         _RECEIVED.append(signum)
         raise Interrupted(signum)
 
-    old = {s: signal.signal(s, handler) for s in _CAUGHT_SIGNALS}
+    old = {s: signal.signal(s, handler) for s in _SIGNALS}
     try:
         yield
     finally:
         for s, h in old.items():
             signal.signal(s, h)
         _RECEIVED.clear()
-        _ROLLED_BACK.clear()
 
 
 def interrupted_by() -> int | None:
@@ -644,43 +604,43 @@ def error_report(
 
     An error that follows a signal whose exception was lost is reported as the signal.
     """
-    with _signals_blocked():  # a second signal must not cut the report short
-        return _report(exc, command, as_json, sys.stderr if stream is None else stream)
+    stream = sys.stderr if stream is None else stream
+    with _signals_held():  # a second signal must not cut the report short
+        tb = None
+        nothing = "; no output was written" if getattr(exc, "nothing_written", False) else ""
+        if _RECEIVED and not isinstance(exc, KeyboardInterrupt):
+            exc = Interrupted(_RECEIVED[0])  # the error that followed a lost interruption
+        if isinstance(exc, ParameterError):
+            kind, code, msg = "bad-input", EXIT_BAD_INPUT, str(exc)
+        elif isinstance(exc, KeyboardInterrupt):
+            signum = getattr(exc, "signum", signal.SIGINT)
+            kind, code = "interrupted", 128 + int(signum)
+            msg = f"interrupted by {signal.Signals(signum).name}{nothing}"
+        elif isinstance(exc, OSError):
+            kind, code = "os-error", EXIT_OS_ERROR
+            where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
+            msg = f"{exc.strerror or exc}{where}{nothing}"
+        else:
+            import traceback
 
-
-def _report(exc: BaseException, command: str | None, as_json: bool, stream: TextIO) -> int:
-    tb = None
-    nothing = "; no output was written" if _ROLLED_BACK else ""
-    signum = interrupted_by()
-    if signum is not None and not isinstance(exc, KeyboardInterrupt):
-        exc = Interrupted(signum)  # the error that followed a swallowed interruption
-    if isinstance(exc, ParameterError):
-        kind, code, msg = "bad-input", EXIT_BAD_INPUT, str(exc)
-    elif isinstance(exc, KeyboardInterrupt):
-        signum = getattr(exc, "signum", signal.SIGINT)
-        kind, code = "interrupted", 128 + int(signum)
-        msg = f"interrupted by {signal.Signals(signum).name}{nothing}"
-    elif isinstance(exc, OSError):
-        kind, code = "os-error", EXIT_OS_ERROR
-        where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
-        msg = f"{exc.strerror or exc}{where}{nothing}"
-    else:
-        kind, code = "internal", EXIT_INTERNAL
-        msg = (
-            f"internal error {type(exc).__name__}: {exc} (a bug in beatsync; please report "
-            "it with the command line and this message)"
-        )
-        import traceback
-
-        tb = "".join(traceback.format_exception(exc))
-    prefix = f"beatsync {command}" if command else "beatsync"
-    if as_json:
-        obj: dict[str, Any] = {"error": msg, "kind": kind, "command": command, "exit_code": code}
-        if tb is not None:
-            obj["traceback"] = tb
-        print(json.dumps(obj), file=stream, flush=True)
-    else:
-        if tb is not None:
-            stream.write(tb)
-        print(f"{prefix}: error: {msg}", file=stream, flush=True)
-    return code
+            kind, code = "internal", EXIT_INTERNAL
+            msg = (
+                f"internal error {type(exc).__name__}: {exc} (a bug in beatsync; please "
+                "report it with the command line and this message)"
+            )
+            tb = "".join(traceback.format_exception(exc))
+        if as_json:
+            obj: dict[str, Any] = {
+                "error": msg,
+                "kind": kind,
+                "command": command,
+                "exit_code": code,
+            }
+            if tb is not None:
+                obj["traceback"] = tb
+            print(json.dumps(obj), file=stream, flush=True)
+        else:
+            stream.write(tb or "")
+            prefix = f"beatsync {command}" if command else "beatsync"
+            print(f"{prefix}: error: {msg}", file=stream, flush=True)
+        return code

@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import add_json_flag, add_mode, add_period_range, emit
-from ._tempo import add_tempo_range, tempo_options
+from ._common import (
+    add_mode,
+    add_output_flags,
+    add_period_range,
+    add_tempo_range,
+    emit,
+    tempo_options,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -13,7 +19,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "batch",
         help="sync every motion clip with every song, in parallel on Dask",
         description="Track each song's beats once, segment each clip once, then sync every "
-        "(clip, song) pair on a Dask cluster (local by default). Writes "
+        "(clip, song) pair on a Dask cluster (local by default), as `beatsync sync` does with its "
+        "defaults (--mode auto, the dance looped to the song's last beat). Clips or songs "
+        "whose file names repeat (one folder per take) are named by their folder. Writes "
         "OUT_DIR/<clip>__<song> in the clip's own kind of file (.bvh with a skeleton; joint "
         "positions in the input's layout: .json, .npy, .npz, .c3d; else .csv) and a "
         "summary CSV, all at the end (an error or Ctrl-C "
@@ -40,21 +48,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
     add_tempo_range(p)
     add_period_range(p)
-    add_mode(p, default="periods")
+    add_mode(p, default="auto")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument(
         "--workers", type=int, default=None, help="local cluster workers (default: cores)"
     )
     p.add_argument("--summary", default=None, help="summary CSV (default OUT_DIR/summary.csv)")
-    add_json_flag(p)
+    add_output_flags(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
 
     from .. import io
-    from ..batch import output_suffixes, sync_grid
+    from ..batch import item_names, output_suffixes, sync_grid
     from ..cluster import check_cluster_options
     from ..errors import ParameterError
     from ..io import check_input_file
@@ -69,15 +76,17 @@ def run(args: argparse.Namespace) -> int:
     with Outputs(inputs=inputs) as outs:
         out_dir = outs.add_folder(args.out_dir, option="--out-dir")
         summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
-        for c in args.clips:
-            for s in args.songs:
+        clip_names = item_names(args.clips, "clip")
+        song_names = item_names(args.songs, "song")
+        for c, cn in zip(args.clips, clip_names, strict=True):
+            for sn in song_names:
                 for suffix in output_suffixes(c):  # the pair's output, whichever it will be
-                    name = f"{Path(c).stem}__{Path(s).stem}{suffix}"
+                    name = f"{cn}__{sn}{suffix}"
                     pair = check_output(out_dir / name, option="--out-dir", inputs=inputs)
                     if pair.resolve() == summary.resolve():
                         raise ParameterError(
                             f"--summary {str(summary)!r} would be the synchronised "
-                            f"{Path(c).name} x {Path(s).name} in --out-dir; give the "
+                            f"{cn} x {sn} in --out-dir; give the "
                             "summary another name"
                         )
         with feedback(args).step("batch") as progress:

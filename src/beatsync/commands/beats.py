@@ -14,8 +14,7 @@ from typing import Any
 
 from ..errors import ParameterError
 from . import COMMAND_HELP
-from ._common import Outputs, add_output_flags, emit, feedback
-from ._tempo import add_tempo_range, tempo_options
+from ._common import Outputs, add_output_flags, add_tempo_range, emit, feedback, tempo_options
 
 __all__ = ["register", "run"]
 

@@ -23,8 +23,14 @@ import numpy as np
 
 from ..errors import ParameterError
 from . import COMMAND_HELP
-from ._common import Outputs, add_output_flags, emit, feedback
-from ._tempo import add_music_beat_options, tempo_options
+from ._common import (
+    Outputs,
+    add_music_beat_options,
+    add_output_flags,
+    emit,
+    feedback,
+    tempo_options,
+)
 
 __all__ = ["register", "run"]
 

@@ -15,7 +15,7 @@ EXIT_FAILED_ITEMS = 1  # as beatsync.commands._common (not imported: --help stay
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from ..peers import PEERS
+    from ..other_trackers import TRACKERS
 
     p = subparsers.add_parser(
         "evaluate",
@@ -47,7 +47,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     b.add_argument(
         "--method",
         default="psf",
-        choices=list(PEERS),
+        choices=list(TRACKERS),
         help="beat tracker (default psf, ours; essentia-* need pip install 'beatsync[peers]')",
     )
     b.add_argument("--out", required=True, metavar="RESULTS_DIR", help="results folder")
@@ -94,7 +94,7 @@ def run_beats(args: argparse.Namespace) -> int:
 
     import pandas as pd
 
-    from .. import peers
+    from .. import other_trackers
     from ..cluster import check_cluster_options
     from ..errors import ParameterError
     from ..evaluate.beats import EMPTY_REFERENCE_TEXT
@@ -106,7 +106,7 @@ def run_beats(args: argparse.Namespace) -> int:
     # cheapest first: options, then the output folder, then the inputs
     workers = check_cluster_options(args.scheduler, args.workers)
     mbt = check_positive(args.min_beat_time, name="--min-beat-time", unit="s", allow_zero=True)
-    tempo = peers.check_tempo_range(
+    tempo = other_trackers.check_tempo_range(
         args.method, args.min_bpm, args.max_bpm, names=("--min-bpm", "--max-bpm")
     )
     out = Path(args.out)
@@ -123,7 +123,7 @@ def run_beats(args: argparse.Namespace) -> int:
                 "files that evaluate beats did not write, which it would replace; choose "
                 "another folder, or remove them"
             )
-    peers.get(args.method)
+    other_trackers.get(args.method)
     found = find_tracks(args.audio, args.annotations)
     if found.unmatched:
         fb.warn(
@@ -172,7 +172,7 @@ def run_beats(args: argparse.Namespace) -> int:
     t = run.tracks
     failed = t[t["status"] != "ok"]
     warned = t["warning"].fillna("").astype(str) if "warning" in t else pd.Series("", t.index)
-    outside = t[(t["status"] == "ok") & warned.str.contains(peers.OUT_OF_RANGE_TEXT)]
+    outside = t[(t["status"] == "ok") & warned.str.contains(other_trackers.OUT_OF_RANGE_TEXT)]
     empty_ref = t[(t["status"] == "ok") & warned.str.contains(EMPTY_REFERENCE_TEXT)]
     result = {
         "method": args.method,

@@ -28,13 +28,14 @@ from ._common import (
     Feedback,
     Outputs,
     add_mode,
+    add_music_beat_options,
     add_output_flags,
     add_position_options,
     emit,
     feedback,
     position_options,
+    tempo_options,
 )
-from ._tempo import add_music_beat_options, tempo_options
 
 __all__ = ["register", "run"]
 
@@ -88,8 +89,9 @@ def register(subparsers: Any) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="music beats per motion period, or per motion beat with --mode beats "
-        "(default: round(motion period / beat), respecting the meters)",
+        help="music beats per motion period, or per median motion beat with --mode beats "
+        "(default: periods round(motion period / beat), respecting the meters; motion "
+        "beats: chosen for the whole dance within the playback speed band)",
     )
     p.add_argument(
         "--first-beat",
@@ -133,8 +135,9 @@ def register(subparsers: Any) -> None:
         default=None,
         metavar="N",
         help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
-        "a waltz box); beats per period are then a multiple of it, and a warning says so "
-        "when the song's meter does not fit",
+        "a waltz box); with periods, beats per period are then a multiple of it (a warning "
+        "says so when the song's meter does not fit); with motion beats, every N motion "
+        "beats start on a bar line of the song where the speed allows",
     )
     p.add_argument(
         "--period-range",
@@ -391,11 +394,17 @@ def _text(result: dict[str, Any]) -> str:
         + (" (auto: periodic)" if r["mode_requested"] == "auto" and not r["mode_note"] else "")
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
         f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "
-        f"{r['beats_per_period']} beat(s) per {unit[:-1]} ({r['beats_per_period_rule']})"
-        f"{meter}, first on beat {r['first_beat']}"
+        f"first on beat {r['first_beat']}"
         + (f", {r['phase_offset_s'] * 1000:+.0f} ms after it" if r["phase_offset_s"] else ""),
-        f"tempo    playback speed x{r['tempo_ratio_range'][0]:.3f} .. "
-        f"x{r['tempo_ratio_range'][1]:.3f}",
+        f"beats    per {unit[:-1]} used: {_counts_text(r['beats_per_motion_beat_used'])} "
+        f"({r['beats_per_period_rule']}){meter}"
+        + (
+            f"; {r['n_merged_intervals']} merged with a neighbour"
+            if r["n_merged_intervals"]
+            else ""
+        )
+        + (f"; {r['n_half_beat_landings']} on a half beat" if r["n_half_beat_landings"] else ""),
+        *_speed_lines(r),
         f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
         f"({r['output_duration_s']:.2f} s)",
         f"residual warp max {res.max():.3f} ms; nearest frame max {near.max():.2f} ms "
@@ -404,3 +413,58 @@ def _text(result: dict[str, Any]) -> str:
     for k, v in result["outputs"].items():
         lines.append(f"wrote    {k}: {v}")
     return "\n".join(lines)
+
+
+def _placement_notes(r: dict[str, Any]) -> str:
+    """Where no whole number of beats fitted: merges and half-beat landings."""
+    out = ""
+    if r["n_merged_intervals"]:
+        out += f"; {r['n_merged_intervals']} merged with a neighbour"
+    if r["n_half_beat_landings"]:
+        out += f"; {r['n_half_beat_landings']} landing on a half beat"
+    if r.get("phrases_on_bars") is not None:
+        out += f"; {r['phrases_on_bars']:.0%} of the dance bars start on a bar line"
+    return out
+
+
+def _counts_text(used: dict[str, int]) -> str:
+    """``{"1": 6, "2": 8}`` as ``1 x6, 2 x8``."""
+    return ", ".join(f"{k} x{v}" for k, v in sorted(used.items(), key=lambda kv: float(kv[0])))
+
+
+def _speed_lines(r: dict[str, Any]) -> list[str]:
+    """Playback speed, joint kinematics and the loop joins, as measured on the output."""
+    sp = r["playback_speed"]
+    lo, hi = sp["band"]
+    lines = []
+    for what, key in (("instant.", "instantaneous"), ("interval", "per_interval")):
+        x = sp[key]
+        if x is not None:
+            lines.append(
+                f"speed    {what} x{x['min']:.2f} .. x{x['median']:.2f} (median) .. "
+                f"x{x['max']:.2f}; {x['in_band']:.0%} of the output within x{lo:g}-x{hi:g}"
+            )
+    k = r.get("kinematics")
+    if k is not None:
+        i, o = k["input"], k["output"]
+        lines.append(
+            f"joints   p99 speed {o['p99_joint_speed']:.2f} (input {i['p99_joint_speed']:.2f}), "
+            f"p99 acceleration {o['p99_joint_accel']:.1f} (input {i['p99_joint_accel']:.1f}), "
+            f"peak speed {o['peak_joint_speed']:.2f} (input {i['peak_joint_speed']:.2f}) "
+            "[position unit/s, /s^2]"
+        )
+    if r.get("loop"):
+        lp = r["loop"]
+        joins = ", ".join(
+            f"{j['time_s']:.1f} s"
+            + (f" (peak {j['peak_joint_speed']:.2f})" if "peak_joint_speed" in j else "")
+            for j in r["joins"]
+        )
+        lines.append(
+            f"loop     clip {lp['start_s']:.2f}-{lp['end_s']:.2f} s repeated, turned "
+            f"{lp['turn_deg']:+.0f} deg per pass, blended over {lp['blend_s']:.1f} s; joins at "
+            f"{joins or 'none inside the song'}"
+        )
+    if r.get("speed_warning"):
+        lines.append(f"warning  {r['speed_warning']}")
+    return lines

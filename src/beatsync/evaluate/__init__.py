@@ -18,11 +18,10 @@ from .alignment import (
     offset_control,
     sync_residuals,
 )
-from .beats import METRICS, evaluate_beats, octave_relation, tempo_octave
+from .beats import METRICS, octave_relation, tempo_octave
 from .segmentation import boundary_errors
 
 __all__ = [
-    "evaluate_beats",
     "octave_relation",
     "tempo_octave",
     "METRICS",

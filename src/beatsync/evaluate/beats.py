@@ -8,13 +8,14 @@ increasing and >= 0. :func:`validate` checks both and diagnoses the usual mistak
 explicit: mir_eval's default (5 s) silently drops the first 5 s, which is most of a
 short clip.
 
-Every metric takes ``(reference, estimated)`` already trimmed; :func:`evaluate`
-validates, trims and returns all of them (:data:`METRICS`): F-measure, Cemgil (and
-its max-over-variants form), Goto, P-score, CMLc, CMLt, AMLc, AMLt and information
-gain. :func:`tempo_octave` names the metrical relation of the estimated tempo to the
+:func:`evaluate` validates both sequences and returns every metric of
+:func:`mir_eval.beat.evaluate` (:data:`METRICS`): F-measure, Cemgil (and its
+max-over-variants form), Goto, P-score, CMLc, CMLt, AMLc, AMLt and information gain.
+:func:`tempo_octave` names the metrical relation of the estimated tempo to the
 reference (correct, double, half, triple, third, other).
 
-This module never runs a tracker: :mod:`beatsync.study.beat_evaluation` does that.
+This module never runs a tracker: :mod:`beatsync.study` does (test items in
+:mod:`~beatsync.study.paper_a_beats`, datasets of files in :mod:`~beatsync.study.beat_dataset`).
 
 Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
 """
@@ -34,21 +35,13 @@ __all__ = [
     "validate",
     "diagnose_times",
     "not_seconds_detail",
-    "f_measure",
-    "cemgil",
-    "goto",
-    "p_score",
-    "continuity",
-    "information_gain",
     "evaluate",
-    "evaluate_beats",
     "median_tempo",
     "octave_relation",
     "tempo_octave",
     "count_octave_errors",
     "count_other_tempo",
     "METRICS",
-    "TABLE_METRICS",
     "OCTAVE_ERRORS",
     "MAX_BEAT_INTERVAL",
 ]
@@ -59,17 +52,9 @@ __all__ = [
 MAX_BEAT_INTERVAL = 60.0 / MIN_BPM
 
 #: mir_eval's limit on beat times [s] (``mir_eval.beat.MAX_TIME``; its scores refuse a
-#: later beat), copied so that reading an annotation does not import mir_eval: with
-#: scipy.stats, that took 1.6 s of ``evaluate beats``' start-up in the process that
-#: only hands the tracks to its workers.
+#: later beat), copied so that reading an annotation does not import mir_eval (with
+#: scipy.stats, slow to import in a process that only hands tracks to its workers).
 MIR_EVAL_MAX_TIME = 30000.0
-
-
-def _mir_beat():
-    """:mod:`mir_eval.beat`, imported where scores are computed (see above)."""
-    import mir_eval.beat  # noqa: PLC0415
-
-    return mir_eval.beat
 
 
 #: Keys of the dict returned by :func:`evaluate`.
@@ -82,16 +67,6 @@ METRICS = (
     "Correct Metric Level Continuous",
     "Correct Metric Level Total",
     "Any Metric Level Continuous",
-    "Any Metric Level Total",
-    "Information gain",
-)
-
-#: Metrics shown in the study tables (``notebooks/paper_a_sec4_beat_tracking.ipynb``).
-TABLE_METRICS = (
-    "F-measure",
-    "Cemgil",
-    "P-score",
-    "Correct Metric Level Total",
     "Any Metric Level Total",
     "Information gain",
 )
@@ -176,44 +151,13 @@ def _check(beats: Any, name: str) -> np.ndarray:
     return arr
 
 
-def f_measure(reference: np.ndarray, estimated: np.ndarray) -> float:
-    """F-measure with a +-70 ms window (:func:`mir_eval.beat.f_measure`)."""
-    return float(_mir_beat().f_measure(reference, estimated))
-
-
-def cemgil(reference: np.ndarray, estimated: np.ndarray) -> tuple[float, float]:
-    """Cemgil accuracy and its best over metrical variants (:func:`mir_eval.beat.cemgil`)."""
-    a, b = _mir_beat().cemgil(reference, estimated)
-    return float(a), float(b)
-
-
-def goto(reference: np.ndarray, estimated: np.ndarray) -> float:
-    """Goto's binary accuracy (:func:`mir_eval.beat.goto`)."""
-    return float(_mir_beat().goto(reference, estimated))
-
-
-def p_score(reference: np.ndarray, estimated: np.ndarray) -> float:
-    """McKinney's P-score (:func:`mir_eval.beat.p_score`)."""
-    return float(_mir_beat().p_score(reference, estimated))
-
-
-def continuity(reference: np.ndarray, estimated: np.ndarray) -> tuple[float, ...]:
-    """CMLc, CMLt, AMLc, AMLt (:func:`mir_eval.beat.continuity`)."""
-    return tuple(float(v) for v in _mir_beat().continuity(reference, estimated))
-
-
-def information_gain(reference: np.ndarray, estimated: np.ndarray) -> float:
-    """Normalised information gain (:func:`mir_eval.beat.information_gain`)."""
-    return float(_mir_beat().information_gain(reference, estimated))
-
-
 def evaluate(
     reference: Any,
     estimated: Any,
     *,
     min_beat_time: float,
 ) -> dict[str, float]:
-    """All mir_eval.beat metrics of an estimate against a reference.
+    """Every metric of :func:`mir_eval.beat.evaluate`, on validated beat times.
 
     Parameters
     ----------
@@ -247,29 +191,20 @@ def evaluate(
     >>> evaluate(ref, ref, min_beat_time=0.0)["F-measure"]
     1.0
     """
+    import mir_eval.beat  # here, not at the top: see MIR_EVAL_MAX_TIME
+
     mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
     ref, est = validate(reference, estimated)
-    ref = _mir_beat().trim_beats(ref, min_beat_time=mbt)
-    est = _mir_beat().trim_beats(est, min_beat_time=mbt)
+    ref = mir_eval.beat.trim_beats(ref, min_beat_time=mbt)
+    est = mir_eval.beat.trim_beats(est, min_beat_time=mbt)
     if ref.size == 0 or est.size == 0:
         which = EMPTY_REFERENCE_TEXT if ref.size == 0 else "the estimated beats are empty"
         warn(f"{which} after min_beat_time={mbt:g} s: every score is 0", stacklevel=2)
         return {k: 0.0 for k in METRICS}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # mir_eval warns about what we have checked
-        values = (
-            f_measure(ref, est),
-            *cemgil(ref, est),
-            goto(ref, est),
-            p_score(ref, est),
-            *continuity(ref, est),
-            information_gain(ref, est),
-        )
-    return dict(zip(METRICS, values, strict=True))
-
-
-#: The name used before the mir_eval-style :func:`evaluate` (same function).
-evaluate_beats = evaluate
+        scores = mir_eval.beat.evaluate(ref, est, min_beat_time=mbt)
+    return {k: float(scores[k]) for k in METRICS}
 
 
 def median_tempo(beats: Any) -> float:

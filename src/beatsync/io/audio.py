@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import sys
 import tempfile
 import threading
@@ -11,7 +12,7 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 from types import MappingProxyType
-from typing import Literal
+from typing import Any
 
 import numpy as np
 
@@ -75,9 +76,11 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     try:
         # libmpg123 prints its own warnings to the process's stderr ("Xing stream size
         # off by more than 1%"): kept apart, then said once the read is judged
-        with _c_stderr_captured(p.suffix.lower() == ".mp3") as decoder, sf.SoundFile(p) as f:
-            announced, file_sr = f.frames, f.samplerate
-            data = f.read(dtype="float32", always_2d=True)
+        with _c_stderr_captured(p.suffix.lower() == ".mp3") as decoder:
+            with sf.SoundFile(p) as f:
+                file_sr = f.samplerate
+                data = f.read(dtype="float32", always_2d=True)
+            info = sf.info(str(p))
         y = data.mean(axis=1)
     except Exception as sf_exc:
         if SOUNDFILE_SUFFIXES.get(p.suffix.lower()) in sf.available_formats():
@@ -103,7 +106,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
                 "is it a WAV/FLAC/OGG/MP3 file?"
             ) from None
     else:
-        _check_complete(p, announced, y.size, file_sr)  # its own words if cut short
+        _check_complete(p, info, y.size, file_sr)  # its own words if cut short
         if decoder:
             warn(
                 f"the MP3 decoder (libmpg123) reported on {str(p)!r}: "
@@ -180,39 +183,40 @@ def _c_stderr_captured(active: bool = True) -> Iterator[list[str]]:
             lines.extend(line.strip() for line in text.splitlines() if line.strip())
 
 
-def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
+def _check_complete(p: Path, info: Any, n_read: int, rate: float) -> None:
     """Refuse a file cut short: fewer samples than its header announces.
 
-    libsndfile reads what is there without a word: it trims the length of a WAV, RF64,
-    W64, AIFF or AU file to the bytes present, decodes an MP3 until its data ends, and
-    an Ogg stream until its last page. For the first five, the bytes the header
-    announces for the audio are compared with the bytes present (:func:`_data_bytes`;
-    not when the size says "unknown"); an Ogg file must end with its stream's last
-    page (:func:`_ogg_is_cut`); for other formats, libsndfile's announced count is
-    compared with the samples read (for an MP3 only with a Xing, Info or VBRI header).
+    ``info`` is ``soundfile.info(p)``. libsndfile reads what is there without a word:
+    for a WAV, RF64, W64, AIFF or AU file it trims the length to the bytes present and
+    notes each size the header declares beyond them in its log (``data : 661500
+    (should be 165342)``); an MP3's declared length (from its Xing, Info or VBRI
+    header) is ``info.frames``; an Ogg stream it decodes until its last complete page
+    (:func:`_ogg_is_cut`).
     """
-    if (sizes := _data_bytes(p)) is not False:
-        # libsndfile's count is already trimmed to the bytes present: compare the bytes
-        # the header announces with those there (no frame size needed; a wrong block
-        # alignment in the header does not matter)
-        if sizes is None or sizes[1] <= 0:
-            return  # data size unknown (streamed) or a header this walk cannot follow
-        declared, present = sizes
-        announced = int(round(n_read * declared / present)) if declared > present else n_read
-    elif p.suffix.lower() == ".mp3" and not _mp3_has_length_header(p):
-        # without a Xing/Info/VBRI header libsndfile guesses the length of a VBR file
+    announced = int(info.frames)
+    missing = [
+        int(declared) - int(present)
+        for declared, present in _SHOULD_BE.findall(info.extra_info)
+        if not _unknown_size(int(declared))
+    ]
+    if missing and max(missing) > 0:
+        if info.subtype in _SAMPLE_BYTES:
+            frame_bytes = _SAMPLE_BYTES[info.subtype] * info.channels
+        else:  # a compressed subtype: its mean frame size
+            frame_bytes = p.stat().st_size / max(n_read, 1)
+        announced = n_read + int(max(missing) // frame_bytes)
+    if p.suffix.lower() == ".mp3" and not _mp3_has_length_header(p):
+        # without a Xing/Info/VBRI header libmpg123 guesses the length of a VBR file
         # from its first frame's bit rate (a quiet intro: a guess too long)
-        return
-    elif _ogg_is_cut(p):
+        announced = n_read
+    if _ogg_is_cut(p):
         raise ParameterError(
             f"audio file {str(p)!r} is cut short: its Ogg stream stops without its last "
             f"page (read {n_read / rate:.3f} s); an interrupted copy or download? Copy "
             "the file again"
         )
-    missing = announced - n_read
-    if rate <= 0 or missing <= 0:
-        return
-    if missing > SHORT_FILE_FRACTION * announced and missing >= SHORT_FILE_MIN_S * rate:
+    short = announced - n_read
+    if short > SHORT_FILE_FRACTION * announced and short >= SHORT_FILE_MIN_S * rate:
         raise ParameterError(
             f"audio file {str(p)!r} is cut short: its header announces "
             f"{announced / rate:.3f} s ({announced} samples at {rate:g} Hz) but it holds "
@@ -220,112 +224,34 @@ def _check_complete(p: Path, announced: int, n_read: int, rate: float) -> None:
         )
 
 
-#: 32-bit data sizes that mean "unknown" rather than a length.
-_UNKNOWN_DATA_SIZES = (0, 0x7FFFF000, 0x7FFFFFFF, 0xFFFFFFFF)
+#: libsndfile's log line for a chunk size a header declares beyond the bytes present.
+_SHOULD_BE = re.compile(
+    r"^\s*(?:RIFF|riff|Riff size|FORM|SSND|data|Data Size)\s*:\s*(\d+) \(should be (\d+)\)",
+    re.MULTILINE,
+)
 
-#: 64-bit data sizes from here up mean "unknown" (writers that could not seek back put
-#: 0x7FFF...FF or 0xFFFF...FF; ffmpeg writing W64 to a pipe, the former).
-_UNKNOWN_64 = 2**62
+#: Bytes per sample of libsndfile's uncompressed subtypes.
+_SAMPLE_BYTES = {"PCM_S8": 1, "PCM_U8": 1, "ULAW": 1, "ALAW": 1, "PCM_16": 2, "PCM_24": 3}
+_SAMPLE_BYTES.update({"PCM_32": 4, "FLOAT": 4, "DOUBLE": 8})
 
-#: The audio bytes SoX announces in an AIFF(-C) written to a pipe: 0x7F000000 rounded
-#: down to whole frames (never filled in).
-_SOX_AIFF_PIPE = 0x7F000000
 
-#: The first sixteen bytes of a Sony Wave64 file: the GUID of its "riff" chunk.
-_W64_RIFF = b"riff\x2e\x91\xcf\x11\xa5\xd6\x28\xdb\x04\xc1\x00\x00"
+def _unknown_size(size: int) -> bool:
+    """Whether a declared size is a placeholder for "unknown" rather than a length: 0,
+    or what writers that cannot seek back leave (0xFFFFFFFF; SoX to a pipe 0x7FFFF000
+    in a WAV, 0x7F000000 in an AIFF; 0x7FFF...FF in a 64-bit size)."""
+    return size == 0 or 0x7F000000 <= size < 0x80000000 or size == 0xFFFFFFFF or size >= 2**62
 
 
 def _mp3_has_length_header(p: Path) -> bool:
     """Whether an MP3's first frame carries a Xing, Info or VBRI header (a frame count)."""
-    try:
-        with open(p, "rb") as f:
-            head = f.read(10)
-            start = 0
-            if head[:3] == b"ID3" and len(head) == 10:  # skip an ID3v2 tag (syncsafe size)
-                size = 0
-                for byte in head[6:10]:
-                    size = (size << 7) | (byte & 0x7F)
-                start = 10 + size
-            f.seek(start)
-            frame = f.read(4096)
-    except OSError:
-        return False
+    with open(p, "rb") as f:
+        head = f.read(10)
+        if head[:3] == b"ID3" and len(head) == 10:  # skip an ID3v2 tag (syncsafe size)
+            f.seek(10 + sum((b & 0x7F) << (7 * (3 - i)) for i, b in enumerate(head[6:10])))
+        else:
+            f.seek(0)
+        frame = f.read(4096)
     return any(tag in frame for tag in (b"Xing", b"Info", b"VBRI"))
-
-
-def _data_bytes(p: Path) -> tuple[int, int] | None | Literal[False]:
-    """The bytes of audio a WAV, RF64, W64, AIFF(-C) or AU header announces, and the
-    bytes present after the header, by the magic bytes; None for one of these with an
-    unknown size or a header this walk does not understand; False for other formats."""
-    import struct
-
-    try:
-        size_on_disk = p.stat().st_size
-        with open(p, "rb") as f:
-            head = f.read(40)
-            if head[:4] == b"RIFF" and head[8:12] == b"WAVE":
-                return _known(_walk_chunks(f, 12, size_on_disk, "<I", b"data"))
-            if head[:4] == b"RF64" and head[8:12] == b"WAVE":
-                # the sizes are 64-bit, in the ds64 chunk that comes first
-                if head[12:16] != b"ds64" or len(head) < 36:
-                    return None
-                declared = struct.unpack("<Q", head[28:36])[0]
-                found = _walk_chunks(f, 12, size_on_disk, "<I", b"data")
-                if not found or not declared or declared >= _UNKNOWN_64:
-                    return None
-                return declared, found[1]
-            if head[:4] == b"FORM" and head[8:12] in (b"AIFF", b"AIFC"):
-                sizes = _known(_walk_chunks(f, 12, size_on_disk, ">I", b"SSND"))
-                if sizes is None or _SOX_AIFF_PIPE - 256 < sizes[0] - 8 <= _SOX_AIFF_PIPE:
-                    return None
-                # the chunk's size counts its 8-byte offset and block size
-                return sizes[0] - 8, sizes[1] - 8
-            if head[:16] == _W64_RIFF and len(head) == 40 and head[24:28] == b"wave":
-                f.seek(40)
-                for _ in range(64):
-                    chunk = f.read(24)
-                    if len(chunk) < 24:
-                        return None
-                    size = struct.unpack("<Q", chunk[16:24])[0]  # counts the 24-byte header
-                    if chunk[:4] == b"data":
-                        if size <= 24 or size >= _UNKNOWN_64:
-                            return None
-                        return size - 24, size_on_disk - f.tell()
-                    if size < 24 or size > size_on_disk:
-                        return None
-                    f.seek(size - 24 + (-size) % 8, os.SEEK_CUR)
-                return None
-            if head[:4] == b".snd" and len(head) >= 12:
-                offset, size = struct.unpack(">II", head[4:12])
-                if size in _UNKNOWN_DATA_SIZES or offset < 24:
-                    return None
-                return size, size_on_disk - offset
-    except (OSError, ValueError, OverflowError):  # a seek past what an offset can hold
-        return None
-    return False
-
-
-def _walk_chunks(f, start: int, size_on_disk: int, fmt: str, target: bytes):
-    """Follow 4-byte-ID chunks from ``start`` to ``target``: (its announced size, the
-    bytes present after its header), or None (not found)."""
-    import struct
-
-    f.seek(start)
-    for _ in range(64):  # chunks before the data: fmt, fact, LIST, COMM, ...
-        chunk = f.read(8)
-        if len(chunk) < 8:
-            return None
-        cid, size = chunk[:4], struct.unpack(fmt, chunk[4:])[0]
-        if cid == target:
-            return size, size_on_disk - f.tell()
-        f.seek(size + size % 2, os.SEEK_CUR)
-    return None
-
-
-def _known(sizes: tuple[int, int] | None) -> tuple[int, int] | None:
-    # the sizes writers put when they cannot seek back to fill the real one in (0,
-    # 0xFFFFFFFF; SoX writes 0x7FFFF000 to a pipe) say nothing about the length
-    return None if sizes is None or sizes[0] in _UNKNOWN_DATA_SIZES else sizes
 
 
 #: Longest Ogg page [bytes]: a 27-byte header, 255 lacing values of up to 255 each.
@@ -336,16 +262,11 @@ def _ogg_is_cut(p: Path) -> bool:
     """Whether an Ogg file stops inside a page, or after a page that does not end its
     stream (no end-of-stream flag): a download cut short. False for other files and
     for an Ogg file whose last page cannot be found (nothing is claimed then)."""
-    try:
-        size_on_disk = p.stat().st_size
-        with open(p, "rb") as f:
-            if f.read(4) != b"OggS":
-                return False
-            start = max(0, size_on_disk - _OGG_MAX_PAGE)
-            f.seek(start)
-            tail = f.read()
-    except OSError:
-        return False
+    with open(p, "rb") as f:
+        if f.read(4) != b"OggS":
+            return False
+        f.seek(max(0, p.stat().st_size - _OGG_MAX_PAGE))
+        tail = f.read()
     at = len(tail)
     while (at := tail.rfind(b"OggS", 0, at)) >= 0:
         header = tail[at : at + 27]

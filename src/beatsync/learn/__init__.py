@@ -44,7 +44,8 @@ class Verdict:
 
     def _repr_html_(self) -> str:
         colour = "#1a7f37" if self.right else "#b35900"
-        return f'<p style="color:{colour}"><b>{"&#10003;" if self.right else "&#10007;"}</b> {self}</p>'
+        mark = "&#10003;" if self.right else "&#10007;"
+        return f'<p style="color:{colour}"><b>{mark}</b> {self}</p>'
 
 
 def exercise(name: str) -> Callable[[Callable[[Any], str | None]], Callable[[Any], str | None]]:

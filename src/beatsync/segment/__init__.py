@@ -80,18 +80,17 @@ Documented rules (choices the paper leaves open)
   of the music). A range wider than a factor 5 is searched in tiers of a factor 5,
   shortest first (:func:`.period.period_tiers`); the first tier whose optimum passes
   the periodicity test gives the period, the shortest repeating cycle (otherwise the
-  energy estimate prefers multiples of a step: CMU salsa 61_04 searched over
-  0.25-6 s at once gave 2.9 s, three steps). The wide range is not the default
-  because the periodicity test accepts the CMU 005_02 pirouette in the long tier
-  (4 x 1.66 s). Long periods stay within memory through the decimated search.
+  energy estimate prefers multiples of a step: a salsa clip searched over the whole
+  range at once comes out as three steps). The wide range is not the default because
+  the periodicity test accepts a non-periodic pirouette in the long tier. Long
+  periods stay within memory through the decimated search.
 - Clip length: a clip shorter than ``MIN_CLIP_PERIODS`` (3) of the shortest period
   of the range is refused first. With the count estimated, a clip shorter than 3 of
   its own estimated period (the optimum then has a single pair of consecutive periods)
   is accepted only if that pair is clearly alike, mean Pearson distance below
   ``SHORT_CLIP_MAX_ENERGY`` (0.5, i.e. mean r above 0.5), else refused as too short.
-  Calibration: the CMU walks 007_* (2.4-2.5 gait cycles) have 0.03-0.08 and are
-  segmented; a 1 s salsa excerpt (period ~1 s) estimated at 0.45 s had 0.95 and used
-  to be cut into two "periods". The period is estimated among periods that fit twice
+  Set between short real walks and a short salsa excerpt at a wrong period
+  (docs/tuning.md#short-clips). The period is estimated among periods that fit twice
   in the clip. With the count given (``n_periods >= 2``) the caller vouches for it.
 - Periodicity: a clip is refused as not periodic when the optimum's mean Pearson
   distance per channel and pair, ``E / (n_channels * (p - 1))``, reaches
@@ -99,14 +98,9 @@ Documented rules (choices the paper leaves open)
   when its periodicity contrast (:func:`periodicity_contrast`: how much better the
   uniform segmentation at the found period is than uniform segmentations at 0.5,
   0.75, 1.25 and 1.5 times it) is below ``MIN_PERIODICITY_CONTRAST`` (0.05).
-  Calibration (default channels, both period methods): CMU salsa 60_01/61_01/60_04/
-  61_04 0.053-0.16, CMU walks 007_* 1.06-1.27, MoCap Toolbox dance1/dance2/walk1/walk2
-  0.14-0.90; the CMU 005_02 pirouette -0.16 and -0.12; white noise (4 or 29 channels,
-  16 trials) <= 0.04. Known limits: the margin is small (salsa 61_04 with the FFT
-  period: 0.053), and a random walk (integrated noise) passed in 7 of 16 trials.
-  Re-measured on 750 frames at 25 fps, seeds 1000-1015, default range: white noise
-  accepted in 2 of 16 trials with 4 channels and 0 of 16 with 29; a random walk in 1
-  of 16 with 4 channels and 0 of 16 with 29.
+  Set between real periodic dances and walks on one side and a pirouette and white
+  noise on the other; the margin to real salsa is small, and integrated noise
+  (a random walk) can pass (docs/tuning.md#periodicity-check-of-the-segmentation).
 - Free ends: real clips do not start or end on a period boundary, so the first
   boundary may lie anywhere in the lead-in ``t_0 < lo`` and the last in the tail
   ``t_p >= n - lo`` (``lo``: shortest allowed period); the band of eq. 3 is rounded

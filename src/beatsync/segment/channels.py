@@ -88,8 +88,8 @@ def select_channels(
     channels : "default", "all" or sequence of str
         ``"default"``: rotation channels of the main limb and spine joints (CMU:
         abdomen chest neck rShldr rForeArm lShldr lForeArm rThigh rShin rFoot lThigh
-        lShin lFoot; iClone: CC_Base_Waist/Spine01/Spine02/*_Upperarm/*_Forearm/
-        *_Thigh/*_Calf/*_Foot; no twist bones, hands, toes, face, nor the root's
+        lShin lFoot; iClone: ``CC_Base_Waist/Spine01/Spine02/*_Upperarm/*_Forearm/``
+        ``*_Thigh/*_Calf/*_Foot``; no twist bones, hands, toes, face, nor the root's
         global orientation), plus every ``*_angle`` channel (marker-derived angles).
         If nothing matches, all channels are used with a :class:`BeatsyncWarning`.
         ``"all"``: every channel (constant ones are dropped later). A sequence: exactly

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import as_float, as_float_array, as_int, check_finite, check_range
+from ..units import as_float, as_float_array, as_int, check_finite, check_interval
 from .period import PERIOD_METHODS
 
 __all__ = [
@@ -48,13 +48,7 @@ def check_alpha(alpha: Any) -> float:
 
 def check_period_range(period_range: Any) -> tuple[float, float]:
     """Shortest and longest period [s]: two finite numbers, ``0 < lo < hi``."""
-    try:
-        lo, hi = period_range
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"period_range={period_range!r} must be two numbers (shortest, longest) [s]"
-        ) from None
-    return check_range(lo, hi, name="period_range", unit="s")
+    return check_interval(period_range, name="period_range", unit="s")
 
 
 def check_n_periods(n_periods: Any) -> int | None:

@@ -27,10 +27,10 @@ from ..errors import NotPeriodicError, ParameterError
 from ..units import (
     MAX_BPM,
     MIN_BPM,
-    check_between,
+    as_float,
     check_finite,
     check_fps,
-    check_range,
+    check_interval,
     frames_to_time,
     time_to_frames,
 )
@@ -76,8 +76,7 @@ The paper's range: dance steps and gait cycles. Longer cycles (dance figures: a
 waltz box of 6 beats lasts about 4 s) need a wider range, :data:`DANCE_PERIOD_RANGE`
 or :func:`period_range_from_beat` when the music is known. It is not the default
 because the periodicity test cannot yet tell a long figure from a non-periodic motion:
-with :data:`DANCE_PERIOD_RANGE`, the CMU 005_02 pirouette is accepted as 4 periods
-of 1.66 s (periodicity contrast 0.20, in the range of real figures, 0.14-0.26)."""
+with :data:`DANCE_PERIOD_RANGE`, the CMU 005_02 pirouette is accepted as periodic."""
 
 DANCE_PERIOD_RANGE = (0.25, 6.25)
 """Steps (0.25-1.25 s) and figures (1.25-6.25 s), searched shortest first (see
@@ -471,10 +470,24 @@ def segment(
     >>> seg.n_periods, round(seg.mean_period, 3)
     (10, 1.196)
     """
-    alpha = check_alpha(alpha)
     p = check_n_periods(n_periods)
-    lo_s, hi_s = check_period_range(period_range)
-    method = check_period_method(period_method, p)
+    return _segment_motion(motion, alpha=check_alpha(alpha), n_periods=p,
+                           period_range=check_period_range(period_range),
+                           method=check_period_method(period_method, p),
+                           channels=channels)  # fmt: skip
+
+
+def _segment_motion(
+    motion: Motion,
+    *,
+    alpha: float,
+    n_periods: int | None,
+    period_range: tuple[float, float],
+    method: str,
+    channels: str | Sequence[str] = "default",
+) -> Segmentation:
+    """:func:`segment` with its settings already checked (the motion's data is checked
+    here: the channels, their values and the frame count)."""
     names = select_channels(motion.channels, channels)
     idx = [motion.channel_index(nm) for nm in names]
     values = check_finite(motion.values[:, idx], name=f"motion {motion.name!r} values")
@@ -483,7 +496,7 @@ def segment(
             f"motion {motion.name!r} has {values.shape[0]} frame(s); a segmentation needs more"
         )
     return _segment(unwrap_rotations(values, names), names, fps=motion.fps, alpha=alpha,
-                    n_periods=p, period_range=(lo_s, hi_s), method=method)  # fmt: skip
+                    n_periods=n_periods, period_range=period_range, method=method)  # fmt: skip
 
 
 def estimate_period_count(
@@ -569,12 +582,11 @@ def period_range_from_beat(
     >>> period_range_from_beat(0.5)
     (0.5, 4.0)
     """
-    hint = "a beat period in seconds is 60 / BPM; is it a tempo in BPM?"
-    bp = check_between(beat_period, name="beat_period", unit="s", low=60.0 / MAX_BPM,
-                       high=60.0 / MIN_BPM, closed="both", hint=hint)  # fmt: skip
-    try:
-        b_lo, b_hi = beats
-    except (TypeError, ValueError):
-        raise ParameterError(f"beats={beats!r} must be two numbers (fewest, most)") from None
-    b_lo, b_hi = check_range(b_lo, b_hi, name="beats", unit="beats")
+    bp = as_float(beat_period, name="beat_period", unit="s", text=True)
+    if not 60.0 / MAX_BPM <= bp <= 60.0 / MIN_BPM:
+        raise ParameterError(
+            f"beat_period={beat_period!r} must be in [{60.0 / MAX_BPM:g}, {60.0 / MIN_BPM:g}] "
+            "[s] (a beat period in seconds is 60 / BPM; is it a tempo in BPM?)"
+        )
+    b_lo, b_hi = check_interval(beats, name="beats", unit="beats")
     return b_lo * bp, b_hi * bp

@@ -50,7 +50,7 @@ __all__ = [
 SEARCH_MEMORY_BUDGET = 512 * 2**20
 """Bytes [B] the exact search may use; above it the search runs on a decimated signal."""
 
-_FAST_DTYPE = np.float32  # edge-cost sums in float32: ~2x faster, |error| ~1e-5 per edge
+_FAST_DTYPE = np.float32  # edge-cost sums in float32: faster, |error| ~1e-5 per edge
 _DP_BLOCK_ELEMENTS = 2e6  # elements of one block of the fixed-count DP
 _MAX_REFINE_PASSES = 10  # full-rate refinement passes after a decimated search
 

@@ -7,9 +7,8 @@ never import it. Modules:
 - :mod:`.artifacts`: :func:`~.artifacts.write_artifacts`, the one artefact layout of
   every notebook (``results/<notebook>/``: tables as CSV at a fixed precision, figures
   as PNG with fixed metadata, ``params.json`` with the parameters and package version).
-- :mod:`.beat_evaluation`: beat trackers run and scored on test items (tables of
-  paper A, section 4); :mod:`.beat_dataset`: on a dataset of files, on Dask
-  (``beatsync evaluate beats``; each track is the task of :mod:`.beat_task`).
+- :mod:`.beat_dataset`: beat trackers run and scored over a dataset of annotated audio
+  files, on Dask (``beatsync evaluate beats``).
 - one module per block of the papers (paper A: segmentation, beat tracking, sync;
   paper B: composition), each named after the paper and the block.
 """

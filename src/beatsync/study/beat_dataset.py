@@ -1,60 +1,382 @@
-"""Beat trackers run and scored over a dataset of audio files, on Dask.
+"""Beat trackers run and scored against the annotations of a dataset, on Dask.
 
-``beatsync evaluate beats`` calls this module. :func:`find_tracks`
-(:mod:`beatsync.study.beat_tracks`, re-exported here) pairs every audio file with the
-annotation of the same stem (``.beats``: one time [s] per line, an optional second
-column such as the beat in the bar is ignored);
-:func:`evaluate_dataset` tracks and scores every pair on Dask
-(:func:`beatsync.cluster.dask_client`), in groups of tracks (:func:`_groups`), and
-records one row per track as soon as its group finishes in ``OUT/tracks.jsonl``
-(append-only: a crash or Ctrl-C loses at most the groups in flight; a rerun skips the
-tracks already scored), then writes
-``OUT/tracks.csv`` and ``OUT/summary.csv`` (means per method and folder) atomically.
-A track that fails (unreadable, silent, too short) is recorded with its error.
+Every score is :func:`beatsync.evaluate.beats.evaluate` (``mir_eval.beat.evaluate`` on
+validated beat times); methods are named as in
+:data:`beatsync.other_trackers.TRACKERS` (``psf`` is ours). Every time is in seconds,
+every tempo in BPM.
 
-Methods are named as in :data:`beatsync.peers.PEERS` (``psf`` is ours); scores are
-:func:`beatsync.evaluate.beats.evaluate`. Every time is in seconds, every tempo in BPM.
+- :func:`find_tracks` pairs every audio file with the annotation of the same stem
+  (``.beats``: one time [s] per line, an optional second column such as the beat in
+  the bar is ignored); :func:`read_annotation` refuses values that are not seconds.
+- :func:`evaluate_track` reads, tracks and scores one file into a row; a track that
+  fails (unreadable, silent, too short) is a row with its error, never an exception.
+- :func:`evaluate_dataset` (``beatsync evaluate beats``) runs the tracks on Dask
+  (:func:`beatsync.cluster.dask_client`) in groups, appends each row to
+  ``OUT/tracks.jsonl`` as soon as its group finishes (a crash or Ctrl-C loses at most
+  the groups in flight; a rerun skips the tracks already scored), then writes
+  ``OUT/tracks.csv`` and ``OUT/summary.csv`` (:func:`summarize_dataset`) atomically.
+
+pandas is imported by the table functions only: a worker imports this module to run
+:func:`evaluate_tracks` and needs none of it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import itertools
 import os
+import time
 import uuid
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
-from .. import io, peers
-from ..errors import ParameterError
-from ..evaluate.beats import METRICS, count_octave_errors, count_other_tempo
-from . import beat_task
-from .beat_task import _audio_bytes, evaluate_track, reference_digest
-from .beat_tracks import ANNOTATION_SUFFIX, Track, TrackList, find_tracks, read_annotation
+from .. import io, other_trackers
+from ..errors import ParameterError, collect_warnings
+from ..evaluate.beats import (
+    METRICS,
+    count_octave_errors,
+    count_other_tempo,
+    evaluate,
+    not_seconds_detail,
+    tempo_octave,
+)
+from ..units import MAX_BPM
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
+    "ANNOTATION_SUFFIX",
     "Track",
     "TrackList",
     "find_tracks",
     "read_annotation",
     "evaluate_track",
+    "evaluate_tracks",
     "TrackLog",
     "DatasetRun",
     "evaluate_dataset",
     "summarize_dataset",
-    "ANNOTATION_SUFFIX",
     "RESULT_FILES",
 ]
 
 
+# ------------------------------------------------------------------ tracks of a dataset
+
+#: Suffix of beat annotation files: one time [s] per line, optionally a second column.
+ANNOTATION_SUFFIX = ".beats"
+
+
+@dataclass(frozen=True)
+class Track:
+    """One audio file and its annotation.
+
+    Attributes
+    ----------
+    key : str
+        The audio file's path relative to the audio folder, without suffix (POSIX).
+    group : str
+        Its folder relative to the audio folder (``"."`` at the top).
+    audio, annotation : Path
+    """
+
+    key: str
+    group: str
+    audio: Path
+    annotation: Path
+
+
+@dataclass(frozen=True)
+class TrackList:
+    """Output of :func:`find_tracks`: the pairs, and the audio files left without one.
+
+    Attributes
+    ----------
+    tracks : list of Track
+    unmatched : list of Path
+        Audio files with no annotation of their name.
+    shared : dict of Path -> list of Path
+        Annotations found by name only (a flat folder) that more than one audio file
+        would use (``a/x.wav`` and ``b/x.wav`` for ``x.beats``), or that another audio
+        file has at its own relative path: the audio files that found them by name are
+        skipped, as an annotation fits one recording at most.
+    duplicates : list of Path
+        Audio files skipped because a file of the same path and name with another
+        suffix was taken (``x.wav`` beside ``x.flac``: the first in sorted order).
+    """
+
+    tracks: list[Track]
+    unmatched: list[Path] = field(default_factory=list)
+    shared: dict[Path, list[Path]] = field(default_factory=dict)
+    duplicates: list[Path] = field(default_factory=list)
+
+
+def _folder(path: str | os.PathLike[str], what: str) -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"{what} folder {str(p)!r} does not exist")
+    if not p.is_dir():
+        raise ParameterError(f"{what} folder {str(p)!r} is a file, not a folder")
+    return p
+
+
+def find_tracks(
+    audio_dir: str | os.PathLike[str], annotation_dir: str | os.PathLike[str]
+) -> TrackList:
+    """Pair every audio file under ``audio_dir`` with the ``.beats`` file of its stem.
+
+    The annotation at the same relative path is preferred (``a/x.wav`` ->
+    ``a/x.beats``); otherwise the only ``x.beats`` anywhere under ``annotation_dir``
+    (flat annotation folders, as in most datasets). Audio files are those with a
+    suffix in :data:`beatsync.io.AUDIO_SUFFIXES`, searched recursively.
+
+    Raises
+    ------
+    ParameterError
+        A folder that is missing or a file; no audio file; no annotation file; no
+        audio file with an annotation of its own (see :class:`TrackList`).
+    """
+    a_dir = _folder(audio_dir, "audio")
+    b_dir = _folder(annotation_dir, "annotation")
+    audio = sorted(
+        p for p in a_dir.rglob("*") if p.suffix.lower() in io.AUDIO_SUFFIXES and p.is_file()
+    )
+    if not audio:
+        raise ParameterError(
+            f"audio folder {str(a_dir)!r} holds no audio file ({', '.join(io.AUDIO_SUFFIXES)})"
+        )
+    notes = sorted(p for p in b_dir.rglob(f"*{ANNOTATION_SUFFIX}") if p.is_file())
+    if not notes:
+        raise ParameterError(
+            f"annotation folder {str(b_dir)!r} holds no {ANNOTATION_SUFFIX} file "
+            "(one beat time [s] per line)"
+        )
+    by_rel = {p.relative_to(b_dir).with_suffix("").as_posix(): p for p in notes}
+    by_stem: dict[str, list[Path]] = {}
+    for p in notes:
+        by_stem.setdefault(p.stem, []).append(p)
+    tracks, unmatched, duplicates = [], [], []
+    by_name: dict[Path, list[Path]] = {}  # annotations found by name only, and their users
+    by_path: set[Path] = set()  # annotations found at their audio file's relative path
+    seen: set[str] = set()
+    for p in audio:
+        rel = p.relative_to(a_dir)
+        key = rel.with_suffix("").as_posix()
+        if key in seen:  # x.wav beside x.flac
+            duplicates.append(p)
+            continue
+        note = by_rel.get(key)
+        if note is not None:
+            by_path.add(note)
+        elif len(by_stem.get(p.stem, [])) == 1:
+            note = by_stem[p.stem][0]
+            by_name.setdefault(note, []).append(p)
+        if note is None:
+            unmatched.append(p)
+            continue
+        seen.add(key)
+        tracks.append(Track(key, rel.parent.as_posix(), p, note))
+    # an annotation found by name that another audio file uses by its path, or that
+    # several use by name, fits one recording at most
+    shared = {note: users for note, users in by_name.items() if len(users) > 1 or note in by_path}
+    taken = {p for users in shared.values() for p in users}
+    tracks = [t for t in tracks if t.audio not in taken]
+    if not tracks:
+        raise ParameterError(
+            f"none of the {len(audio)} audio files under {str(a_dir)!r} has an annotation "
+            f"of the same name ({ANNOTATION_SUFFIX}) under {str(b_dir)!r}, e.g. "
+            f"{audio[0].stem}{ANNOTATION_SUFFIX}"
+        )
+    return TrackList(tracks, unmatched, shared, duplicates)
+
+
+def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
+    """Beat times [s] of an annotation file, refused if they are not seconds.
+
+    Raises
+    ------
+    ParameterError
+        Unreadable, empty, unsorted, non-numeric (:func:`beatsync.io.read_beats`),
+        values that look like frame indices or milliseconds (the message says which),
+        or times closer than a beat at 400 BPM (minutes, or onsets).
+    """
+    times = io.read_beats(path)
+    detail = not_seconds_detail(times)
+    if detail is not None:
+        raise ParameterError(
+            f"annotation {str(path)!r} is not beat times in seconds: it ends at {detail}"
+        )
+    if times.size >= 3:
+        step = float(np.median(np.diff(times)))
+        if step < 60.0 / MAX_BPM:
+            raise ParameterError(
+                f"annotation {str(path)!r} is not beat times in seconds: its times are a "
+                f"median {step:.4g} apart ({60.0 / step:.0f} BPM read as seconds, faster "
+                f"than any beat, over {MAX_BPM:g} BPM): minutes, or onsets rather than beats?"
+            )
+    return times
+
+
+# ------------------------------------------------------------------- one track's row
+
+
+def evaluate_track(
+    audio: str,
+    reference: np.ndarray,
+    *,
+    method: str,
+    min_beat_time: float,
+    name: str,
+    group: str = ".",
+    min_bpm: float | None = None,
+    max_bpm: float | None = None,
+) -> dict[str, Any]:
+    """Track one audio file and score it; a failure becomes the row's ``error``.
+
+    The work of a Dask task of :func:`evaluate_dataset` (:func:`evaluate_tracks`); it
+    never raises for a bad track (unreadable, silent, too short), so that one track
+    cannot stop a run.
+
+    Parameters
+    ----------
+    audio : str
+        Audio file path (valid on the worker).
+    reference : np.ndarray [s]
+        Annotated beats (:func:`read_annotation`).
+    method : str
+        A name of :data:`beatsync.other_trackers.TRACKERS`.
+    min_beat_time : float >= 0 [s]
+    name, group : str
+        The track's :attr:`Track.key` (recorded as ``key``) and :attr:`Track.group`.
+    min_bpm, max_bpm : float, optional [BPM]
+        The tempo range searched (:func:`beatsync.other_trackers.check_tempo_range`);
+        ``None``: the method's default. Recorded as checked (a bound equal to the
+        default as ``None``); a range the method refuses is the row's ``error``.
+
+    Returns
+    -------
+    dict
+        ``key, group, audio, audio_bytes`` (its size, None if unreadable),
+        ``reference_digest``, ``method, min_beat_time, min_bpm, max_bpm, status``
+        (``"ok"`` or ``"error"``), ``error``, ``warning`` (the tracker's or scorer's
+        warnings), ``n_ref, n_est, tempo_ref, tempo_est, octave``, every metric of
+        :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking
+        time), ``audio_seconds`` and ``beats`` (the estimated times).
+    """
+    row = _failed_row(
+        audio, reference, "", method=method, min_beat_time=min_beat_time, name=name,
+        group=group, min_bpm=min_bpm, max_bpm=max_bpm,
+    )  # fmt: skip
+    t0 = time.perf_counter()
+    try:
+        tempo = other_trackers.check_tempo_range(method, min_bpm, max_bpm)
+        row.update(min_bpm=tempo.get("min_bpm"), max_bpm=tempo.get("max_bpm"))
+        # ours collected per thread (several tracks may share a worker's threads); any
+        # other package's warnings are not the row's
+        with collect_warnings() as caught, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            y, sr = io.read_audio(audio)
+            if reference.size and reference[0] >= y.size / sr:
+                raise ParameterError(
+                    f"no annotated beat falls inside the audio: the first is at "
+                    f"{reference[0]:.3f} s and the audio ends at {y.size / sr:.3f} s; the "
+                    "annotation of another recording?"
+                )
+            est = other_trackers.track(method, y, sr, **tempo)
+            seconds = time.perf_counter() - t0
+            scores = evaluate(reference, est, min_beat_time=min_beat_time)
+    except ParameterError as exc:
+        row["error"] = str(exc)
+        return row
+    except Exception as exc:  # one broken track must not stop a run over thousands
+        row["error"] = f"{type(exc).__name__}: {exc}"
+        return row
+    row.update(
+        status="ok",
+        warning="; ".join(dict.fromkeys(_dataset_hint(message) for message in caught)),
+        n_ref=int(reference.size),
+        n_est=int(est.size),
+        **tempo_octave(reference, est),
+        **scores,
+        seconds=seconds,
+        audio_seconds=y.size / sr,
+        beats=[round(float(b), 6) for b in est],
+    )
+    return row
+
+
+def evaluate_tracks(
+    items: list[tuple[str, np.ndarray, str, str]], **settings: Any
+) -> list[dict[str, Any]]:
+    """:func:`evaluate_track` on each ``(audio, reference, name, group)`` in turn: the
+    task of :func:`evaluate_dataset` (one task for several short tracks)."""
+    return [
+        evaluate_track(audio, reference, name=name, group=group, **settings)
+        for audio, reference, name, group in items
+    ]
+
+
+def _failed_row(
+    audio: str | os.PathLike[str], reference: np.ndarray, error: str, *, method: str,
+    min_beat_time: float, name: str, group: str, min_bpm: float | None, max_bpm: float | None,
+) -> dict[str, Any]:  # fmt: skip
+    """A track's row with its inputs and settings, ``status`` "error" and ``error``:
+    where :func:`evaluate_track` starts, and the row of a task that failed outside it."""
+    return {
+        "key": name,
+        "group": group,
+        "audio": str(audio),
+        "audio_bytes": _audio_bytes(audio),
+        "reference_digest": _reference_digest(reference),
+        "method": method,
+        "min_beat_time": float(min_beat_time),
+        "min_bpm": min_bpm,
+        "max_bpm": max_bpm,
+        "status": "error",
+        "error": error,
+        "warning": "",
+    }
+
+
+def _dataset_hint(message: str) -> str:
+    """A tracker's warning with the advice a dataset run can follow (it has no --bpm)."""
+    from ..beats.tracker import KNOWN_TEMPO_HINT
+
+    return message.replace(
+        KNOWN_TEMPO_HINT, "a tempo range (--min-bpm, --max-bpm) narrows the search"
+    )
+
+
+def _reference_digest(reference: np.ndarray) -> str:
+    """A short digest of an annotation's beat times: a row records the one it was scored
+    against, and a resume re-runs a track whose annotation changed since."""
+    data = np.ascontiguousarray(np.asarray(reference, dtype=np.float64)).tobytes()
+    return hashlib.sha256(data).hexdigest()[:16]
+
+
+def _audio_bytes(path: str | os.PathLike[str]) -> int | None:
+    try:
+        return os.stat(path).st_size
+    except OSError:
+        return None
+
+
+# --------------------------------------------------------------------- a dataset run
+
 #: Files a run writes in its output folder.
 RESULT_FILES = ("tracks.jsonl", "tracks.csv", "summary.csv")
+
+#: The settings a row records besides the method: one value per method in a folder.
+SETTINGS = ("min_beat_time", "min_bpm", "max_bpm")
+
+#: The most tracks one task reads, tracks and scores in turn (:func:`_groups`).
+GROUP_TRACKS = 8
 
 
 class TrackLog:
@@ -84,14 +406,6 @@ class TrackLog:
         io.append_jsonl(self.path, *rows)
 
 
-#: Columns of ``summary.csv`` after the keys (means of the metrics over ``ok`` tracks).
-SUMMARY_METRICS = METRICS
-
-
-#: The settings a row records besides the method: one value per method in a folder.
-SETTINGS = ("min_beat_time", "min_bpm", "max_bpm")
-
-
 def _setting(rows: pd.DataFrame, key: str) -> float:
     """The one value of ``key`` in ``rows`` (NaN if none, absent, not a number (a
     refused bound, recorded as given) or they differ)."""
@@ -119,30 +433,34 @@ def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
         none scored), ``tracks``, ``failed``, the mean of every metric over the scored
         tracks, ``octave errors`` and ``other tempo`` (counts).
     """
+    import pandas as pd
+
     table = pd.DataFrame(list(rows))
     if table.empty:
         return pd.DataFrame(columns=["method", "group", "tracks", "failed", *METRICS])
     parts = []
-    for group_by_folder in (True, False):
-        t = table if group_by_folder else table.assign(group="all")
+    for t in (table, table.assign(group="all")):
         for (method, group), sub in t.groupby(["method", "group"], sort=True):
             ok = sub[sub["status"] == "ok"]
-            rec: dict[str, Any] = {
-                "method": method,
-                "group": group,
-                # the scored rows' settings (failed rows are re-run with today's)
-                **{key: _setting(ok if len(ok) else sub, key) for key in SETTINGS},
-                "tracks": len(sub),
-                "failed": int((sub["status"] != "ok").sum()),
-            }
-            for m in METRICS:
-                rec[m] = float(ok[m].mean()) if len(ok) and m in ok else float("nan")
             octave = ok["octave"] if "octave" in ok else pd.Series(dtype=object)
-            rec["octave errors"] = count_octave_errors(octave)
-            rec["other tempo"] = count_other_tempo(octave)
-            parts.append(rec)
+            parts.append(
+                {
+                    "method": method,
+                    "group": group,
+                    # the scored rows' settings (failed rows are re-run with today's)
+                    **{key: _setting(ok if len(ok) else sub, key) for key in SETTINGS},
+                    "tracks": len(sub),
+                    "failed": int((sub["status"] != "ok").sum()),
+                    **{
+                        m: float(ok[m].mean()) if m in ok and len(ok) else float("nan")
+                        for m in METRICS
+                    },
+                    "octave errors": count_octave_errors(octave),
+                    "other tempo": count_other_tempo(octave),
+                }
+            )
     out = pd.DataFrame(parts)
-    if out["group"].nunique() == 2 and set(out["group"]) == {".", "all"}:
+    if set(out["group"]) == {".", "all"}:
         out = out[out["group"] == "all"]  # one folder: the per-folder rows repeat "all"
     return out.reset_index(drop=True)
 
@@ -159,11 +477,11 @@ class DatasetRun:
         :func:`summarize_dataset` of every method recorded in the output folder.
     scored, skipped : int
         Tracks run now, and tracks already recorded by an earlier run.
+    files : dict of str -> Path
+        ``log`` (``tracks.jsonl``), ``tracks`` (CSV) and ``summary`` (CSV).
     changed : int
         Tracks run now although scored before: their audio file (path or size) or
         annotation changed since.
-    files : dict of str -> Path
-        ``log`` (``tracks.jsonl``), ``tracks`` (CSV) and ``summary`` (CSV).
     """
 
     tracks: pd.DataFrame
@@ -175,6 +493,8 @@ class DatasetRun:
 
 
 def _table(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
+    import pandas as pd
+
     table = pd.DataFrame([{k: v for k, v in r.items() if k != "beats"} for r in rows])
     return table.sort_values(["method", "key"]).reset_index(drop=True) if len(table) else table
 
@@ -214,13 +534,13 @@ def evaluate_dataset(
         Results folder (created if missing; its parent must exist): ``tracks.jsonl``
         (one row per finished track, appended), ``tracks.csv``, ``summary.csv``.
     method : str
-        A name of :data:`beatsync.peers.PEERS`.
+        A name of :data:`beatsync.other_trackers.TRACKERS`.
     min_beat_time : float >= 0 [s]
         Beats before this time are not scored (mir_eval/MIREX use 5 s; 0 scores all).
     min_bpm, max_bpm : float, optional [BPM]
         The tempo range the method searches on every track; a bound not given keeps the
-        method's default (:func:`beatsync.peers.check_tempo_range`). Recorded in each
-        row.
+        method's default (:func:`beatsync.other_trackers.check_tempo_range`). Recorded
+        in each row.
     force : bool
         Re-run these tracks although recorded for ``method`` (default: skip those
         scored). The new rows are appended; once the run completes, the record keeps
@@ -232,8 +552,7 @@ def evaluate_dataset(
         See :func:`beatsync.cluster.dask_client`. Workers of an existing cluster must
         see the audio files at the same paths.
     progress : callable ``progress(done, total=None)``, optional
-        Called as groups of tracks finish, with the number of tracks done (e.g. a
-        command's progress bar).
+        Called as groups of tracks finish, with the number of tracks done.
 
     Raises
     ------
@@ -248,9 +567,9 @@ def evaluate_dataset(
     from ..cluster import check_cluster_options, dask_client
     from ..units import check_positive
 
-    peers.get(method)
+    other_trackers.get(method)
     mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
-    tempo = peers.check_tempo_range(method, min_bpm, max_bpm)
+    tempo = other_trackers.check_tempo_range(method, min_bpm, max_bpm)
     bpm_range = (tempo.get("min_bpm"), tempo.get("max_bpm"))
     check_cluster_options(scheduler, n_workers)
     if not tracks:
@@ -262,6 +581,7 @@ def evaluate_dataset(
     refs = {t.key: read_annotation(t.annotation) for t in tracks}
     log = TrackLog(out / "tracks.jsonl")
     previous = {k: r for (m, k), r in log.latest().items() if m == method}
+    done, changed = set(), 0
     if not force:
         # only scored rows bind a resume: failed ones are re-run with today's settings
         scored = [r for r in previous.values() if r.get("status") == "ok"]
@@ -271,8 +591,7 @@ def evaluate_dataset(
                 f"{str(log.path)!r} holds {method} results scored with --min-beat-time "
                 f"{other[0]:g} s, not {mbt:g} s; use --force to re-run them or another --out"
             )
-        stored = {(r.get("min_bpm"), r.get("max_bpm")) for r in scored}
-        ranges = {_recorded_range(method, bounds) for bounds in stored}
+        ranges = {_recorded_range(method, (r.get("min_bpm"), r.get("max_bpm"))) for r in scored}
         other_range = sorted(ranges - {bpm_range}, key=str)
         if other_range:
             raise ParameterError(
@@ -280,9 +599,6 @@ def evaluate_dataset(
                 f"{_range_text(other_range[0])}, not {_range_text(bpm_range)}; use --force "
                 "to re-run them or another --out"
             )
-    done = set()
-    changed = 0
-    if not force:
         for t in tracks:
             row = previous.get(t.key)
             if row is None or row.get("status") != "ok":
@@ -307,10 +623,8 @@ def evaluate_dataset(
                 )
             out.mkdir(exist_ok=True)
             if todo:
-                _run(
-                    client, todo, refs, log, method=method, mbt=mbt, tempo=tempo,
-                    progress=progress,
-                )  # fmt: skip
+                _run(client, todo, refs, log, method=method, mbt=mbt, tempo=tempo,
+                     progress=progress)  # fmt: skip
     except BaseException:
         with contextlib.suppress(OSError):  # never hide the interrupt behind this
             if created and out.is_dir() and not any(out.iterdir()):
@@ -347,12 +661,29 @@ def _same_inputs(row: dict[str, Any], track: Track, reference: np.ndarray) -> bo
     if size is not None and size != _audio_bytes(track.audio):
         return False
     digest = row.get("reference_digest")
-    return digest is None or digest == reference_digest(reference)
+    return digest is None or digest == _reference_digest(reference)
 
 
 def _row_settings(method: str, row: dict[str, Any]) -> tuple[Any, ...]:
     bounds = _recorded_range(method, (row.get("min_bpm"), row.get("max_bpm")))
     return (row.get("min_beat_time"), *bounds)
+
+
+def _recorded_range(method: str, bounds: tuple[Any, Any]) -> tuple[float | None, float | None]:
+    """A stored row's tempo range ``bounds`` as :func:`check_tempo_range` records it
+    today (a bound equal to the default as ``None``)."""
+    try:
+        tempo = other_trackers.check_tempo_range(method, *bounds)
+    except ParameterError:
+        return bounds
+    return (tempo.get("min_bpm"), tempo.get("max_bpm"))
+
+
+def _range_text(bounds: tuple[float | None, float | None]) -> str:
+    """``(None, None)`` -> "the default tempo range"; ``(60, None)`` -> "--min-bpm 60"."""
+    names = ("--min-bpm", "--max-bpm")
+    given = [f"{k} {v:g}" for k, v in zip(names, bounds, strict=True) if v is not None]
+    return " and ".join(given) if given else "the default tempo range"
 
 
 def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> None:
@@ -385,54 +716,27 @@ def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> No
         raise ParameterError("; ".join(refused) + "; nothing was run")
 
 
-def _recorded_range(method: str, bounds: tuple[Any, Any]) -> tuple[float | None, float | None]:
-    """A stored row's tempo range ``bounds``, as :func:`check_tempo_range` would record
-    it today (a bound equal to the default as ``None``: rows written before that rule
-    resume)."""
-    try:
-        tempo = peers.check_tempo_range(method, *bounds)
-    except ParameterError:
-        return bounds
-    return (tempo.get("min_bpm"), tempo.get("max_bpm"))
-
-
-def _range_text(bounds: tuple[float | None, float | None]) -> str:
-    """``(None, None)`` -> "the default tempo range"; ``(60, None)`` -> "--min-bpm 60"."""
-    names = ("--min-bpm", "--max-bpm")
-    given = [f"{k} {v:g}" for k, v in zip(names, bounds, strict=True) if v is not None]
-    return " and ".join(given) if given else "the default tempo range"
-
-
 def _prepare_workers(client, method: str) -> None:
-    """:func:`beatsync.peers.prepare` on each worker in turn, never on two at once.
-
-    A fresh install's workers would otherwise compile librosa's numba cache together,
-    which can crash them (see :func:`~beatsync.peers.prepare`). A worker that fails here
-    is left to record the error with its first track.
-    """
+    """:func:`beatsync.other_trackers.prepare` on each worker in turn, never two at once:
+    a fresh install's workers would otherwise compile librosa's numba cache together,
+    which can crash them. A worker that fails here records the error with its first
+    track."""
     if method != "librosa":
         return
-    for address in client.nthreads():  # every worker (scheduler_info held 5 in some versions)
+    for address in client.nthreads():  # every worker
         with contextlib.suppress(Exception):
-            client.run(peers.prepare, method, workers=[address])
-
-
-#: The most tracks one task reads, tracks and scores in turn (:func:`_groups`).
-GROUP_TRACKS = 8
+            client.run(other_trackers.prepare, method, workers=[address])
 
 
 def _groups(todo: Sequence[Track], n_threads: int) -> list[list[Track]]:
     """The tracks in order, in groups of decreasing size: one task each.
 
-    Dask spends a few milliseconds on every task, in the worker and in this process
-    (which, on a machine of two cores, takes them from the workers), and a 30 s excerpt
-    takes about 30 ms to track here: with one track a task, 2 workers gave 1.62-1.67x
-    the throughput of 1 (``benchmarks/bench_evaluate.py``). Dask's best practices
-    counsel fewer, larger tasks when each is short. Each group holds the remaining
-    tracks over the worker threads, at most :data:`GROUP_TRACKS` (guided
-    self-scheduling, Polychronopoulos & Kuck 1987), so the last groups hold one track
-    and the workers finish together. A group's rows are recorded when it finishes: a
-    crash or Ctrl-C loses at most the groups in flight.
+    Dask spends a few milliseconds on every task, comparable to tracking a short
+    excerpt, so each task takes several tracks (Dask's best practices: fewer, larger
+    tasks). Each group holds the remaining tracks over the worker threads, at most
+    :data:`GROUP_TRACKS` (guided self-scheduling, Polychronopoulos & Kuck 1987), so the
+    last groups hold one track and the workers finish together. A group's rows are
+    recorded when it finishes: a crash or Ctrl-C loses at most the groups in flight.
     """
     groups, i = [], 0
     while i < len(todo):
@@ -443,25 +747,10 @@ def _groups(todo: Sequence[Track], n_threads: int) -> list[list[Track]]:
 
 
 def _longest_first(todo: Sequence[Track]) -> list[Track]:
-    """The tracks by audio file size, largest first (their order otherwise): the longest
+    """The tracks by audio file size, largest first (ties in their order): the longest
     go out in the first, largest groups and the shortest last, so the workers finish
-    together (longest processing time first; a file's size stands for its length).
-
-    Measured on 42 copies of the three bundled annotated recordings (2.8-56 s; a scratch
-    run of ``benchmarks/bench_evaluate.py``'s Dask path, 12 pairs alternating): 0.94x
-    the time of the tracks in key order with 1 worker and 0.95x with 2; the 2-worker
-    ratio stayed the same (1.69x against 1.68x).
-    """
+    together (longest processing time first; a file's size stands for its length)."""
     return sorted(todo, key=lambda t: -(_audio_bytes(t.audio) or 0))
-
-
-def _failed_row(t: Track, ref: np.ndarray, exc: Exception, *, method, mbt, tempo) -> dict:
-    """The row of a track whose task failed outside :func:`evaluate_track` (its worker
-    died, e.g. out of memory, or the task was cancelled)."""
-    return beat_task.failed_row(
-        t.audio, ref, f"{type(exc).__name__}: {exc}", method=method, min_beat_time=mbt,
-        name=t.key, group=t.group, min_bpm=tempo.get("min_bpm"), max_bpm=tempo.get("max_bpm"),
-    )  # fmt: skip
 
 
 def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
@@ -470,38 +759,41 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
     from dask.distributed import KilledWorker, as_completed
 
     _prepare_workers(client, method)
-
     run = uuid.uuid4().hex
     numbers = itertools.count()
 
-    def submit(groups: list[list[Track]]) -> list:
-        # in one call, so that the scheduler sees the run's tasks as one group and can
-        # queue them (worker-saturation; Dask queues a group of more tasks than twice the
-        # threads) instead of handing the first ones out at once; it runs them in this
-        # order. One key prefix for the run: Dask groups tasks by it, and a track's name
-        # in it made a group of each task
-        return client.map(
-            beat_task.evaluate_tracks,
+    def failed(t: Track, exc: BaseException) -> dict[str, Any]:
+        # a task that failed outside evaluate_track (its worker died, or it was cancelled)
+        return _failed_row(
+            t.audio, refs[t.key], f"{type(exc).__name__}: {exc}", method=method,
+            min_beat_time=mbt, name=t.key, group=t.group, min_bpm=tempo.get("min_bpm"),
+            max_bpm=tempo.get("max_bpm"),
+        )  # fmt: skip
+
+    def submit(groups: list[list[Track]]) -> None:
+        # in one call, so that the scheduler sees the run's tasks as one group and queues
+        # them (worker-saturation) instead of handing the first ones out at once, in this
+        # order; one key prefix for the run, as Dask groups tasks by it
+        futs = client.map(
+            evaluate_tracks,
             [[(str(t.audio), refs[t.key], t.key, t.group) for t in group] for group in groups],
             key=[f"evaluate-{method}-{run}-{next(numbers):06d}" for _ in groups],
             method=method,
             min_beat_time=mbt,
             **tempo,
         )
-
-    def resubmit(groups: list[list[Track]]) -> None:
-        for fut, group in zip(submit(groups), groups, strict=True):
+        for fut, group in zip(futs, groups, strict=True):
             futures[fut] = group
             queue.add(fut)
 
-    groups = _groups(_longest_first(todo), sum(client.nthreads().values()))
-    futures = dict(zip(submit(groups), groups, strict=True))
+    futures: dict[Any, list[Track]] = {}
+    queue = as_completed(loop=client.loop)
+    submit(_groups(_longest_first(todo), sum(client.nthreads().values())))
     again: set[str] = set()  # tracks run alone a second time
     if progress is not None:
         progress(0, total=len(todo))
     done = 0
     try:
-        queue = as_completed(futures)
         for fut in queue:
             # released once read: a finished task's result would stay on its worker,
             # and Dask computes it again if that worker dies
@@ -509,21 +801,19 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
             try:
                 rows = fut.result()
             except CancelledError as exc:  # cancelled outside the run, or the scheduler lost
-                rows = [_failed_row(t, refs[t.key], exc, method=method, mbt=mbt, tempo=tempo)
-                        for t in group]  # fmt: skip
+                rows = [failed(t, exc) for t in group]
             except Exception as exc:  # a worker died (e.g. out of memory)
                 if len(group) > 1:  # one track may be the cause: each alone, again
-                    resubmit([[t] for t in group])
+                    submit([[t] for t in group])
                     continue
                 t = group[0]
                 if not isinstance(exc, KilledWorker) and t.key not in again:
                     # not its own fault: it finished on a worker that another track then
-                    # killed before its result was fetched (Dask raised RuntimeError "...
-                    # bound to a different event loop"); once more
+                    # killed before its result was fetched; once more
                     again.add(t.key)
-                    resubmit([[t]])
+                    submit([[t]])
                     continue
-                rows = [_failed_row(t, refs[t.key], exc, method=method, mbt=mbt, tempo=tempo)]
+                rows = [failed(t, exc)]
             log.append(*rows)  # in one write: an interrupt keeps the group or not at all
             done += len(rows)
             if progress is not None:

@@ -1,4 +1,4 @@
-"""Paper A, section 4: the beat-tracking study (our tracker beside the peers).
+"""Paper A, section 4: the beat-tracking study (our tracker beside other trackers).
 
 One function per step of ``notebooks/paper_a_sec4_beat_tracking.ipynb``: build the
 items (the synthetic set with exact beats, and every real recording with human
@@ -7,10 +7,10 @@ group, check the targets, plot the tempo curves of the tempo-change items, sweep
 the phase-slope front end on the development recordings and the synthetic set, and
 sweep the weight of the drum-pattern cue (:mod:`beatsync.beats.drums`).
 
-Methods (:mod:`beatsync.peers`): ``psf`` (ours), ``librosa`` and, when the optional
-``essentia`` package is installed, essentia's ``BeatTrackerDegara`` and
-``BeatTrackerMultiFeature`` (:func:`available_methods` says which ran). Items are
-tracked and scored by :mod:`beatsync.study.beat_evaluation` (mir_eval metrics). Synthetic
+Methods (:mod:`beatsync.other_trackers`): ``psf`` (ours), ``librosa`` and, when the
+optional ``essentia`` package is installed, essentia's ``BeatTrackerDegara`` and
+``BeatTrackerMultiFeature`` (:func:`available_methods` says which ran), scored with
+:func:`beatsync.evaluate.beats.evaluate` (``mir_eval.beat.evaluate``). Synthetic
 items use the notebook's ``min_beat_time``; the two long real recordings use
 mir_eval's default 5 s (their annotations' convention), the 2.8 s madmom sample 0 s.
 Two or three recordings are a sanity check, not a benchmark.
@@ -19,17 +19,18 @@ Two or three recordings are a sanity check, not a benchmark.
 from __future__ import annotations
 
 import itertools
+import time
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from .. import datasets, peers
+from .. import datasets, other_trackers
 from ..beats import FRONTEND_DEFAULTS, beat_tempo, track_beats
 from ..errors import silenced
+from ..evaluate.beats import evaluate, tempo_octave
 from ..synth.audio import BeatTestItem, make_beat_test_set
-from . import beat_evaluation
 
 __all__ = [
     "SHORT_NAMES",
@@ -72,12 +73,12 @@ _REAL_MIN_BEAT_TIME = {"hainsworth_001": 5.0, "ballroom_waltz": 5.0, "madmom_sam
 
 
 def available_methods() -> list[str]:
-    """Trackers that can run here, ours first (:func:`beatsync.peers.available`).
+    """Trackers that can run here, ours first (:func:`beatsync.other_trackers.available`).
 
     Always ``psf`` and ``librosa``; essentia's two trackers when the optional
     ``essentia`` package is installed.
     """
-    return [name for name, ok in peers.available().items() if ok]
+    return [name for name, ok in other_trackers.available().items() if ok]
 
 
 def methods_note(methods: Sequence[str]) -> str:
@@ -139,27 +140,31 @@ def score_items(
 ) -> pd.DataFrame:
     """Track and score every item with every method; one row per item and method.
 
-    :func:`beatsync.study.beat_evaluation.score_items`, with each real recording
-    scored from its own ``min_beat_time`` and the study's short metric names.
-    Columns: item, group, method, tempo_ref, tempo_est, octave, F, CMLt, AMLt,
-    seconds. ``track_kwargs`` go to the ``psf`` tracker (front-end parameters).
+    Each real recording is scored from its own ``min_beat_time``, with the study's short
+    metric names. Columns: item, group, method, tempo_ref, tempo_est, octave
+    (:func:`~beatsync.evaluate.beats.tempo_octave`), F, CMLt, AMLt, seconds (tracking
+    time, not for display). ``track_kwargs`` go to the ``psf`` tracker (front-end
+    parameters).
     """
     methods = available_methods() if methods is None else list(methods)
-    frames = []
-    by_time: dict[float, list[BeatTestItem]] = {}
-    for it in items:
-        by_time.setdefault(_min_beat_time(it, min_beat_time), []).append(it)
-    for mbt, group in by_time.items():
-        frames.append(
-            beat_evaluation.score_items(
-                group, methods=methods, min_beat_time=mbt, track_kwargs=track_kwargs
-            )
-        )
-    scores = pd.concat(frames, ignore_index=True).rename(columns=SHORT_NAMES)
-    order = {it.name: i for i, it in enumerate(items)}
-    scores = scores.sort_values("item", key=lambda c: c.map(order), kind="stable")
+    for m in methods:
+        other_trackers.get(m)
+    rows = []
+    for it, method in itertools.product(items, methods):
+        t0 = time.perf_counter()
+        with silenced():
+            if method == "psf" and track_kwargs:
+                est = track_beats(it.y, it.sr, **track_kwargs).beats
+            else:
+                est = other_trackers.track(method, it.y, it.sr)
+            seconds = time.perf_counter() - t0
+            scores = evaluate(it.beats, est, min_beat_time=_min_beat_time(it, min_beat_time))
+        rows.append(
+            {"item": it.name, "group": it.group, "method": method,
+             **tempo_octave(it.beats, est), **scores, "seconds": seconds}
+        )  # fmt: skip
     cols = ["item", "group", "method", "tempo_ref", "tempo_est", "octave", "F", "CMLt", "AMLt"]
-    return scores[[*cols, "seconds"]].reset_index(drop=True)
+    return pd.DataFrame(rows).rename(columns=SHORT_NAMES)[[*cols, "seconds"]]
 
 
 def meter_estimates(items: Sequence[BeatTestItem]) -> pd.DataFrame:

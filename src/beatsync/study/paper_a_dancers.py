@@ -14,7 +14,14 @@ dancer:
     covering that song with ``fill="loop"``;
 (c) a random-offset control (:func:`beatsync.evaluate.alignment.offset_control`: the
     motion beats shifted by one random offset within a beat period), for (a) and (b);
-(d) the dance's period and motion-beat interval against the song's beat period.
+(d) the dance's period and motion-beat interval against the song's beat period;
+(e) whether the re-synchronised dancer still moves like the dancer
+    (:func:`motion_table`): the playback speed (instantaneous and per interval, share
+    of the output within 0.8-1.25), p99 joint speed and acceleration against the
+    dancer's own, the peak joint speed at the loop joins and overall, next to the
+    alignment scores of (a)-(c); and the same figures measured on the code before the
+    whole-dance beat counts and seamless loops (:func:`before_table`, read from the
+    record of ``benchmarks/bench_resync.py --label before``).
 
 What the data can and cannot show: the dataset says which part of each song was
 danced (25 fps frame ranges), not that the steps sit on its beats; its own
@@ -52,6 +59,9 @@ __all__ = [
     "dancer_table",
     "period_table",
     "summary_table",
+    "motion_table",
+    "before_table",
+    "speed_figure",
     "beats_figure",
     "dancer_video",
     "video_html",
@@ -325,6 +335,134 @@ def summary_table(table: Any, *, mode: str = "beats") -> Any:
     cols = ["dancer", "style", "song"]
     cols += [f"{w}_{s}" for s in ("motion", "music") for w in ("own", "after", "after_control")]
     return t[cols + ["beats_motion_target", "beats_music_target"]].reset_index(drop=True)
+
+
+def _joint_speeds(motion: Any) -> np.ndarray:
+    pos = motion.positions()
+    return np.linalg.norm(np.diff(pos, axis=0), axis=-1) * motion.fps
+
+
+def _playback_speed(result: Any) -> np.ndarray:
+    """Source seconds per output second between output frames, where the warp is live."""
+    fps = result.motion.fps
+    t = np.arange(result.warp_src_times.size) / fps
+    live = (t[1:] > result.warp.tgt[0]) & (t[1:] <= result.warp.tgt[-1] + 1e-9)
+    return np.diff(result.warp_src_times)[live] * fps
+
+
+def motion_table(
+    pairs: dict[str, DancePair],
+    table: Any,
+    results: dict[tuple[str, str], Any],
+    *,
+    mode: str = "beats",
+    band: tuple[float, float] = (0.8, 1.25),
+) -> Any:
+    """(e) Per dancer re-synchronised to :data:`OTHER_SONG` (one sync ``mode``): playback
+    speed, joint kinematics against the dancer's own, the joins, and the alignment
+    scores of :func:`dancer_table` (after, random-offset control, own song).
+
+    Speeds and kinematics are measured here on the output frames (not read from the
+    sync report); joint speeds in m/s, accelerations in m/s^2, finite differences over
+    all joints and frames.
+    """
+    import pandas as pd
+
+    rows = []
+    t = table[table["mode"] == mode].set_index("dancer")
+    for name, pair in pairs.items():
+        res = results[(name, mode)]
+        own_v = _joint_speeds(pair.motion)
+        out_v = _joint_speeds(res.motion)
+        own_a = np.linalg.norm(np.diff(pair.motion.positions(), 2, axis=0), axis=-1)
+        out_a = np.linalg.norm(np.diff(res.motion.positions(), 2, axis=0), axis=-1)
+        speed = _playback_speed(res)
+        joins = [j.get("peak_joint_speed", np.nan) for j in res.report.get("joins", [])]
+        used = res.report.get("beats_per_motion_beat_used", {})
+        rows.append(
+            {
+                "dancer": name,
+                "song": OTHER_SONG[name],
+                "beats per motion beat used": ", ".join(f"{k}x{v}" for k, v in used.items()),
+                "speed in band": float(np.mean((speed >= band[0]) & (speed <= band[1]))),
+                "speed min": float(speed.min()),
+                "speed median": float(np.median(speed)),
+                "speed max": float(speed.max()),
+                "p99 speed / own": float(np.percentile(out_v, 99) / np.percentile(own_v, 99)),
+                "p99 accel / own": float(np.percentile(out_a, 99) / np.percentile(own_a, 99)),
+                "peak / own peak": float(out_v.max() / own_v.max()),
+                "joins": len(joins),
+                "join peak / own peak": float(np.max(joins) / own_v.max()) if joins else np.nan,
+                "after_motion": t.loc[name, "after_motion"],
+                "control_motion": t.loc[name, "after_control_motion"],
+                "own_motion": t.loc[name, "own_motion"],
+                "after_music": t.loc[name, "after_music"],
+                "control_music": t.loc[name, "after_control_music"],
+                "own_music": t.loc[name, "own_music"],
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def before_table(path: str | Path, pairs: dict[str, DancePair] | None = None) -> Any:
+    """(e) before: the record of ``benchmarks/bench_resync.py --label before`` (the code
+    before the whole-dance beat counts and seamless loops; every dancer on every other
+    song with ``sync``'s defaults), for the pairs of :data:`OTHER_SONG`, in the columns
+    of :func:`motion_table`. Empty when the record is missing (a benchmark not run)."""
+    import json
+
+    import pandas as pd
+
+    p = Path(path)
+    if not p.is_file():
+        return pd.DataFrame()
+    names = list(OTHER_SONG) if pairs is None else list(pairs)
+    rows = []
+    for r in json.loads(p.read_text())["rows"]:
+        if r["dancer"] not in names or OTHER_SONG[r["dancer"]] != r["song"]:
+            continue
+        s = r["speed"]
+        rows.append(
+            {
+                "dancer": r["dancer"],
+                "song": r["song"],
+                "speed in band": s["in_band"],
+                "speed min": s["min"],
+                "speed median": s["median"],
+                "speed max": s["max"],
+                "p99 speed / own": r["p99_speed_ratio"],
+                "p99 accel / own": r["p99_accel_ratio"],
+                "peak / own peak": r["peak_ratio"],
+                "after_motion": r["after"]["motion"],
+                "control_motion": r["control"]["motion"],
+                "own_motion": r["own"]["motion"],
+                "after_music": r["after"]["music"],
+                "control_music": r["control"]["music"],
+                "own_music": r["own"]["music"],
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def speed_figure(results: dict[tuple[str, str], Any], *, mode: str = "beats") -> Any:
+    """Distribution of the instantaneous playback speed of every re-synchronised dancer
+    (share of output time), the band 0.8-1.25 shaded."""
+    import matplotlib.pyplot as plt
+
+    names = [d for d, m in results if m == mode]
+    fig, axes = plt.subplots(1, len(names), figsize=(3.0 * len(names), 2.6), sharey=True)
+    axes = np.atleast_1d(axes)
+    bins = np.linspace(0.3, 2.5, 45)
+    for ax, name in zip(axes, names, strict=True):
+        speed = _playback_speed(results[(name, mode)])
+        w = np.full(speed.size, 1.0 / max(speed.size, 1))
+        ax.axvspan(0.8, 1.25, color="tab:green", alpha=0.15, lw=0)
+        ax.hist(np.clip(speed, bins[0], bins[-1]), bins=bins, weights=w, color="tab:blue")
+        ax.set_title(f"{name} on {OTHER_SONG[name]}", fontsize=9)
+        ax.set_xlabel("playback speed")
+    axes[0].set_ylabel("share of output time")
+    fig.tight_layout()
+    return fig
 
 
 def beats_figure(

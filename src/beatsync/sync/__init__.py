@@ -66,8 +66,16 @@ Beyond the paper (for real dances)
 ----------------------------------
 - ``mode="beats"``: a dance that is not strictly periodic (ballroom figures vary) is
   warped on its own motion beats (:func:`beatsync.motion_beats.kinematic_beats`)
-  instead of periods: every motion-beat interval spans a whole number of music
-  beats (:func:`beats_per_unit`), with the same smooth rate of eq. 9.
+  instead of periods. The number of beats of every motion-beat interval is chosen
+  for the whole dance at once (:func:`.counts.plan_counts`, dynamic programming over
+  the intervals): playback speed within 0.8-1.25 wherever the song allows (paper B's
+  time-scale bound, :mod:`beatsync.graph.timescale`), and never faster than keeps the
+  joints within the dancer's own peak speed; smooth from one interval to the next;
+  dance bars (``dance_beats_per_period`` motion beats) starting on the music's bar
+  lines; where no whole number of beats fits, an interval is merged with its
+  neighbour or lands on a half beat (the report counts both). The same smooth rate
+  of eq. 9 then lands them. ``beats_per_period=`` keeps one count for the median
+  interval and proportional counts for the others (:func:`beats_per_unit`).
   ``mode="auto"`` uses periods when the periodicity test accepts the motion and
   falls back to beats, with a warning, when it refuses.
 - ``boundaries=None``: the motion is segmented here; in ``mode="periods"`` by default
@@ -76,14 +84,24 @@ Beyond the paper (for real dances)
   so dances periodic at the step level keep paper A's method and real ballroom
   figures (longer, varying) are warped on their motion beats, which aligned them
   far better with a new song on the four real dancers we have.
-- ``fill="loop"``: whole periods (or beat segments) are repeated with blended joins
-  (:mod:`beatsync.sync.fill`) until the dance covers the song to its last beat;
+- ``fill="loop"``: whole periods (or beat segments) are repeated until the dance
+  covers the song to its last beat (:mod:`beatsync.sync.fill`): the loop is chosen
+  where the poses at its two ends are most alike (paper B's motion-graph distance),
+  each pass is turned and moved on the floor to start where the previous one ended,
+  and the joins are blended over 0.6 s with a continuous velocity;
   ``fill="stop"`` (paper A) ends with the last period that fits.
+- The report measures what the warp did to the dance (:mod:`.quality`): playback speed
+  (instantaneous and per interval, the share of output time within 0.8-1.25), joint
+  speed and acceleration against the input's, each loop join's peak joint speed; a
+  warning names the tempo that would fit when the song cannot be followed within the
+  band. The JSON layout's root track (``center``) is resampled with the joints.
 - Position-only motion (joint or marker positions, no skeleton) is resampled
   linearly; rotations by slerp.
 
 Modules: :mod:`.warp` (eq. 9 and the warp), :mod:`.mapping` (beats per period,
-meters, accent lag), :mod:`.fill` (looping), :mod:`.core` (:func:`synchronize`).
+meters, accent lag), :mod:`.counts` (beat counts of a whole dance), :mod:`.fill`
+(looping), :mod:`.placement` (beats mode: loop, then counts), :mod:`.quality` (the
+report's measurements), :mod:`.core` (:func:`synchronize`).
 
 The residual of a boundary is measured twice in the report: on the warp as realised
 by the output frames (``residual_ms``: the music time at which the resampled motion

@@ -9,16 +9,18 @@ import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..units import (
+    as_int,
+    check_interval,
     check_motion_fps,
-    check_range,
     check_times,
-    check_whole,
     frames_to_time,
     time_to_frames,
 )
-from .fill import LoopedClip, loop_events
+from .fill import LoopedClip, choose_loop, loop_events, with_center
 from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
+from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
+from .quality import report_entries
 from .warp import TimeWarp, integrate_warp
 
 __all__ = [
@@ -35,8 +37,6 @@ __all__ = [
 MODES = ("periods", "beats", "auto")
 LANDINGS = ("boundaries", "accents")
 FILLS = ("stop", "loop")
-#: width of the blended window at each loop join [s] (capped at half an interval)
-JOIN_S = 0.2
 #: default period range when segmenting, in music beats: one to eight beats
 PERIOD_BEATS = (0.9, 8.5)
 #: period range of the periodicity test in mode="auto": paper A's (steps, not figures)
@@ -73,7 +73,17 @@ class SyncResult:
         ``boundaries_s``, ``residual_ms`` (one per boundary),
         ``residual_nearest_frame_ms``, ``max_abs_residual_ms``,
         ``max_abs_residual_frames``, ``lead_in_hold_frames``, ``n_scaled_periods``,
-        ``covered_s`` (music time span the dance covers).
+        ``covered_s`` (music time span the dance covers); measured on the result
+        (:mod:`beatsync.sync.quality`): ``beats_per_motion_beat_used`` (count -> number
+        of intervals, halves allowed), ``n_merged_intervals``,
+        ``n_half_beat_landings``, ``phrases_on_bars`` (share of the dance bars, given
+        ``dance_beats_per_period``, that start on a bar line), ``playback_speed``
+        (``instantaneous`` and ``per_interval``: min, median, max, ``in_band`` share
+        of output time; ``band``; ``held_lead_in_s``), ``kinematics`` (p99 and peak
+        joint speed, p99 acceleration of input and output, and their ratios; None
+        without joint positions), ``loop`` (span, blend, turn per pass, pose
+        distance) and ``joins`` (music time and peak joint speed of each),
+        ``speed_warning``.
     warp : TimeWarp
         The warp itself (for plots).
     """
@@ -150,14 +160,14 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
         Bad settings (``alpha``, ``period_range``), or a dancer whose joints do not move.
     """
     from ..motion import segmentation_view
-    from ..segment import segment
     from ..segment.checks import check_alpha, check_period_range
-    from ..segment.core import PeriodicityRefused
+    from ..segment.core import PeriodicityRefused, _segment_motion
 
     alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
     period_range = check_period_range(period_range)
     try:
-        seg = segment(segmentation_view(motion), alpha=alpha, period_range=period_range)
+        seg = _segment_motion(segmentation_view(motion), alpha=alpha, n_periods=None,
+                              period_range=period_range, method="energy")  # fmt: skip
     except PeriodicityRefused as exc:
         # the channels are segmentation_view's here (sync and batch have no --channels)
         raise NotPeriodicError(exc.advised(PERIODS_ADVICE)) from None
@@ -286,8 +296,11 @@ def synchronize(
         The music's meter (e.g. ``track.beats_per_bar``); respected when choosing.
     dance_beats_per_period : int >= 1, optional
         The dance's meter: beats of one period of the dance (3 for a waltz step, 6
-        for a waltz box); the count then is a multiple of it (or it halved), and a
-        warning says so when it cannot also respect ``beats_per_bar``. The report's
+        for a waltz box). In ``mode="periods"`` the count then is a multiple of it (or
+        it halved), and a warning says so when it cannot also respect
+        ``beats_per_bar``; in ``mode="beats"`` every such group of motion beats starts
+        on a bar line of the music where the speed band allows, and a loop holds
+        whole groups. The report's
         ``motion_beats_per_period_counted`` (kinematic beats per period) is a hint.
     first_beat : int >= 0
         Index of the beat the first boundary lands on.
@@ -347,7 +360,7 @@ def synchronize(
             f"the music has {beats.size} detectable beat(s); at least 2 are needed "
             "(is it silent or without rhythm? give the tempo with bpm / --bpm)"
         )
-    first_beat = check_whole(first_beat, name="first_beat")
+    first_beat = as_int(first_beat, name="first_beat", minimum=0)
     if first_beat >= beats.size:
         raise ParameterError(
             f"first_beat={first_beat} but the music has only {beats.size} beats (indices from 0)"
@@ -355,17 +368,13 @@ def synchronize(
     override = (
         None
         if beats_per_period is None
-        else check_whole(beats_per_period, name="beats_per_period", minimum=1)
+        else as_int(beats_per_period, name="beats_per_period", minimum=1)
     )
-    bar = (
-        None
-        if beats_per_bar is None
-        else check_whole(beats_per_bar, name="beats_per_bar", minimum=1)
-    )
+    bar = None if beats_per_bar is None else as_int(beats_per_bar, name="beats_per_bar", minimum=1)
     dance = (
         None
         if dance_beats_per_period is None
-        else check_whole(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
+        else as_int(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
     )
     try:
         phase_offset = float(phase_offset)
@@ -393,13 +402,7 @@ def synchronize(
     elif period_range is None:
         period_range = (PERIOD_BEATS[0] * beat_period, PERIOD_BEATS[1] * beat_period)
     else:
-        try:
-            lo, hi = period_range
-        except (TypeError, ValueError):
-            raise ParameterError(
-                f"period_range={period_range!r} must be (shortest, longest) [s]"
-            ) from None
-        period_range = check_range(lo, hi, name="period_range", unit="s")
+        period_range = check_interval(period_range, name="period_range", unit="s")
     duration = float(frames_to_time(n_frames - 1, fps=fps))  # sample_motion clips here
 
     events, used_mode, note = _events(
@@ -408,8 +411,14 @@ def synchronize(
     intervals = np.diff(events)
     unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
     counted = motion_beat_count(motion, events) if used_mode == "periods" else None
+    whole_dance = used_mode == "beats" and override is None
     if override is not None:
         count = BeatCount(override, "override", unit / beat_period)
+    elif whole_dance:
+        count = BeatCount(
+            max(1, int(np.rint(unit / beat_period))), "whole dance (dynamic programming)",
+            unit / beat_period,
+        )  # fmt: skip
     else:
         count = choose_count(unit / beat_period, dance=dance, bar=bar)
     if count.meter_fit is False:
@@ -422,7 +431,9 @@ def synchronize(
     plan = {
         "motion": motion,
         "events": events,
-        "counts": counts,
+        "counts": None if whole_dance else counts,
+        "dance": dance if used_mode == "beats" else None,
+        "bar": bar,
         "beats": beats,
         "fill": fill,
         "first_beat": first_beat,
@@ -447,7 +458,7 @@ def synchronize(
             plan["first_beat"] = first_beat = first_beat + 1
         res = _resample(plan, -lag)
     ratio = unit / beat_period / count.m
-    if ratio > 2.0 or ratio < 0.5:
+    if not whole_dance and (ratio > 2.0 or ratio < 0.5):
         warn(
             f"motion {'beats' if used_mode == 'beats' else 'periods'} ({unit:.3f} s) become "
             f"{count.m} beat(s) of {beat_period:.3f} s: the dance is played {ratio:.2f}x its "
@@ -473,7 +484,35 @@ def synchronize(
             "beat_period_s": beat_period,
         }
     )
+    if whole_dance:  # the count used most
+        used_counts = res.report["beats_per_motion_beat_used"]
+        res.report["beats_per_period"] = float(max(used_counts, key=used_counts.get))
+    _speed_warning(res.report, beat_period)
     return res
+
+
+#: share of output time within the speed band below which a warning is given
+BAND_SHARE = 0.95
+
+
+def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
+    """Warn when the song cannot be followed within the speed band, naming a tempo
+    that would fit."""
+    from .quality import fitting_tempo
+
+    sp = report["playback_speed"]
+    share = (sp["instantaneous"] or sp["per_interval"])["in_band"]
+    report["speed_warning"] = ""
+    if share < BAND_SHARE:
+        lo, hi = sp["band"]
+        note = (
+            f"the dance plays within x{lo:g}-x{hi:g} of its speed for only {share:.0%} of "
+            f"the song ({60.0 / beat_period:.0f} BPM); a song at about "
+            f"{fitting_tempo(sp['per_interval']['median'], 60.0 / beat_period)} would fit "
+            "with the same beat counts"
+        )
+        report["speed_warning"] = note
+        warn(note, stacklevel=3)
 
 
 def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
@@ -482,43 +521,48 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     first_beat, fps, out_fps = plan["first_beat"], plan["fps"], plan["out_fps"]
     duration = plan["duration"]
     n_avail = events.size - 1
-    cum = np.concatenate([[0], np.cumsum(counts)])
     last_beat = beats.size - 1
     looped: LoopedClip | None = None
-    if plan["fill"] == "loop" and cum[-1] < last_beat - first_beat:
-        # enough repetitions that whole intervals reach the last beat, plus one for the tail
-        per_rep = int(cum[-1] - cum[0])
-        need = -(-(last_beat - first_beat) // max(per_rep, 1)) * n_avail + 1
-        looped = loop_events(events, need, join=JOIN_S)
-        events = looped.events
-        counts = np.resize(counts, events.size - 1)
-        cum = np.concatenate([[0], np.cumsum(counts)])
-    n_fit = int(np.searchsorted(cum, last_beat - first_beat, side="right")) - 1
-    if n_fit < 1:
-        raise ParameterError(
-            f"the music is too short: {beats.size - first_beat} beat(s) from beat {first_beat} "
-            f"(last at {beats[-1]:.2f} s) cannot hold one motion period of {int(counts[0])} "
-            f"beat(s) ({float(events[1] - events[0]):.2f} s of motion); use a longer song, an "
-            "earlier first_beat or fewer beats_per_period"
-        )
-    p = min(n_avail if looped is None else events.size - 1, n_fit)
-    targets = beats[first_beat + cum[: p + 1]] + phase_offset
-    if targets[0] < 0:
-        raise ParameterError(
-            f"phase_offset={phase_offset:.3f} s puts the first boundary at {targets[0]:.3f} s, "
-            "before the music starts; use first_beat >= 1 or a smaller offset"
-        )
-    used = events[: p + 1]
-    end = None
-    if p == events.size - 1 and duration > used[-1]:
-        end = duration  # the clip's tail after its last boundary
-    warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
-    if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
-        # cover the beats after the last whole interval with part of the next one: the
-        # warp goes on at its end rate up to the last beat (within that interval)
-        need = beats[last_beat] + phase_offset - targets[-1]
-        end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
+    if counts is None:  # beats mode: the whole dance's counts at once
+        looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
         warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        p = used.size - 1
+    else:
+        cum = np.concatenate([[0], np.cumsum(counts)])
+        if plan["fill"] == "loop" and cum[-1] < last_beat - first_beat:
+            # enough repetitions that whole intervals reach the last beat, plus one for the tail
+            a, b, angle, shift, dist, join = choose_loop(motion, events)
+            per_rep = max(int(cum[b] - cum[a]), 1)
+            need = b + 1 + -(-max(0, last_beat - first_beat - int(cum[b])) // per_rep) * (b - a)
+            looped = loop_events(
+                events, need, join=join, span=(a, b), angle=angle, shift=shift, distance=dist
+            )
+            counts = counts[looped.event_index[1:] - 1]
+            events = looped.events
+            cum = np.concatenate([[0], np.cumsum(counts)])
+        n_fit = int(np.searchsorted(cum, last_beat - first_beat, side="right")) - 1
+        if n_fit < 1:
+            raise ParameterError(
+                f"the music is too short: {beats.size - first_beat} beat(s) from beat "
+                f"{first_beat} (last at {beats[-1]:.2f} s) cannot hold one motion period of "
+                f"{int(counts[0])} beat(s) ({float(events[1] - events[0]):.2f} s of motion); use "
+                "a longer song, an earlier first_beat or fewer beats_per_period"
+            )
+        p = min(n_avail if looped is None else events.size - 1, n_fit)
+        targets = beats[first_beat + cum[: p + 1]] + phase_offset
+        check_start(targets, phase_offset)
+        used = events[: p + 1]
+        end = None
+        if p == events.size - 1 and duration > used[-1]:
+            end = duration  # the clip's tail after its last boundary
+        warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
+            # cover the beats after the last whole interval with part of the next one: the
+            # warp goes on at its end rate up to the last beat (within that interval)
+            need = beats[last_beat] + phase_offset - targets[-1]
+            end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
+            warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
     tau_end = float(warp.tgt[-1])
     if tau_end <= 0:
         raise ParameterError(
@@ -543,7 +587,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
         )
         values = pos.reshape(n_out, -1)
-    out_motion = motion.with_values(values, fps=out_fps)
+    out_motion = with_center(motion.with_values(values, fps=out_fps), motion, src_times, looped)
 
     # residuals: realised warp (interpolated between output frames) and nearest frame
     live = (out_times > warp.tgt[0]) & (out_times < warp.tgt[-1])
@@ -598,4 +642,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     }
     # the first boundary frame index in the output, for users who trim
     report["first_boundary_frame"] = int(time_to_frames(targets[0], fps=out_fps))
+    report.update(
+        report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed)
+    )
     return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)

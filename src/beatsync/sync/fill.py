@@ -1,68 +1,102 @@
-"""Looping a clip's whole periods (or beat segments) so the dance covers a whole song.
+"""Seamless loops: repeating a span of a clip so the dance covers a whole song.
 
-A clip with events ``e_0 < ... < e_P`` (period boundaries, or motion beats) is played
-once as it is up to ``e_P``, then its span ``[e_0, e_P]`` is repeated. The *looped
-timeline* ``t`` runs on: repetition ``r >= 1`` covers ``[e_P + (r-1) L, e_P + r L]``,
-``L = e_P - e_0``, and shows the clip at ``e_0 + (t - start_r)``. The events of the
-looped timeline are the clip's events, then ``e_1 .. e_P`` shifted by ``r L`` per
-repetition, so every repetition brings whole periods.
+Where to loop (:func:`choose_loop`)
+    A clip with events ``e_0 < ... < e_P`` (period boundaries, or motion beats) is
+    played once up to ``e_b`` and then its span ``[e_a, e_b]`` is repeated. The pair
+    ``(a, b)`` is the one whose poses are most alike by paper B's motion-graph
+    distance (:func:`beatsync.graph.distance.aligned_distance_matrix`, after Kovar et
+    al. 2002: the joints' point clouds over a window around both events compared after
+    the best rotation about the vertical axis and translation on the floor), among the
+    pairs whose span holds at least ``MIN_SPAN`` of the clip's events (so the loop keeps
+    most of the dance) and with half a blend window of clip on both sides. With a dance
+    meter of ``N`` motion beats, ``a`` and ``b - a`` are multiples of ``N`` (a loop
+    starts a dance bar and holds whole bars).
 
-Joins are blended: within ``join/2`` of a join at ``J``, the pose is the blend of the
-ending repetition's continuation (clip time ``e_P + (t - J)``) and the starting one's
-lead (``e_0 + (t - J)``) with a raised-cosine weight going 0 -> 1 across the window
-(quaternion slerp for rotations, linear for positions; see
-:func:`beatsync.rotations.blend_values`). Clip times outside the clip are held at its
-ends; the held part carries little weight near the window's edges. Period boundaries
-are similar poses by construction, so the blend is short and gentle.
+The looped timeline
+    ``t`` runs on from the clip: repetition ``r >= 1`` covers
+    ``[e_b + (r-1) L, e_b + r L]``, ``L = e_b - e_a``, and shows the clip at
+    ``e_a + (t - start_r)``. Its events are the clip's up to ``e_b``, then
+    ``e_{a+1} .. e_b`` shifted by ``r L`` per repetition (whole intervals).
 
-Travel is carried across joins: repetition ``r`` is moved along the floor by ``r``
-times the clip's ground travel over its span (root position at ``e_P`` minus at
-``e_0``), so a dancer who moves across the floor goes on from where the previous pass
-ended instead of jumping back to the start (a walk looped without it teleported 3.45 m
-at every join, at up to 28 m/s). The floor is the plane of the non-vertical axes: y is
-up in skeleton (BVH) motion, z in position-only motion (see :mod:`beatsync.motion`);
-the travel of position-only motion is that of the joints' centroid, and every joint is
-moved. A turn over the span is not carried on (each pass starts at the clip's
-heading), and motion without positions (angle tables) is looped as it is.
+Aligned and blended joins
+    Repetition ``r`` is moved by ``M^r``, ``M`` the rigid floor transform (rotation
+    about the vertical axis, translation on the floor) that carries the pose at
+    ``e_a`` onto the pose at ``e_b``: each pass starts where and facing where the
+    previous one ended, so a dancer who travels or turns goes on instead of jumping
+    back. Within ``join / 2`` of a join the pose blends the ending pass's continuation
+    (clip time ``e_b + d``, moved by ``M^(r-1)``) into the starting pass's lead
+    (``e_a + d``, moved by ``M^r``) with a raised-cosine weight, whose derivative
+    vanishes at both ends of the window: both motions carry their own velocity, so
+    the velocity is continuous and the blend adds only ``w'`` times the (small)
+    remaining pose difference. A skeleton's root is turned (its rotation channels and
+    its floor position) and moved; joint positions are rotated and translated. Rotation
+    channels are blended by slerp, positions linearly.
+
+Data contract: times in seconds of the clip (``e``) or of the looped timeline
+(``t``); positions ``(frames, joints, 3)`` with z up (position-only motion) or the
+skeleton's root channels with y up (BVH).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from ..rotations import blend_values, sample_motion
+from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
 
-__all__ = ["LoopedClip", "loop_events"]
+__all__ = ["LOOP_BLEND_S", "MIN_SPAN", "LoopedClip", "choose_loop", "loop_events", "with_center"]
+
+#: width of the blended window at each join [s]
+LOOP_BLEND_S = 0.6
+#: shortest loop, as a share of the clip's events
+MIN_SPAN = 0.5
 
 
 @dataclass(frozen=True)
 class LoopedClip:
-    """A clip's span of events repeated ``repetitions`` times in a looped timeline.
+    """A clip's span ``[first, last]`` repeated ``repetitions`` times in a looped timeline.
 
     Attributes
     ----------
     events : np.ndarray [s]
-        Events in the looped timeline (the clip's, then each repetition's).
-    first : float [s]
-        ``e_0``, the clip's first event.
-    last : float [s]
-        ``e_P``, the clip's last event (the first join).
+        Events in the looped timeline.
+    event_index : np.ndarray [int]
+        Each looped event's index among the clip's events.
+    first, last : float [s]
+        ``e_a`` and ``e_b``: the clip times where a repetition starts and ends.
     length : float [s]
-        ``L = e_P - e_0``, the span repeated.
+        ``L = e_b - e_a``.
     repetitions : int >= 1
-        Passes through the span (1: the clip as it is).
     join : float [s]
         Width of the blended window around each join.
+    angle : float [rad]
+        Rotation about the vertical axis from one pass to the next.
+    shift : np.ndarray [shape=(2,)] or None
+        Translation on the floor from one pass to the next, on the floor axes of
+        :func:`beatsync.graph.distance.ground_axes` (x, y for joint positions; z, x
+        for a skeleton's root); None: no positions.
+    distance : float
+        Pose distance at the join (motion-graph distance, position unit).
     """
 
     events: np.ndarray
+    event_index: np.ndarray
     first: float
     last: float
     length: float
     repetitions: int
     join: float
+    angle: float = 0.0
+    shift: np.ndarray | None = None
+    distance: float = float("nan")
+
+    @property
+    def join_times(self) -> np.ndarray:
+        """Looped times of the joins [s]."""
+        return self.last + np.arange(self.repetitions - 1) * self.length
 
     def source_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Clip times for looped times ``t``: ``(a, b, w)``, pose = blend(a, b, w).
@@ -82,7 +116,7 @@ class LoopedClip:
         ra, rb = r, r.copy()
         half = 0.5 * self.join
         if half > 0 and self.repetitions > 1:
-            joins = self.last + np.arange(self.repetitions - 1) * self.length
+            joins = self.join_times
             k = np.clip(np.searchsorted(joins, t), 0, joins.size - 1)
             for kk in (k, np.maximum(k - 1, 0)):
                 d = t - joins[kk]
@@ -95,52 +129,196 @@ class LoopedClip:
                 rb = np.where(near, kk + 1.0, rb)
         return a, b, w, ra, rb
 
-    def sample(self, motion: object, t: np.ndarray) -> np.ndarray:
-        """Values of ``motion`` at looped times ``t`` (moved by the travel of the
-        repetitions before, blended at the joins)."""
+    def _moves(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rotation angles and floor translations of ``M^r`` for each repetition."""
+        n = self.repetitions
+        ang = np.arange(n) * self.angle
+        off = np.zeros((n, 2))
+        if self.shift is not None:
+            c, s = np.cos(self.angle), np.sin(self.angle)
+            for r in range(1, n):  # M^r = M o M^(r-1): x -> R x + shift
+                x, y = off[r - 1]
+                off[r] = (c * x - s * y + self.shift[0], s * x + c * y + self.shift[1])
+        idx = reps.astype(np.int64)
+        return ang[idx], off[idx]
+
+    def sample_positions(self, pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
+        """Positions ``(frames, points, 3)`` (z up) at looped times ``t``: interpolated
+        linearly, each pass moved by ``M^r``, blended at the joins."""
         a, b, w, ra, rb = self._locate(t)
-        travel = _floor_travel(motion, self.first, self.last)
-        values = sample_motion(motion, a)
-        if travel is not None:
-            values[:, travel[0]] += ra[:, None] * travel[1]
+        out = _move(_interp(pos, fps, a), *self._moves(ra))
         blend = w > 0
         if blend.any():
-            vb = sample_motion(motion, b[blend])
-            if travel is not None:
-                vb[:, travel[0]] += rb[blend, None] * travel[1]
+            vb = _move(_interp(pos, fps, b[blend]), *(x[blend] for x in self._moves(rb)))
+            wb = w[blend, None, None]
+            out[blend] = (1.0 - wb) * out[blend] + wb * vb
+        return out
+
+    def sample(self, motion: object, t: np.ndarray) -> np.ndarray:
+        """Values of ``motion`` at looped times ``t`` (each pass moved by ``M^r``,
+        blended at the joins)."""
+        if motion.is_positional:
+            pos = motion.values.reshape(motion.n_frames, -1, 3)
+            return self.sample_positions(pos, motion.fps, t).reshape(len(t), -1)
+        a, b, w, ra, rb = self._locate(t)
+        values = self._move_root(motion, sample_motion(motion, a), ra)
+        blend = w > 0
+        if blend.any():
+            vb = self._move_root(motion, sample_motion(motion, b[blend]), rb[blend])
             values[blend] = blend_values(motion, values[blend], vb, w[blend])
         return values
 
+    def _move_root(self, motion: object, values: np.ndarray, reps: np.ndarray) -> np.ndarray:
+        """Skeleton motion: the root turned about the vertical (y) axis and moved on the
+        floor by ``M^r`` (its position and its rotation channels)."""
+        cols = _root_floor_columns(motion)
+        if cols is None or self.shift is None:
+            return values
+        ang, off = self._moves(reps)
+        if np.any(ang):
+            zx = values[:, cols]
+            c, s = np.cos(ang), np.sin(ang)
+            values[:, cols[0]] = c * zx[:, 0] - s * zx[:, 1]
+            values[:, cols[1]] = s * zx[:, 0] + c * zx[:, 1]
+            triple = _root_rotation(motion)
+            if triple is not None:
+                idx, order = triple
+                euler = values[:, idx]
+                turned = Rotation.from_euler("y", ang[:, None]) * euler_to_rotation(euler, order)
+                values[:, idx] = rotation_to_euler(turned, order, reference=euler)
+        values[:, cols] += off
+        return values
 
-def _floor_travel(
-    motion: object, start: float, stop: float
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """Ground travel of ``motion`` from clip time ``start`` to ``stop`` [s].
 
-    Returns ``(columns, step)``: the value columns holding floor coordinates and what
-    to add to them per repetition; None for motion without positions. Skeleton motion:
-    the root's two horizontal position channels (y up); position-only motion: every
-    joint's x and y (z up), moved by the travel of the joints' centroid.
-    """
-    ends = sample_motion(motion, np.array([start, stop], dtype=np.float64))
-    if motion.is_positional:
-        n_joints = ends.shape[1] // 3
-        xy = ends.reshape(2, n_joints, 3)[:, :, :2].mean(axis=1)  # centroid on the floor
-        cols = (3 * np.arange(n_joints)[:, None] + np.arange(2)[None, :]).ravel()
-        return cols, np.tile(xy[1] - xy[0], n_joints)
-    skeleton = motion.skeleton
+def _interp(pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
+    f = np.clip(np.asarray(t) * fps, 0.0, pos.shape[0] - 1)
+    i0 = np.floor(f).astype(np.int64)
+    i1 = np.minimum(i0 + 1, pos.shape[0] - 1)
+    w = (f - i0)[:, None, None]
+    return (1.0 - w) * pos[i0] + w * pos[i1]
+
+
+def _move(p: np.ndarray, ang: np.ndarray, off: np.ndarray) -> np.ndarray:
+    """Rotate ``p`` (frames, points, 3; z up) about the vertical axis by ``ang`` and
+    translate it on the floor by ``off`` (per frame)."""
+    if not np.any(ang) and not np.any(off):
+        return p
+    c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]
+    out = p.copy()
+    out[:, :, 0] = c * p[:, :, 0] - s * p[:, :, 1] + off[:, 0:1]
+    out[:, :, 1] = s * p[:, :, 0] + c * p[:, :, 1] + off[:, 1:2]
+    return out
+
+
+def _root_floor_columns(motion: object) -> np.ndarray | None:
+    """The skeleton root's two horizontal position channels (y up), in the order of
+    :func:`beatsync.graph.distance.ground_axes` (z, x), or None."""
+    skeleton = getattr(motion, "skeleton", None)
     if skeleton is None:
         return None
     root = skeleton.joints[0].name
-    names = (f"{root}_Xposition", f"{root}_Zposition")
+    names = (f"{root}_Zposition", f"{root}_Xposition")
     if not all(n in motion.channels for n in names):
         return None
-    cols = np.array([motion.channels.index(n) for n in names])
-    return cols, ends[1, cols] - ends[0, cols]
+    return np.array([motion.channels.index(n) for n in names])
 
 
-def loop_events(events: np.ndarray, n_needed: int, *, join: float) -> LoopedClip:
-    """Repeat the span of ``events`` until it has at least ``n_needed`` intervals.
+def _root_rotation(motion: object) -> tuple[list[int], str] | None:
+    """The skeleton root's rotation channels and their Euler order, or None."""
+    root = motion.skeleton.joints[0].name
+    for joint, idx, order in motion.rotation_triples():
+        if joint == root:
+            return list(idx), order
+    return None
+
+
+def _positions(motion: object) -> tuple[np.ndarray, int] | None:
+    """Joint positions and the index of their vertical axis, or None (angle tables)."""
+    from ..errors import ParameterError
+    from ..motion_beats import motion_positions
+
+    if motion.is_positional:
+        return motion.values.reshape(motion.n_frames, -1, 3), 2
+    if _root_floor_columns(motion) is None:
+        return None
+    try:
+        return motion_positions(motion), 1
+    except ParameterError:
+        return None
+
+
+def choose_loop(
+    motion: object, events: np.ndarray, *, join: float = LOOP_BLEND_S, dance: int | None = None
+) -> tuple[int, int, float, np.ndarray | None, float, float]:
+    """Where to loop a clip: ``(a, b, angle, shift, distance, join)``.
+
+    ``a < b`` index ``events``; ``angle`` [rad] and ``shift`` (floor translation,
+    position unit; None without positions) carry the pose at ``e_a`` onto the pose at
+    ``e_b``; ``distance`` is their motion-graph distance; ``join`` the blend width [s]
+    (shortened only when the clip leaves no room for it). See the module docstring.
+    """
+    from ..graph.distance import aligned_distance_matrix, ground_axes, point_clouds
+
+    p = events.size - 1
+    duration = (motion.n_frames - 1) / motion.fps
+    got = _positions(motion)
+    half_t = 0.5 * join
+    room = (events - half_t >= 0) & (events + half_t <= duration)
+    idx = np.nonzero(room)[0]
+    if got is None or idx.size < 2:
+        # nothing to compare or no room: the whole span, blended over what fits
+        fit = float(min(join, 0.5 * np.min(np.diff(events))))
+        return 0, p, 0.0, None, float("nan"), fit
+    pos, up = got
+    fps = float(motion.fps)
+    frames = np.rint(events[idx] * fps).astype(np.int64)
+    half = max(1, int(round(half_t * fps / 2)))
+    clouds = point_clouds(pos, frames, half)
+    dist = aligned_distance_matrix(clouds, clouds, up=up)
+    ii, jj = np.meshgrid(idx, idx, indexing="ij")
+    ok = jj - ii >= max(1, int(np.ceil(MIN_SPAN * p)))
+    if dance is not None:
+        ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
+    ok &= events[jj] - events[ii] > 2.0 * join
+    if not ok.any():
+        fit = float(min(join, 0.5 * np.min(np.diff(events))))
+        return 0, p, 0.0, None, float("nan"), fit
+    score = np.where(ok, dist, np.inf)
+    # the most alike pair; among equals the longest span
+    best = np.flatnonzero(score == score.min())
+    pick = best[np.argmax((jj - ii).ravel()[best])]
+    ia, ib = np.unravel_index(pick, score.shape)
+    a, b = int(idx[ia]), int(idx[ib])
+    # the floor rotation (about the vertical, in the plane of ground_axes: R_y for y up)
+    # and translation that carry the clouds at e_a onto those at e_b
+    g0, g1 = ground_axes(up)
+    src = clouds[ia][:, [g0, g1]]
+    dst = clouds[ib][:, [g0, g1]]
+    ms, md = src.mean(axis=0), dst.mean(axis=0)
+    ps, pd = src - ms, dst - md
+    angle = float(
+        np.arctan2(
+            np.sum(ps[:, 0] * pd[:, 1] - ps[:, 1] * pd[:, 0]),
+            np.sum(ps[:, 0] * pd[:, 0] + ps[:, 1] * pd[:, 1]),
+        )
+    )
+    c, s = np.cos(angle), np.sin(angle)
+    shift = md - np.array([c * ms[0] - s * ms[1], s * ms[0] + c * ms[1]])
+    return a, b, angle, shift, float(score.flat[pick]), float(join)
+
+
+def loop_events(
+    events: np.ndarray,
+    n_needed: int,
+    *,
+    join: float,
+    span: tuple[int, int] | None = None,
+    angle: float = 0.0,
+    shift: np.ndarray | None = None,
+    distance: float = float("nan"),
+) -> LoopedClip:
+    """Repeat the span ``events[a] .. events[b]`` until the timeline holds ``n_needed``
+    intervals.
 
     Parameters
     ----------
@@ -149,24 +327,48 @@ def loop_events(events: np.ndarray, n_needed: int, *, join: float) -> LoopedClip
     n_needed : int >= 1
         Intervals (periods or beat segments) the looped timeline must hold.
     join : float >= 0 [s]
-        Width of the blended window around each join (capped at half the shortest
-        interval).
+        Width of the blended window around each join.
+    span : (int, int), optional
+        ``(a, b)``: indices of the loop's first and last events; default the whole clip.
+    angle, shift, distance
+        The floor transform from one pass to the next (:func:`choose_loop`).
 
     Returns
     -------
     LoopedClip
     """
-    p = events.size - 1
-    reps = max(1, -(-int(n_needed) // p))  # ceil
-    length = float(events[-1] - events[0])
-    rel = events[1:] - events[0]
-    parts = [events] + [events[-1] + (r - 1) * length + rel for r in range(1, reps)]
-    join = float(min(join, 0.5 * np.min(np.diff(events))))
+    a, b = (0, events.size - 1) if span is None else span
+    head = events[: b + 1]
+    per = b - a
+    reps = 1 + max(0, -(-(int(n_needed) - b) // per))  # the clip, then enough passes
+    length = float(events[b] - events[a])
+    rel = events[a + 1 : b + 1] - events[a]
+    parts = [head] + [events[b] + (r - 1) * length + rel for r in range(1, reps)]
+    index = [np.arange(b + 1)] + [np.arange(a + 1, b + 1)] * (reps - 1)
     return LoopedClip(
         events=np.concatenate(parts),
-        first=float(events[0]),
-        last=float(events[-1]),
+        event_index=np.concatenate(index),
+        first=float(events[a]),
+        last=float(events[b]),
         length=length,
         repetitions=reps,
-        join=join,
+        join=float(join),
+        angle=float(angle),
+        shift=shift,
+        distance=float(distance),
     )
+
+
+def with_center(out: Any, motion: Any, src_times: np.ndarray, looped: LoopedClip | None) -> Any:
+    """The output with the input's root track (``position_info.center``, the JSON
+    layout's ``center``) resampled like the joints, so joints keep their place
+    relative to it."""
+    info = getattr(motion, "position_info", None)
+    if info is None or info.center is None or len(info.center) != motion.n_frames:
+        return out
+    center = np.asarray(info.center, dtype=np.float64)[:, None, :]
+    if looped is None:
+        c = _interp(center, motion.fps, src_times)
+    else:
+        c = looped.sample_positions(center, motion.fps, src_times)
+    return replace(out, position_info=replace(info, center=c[:, 0, :]), _cache={})

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import beat_phase, check_positive, check_times, check_whole
+from ..units import as_int, beat_phase, check_positive, check_times
 
 __all__ = [
     "BeatCount",
@@ -161,7 +161,7 @@ def beats_per_period(
     3
     """
     if override is not None:
-        return check_whole(override, name="beats_per_period", minimum=1)
+        return as_int(override, name="beats_per_period", minimum=1)
     beats = check_times(beats, name="beats")
     if beats.size < 2:
         raise ParameterError(
@@ -171,12 +171,8 @@ def beats_per_period(
     mean_period = check_positive(mean_period, name="mean_period", unit="s")
     dance = None
     if dance_beats_per_period is not None:
-        dance = check_whole(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
-    bar = (
-        None
-        if beats_per_bar is None
-        else check_whole(beats_per_bar, name="beats_per_bar", minimum=1)
-    )
+        dance = as_int(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
+    bar = None if beats_per_bar is None else as_int(beats_per_bar, name="beats_per_bar", minimum=1)
     beat_period = float(np.median(np.diff(beats)))
     return choose_count(mean_period / beat_period, dance=dance, bar=bar).m
 

@@ -1,14 +1,12 @@
-"""The beat trackers a user would pick instead of ours, behind one signature.
+"""Every beat tracker by name, ours and the others a user would pick instead.
 
 Every method is a function ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``:
-mono audio ``y`` (float, finite) at ``sr`` [Hz] in, beat times [s] out (1-D
-``float64``, strictly increasing), each with its published default settings. A tempo
-range narrows the tempi searched; a bound not given keeps the method's default
-(:func:`check_tempo_range` says what each method accepts; librosa given a bound
-other than its default searches a flat tempo prior inside the range instead of its own
-log-normal one around 120 BPM, but only its tempo estimate keeps to the range, not
-the beats it then picks; essentia's trackers take the range as a preference, not a
-limit; :func:`track` warns when the beats fall outside it). :data:`PEERS` names them:
+mono audio ``y`` at ``sr`` [Hz] in, beat times [s] out (1-D ``float64``, strictly
+increasing), each with its published default settings. A tempo range narrows the
+tempi searched; a bound not given keeps the method's default (:func:`check_tempo_range`).
+Only ours keeps its beats inside the range: librosa's range bounds its tempo estimate,
+essentia's trackers take it as a preference (:func:`track` warns when the beats fall
+outside it). :data:`TRACKERS` names them:
 
 - ``"psf"``: ours, :func:`beatsync.beats.track_beats` (phase-slope onsets and a
   tempo/phase HMM; paper A, section 4).
@@ -20,9 +18,8 @@ limit; :func:`track` warns when the beats fall outside it). :data:`PEERS` names 
   2014, a committee of five onset features), at 44.1 kHz.
 
 The essentia methods need the optional ``essentia`` package
-(``pip install 'beatsync[peers]'``; AGPL-3.0): without it they are listed by
-:func:`available` as missing and :func:`get` refuses them with that instruction;
-everything else works.
+(``pip install 'beatsync[peers]'``; AGPL-3.0): without it :func:`available` lists them
+as missing and :func:`get` refuses them with that instruction.
 """
 
 from __future__ import annotations
@@ -38,8 +35,8 @@ from .errors import ParameterError
 from .io import resample_audio
 
 __all__ = [
-    "Peer",
-    "PEERS",
+    "Tracker",
+    "TRACKERS",
     "get",
     "available",
     "track",
@@ -59,7 +56,7 @@ ESSENTIA_TEMPO = {"min": (40, 180), "max": (60, 250), "default": (40, 208), "spa
 
 
 @dataclass(frozen=True)
-class Peer:
+class Tracker:
     """A beat-tracking method.
 
     Attributes
@@ -191,18 +188,20 @@ def track_essentia_multifeature(
 
 
 #: Every method by name, ours first.
-PEERS: dict[str, Peer] = {
+TRACKERS: dict[str, Tracker] = {
     p.name: p
     for p in (
-        Peer("psf", "ours: phase-slope onsets, tempo/phase HMM (paper A)", track_psf),
-        Peer("librosa", "librosa.beat.beat_track: dynamic programming (Ellis 2007)", track_librosa),
-        Peer(
+        Tracker("psf", "ours: phase-slope onsets, tempo/phase HMM (paper A)", track_psf),
+        Tracker(
+            "librosa", "librosa.beat.beat_track: dynamic programming (Ellis 2007)", track_librosa
+        ),
+        Tracker(
             "essentia-degara",
             "essentia BeatTrackerDegara: probabilistic beat periods (Degara et al. 2012)",
             track_essentia_degara,
             "essentia",
         ),
-        Peer(
+        Tracker(
             "essentia-multifeature",
             "essentia BeatTrackerMultiFeature: five onset features (Zapata et al. 2014)",
             track_essentia_multifeature,
@@ -214,10 +213,10 @@ PEERS: dict[str, Peer] = {
 
 def available() -> dict[str, bool]:
     """Every method name -> whether it can run here (its optional package is installed)."""
-    return {name: p.is_available for name, p in PEERS.items()}
+    return {name: p.is_available for name, p in TRACKERS.items()}
 
 
-def get(name: str) -> Peer:
+def get(name: str) -> Tracker:
     """The method called ``name``.
 
     Raises
@@ -226,15 +225,15 @@ def get(name: str) -> Peer:
         Unknown name (the message lists the names), or a method whose optional
         package is not installed (the message says how to install it).
     """
-    peer = PEERS.get(name)
-    if peer is None:
-        raise ParameterError(f"unknown beat-tracking method {name!r}; choose from {list(PEERS)}")
-    if not peer.is_available:
+    tracker = TRACKERS.get(name)
+    if tracker is None:
+        raise ParameterError(f"unknown beat-tracking method {name!r}; choose from {list(TRACKERS)}")
+    if not tracker.is_available:
         raise ParameterError(
-            f"method {name!r} needs the optional package {peer.requires!r}, which is not "
+            f"method {name!r} needs the optional package {tracker.requires!r}, which is not "
             "installed: pip install 'beatsync[peers]'"
         )
-    return peer
+    return tracker
 
 
 def check_tempo_range(
@@ -276,8 +275,8 @@ def check_tempo_range(
     from .beats.tracker import LIBROSA_MAX_TEMPO
     from .units import check_bpm
 
-    peer = PEERS.get(name)
-    if peer is None:
+    tracker = TRACKERS.get(name)
+    if tracker is None:
         get(name)  # raises: unknown method
     given = {
         key: check_bpm(value, name=label)
@@ -286,8 +285,8 @@ def check_tempo_range(
     }
     if not given:
         return {}
-    defaults = _default_range(peer)
-    if peer.requires == "essentia":
+    defaults = _default_range(tracker)
+    if tracker.requires == "essentia":
         span = ESSENTIA_TEMPO["span"]
         limits = {"min_bpm": ESSENTIA_TEMPO["min"], "max_bpm": ESSENTIA_TEMPO["max"]}
     else:
@@ -326,9 +325,9 @@ def check_tempo_range(
     return {k: v for k, v in given.items() if v != defaults[k]}
 
 
-def _default_range(peer: Peer) -> dict[str, float]:
-    """The tempo range [BPM] ``peer`` searches when given no bound."""
-    if peer.requires == "essentia":
+def _default_range(tracker: Tracker) -> dict[str, float]:
+    """The tempo range [BPM] ``tracker`` searches when given no bound."""
+    if tracker.requires == "essentia":
         return dict(zip(("min_bpm", "max_bpm"), ESSENTIA_TEMPO["default"], strict=True))
     from .beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM
 
@@ -349,14 +348,14 @@ def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) ->
         return
     from .errors import warn
 
-    bounds = {**_default_range(PEERS[name]), **tempo}
+    bounds = {**_default_range(TRACKERS[name]), **tempo}
     lo, hi = bounds["min_bpm"], bounds["max_bpm"]
     # evaluate.beats.median_tempo is a layer above this module: the same two lines here
     bpm = 60.0 / float(np.median(np.diff(beats)))
     tol = OUT_OF_RANGE_TOLERANCE
     if lo / (1 + tol) <= bpm <= hi * (1 + tol):
         return
-    if PEERS[name].requires == "essentia":
+    if TRACKERS[name].requires == "essentia":
         why = "essentia's trackers take the range as a preference, not a limit"
     elif name == "librosa":
         why = "librosa's range bounds its tempo estimate, not the beats it then picks"
@@ -402,30 +401,26 @@ def track(
         Given a range, the beats' median tempo lies more than
         :data:`OUT_OF_RANGE_TOLERANCE` outside it: only ours keeps to the range; librosa's
         bounds its tempo estimate, not the beats it then picks, and essentia's trackers
-        take it as a preference. An 80 BPM pattern given 180-250 BPM is tapped at 161 by
-        librosa, and at 80-162 by essentia's two, different from one call to the next in
-        the same process (inside essentia; a similar instability is reported upstream as
-        MTG/essentia issue 1097). With their default range on the bundled real
-        recordings, or given 75-101 BPM on the madmom sample, they repeat.
+        take it as a preference (outside it, their beats can differ from one call to the
+        next; MTG/essentia issue 1097).
 
     Raises
     ------
     ParameterError
         Unknown or unavailable method (:func:`get`); a tempo range the method does not
         accept; empty, silent, constant or non-finite audio, ``sr <= 0``, or audio
-        shorter than 1.5 s (:func:`beatsync.beats.tracker.check_duration`; librosa
-        returned one beat for 0.5 s, essentia's none): checked here for every method,
-        as ours does.
+        shorter than 1.5 s (:func:`beatsync.beats.tracker.check_duration`): checked
+        here for every method, as ours does.
     """
     from .beats import check_audio
     from .beats.tracker import check_duration
 
-    peer = get(name)
+    tracker = get(name)
     tempo = check_tempo_range(name, min_bpm, max_bpm)
     y, sr = check_audio(y, sr)
     check_duration(y.size, sr)
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", category=FutureWarning)
-        beats = peer.track(y, sr, **tempo)
+        beats = tracker.track(y, sr, **tempo)
     _warn_out_of_range(name, beats, tempo)
     return beats
