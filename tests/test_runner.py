@@ -151,7 +151,6 @@ def test_cli_refuses_zero_jobs(nbdir, tmp_path, capsys):
 
 @pytest.mark.parametrize("preset", [None, "3"])
 def test_kernels_get_one_blas_thread_unless_the_user_chose(tmp_path, monkeypatch, preset):
-    import os
 
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         monkeypatch.delenv(var, raising=False)
@@ -164,8 +163,6 @@ def test_kernels_get_one_blas_thread_unless_the_user_chose(tmp_path, monkeypatch
     p.write_text("one: {n: 0}\n")
     run_notebooks(p, notebooks_dir=d, output_dir=tmp_path / "out", jobs=1)
     assert _outputs(tmp_path / "out" / "one.ipynb").split()[2] == (preset or "1")
-    assert os.environ.get("OPENBLAS_NUM_THREADS") == preset  # ours restored
-    assert "OMP_NUM_THREADS" not in os.environ
 
 
 def test_a_run_of_some_notebooks_keeps_the_others_in_the_manifest(nbdir, tmp_path):
@@ -192,29 +189,6 @@ def test_a_run_of_some_notebooks_keeps_the_others_in_the_manifest(nbdir, tmp_pat
     assert [n["name"] for n in manifest["notebooks"]] == ["tiny"]
 
 
-def test_entries_of_an_older_manifest_get_its_parameter_file(nbdir, tmp_path):
-    # manifests written before entries named their parameter file and version
-    _notebook(nbdir / "other.ipynb")
-    p = tmp_path / "p.yaml"
-    p.write_text("other:\n  n: 5\ntiny:\n  n: 21\n")
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "other.ipynb").write_text("{}")
-    old = {"beatsync_version": "0.0.9", "params_file": "params/paper.yaml",
-           "notebooks": [{"name": "other", "parameters": {"n": 5}, "seconds": 3.0}]}  # fmt: skip
-    (out / "run_manifest.json").write_text(json.dumps(old))
-    run_notebooks(p, notebooks_dir=nbdir, output_dir=out, only=["tiny"], jobs=1)
-    entries = json.loads((out / "run_manifest.json").read_text())["notebooks"]
-    assert entries[0] == {
-        "name": "other",
-        "params_file": "params/paper.yaml",
-        "beatsync_version": "0.0.9",
-        "parameters": {"n": 5},
-        "seconds": 3.0,
-    }
-    assert entries[1]["name"] == "tiny" and entries[1]["params_file"] == str(p)
-
-
 @pytest.mark.skipif(os.name != "posix", reason="Unix sockets only where the system has them")
 def test_kernels_talk_over_private_unix_sockets(tmp_path, capfd):
     # over TCP every kernel warned on stderr that it runs without encryption
@@ -237,11 +211,10 @@ def test_kernels_talk_over_private_unix_sockets(tmp_path, capfd):
 
 
 def test_a_temporary_folder_too_long_for_a_socket_path_falls_back_to_tcp(tmp_path, monkeypatch):
-    import tempfile
 
     long_tmp = tmp_path / ("t" * 100)
     long_tmp.mkdir()
-    monkeypatch.setattr(tempfile, "tempdir", str(long_tmp))
+    monkeypatch.setenv("TMPDIR", str(long_tmp))  # the notebook's worker process
     d = tmp_path / "notebooks"
     d.mkdir()
     body = "from ipykernel.kernelapp import IPKernelApp\nprint(IPKernelApp.instance().transport)"
@@ -266,6 +239,60 @@ def test_an_interrupt_after_the_run_leaves_no_running_copy(nbdir, tmp_path, monk
     monkeypatch.setattr(nbf, "read", interrupted)
     dest = tmp_path / "out" / "tiny.ipynb"
     dest.parent.mkdir()
+    spec = {"parameters": {"n": 1}, "dest": str(dest), "write_to": str(dest)}
     with pytest.raises(KeyboardInterrupt):
-        runner._execute(nbdir / "tiny.ipynb", {"n": 1}, nbdir, dest, dest)
+        runner._execute("tiny", str(nbdir / "tiny.ipynb"), **spec)
     assert list(dest.parent.iterdir()) == []
+
+
+def test_a_failing_notebook_is_named_and_kept_for_its_traceback(tmp_path):
+    from beatsync.runner import NotebookFailed
+
+    d = tmp_path / "notebooks"
+    d.mkdir()
+    _notebook(d / "bad.ipynb", "raise RuntimeError('broken analysis')")
+    p = tmp_path / "p.yaml"
+    p.write_text("bad: {}\n")
+    out = tmp_path / "out"
+    with pytest.raises(NotebookFailed, match="(?s)notebook 'bad' failed.*broken analysis"):
+        run_notebooks(p, notebooks_dir=d, output_dir=out, jobs=1)
+    assert sorted(x.name for x in out.iterdir()) == ["bad.failed.ipynb"]
+
+
+def test_cli_check_in_place_and_quiet(nbdir, tmp_path, capsys):
+    p = tmp_path / "p.yaml"
+    p.write_text("tiny:\n  n: 21\n")
+    base = ["reproduce", "--params", str(p), "--notebooks", str(nbdir)]
+    assert main([*base, "--check"]) == 0
+    assert "OK for 1 notebook(s): tiny" in capsys.readouterr().out
+    assert sorted(x.name for x in nbdir.iterdir()) == ["tiny.ipynb"]  # nothing run
+    # --quiet: nothing but errors and warnings, on either stream
+    assert main([*base, "--in-place", "--quiet"]) == 0
+    assert capsys.readouterr() == ("", "")
+    assert "42\n" in _outputs(nbdir / "tiny.ipynb")  # the notebook itself, executed
+    assert sorted(x.name for x in nbdir.iterdir()) == ["tiny.ipynb"]  # and no manifest
+
+
+def test_a_relative_results_folder_is_found_from_the_notebooks_whatever_the_cwd(
+    tmp_path, monkeypatch
+):
+    # papermill notebooks/X.ipynb from the repository root wrote "../results" outside it
+    from beatsync.study.artifacts import results_folder
+
+    root = Path(__file__).resolve().parents[1]
+    for cwd in (root, root / "notebooks", root / "src" / "beatsync", tmp_path):
+        monkeypatch.chdir(cwd)
+        assert results_folder("../results/ci") == root / "results" / "ci", cwd
+    assert results_folder(tmp_path / "r") == tmp_path / "r"  # absolute: as given
+    # another clone found from the current folder, before the package's own
+    other = tmp_path / "clone"
+    (other / "notebooks").mkdir(parents=True)
+    (other / "pyproject.toml").write_text("")
+    monkeypatch.chdir(other / "notebooks")
+    assert results_folder("../results") == other / "results"
+
+
+def test_a_file_that_is_not_a_notebook_is_refused_by_name(nbdir):
+    (nbdir / "broken.ipynb").write_text("{not json")
+    with pytest.raises(ParameterError, match="cannot read notebook '.*broken.ipynb'"):
+        check_params({"tiny": {}, "broken": {}}, nbdir)

@@ -1,30 +1,20 @@
 """Run the study's notebooks with papermill from a parameter file.
 
 A parameter file (``params/paper.yaml`` for the full study, ``params/ci.yaml`` for a
-quick run) maps each notebook name (file stem in ``notebooks/``) to the parameters
-it receives::
+quick run) maps each notebook name (file stem in ``notebooks/``) to its parameters::
 
     paper_a_fig02_segmentation:
       n_trials: 20
       results_dir: ../results
 
-Unlike papermill, which only warns, the runner refuses a parameter that the
-notebook's ``parameters`` cell does not declare, a notebook that is missing, and a
-notebook in ``notebooks/`` that the file does not list. Notebooks run with their own
-folder as working directory. A manifest (``run_manifest.json``) records the
-parameter file, parameters, package version and time of every notebook in the output
-folder: a run of some notebooks (``only``) keeps the entries of the others.
-
-Every kernel runs with one BLAS/OpenMP thread (unless the caller set
-``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS``): a threaded BLAS
-sums in an order that depends on the thread count, and one result of the study (a
-composition's search) moved in its third digit between one and two threads. So the
-artefacts do not depend on the machine's core count. With ``jobs`` > 1 the notebooks
-run side by side, each in a worker process of its own (``python -m beatsync.runner``),
-the longest first (by the previous manifest's times); the notebooks write separate
-artefact folders, so the order changes nothing but the wall time. A failing notebook
-stops the others; an interruption (Ctrl-C, SIGTERM) is passed on to the workers, which
-shut their kernels down and delete their partial output.
+Unlike papermill, which only warns, the runner refuses a parameter that a notebook's
+``parameters`` cell does not declare, a missing notebook and an unlisted one. Each
+notebook runs with its own folder as working directory and one BLAS/OpenMP thread (unless
+the caller set one: a threaded BLAS sums in an order that depends on the thread count,
+and the artefacts must not depend on the machine). With ``jobs`` > 1 the notebooks run
+side by side, each in a process of its own (``python -m beatsync.runner``), the longest
+first (by the previous manifest); they write separate artefact folders. A manifest
+(``run_manifest.json``) records each notebook's parameter file, parameters and time.
 """
 
 from __future__ import annotations
@@ -32,43 +22,29 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from .errors import ParameterError
 
-__all__ = [
-    "load_params",
-    "check_params",
-    "planned_outputs",
-    "run_notebooks",
-    "default_jobs",
-    "usable_cpus",
-    "kernel_env",
-    "NotebookRun",
-    "NotebookFailed",
-]
+__all__ = ["load_params", "check_params", "planned_outputs", "run_notebooks", "default_jobs"]
 
 MANIFEST = "run_manifest.json"
-
-#: Longest Unix socket path, in bytes, on every system we run on (``sun_path`` holds
-#: 108 bytes on Linux, 104 on macOS and the BSDs, with the closing NUL).
-MAX_SOCKET_PATH = 103
-
 
 #: Environment variables that set the BLAS/OpenMP thread count of a kernel.
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 class NotebookFailed(RuntimeError):
-    """A notebook raised an error in one of its cells (its message is kept)."""
+    """A notebook raised an error in one of its cells (its name and message are kept)."""
 
 
 @dataclass(frozen=True)
@@ -90,23 +66,9 @@ def load_params(params_file: str | Path) -> dict[str, dict[str, Any]]:
         data = yaml.safe_load(p.read_text()) or {}
     except yaml.YAMLError as exc:
         raise ParameterError(f"parameter file {str(p)!r} is not valid YAML: {exc}") from None
-    if not isinstance(data, dict) or not all(
-        isinstance(v, dict) or v is None for v in data.values()
-    ):
-        raise ParameterError(
-            f"parameter file {str(p)!r} must map notebook names to parameter mappings"
-        )
+    if not isinstance(data, dict) or not all(isinstance(v, dict | None) for v in data.values()):
+        raise ParameterError(f"parameter file {str(p)!r} must map notebook names to mappings")
     return {str(k): dict(v or {}) for k, v in data.items()}
-
-
-def declared_parameters(notebook: Path) -> dict[str, Any]:
-    """Parameters declared in the notebook's ``parameters`` cell (papermill's inspection)."""
-    import papermill as pm
-
-    try:
-        return dict(pm.inspect_notebook(str(notebook)))
-    except Exception as exc:
-        raise ParameterError(f"cannot inspect notebook {str(notebook)!r}: {exc}") from None
 
 
 def check_params(
@@ -114,31 +76,30 @@ def check_params(
 ) -> dict[str, Path]:
     """Check the parameter mapping against the notebooks; return ``{name: path}`` to run.
 
-    Raises
-    ------
-    ParameterError
-        A listed notebook that does not exist, a notebook not listed, or a parameter
-        a notebook does not declare.
+    Raises :class:`~beatsync.errors.ParameterError` for a listed notebook that does not
+    exist, a notebook not listed, an unknown ``only`` name, or a parameter a notebook
+    does not declare.
     """
-    nb_dir = Path(notebooks_dir)
-    present = {p.stem: p for p in sorted(nb_dir.glob("*.ipynb"))}
-    missing = sorted(set(params) - set(present))
+    import papermill as pm
+
+    present = {p.stem: p for p in sorted(Path(notebooks_dir).glob("*.ipynb"))}
+    missing, unlisted = sorted(set(params) - set(present)), sorted(set(present) - set(params))
     if missing:
         raise ParameterError(f"parameter file lists notebooks that do not exist: {missing}")
-    unlisted = sorted(set(present) - set(params))
     if unlisted:
         raise ParameterError(
             f"notebooks {unlisted} are not listed in the parameter file; add them "
             "(with an empty mapping if they need no parameters)"
         )
-    names = list(params)
-    if only:
-        unknown = sorted(set(only) - set(present))
-        if unknown:
-            raise ParameterError(f"unknown notebook(s) {unknown}; choose from {sorted(present)}")
-        names = [n for n in names if n in only]
+    unknown = sorted(set(only or ()) - set(present))
+    if unknown:
+        raise ParameterError(f"unknown notebook(s) {unknown}; choose from {sorted(present)}")
+    names = [n for n in params if not only or n in only]
     for name in names:
-        declared = declared_parameters(present[name])
+        try:
+            declared = pm.inspect_notebook(str(present[name]))
+        except Exception as exc:  # not a notebook (JSON, nbformat)
+            raise ParameterError(f"cannot read notebook {str(present[name])!r}: {exc}") from None
         extra = sorted(set(params[name]) - set(declared))
         if extra:
             raise ParameterError(
@@ -151,295 +112,23 @@ def check_params(
 def planned_outputs(
     todo: dict[str, Path], *, output_dir: str | Path | None = "results/notebooks", in_place: bool
 ) -> dict[str, Path]:
-    """Where :func:`run_notebooks` writes each notebook of ``todo``, and its manifest.
-
-    Returns ``{name: path}`` with the key ``MANIFEST`` for the manifest (not written
-    ``in_place``).
-    """
+    """Where :func:`run_notebooks` writes each notebook, and (key ``MANIFEST``, not
+    ``in_place``) its manifest."""
     if in_place:
         return dict(todo)
     out_dir = Path(output_dir or "results/notebooks")
-    planned = {name: out_dir / path.name for name, path in todo.items()}
-    planned[MANIFEST] = out_dir / MANIFEST
-    return planned
-
-
-def usable_cpus() -> int:
-    """CPUs this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
+    return {**{n: out_dir / p.name for n, p in todo.items()}, MANIFEST: out_dir / MANIFEST}
 
 
 def default_jobs(n_notebooks: int | None = None) -> int:
-    """Notebooks to run at once by default: the usable CPUs, at most 4 (and ``n_notebooks``)."""
-    jobs = max(1, min(usable_cpus(), 4))
-    return min(jobs, n_notebooks) if n_notebooks else jobs
-
-
-def _check_jobs(jobs: Any) -> int:
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise ParameterError(
-            f"jobs={jobs!r}: the number of notebooks run at once must be a whole number >= 1"
-        )
-    return jobs
-
-
-def _execute(
-    path: Path, parameters: dict[str, Any], nb_dir: Path, dest: Path, write_to: Path
-) -> None:
-    """Run one notebook into ``write_to``; a failed run is kept as ``<dest>.failed.ipynb``."""
-    import nbformat
-    import papermill as pm
-
-    from .io import atomic_write
-
-    tmp = _running_copy(dest)
-    try:  # Ctrl-C, SIGTERM at any point: the running copy is removed (finally)
-        try:
-            with _kernel_transport() as transport:
-                pm.execute_notebook(
-                    str(path),
-                    str(tmp),
-                    parameters=parameters,
-                    cwd=str(nb_dir),
-                    progress_bar=False,
-                    report_mode=False,
-                    **transport,
-                )
-        except Exception:
-            # keep the executed notebook with its traceback cells for the user to read
-            if tmp.exists():
-                os.replace(tmp, dest.with_name(f"{dest.stem}.failed.ipynb"))
-            raise
-        executed = nbformat.read(tmp, as_version=4)
-        executed.metadata.setdefault("papermill", {})["output_path"] = dest.name
-        with atomic_write(write_to) as fh:
-            nbformat.write(executed, fh)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
-def _running_copy(dest: Path) -> Path:
-    """Where papermill writes a notebook while it runs (hidden, beside ``dest``)."""
-    return dest.with_name(f".{dest.name}.running.ipynb")
-
-
-@contextlib.contextmanager
-def _kernel_transport() -> Iterator[dict[str, Any]]:
-    """Papermill options for a kernel that talks to the runner over Unix sockets.
-
-    Over TCP, every kernel warns on stderr that it runs without encryption, and any
-    local process could reach its ports (the messages are signed, not hidden). The
-    sockets are made in a private temporary folder of this kernel's own (Jupyter's
-    default, ``kernel-ipc`` in the working folder, is shared by notebooks run side by
-    side, whose kernels then answer each other), removed afterwards. TCP where that is
-    not possible: on Windows (no Unix sockets), and under a temporary folder
-    (``TMPDIR``) too long for a socket path (:data:`MAX_SOCKET_PATH`).
-    """
-    if os.name != "posix":
-        yield {}
-        return
-    import shutil
-
-    from traitlets.config import Config
-
-    folder = tempfile.mkdtemp(prefix="beatsync-kernel-")  # mode 0700
-    try:
-        ip = os.path.join(folder, "kernel")
-        if len(os.fsencode(ip)) + len("-65535") > MAX_SOCKET_PATH:
-            yield {}
-        else:
-            yield {"config": Config({"KernelManager": {"transport": "ipc", "ip": ip}})}
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
-
-
-def _previous_entries(output_dir: Path | None) -> list[dict[str, Any]]:
-    """The notebook entries of the previous manifest of ``output_dir`` (none if there is
-    no readable manifest; an entry without a name or time is dropped). An entry without
-    its own parameter file or version (written before entries had them) gets the
-    manifest's."""
-    if output_dir is None:
-        return []
-    try:
-        data = json.loads((output_dir / MANIFEST).read_text())
-        entries = [dict(n) for n in data["notebooks"]]
-        shared = {k: data[k] for k in ("params_file", "beatsync_version") if k in data}
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        return []
-    out = []
-    for n in entries:
-        try:
-            n["name"], n["seconds"] = str(n["name"]), float(n["seconds"])
-        except (KeyError, TypeError, ValueError):
-            continue
-        out.append({"name": n["name"], **shared, **n})
-    return out
-
-
-def _previous_seconds(output_dir: Path | None) -> dict[str, float]:
-    """Each notebook's time in the previous manifest of ``output_dir`` (empty if none)."""
-    return {n["name"]: n["seconds"] for n in _previous_entries(output_dir)}
-
-
-def _manifest_entries(
-    runs: list[NotebookRun], params: dict[str, Any], params_file: str, output_dir: Path
-) -> list[dict[str, Any]]:
-    """This run's notebooks, and the previous manifest's entries of the notebooks it did
-    not run whose executed copy is still in ``output_dir`` (``--only``): the manifest
-    describes every notebook there. Each entry names its parameter file and version."""
-    from . import __version__
-
-    mine = {
-        r.name: {
-            "name": r.name,
-            "params_file": params_file,
-            "beatsync_version": __version__,
-            "parameters": r.parameters,
-            "seconds": round(r.seconds, 1),
-        }
-        for r in runs
-    }
-    kept = {
-        n["name"]: n
-        for n in _previous_entries(output_dir)
-        if n["name"] not in mine and (output_dir / f"{n['name']}.ipynb").is_file()
-    }
-    both = {**kept, **mine}
-    order = [name for name in params if name in both]  # the parameter file's order
-    order += [name for name in kept if name not in order]
-    return [both[name] for name in order]
+    """Notebooks run at once by default: the usable CPUs, at most 4 (and ``n_notebooks``)."""
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return max(1, min(cpus or 1, 4, n_notebooks or 4))
 
 
 def kernel_env() -> dict[str, str]:
-    """The environment notebook kernels run with: ours, one BLAS thread unless set."""
-    env = dict(os.environ)
-    for var in THREAD_VARIABLES:
-        env.setdefault(var, "1")
-    return env
-
-
-@contextlib.contextmanager
-def _environment(env: dict[str, str]) -> Iterator[None]:
-    """Set ``os.environ`` to ``env`` while the block runs (kernels inherit it)."""
-    saved = dict(os.environ)
-    os.environ.update(env)
-    try:
-        yield
-    finally:
-        for key in set(os.environ) - set(saved):
-            del os.environ[key]
-        os.environ.update(saved)
-
-
-def _run_parallel(
-    todo: dict[str, Path],
-    params: dict[str, dict[str, Any]],
-    nb_dir: Path,
-    dests: dict[str, Path],
-    targets: dict[str, Path],
-    jobs: int,
-    order: list[str],
-    progress: Callable[[str], None] | None,
-) -> dict[str, float]:
-    """Run the notebooks of ``todo`` in up to ``jobs`` worker processes; return their times."""
-    seconds: dict[str, float] = {}
-    pending = list(order)
-    running: dict[str, tuple[subprocess.Popen[bytes], float, Path, Any]] = {}
-    env = kernel_env()
-    with tempfile.TemporaryDirectory(prefix="beatsync-runner-") as scratch:
-        try:
-            while pending or running:
-                while pending and len(running) < jobs:
-                    name = pending.pop(0)
-                    spec = {
-                        "name": name,
-                        "notebook": str(todo[name].resolve()),
-                        "parameters": params[name],
-                        "cwd": str(nb_dir),
-                        "dest": str(dests[name]),
-                        "write_to": str(targets[name].resolve()),
-                    }
-                    result = Path(scratch) / f"{name}.result.json"
-                    log = open(Path(scratch) / f"{name}.log", "wb")  # noqa: SIM115
-                    proc = subprocess.Popen(
-                        [sys.executable, "-m", "beatsync.runner", json.dumps(spec), str(result)],
-                        stdin=subprocess.DEVNULL,
-                        stdout=log,
-                        stderr=subprocess.STDOUT,
-                        env=env,
-                    )
-                    running[name] = (proc, time.perf_counter(), result, log)
-                    if progress:
-                        progress(f"running {name} ...")
-                time.sleep(0.1)
-                for name, (proc, start, result, log) in list(running.items()):
-                    if proc.poll() is None:
-                        continue
-                    del running[name]
-                    log.close()
-                    if proc.returncode != 0:
-                        raise NotebookFailed(_failure_text(name, result, Path(log.name)))
-                    seconds[name] = time.perf_counter() - start
-                    if progress:
-                        progress(f"  {name} done in {seconds[name]:.1f} s -> {dests[name]}")
-        finally:
-            _stop_workers([(p, lg) for p, _, _, lg in running.values()])
-            for name in running:  # a worker killed after the grace time could not clean up
-                _running_copy(dests[name]).unlink(missing_ok=True)
-    return seconds
-
-
-def _failure_text(name: str, result: Path, log: Path) -> str:
-    try:
-        return f"notebook {name!r} failed:\n{json.loads(result.read_text())['error'].strip()}"
-    except (OSError, ValueError, KeyError):
-        tail = log.read_text(errors="replace").strip().splitlines()[-20:]
-        return f"notebook {name!r} failed; its worker printed:\n" + "\n".join(tail)
-
-
-def _stop_workers(workers: list[tuple[subprocess.Popen[bytes], Any]]) -> None:
-    """Ask the running workers to stop (they shut their kernels down), then make sure."""
-    for proc, _ in workers:
-        if proc.poll() is None:
-            proc.send_signal(signal.SIGTERM)
-    deadline = time.monotonic() + 20.0
-    for proc, log in workers:
-        try:
-            proc.wait(timeout=max(0.1, deadline - time.monotonic()))
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-        log.close()
-
-
-def _run_in_process(
-    todo: dict[str, Path],
-    params: dict[str, dict[str, Any]],
-    nb_dir: Path,
-    dests: dict[str, Path],
-    planned: dict[str, Path],
-    target: Callable[[Path], Path],
-    progress: Callable[[str], None] | None,
-) -> dict[str, float]:
-    """Run the notebooks of ``todo`` one after the other in this process; their times."""
-    seconds: dict[str, float] = {}
-    for name, path in todo.items():
-        if progress:
-            progress(f"running {name} ...")
-        start = time.perf_counter()
-        try:
-            _execute(path, params[name], nb_dir, dests[name], target(planned[name]))
-        except Exception:
-            if progress:
-                progress(f"  {name} FAILED; executed notebook kept next to {dests[name]}")
-            raise
-        seconds[name] = time.perf_counter() - start
-        if progress:
-            progress(f"  {name} done in {seconds[name]:.1f} s -> {planned[name]}")
-    return seconds
+    """The environment of the notebook kernels: ours, one BLAS thread unless set."""
+    return {**{var: "1" for var in THREAD_VARIABLES}, **os.environ}
 
 
 def run_notebooks(
@@ -453,95 +142,179 @@ def run_notebooks(
     progress: Callable[[str], None] | None = None,
     write_to: Callable[[Path], Path] | None = None,
 ) -> list[NotebookRun]:
-    """Execute notebooks with papermill.
+    """Execute the notebooks of ``params_file`` with papermill.
 
-    Parameters
-    ----------
-    params_file : path
-    notebooks_dir : path
-    output_dir : path
-        Where executed copies go (ignored with ``in_place``); created if missing.
-    only : list of str, optional
-        Run only these notebooks.
-    in_place : bool
-        Overwrite the notebooks themselves with their executed versions (used to
-        refresh the committed, CI-parameter notebooks).
-    jobs : int
-        Notebooks run at once (1: one after the other, in this process; more: in
-        worker processes, see the module docstring; :func:`default_jobs` suggests one).
-    progress : callable, optional
-        Called with a line of text before and after each notebook.
-    write_to : callable, optional
-        Maps each destination of :func:`planned_outputs` to the file actually written
-        (a command writing all-or-nothing passes its staging paths); default: the
-        destination itself. A notebook that fails is kept, with its traceback cells,
-        as ``<name>.failed.ipynb`` next to its destination.
-
-    Raises
-    ------
-    NotebookFailed
-        With ``jobs`` > 1, a notebook that raised (with ``jobs`` = 1 papermill's own
-        error is raised).
+    ``output_dir`` receives the executed copies and the manifest (created if missing),
+    or ``in_place`` overwrites the notebooks themselves. ``jobs`` notebooks run at once.
+    ``progress`` is called with a line of text before and after each notebook.
+    ``write_to`` maps each destination of :func:`planned_outputs` to the file actually
+    written (a command writing all-or-nothing passes its staging paths). A notebook that
+    fails is kept, with its traceback cells, as ``<name>.failed.ipynb`` next to its
+    destination, and raises :class:`NotebookFailed` naming it.
     """
-    from . import __version__
-    from .io import write_json
-
-    jobs = _check_jobs(jobs)
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ParameterError(f"jobs={jobs!r}: run a whole number >= 1 of notebooks at once")
     params = load_params(params_file)
     todo = check_params(params, notebooks_dir, only=only)
-    nb_dir = Path(notebooks_dir).resolve()
     planned = planned_outputs(todo, output_dir=output_dir, in_place=in_place)
-    out_dir = None if in_place else Path(output_dir or "results/notebooks")
+    target = write_to or (lambda p: p)
+    out_dir = None if in_place else planned[MANIFEST].parent
+    previous = _manifest(out_dir)
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
-    target = write_to or (lambda p: p)
-    dests = {name: planned[name].resolve() for name in todo}
-    if jobs > 1 and len(todo) > 1:
-        before = _previous_seconds(out_dir)
-        order = sorted(todo, key=lambda n: -before.get(n, 0.0))  # longest first (stable)
-        targets = {name: target(planned[name]) for name in todo}
-        seconds = _run_parallel(todo, params, nb_dir, dests, targets, jobs, order, progress)
-    else:
-        with _environment(kernel_env()):
-            seconds = _run_in_process(todo, params, nb_dir, dests, planned, target, progress)
+    order = sorted(todo, key=lambda n: -previous.get(n, {}).get("seconds", 0.0))
+    specs = {
+        name: {
+            "notebook": str(todo[name].resolve()),
+            "parameters": params[name],
+            "dest": str(planned[name].resolve()),
+            "write_to": str(target(planned[name]).resolve()),
+        }
+        for name in order
+    }
+    seconds = _run_all(specs, jobs, progress)
     runs = [NotebookRun(n, planned[n], params[n], seconds[n]) for n in todo]
-    if MANIFEST in planned:
-        assert out_dir is not None
-        write_json(
-            target(planned[MANIFEST]),
-            {
-                "beatsync_version": __version__,
+    if out_dir is not None:
+        from . import __version__
+        from .io import write_json
+
+        entries = {n: e for n, e in previous.items() if (out_dir / f"{n}.ipynb").is_file()}
+        for r in runs:
+            entries[r.name] = {
+                "name": r.name,
                 "params_file": str(params_file),
-                "notebooks": _manifest_entries(runs, params, str(params_file), out_dir),
-            },
-        )
+                "parameters": r.parameters,
+                "seconds": round(r.seconds, 1),
+            }
+        manifest = {
+            "beatsync_version": __version__,
+            "params_file": str(params_file),
+            "notebooks": [entries[n] for n in params if n in entries],
+        }
+        write_json(target(planned[MANIFEST]), manifest)
     return runs
 
 
-def _worker_main(argv: list[str]) -> int:
-    """``python -m beatsync.runner SPEC_JSON RESULT_FILE``: run one notebook (a worker).
+def _manifest(out_dir: Path | None) -> dict[str, dict[str, Any]]:
+    """The previous manifest's entries by notebook (none if there is no readable one)."""
+    if out_dir is not None:
+        with contextlib.suppress(OSError, ValueError, KeyError, TypeError):
+            entries = json.loads((out_dir / MANIFEST).read_text())["notebooks"]
+            return {str(e["name"]): e for e in entries}
+    return {}
 
-    SIGTERM and SIGHUP become KeyboardInterrupt, so papermill shuts the kernel down
-    and the partial output is deleted. The error of a failed notebook is written to
-    ``RESULT_FILE`` as ``{"error": text}``.
+
+def _run_all(specs: dict[str, dict[str, Any]], jobs: int, progress: Any) -> dict[str, float]:
+    """Run the notebooks of ``specs`` in order, ``jobs`` at a time, each in a worker
+    process (:func:`_worker_main`); their times [s]. A failure or an interruption stops
+    the others (they shut their kernels down and delete their running copies)."""
+    say = progress or (lambda line: None)
+    seconds: dict[str, float] = {}
+    pending, running = list(specs), {}
+    try:
+        while pending or running:
+            while pending and len(running) < jobs:
+                name = pending.pop(0)
+                log = tempfile.TemporaryFile()  # noqa: SIM115 (closed below)
+                command = [sys.executable, "-m", "beatsync.runner", name, json.dumps(specs[name])]
+                running[name] = (
+                    subprocess.Popen(command, stdout=log, stderr=log, env=kernel_env()),
+                    log,
+                    time.perf_counter(),
+                )
+                say(f"running {name} ...")
+            time.sleep(0.1)
+            for name, (proc, log, start) in list(running.items()):
+                if proc.poll() is None:
+                    continue
+                del running[name]
+                log.seek(0)
+                text = log.read().decode(errors="replace").strip()
+                log.close()
+                if proc.returncode:  # its message comes after what the kernel printed
+                    found = text.find(f"notebook {name!r} failed")
+                    tail = text[found:] if found >= 0 else f"failed:\n{text[-2000:]}"
+                    raise NotebookFailed(tail if found >= 0 else f"notebook {name!r} {tail}")
+                seconds[name] = time.perf_counter() - start
+                say(f"  {name} done in {seconds[name]:.1f} s -> {specs[name]['dest']}")
+    finally:
+        for proc, _, _ in running.values():
+            proc.send_signal(signal.SIGTERM)
+        for proc, log, _ in running.values():
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()  # it could not delete its running copy
+                proc.wait()
+            log.close()
+        for name in running:
+            _running_copy(Path(specs[name]["dest"])).unlink(missing_ok=True)
+    return seconds
+
+
+def _running_copy(dest: Path) -> Path:
+    """Where papermill writes a notebook while it runs (hidden, beside ``dest``)."""
+    return dest.with_name(f".{dest.name}.running.ipynb")
+
+
+def _execute(name: str, notebook: str, parameters: dict, dest: str, write_to: str) -> None:
+    """Run one notebook into ``write_to`` (a failed run kept as ``<dest>.failed.ipynb``).
+
+    The kernel talks to papermill over Unix sockets in a private folder: over TCP every
+    kernel warns that it runs without encryption, and any local process could reach it.
+    (TCP on Windows, and where the temporary folder's path is too long for a socket.)
     """
+    import nbformat
+    import papermill as pm
+    from traitlets.config import Config
+
+    from .io import atomic_write
+
+    tmp = _running_copy(Path(dest))
+    folder = tempfile.mkdtemp(prefix="beatsync-kernel-")  # mode 0700
+    ip = os.path.join(folder, "kernel")
+    ipc = os.name == "posix" and len(os.fsencode(ip)) + len("-65535") < 104  # sun_path
+    try:  # Ctrl-C, SIGTERM at any point: the running copy is removed (finally)
+        try:
+            pm.execute_notebook(
+                notebook,
+                str(tmp),
+                parameters=parameters,
+                cwd=str(Path(notebook).parent),
+                progress_bar=False,
+                **(
+                    {"config": Config({"KernelManager": {"transport": "ipc", "ip": ip}})}
+                    if ipc
+                    else {}
+                ),
+            )
+        except Exception as exc:
+            if tmp.exists():  # kept for its traceback cells
+                os.replace(tmp, Path(dest).with_name(f"{Path(dest).stem}.failed.ipynb"))
+            raise NotebookFailed(f"notebook {name!r} failed:\n{str(exc).strip()}") from None
+        executed = nbformat.read(tmp, as_version=4)
+        executed.metadata.setdefault("papermill", {})["output_path"] = Path(dest).name
+        with atomic_write(write_to) as fh:
+            nbformat.write(executed, fh)
+    finally:
+        tmp.unlink(missing_ok=True)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _worker_main(argv: list[str]) -> int:
+    """``python -m beatsync.runner NAME SPEC_JSON``: run one notebook (a worker). SIGTERM
+    and SIGHUP become KeyboardInterrupt, so papermill shuts the kernel down; a failure's
+    message goes to stderr."""
 
     def stop(signum: int, frame: Any) -> None:
         raise KeyboardInterrupt
 
     for sig in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, stop)
-    spec, result = json.loads(argv[0]), Path(argv[1])
     try:
-        _execute(
-            Path(spec["notebook"]),
-            spec["parameters"],
-            Path(spec["cwd"]),
-            Path(spec["dest"]),
-            Path(spec["write_to"]),
-        )
-    except Exception as exc:
-        result.write_text(json.dumps({"error": str(exc) or type(exc).__name__}))
+        _execute(argv[0], **json.loads(argv[1]))
+    except NotebookFailed as exc:
+        print(exc, file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         return 130

@@ -42,7 +42,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         type=int,
         metavar="N",
         help="notebooks run at once, each in a process of its own (default: the number of "
-        "CPUs, at most 4; 1 runs them one after the other in this process)",
+        "CPUs, at most 4)",
     )
     p.add_argument(
         "--check", action="store_true", help="only check the parameter file, run nothing"
@@ -111,5 +111,7 @@ def run(args: argparse.Namespace) -> int:
             {"name": r.name, "output": str(r.output), "seconds": round(r.seconds, 1)} for r in runs
         ],
     }
+    if args.quiet and not args.json:
+        return 0  # nothing but errors and warnings
     text = "\n".join(f"{r.name}: {r.seconds:.1f} s -> {r.output}" for r in runs)
     return emit(result, text or "no notebooks run", args)

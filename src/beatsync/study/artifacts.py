@@ -16,10 +16,27 @@ from typing import Any
 from .. import __version__, io
 from ..render import save_figure
 
-__all__ = ["CSV_FLOAT_FORMAT", "write_artifacts"]
+__all__ = ["CSV_FLOAT_FORMAT", "write_artifacts", "results_folder"]
 
 #: printf format of every float in a study CSV (documented precision: 6 significant digits).
 CSV_FLOAT_FORMAT = "%.6g"
+
+
+def results_folder(results_dir: str | Path) -> Path:
+    """The study's results folder ``results_dir``; a relative one is taken from the
+    repository's ``notebooks/`` folder (as the notebooks' ``"../results"``), whatever the
+    current folder: that of the first folder, from the current one upwards, that holds
+    ``notebooks/`` and ``pyproject.toml``, else of the checkout this package runs from,
+    else the current folder itself."""
+    path = Path(results_dir)
+    if path.is_absolute():
+        return path
+    here = Path.cwd().resolve()
+    checkout = Path(__file__).resolve().parents[3]  # src/beatsync/study/artifacts.py
+    for root in [*[here, *here.parents], checkout]:
+        if (root / "notebooks").is_dir() and (root / "pyproject.toml").is_file():
+            return (root / "notebooks" / path).resolve()
+    return path.resolve()
 
 
 def write_artifacts(
@@ -36,7 +53,8 @@ def write_artifacts(
     Parameters
     ----------
     results_dir : path
-        The study's results folder (``results`` or ``results/ci``).
+        The study's results folder (``../results`` or ``../results/ci``: relative ones
+        are found from the repository's ``notebooks/`` folder, :func:`results_folder`).
     notebook : str
         The notebook's name (file stem); the artefacts' folder.
     params : dict
@@ -53,7 +71,7 @@ def write_artifacts(
     list of Path
         Every file written.
     """
-    out = Path(results_dir) / notebook
+    out = results_folder(results_dir) / notebook
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, df in (tables or {}).items():
