@@ -105,6 +105,7 @@ def test_write_video_fallback_gif_and_wav(tmp_path):
         ({"audio": (np.zeros(10), 0)}, "sample rate"),
         ({"beats": [1.0, 0.5]}, "increasing"),
         ({"duration": -1.0}, "duration"),
+        ({"preset": "turbo"}, "turbo"),
     ],
 )
 def test_write_video_bad_inputs(tmp_path, kwargs, match):

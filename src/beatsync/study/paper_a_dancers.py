@@ -509,7 +509,7 @@ def dancer_video(
     *,
     seconds: float,
     fps: float = 15.0,
-    size: tuple[int, int] = (320, 240),
+    size: tuple[int, int] = (640, 480),
     title: str | None = None,
 ) -> Path:
     """The re-synchronised dancer over the first ``seconds`` of the new song, as MP4."""
@@ -523,7 +523,7 @@ def dancer_video(
         seconds=min(float(seconds), float(result.motion.duration)),
         fps=fps,
         size=size,
-        azimuth=0.0,
+        azimuth=30.0,
         title=title,
     )
 

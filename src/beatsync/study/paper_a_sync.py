@@ -682,4 +682,5 @@ def animation_video(
         size=size,
         azimuth=azimuth,
         title=title,
+        preset="veryfast",  # a small file, to commit and to embed in a notebook
     )
