@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from . import exercise
-from .audio_resampling import compare_arrays
+from .resampling import compare_arrays
 
 __all__: list[str] = []
 
