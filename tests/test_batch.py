@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from beatsync import datasets, io
-from beatsync.sync_grid import prepare_clip, sync_grid
 from beatsync.cli import main
 from beatsync.errors import NotPeriodicError, ParameterError
+from beatsync.sync_grid import prepare_clip, sync_grid
 from beatsync.synth.audio import beat_times, click_track
 
 SR = 22050

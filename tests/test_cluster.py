@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 
-from beatsync import cluster
+from beatsync import cluster, validation
 from beatsync.errors import ParameterError
 
 
@@ -25,8 +25,8 @@ def test_bad_worker_counts_are_refused_before_any_cluster_starts(n):
 
 
 def test_good_worker_counts():
-    assert [cluster.check_workers(n) for n in (None, 1, 3, np.int64(4))] == [None, 1, 3, 4]
-    assert cluster.check_workers(cluster.default_workers() * 16) >= 16
+    assert [validation.check_workers(n) for n in (None, 1, 3, np.int64(4))] == [None, 1, 3, 4]
+    assert validation.check_workers(validation.default_workers() * 16) >= 16
 
 
 @pytest.mark.parametrize(
@@ -39,7 +39,7 @@ def test_good_worker_counts():
 )
 def test_bad_cluster_options(scheduler, workers, match):
     with pytest.raises(ParameterError, match=match):
-        cluster.check_cluster_options(scheduler, workers)
+        validation.check_cluster_options(scheduler, workers)
 
 
 def _free_port() -> int:

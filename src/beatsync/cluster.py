@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import numbers
-import os
 import threading
 from collections.abc import Iterator
 from typing import Any
 
 from .errors import ParameterError
+from .validation import check_cluster_options, default_workers
 
 #: Seconds to wait for an existing scheduler (and its handshake) before giving up.
 CONNECT_TIMEOUT = 5.0
@@ -33,40 +32,6 @@ LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
 _START_LOCK = threading.Lock()  # dask.config is global: one local start at a time
 
 
-def default_workers() -> int:
-    """Workers of a local cluster when none are asked for: one per core."""
-    return os.cpu_count() or 1
-
-
-def check_workers(n_workers: Any) -> int | None:
-    """``None`` or a whole number of workers from 1 to 16 per core (at least 64: a typo
-    such as 10**12 would start workers until the machine hangs)."""
-    most = max(16 * default_workers(), 64)
-    if n_workers is not None and (
-        isinstance(n_workers, bool)
-        or not isinstance(n_workers, numbers.Integral)
-        or not 1 <= n_workers <= most
-    ):
-        raise ParameterError(
-            f"--workers={n_workers!r} must be a whole number of workers >= 1 and at most {most} "
-            "here; for a larger cluster give its address with --scheduler"
-        )
-    return None if n_workers is None else int(n_workers)
-
-
-def check_cluster_options(scheduler: Any, n_workers: Any) -> int | None:
-    """Check ``--scheduler`` and ``--workers`` together; return the worker count."""
-    n = check_workers(n_workers)
-    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
-        raise ParameterError(f"--scheduler={scheduler!r} is not an address (tcp://host:port)")
-    if scheduler is not None and n is not None:
-        raise ParameterError(
-            f"--workers {n} sizes a local cluster; --scheduler {scheduler!r} has its own "
-            "workers: give one or the other"
-        )
-    return n
-
-
 @contextlib.contextmanager
 def dask_client(
     *,
@@ -80,7 +45,8 @@ def dask_client(
     ``n_workers`` local workers (default: one per core), processes or threads of this
     process; ``timeout`` [s] (default :data:`CONNECT_TIMEOUT`) to wait for ``scheduler``.
     Raises :class:`~beatsync.errors.ParameterError` for options that
-    :func:`check_cluster_options` refuses, or a scheduler that does not answer in time.
+    :func:`beatsync.validation.check_cluster_options` refuses, or a scheduler that does
+    not answer in time.
     """
     n = check_cluster_options(scheduler, n_workers)
     import dask

@@ -296,10 +296,10 @@ def sync_grid(
     """
     import pandas as pd
 
-    from .cluster import check_cluster_options, dask_client
+    from .cluster import dask_client
     from .segment.checks import check_alpha, check_period_range
     from .sync import MODES
-    from .validation import check_motion_fps
+    from .validation import check_cluster_options, check_motion_fps
 
     check_cluster_options(scheduler, n_workers)
     if mode not in MODES:

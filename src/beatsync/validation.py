@@ -16,7 +16,8 @@ Helpers
   :func:`check_range`, :func:`check_interval` (one pair);
 - rates: :func:`check_fps` [Hz], :func:`check_sample_rate` [Hz], :func:`check_bpm`
   [bpm] (one range, :data:`MIN_BPM`-:data:`MAX_BPM`);
-- arrays: :func:`check_finite`, :func:`check_times` [s], :func:`check_audio`.
+- arrays: :func:`check_finite`, :func:`check_times` [s], :func:`check_audio`;
+- parallel runs: :func:`check_workers`, :func:`check_cluster_options`.
 
 Data contract
 -------------
@@ -29,6 +30,8 @@ Data contract
 
 from __future__ import annotations
 
+import numbers
+import os
 from typing import Any
 
 import numpy as np
@@ -57,6 +60,9 @@ __all__ = [
     "beat_phase",
     "MAX_MOTION_FPS",
     "check_motion_fps",
+    "default_workers",
+    "check_workers",
+    "check_cluster_options",
 ]
 
 #: Frame rates below this [Hz] are refused as a likely frame period in seconds.
@@ -574,3 +580,37 @@ def check_motion_fps(fps: Any, *, name: str = "fps") -> float:
             f"{MAX_MOTION_FPS:g} Hz): is it an audio sample rate, or a rate in another unit?"
         )
     return value
+
+
+def default_workers() -> int:
+    """Workers of a local cluster when none are asked for: one per core."""
+    return os.cpu_count() or 1
+
+
+def check_workers(n_workers: Any) -> int | None:
+    """``None`` or a whole number of workers from 1 to 16 per core (at least 64: a typo
+    such as 10**12 would start workers until the machine hangs)."""
+    most = max(16 * default_workers(), 64)
+    if n_workers is not None and (
+        isinstance(n_workers, bool)
+        or not isinstance(n_workers, numbers.Integral)
+        or not 1 <= n_workers <= most
+    ):
+        raise ParameterError(
+            f"--workers={n_workers!r} must be a whole number of workers >= 1 and at most {most} "
+            "here; for a larger cluster give its address with --scheduler"
+        )
+    return None if n_workers is None else int(n_workers)
+
+
+def check_cluster_options(scheduler: Any, n_workers: Any) -> int | None:
+    """Check ``--scheduler`` and ``--workers`` together; return the worker count."""
+    n = check_workers(n_workers)
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
+        raise ParameterError(f"--scheduler={scheduler!r} is not an address (tcp://host:port)")
+    if scheduler is not None and n is not None:
+        raise ParameterError(
+            f"--workers {n} sizes a local cluster; --scheduler {scheduler!r} has its own "
+            "workers: give one or the other"
+        )
+    return n

@@ -32,8 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
 from ..audio_resampling import resample
+from ..errors import ParameterError
 from ..validation import (
     check_audio,
     check_positive,

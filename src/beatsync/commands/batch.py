@@ -61,10 +61,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
 
     from .. import io
-    from ..sync_grid import item_names, output_suffixes, sync_grid
-    from ..cluster import check_cluster_options
     from ..errors import ParameterError
     from ..io import check_input_file
+    from ..sync_grid import item_names, output_suffixes, sync_grid
+    from ..validation import check_cluster_options
     from ._common import Outputs, check_output, feedback
 
     tempo = tempo_options(args)  # before any work

@@ -95,11 +95,10 @@ def run_beats(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from .. import other_trackers
-    from ..cluster import check_cluster_options
     from ..errors import ParameterError
     from ..evaluate.beats import EMPTY_REFERENCE_TEXT
     from ..study.beat_dataset import RESULT_FILES, evaluate_dataset, find_tracks
-    from ..validation import check_positive
+    from ..validation import check_cluster_options, check_positive
     from ._common import Interrupted, check_output, feedback, interrupted_by
 
     fb = feedback(args)

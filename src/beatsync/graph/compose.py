@@ -29,6 +29,7 @@ from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
 from .plausibility import plausibility
 from .search import METHODS, dp_core
+from .synthesis import SynthesisResult, synthesize_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
     TempoPlan,
@@ -37,7 +38,6 @@ from .timescale import (
     music_grid,
     plan_tempo,
 )
-from .synthesis import SynthesisResult, synthesize_core
 
 __all__ = ["Composition", "compose", "compose_music", "check_music_beats"]
 

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, warn
 from ..audio_resampling import resample
+from ..errors import ParameterError, warn
 from ..validation import as_float, check_audio, check_finite, check_sample_rate, check_times
 from ._files import atomic_write, check_input_file
 

@@ -564,8 +564,8 @@ def evaluate_dataset(
         one holding none of its tempi at a track's sample rate); a bad worker count or
         an unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
     """
-    from ..cluster import check_cluster_options, dask_client
-    from ..validation import check_positive
+    from ..cluster import dask_client
+    from ..validation import check_cluster_options, check_positive
 
     other_trackers.get(method)
     mbt = check_positive(min_beat_time, name="min_beat_time", unit="s", allow_zero=True)
