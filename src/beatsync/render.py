@@ -342,7 +342,8 @@ def find_ffmpeg() -> str | None:
 
 
 class _Stage:
-    """Draws the dancer in perspective, one frame at a time, into an RGB buffer.
+    """Draws the dancer in perspective, one frame at a time, into a Pillow image (in
+    H.264's YCbCr for ffmpeg, or RGB for the GIF fallback).
 
     The camera looks at the dancer from ``azimuth`` degrees about the vertical axis
     and ``elevation`` degrees above the floor, and follows the dancer: it aims at the
@@ -352,8 +353,8 @@ class _Stage:
     two thirds of the frame whatever the units. Bones are drawn far to near, with
     their shadows on the floor; on a beat the figure turns red, a dot lights, and the
     beat ruler at the bottom (beats within two seconds of now, scrolling past a
-    playhead) shows where the beats fall. Pillow draws every frame: no GUI toolkit,
-    about a millisecond per frame.
+    playhead) shows where the beats fall. Pillow draws every frame, from geometry
+    planned for all frames at once (:meth:`_plan`); speed: ``benchmarks/bench_render.py``.
     """
 
     def __init__(
