@@ -107,6 +107,8 @@ def lab(tmp_path_factory):
             server.wait()
 
 
+#: a code cell's execution count ("[ ]:" not run, "[*]:" running or queued, "[3]:" ran)
+PROMPT = ".jp-CodeCell .jp-InputArea-prompt"
 #: what a cell wrote to stderr, tracebacks included
 STDERR = ".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.stderr']"
 #: the live view of `view = explore(...)`: its sliders above the figure it draws
@@ -124,22 +126,27 @@ def test_a_tutorial_runs_and_its_slider_redraws_its_figure(browser, lab):
         page.locator(".jp-Notebook").first.click()
         page.get_by_role("menuitem", name="Run", exact=True).click()
         page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
-        # the last cell ran: every cell above it did, with no error (an error stops Run All)
-        try:
-            page.wait_for_function(
-                """text => [...document.querySelectorAll('.jp-OutputArea-output')]
-                          .some(o => o.textContent.includes(text))""",
-                arg=LAST_OUTPUT,
-                timeout=150_000,
-            )
-        except PlaywrightTimeout:
-            stderr = page.eval_on_selector_all(STDERR, "els => els.map(e => e.textContent)")
-            pytest.fail(f"the tutorial did not run to its end; its errors: {stderr}")
-        # every code cell ran once, in order (Run All stops at the first error)
-        prompts = page.eval_on_selector_all(
-            ".jp-CodeCell .jp-InputArea-prompt", "els => els.map(e => e.textContent.trim())"
+        # Run All queues every cell ("[*]:"); it is over when none is queued any more:
+        # each shows its execution count, or the run stopped at an error and the cells
+        # after it show "[ ]:" again
+        page.wait_for_function(
+            """prompt => {
+                   const texts = [...document.querySelectorAll(prompt)]
+                       .map(p => p.textContent.trim());
+                   return !texts.includes('[*]:') && texts.some(t => /^\\[\\d+\\]:$/.test(t)); }""",
+            arg=PROMPT,
+            timeout=150_000,
         )
-        assert prompts == [f"[{n}]:" for n in range(1, len(prompts) + 1)], prompts
+        prompts = page.eval_on_selector_all(PROMPT, "els => els.map(e => e.textContent.trim())")
+        stderr = page.eval_on_selector_all(STDERR, "els => els.map(e => e.textContent)")
+        # every code cell ran once, in order
+        assert prompts == [f"[{n}]:" for n in range(1, len(prompts) + 1)], (prompts, stderr)
+        page.wait_for_function(
+            """text => [...document.querySelectorAll('.jp-OutputArea-output')]
+                      .some(o => o.textContent.includes(text))""",
+            arg=LAST_OUTPUT,
+            timeout=10_000,
+        )
 
         view = page.locator(VIEW)
         assert view.count() == 1, "the tutorial's live view (an ipywidgets VBox) is not shown"
