@@ -2,9 +2,10 @@
 
     .venv/bin/python tests_browser/screenshots.py     # after `make docs`
 
-Writes ``docs/img/site_home.png`` (the home page) and ``docs/img/site_tutorial.png``,
-the first tutorial with a precomputed slider, scrolled to the slider; while there is no
-such tutorial, ``docs/img/site_notebook.png``, the segmentation notebook at its figure.
+Writes into ``docs/img/``: ``site_home.png`` (the home page), ``site_notebook.png``
+(the segmentation notebook at its figure) and ``site_tutorial.png`` (the first
+tutorial with a precomputed slider, scrolled to the slider, moved once so that the
+picture shows the figure it swapped in).
 """
 
 from __future__ import annotations
@@ -22,13 +23,24 @@ from conftest import CHROMIUM, CHROMIUM_ARGS, ROOT, SITE, is_local  # noqa: E402
 OUT = ROOT / "docs" / "img"
 
 
-def _second_page() -> tuple[Path, str, str]:
-    """The page of the second screenshot, what to scroll to, and the file's name."""
+def _tutorial() -> Path:
+    """The first tutorial page with a precomputed slider."""
     for page in sorted((SITE / "notebooks" / "tutorials").glob("*.html")):
         if re.search(r"<input[^>]*type=[\"']?range", page.read_text(errors="replace")):
-            return page, "input[type=range]", "site_tutorial.png"
-    notebook = SITE / "notebooks" / "paper_a_fig02_segmentation.html"
-    return notebook, "div.cell_output img", "site_notebook.png"
+            return page
+    raise SystemExit(f"no tutorial page with a slider in {SITE}: run `make docs` first")
+
+
+def _shoot(page, path: Path, selector: str, name: str, *, move: bool = False) -> None:
+    page.goto(path.as_uri())
+    page.wait_for_load_state("networkidle")
+    target = page.locator(selector).first
+    if move:  # a slider: one step, so that its figure is one it swapped in
+        target.press("ArrowRight")
+        target.blur()
+    # one scroll down from the top (furo shows its "back to top" button on a scroll up)
+    target.evaluate("e => window.scrollTo(0, e.getBoundingClientRect().top + window.scrollY - 80)")
+    page.screenshot(path=OUT / name)
 
 
 def main() -> None:
@@ -46,15 +58,12 @@ def main() -> None:
         page.goto((SITE / "index.html").as_uri())
         page.wait_for_load_state("networkidle")
         page.screenshot(path=OUT / "site_home.png")
-        path, selector, name = _second_page()
-        page.goto(path.as_uri())
-        page.wait_for_load_state("networkidle")
-        target = page.locator(selector).first
-        target.scroll_into_view_if_needed()
-        page.evaluate("window.scrollBy(0, -120)")
-        page.screenshot(path=OUT / name)
+        notebook = SITE / "notebooks" / "paper_a_fig02_segmentation.html"
+        _shoot(page, notebook, "div.cell_output img", "site_notebook.png")
+        tutorial = _tutorial()
+        _shoot(page, tutorial, "input[type=range]", "site_tutorial.png", move=True)
         browser.close()
-    print(f"wrote {OUT / 'site_home.png'} and {OUT / name} ({path.name})")
+    print(f"wrote site_home.png, site_notebook.png, site_tutorial.png ({tutorial.name}) in {OUT}")
 
 
 if __name__ == "__main__":

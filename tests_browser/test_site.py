@@ -170,6 +170,7 @@ def _sliders_change_their_figures(browser, path: Path) -> int:
             at_max = slider.evaluate("s => s.value === s.max")
             slider.press("Home" if at_max else "End")
             after = slider.evaluate(srcs)
+            assert after, f"{path.name}: slider {i} moved to a state with no figure"
             assert after != before, f"{path.name}: slider {i} did not change its figure"
         assert watch.problems() == {}, watch.problems()
         return count
