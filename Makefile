@@ -40,7 +40,7 @@ help:
 	@echo "make test        set up .venv from uv.lock and run unit tests + nbval on the notebooks"
 	@echo "make lock        re-resolve the newest allowed versions into uv.lock (and environment.yml)"
 	@echo "make bench       run the benchmarks into benchmarks/RESULTS.md"
-	@echo "make notebooks   re-execute the committed notebooks with params/ci.yaml"
+	@echo "make notebooks   re-execute the committed notebooks (params/ci.yaml) and the tutorials"
 	@echo "make lint        ruff on src/ tests/ tests_browser/ benchmarks/ and the site's Python"
 	@echo "make lab         install the lab extra from uv.lock and open JupyterLab at notebooks/"
 	@echo "make docs        build the static site into docs/_build/html (open docs/_build/html/index.html)"
@@ -96,6 +96,9 @@ bench: setup
 
 notebooks: setup
 	$(BIN)/beatsync reproduce --params params/ci.yaml --in-place
+	for nb in notebooks/tutorials/[0-9]*.ipynb; do \
+	    $(BIN)/papermill -k python3 --cwd notebooks/tutorials "$$nb" "$$nb" || exit 1; \
+	done
 
 # JupyterLab at notebooks/ (the tutorials are in notebooks/tutorials/); ipywidgets 8
 # brings the lab extension its sliders need.
