@@ -63,6 +63,8 @@ def test_run_executes_with_parameters(nbdir, tmp_path):
     nb = nbformat.read(out / "tiny.ipynb", as_version=4)
     texts = [o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.outputs]
     assert "42\n" in texts
+    # the executed notebook names its source relative to the repository, not this machine
+    assert nb.metadata["papermill"]["input_path"] == "notebooks/tiny.ipynb"
     manifest = json.loads((out / "run_manifest.json").read_text())
     assert manifest["notebooks"][0]["parameters"] == {"n": 21}
 

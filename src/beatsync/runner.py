@@ -293,7 +293,10 @@ def _execute(name: str, notebook: str, parameters: dict, dest: str, write_to: st
                 os.replace(tmp, Path(dest).with_name(f"{Path(dest).stem}.failed.ipynb"))
             raise NotebookFailed(f"notebook {name!r} failed:\n{str(exc).strip()}") from None
         executed = nbformat.read(tmp, as_version=4)
-        executed.metadata.setdefault("papermill", {})["output_path"] = Path(dest).name
+        meta = executed.metadata.setdefault("papermill", {})
+        # paths relative to the repository, not this machine's
+        meta["input_path"] = f"{Path(notebook).parent.name}/{Path(notebook).name}"
+        meta["output_path"] = Path(dest).name
         with atomic_write(write_to) as fh:
             nbformat.write(executed, fh)
     finally:
