@@ -375,10 +375,7 @@ class _Stage:
         from scipy.ndimage import gaussian_filter1d
 
         w, h = size
-        self.size, self.title, self.bones, self.mode = size, title, bones, mode
-        # colours in the frame's own mode: H.264's limited-range BT.601 YCbCr needs no
-        # conversion by ffmpeg (a third of its work); RGB for the GIF fallback
-        self.ink = (lambda rgb: _ycc(rgb)) if mode == "YCbCr" else (lambda rgb: tuple(rgb))
+        self.size, self.bones, self.mode = size, bones, mode
         # world -> (h1, h2, up) with the vertical last: a right-handed frame
         order = [(up + 1) % 3, (up + 2) % 3, up]
         p = pos[..., order]
@@ -407,19 +404,19 @@ class _Stage:
         self.head = _head_joint(p, bones, names)
         self.height = height
         self.grid = self._grid_segments(track, height)
-        self.draw_module, self.image_module = ImageDraw, Image
+        self.draw_module = ImageDraw
         self.font = ImageFont.load_default(size=max(11, h // 32))
         # sky above the horizon, floor below: the same for every frame
         horizon = int(np.clip(self.centre[1] - self.f * np.tan(e), 0, h))
-        bg = Image.new(mode, (w, h), self.ink(_SKY))
-        ImageDraw.Draw(bg).rectangle((0, horizon, w, h), fill=self.ink(_FLOOR))
+        bg = Image.new(mode, (w, h), self._ink(_SKY))
+        ImageDraw.Draw(bg).rectangle((0, horizon, w, h), fill=self._ink(_FLOOR))
         self.background = bg
-        self.palette = tuple(self.ink(c) for c in (_GRID, _SHADOW, _RED, (30, 30, 30)))
+        self.palette = tuple(self._ink(c) for c in (_GRID, _SHADOW, _RED, (30, 30, 30)))
         # the title once, on the background; each frame writes only its time after it
         title_box = ImageDraw.Draw(bg).textbbox((8, 6), title, font=self.font)
         ImageDraw.Draw(bg).text((8, 6), title, fill=self.palette[3], font=self.font)
         self.clock_at = (title_box[2] + 12, 6)
-        self._plan(fps)
+        self._plan()
 
     def _screen(self, p: np.ndarray, eye: np.ndarray | None = None) -> np.ndarray:
         """(x, y, depth) in pixels of points ``p`` [shape=(n_frames, k, 3)]."""
@@ -465,7 +462,11 @@ class _Stage:
         seg[behind | outside] = np.nan
         return seg
 
-    def _plan(self, fps: float) -> None:
+    def _ink(self, rgb: Any) -> tuple[int, int, int]:
+        """One sRGB colour in the frame's mode (see :func:`_colours`)."""
+        return tuple(_colours(np.asarray(rgb, dtype=np.float64), self.mode).tolist())
+
+    def _plan(self) -> None:
         """Everything a frame draws, for all frames at once (numpy), as Python lists:
         the per-frame loop in :meth:`draw` then only calls Pillow."""
         n = len(self.joints)
@@ -496,13 +497,11 @@ class _Stage:
         # farther joints fade towards the floor's colour: depth at a glance
         span = np.maximum(np.ptp(z, axis=1, keepdims=True), 1e-9)
         depth = 0.45 * (z - z.min(axis=1, keepdims=True)) / span
-        self.bone_ops = []
         self.tones = {}
         for beat, rgb in ((False, _FIGURE), (True, _RED)):
             base = np.asarray(rgb, dtype=np.float64)
             tone = base + depth[..., None] * (np.asarray(_FLOOR, dtype=np.float64) - base)
-            ink = _ycc_array(tone) if self.mode == "YCbCr" else np.rint(tone).astype(int)
-            self.tones[beat] = ink
+            self.tones[beat] = _colours(tone, self.mode)
         self.bone_ops = [
             list(zip(map(tuple, e), map(tuple, c), f, rr, strict=True))
             for e, c, f, rr in zip(
@@ -746,17 +745,12 @@ _SKY, _FLOOR, _GRID, _SHADOW = (226, 232, 240), (206, 203, 196), (178, 174, 166)
 _RED, _FIGURE = (214, 39, 40), (40, 52, 82)
 
 
-def _ycc(rgb: Any) -> tuple[int, int, int]:
-    """An sRGB colour [0-255] as limited-range BT.601 YCbCr, H.264's default."""
-    r, g, b = (float(c) for c in rgb)
-    y = 16 + (65.481 * r + 128.553 * g + 24.966 * b) / 255
-    cb = 128 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255
-    cr = 128 + (112.0 * r - 93.786 * g - 18.214 * b) / 255
-    return int(round(y)), int(round(cb)), int(round(cr))
-
-
-def _ycc_array(rgb: np.ndarray) -> np.ndarray:
-    """:func:`_ycc` of an array of colours [shape=(..., 3)], as ints."""
+def _colours(rgb: np.ndarray, mode: str) -> np.ndarray:
+    """sRGB colours [0-255, shape=(..., 3)] as ints in a frame's mode: ``"YCbCr"`` is
+    H.264's limited-range BT.601 (ffmpeg then converts nothing, a third of its work),
+    ``"RGB"`` (the GIF fallback) is rounded as it is."""
+    if mode != "YCbCr":
+        return np.rint(rgb).astype(int)
     m = np.array([[65.481, 128.553, 24.966], [-37.797, -74.203, 112.0], [112.0, -93.786, -18.214]])
     return np.rint(rgb @ m.T / 255 + np.array([16.0, 128.0, 128.0])).astype(int)
 
