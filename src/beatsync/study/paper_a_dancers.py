@@ -19,7 +19,7 @@ dancer:
     (:func:`motion_table`): the playback speed (instantaneous and per interval, share
     of the output within 0.8-1.25), p99 joint speed and acceleration against the
     dancer's own, the peak joint speed at the loop joins and overall, next to the
-    alignment scores of (a)-(c); and the same figures measured on the code before the
+    alignment scores of (a)-(c); and the same figures for the code before the
     whole-dance beat counts and seamless loops (:func:`before_table`, read from the
     record of ``benchmarks/bench_resync.py --label before``).
 

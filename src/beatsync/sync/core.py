@@ -73,7 +73,7 @@ class SyncResult:
         ``boundaries_s``, ``residual_ms`` (one per boundary),
         ``residual_nearest_frame_ms``, ``max_abs_residual_ms``,
         ``max_abs_residual_frames``, ``lead_in_hold_frames``, ``n_scaled_periods``,
-        ``covered_s`` (music time span the dance covers); measured on the result
+        ``covered_s`` (music time span the dance covers); computed from the output frames
         (:mod:`beatsync.sync.quality`): ``beats_per_motion_beat_used`` (count -> number
         of intervals, halves allowed), ``n_merged_intervals``,
         ``n_half_beat_landings``, ``phrases_on_bars`` (share of the dance bars, given

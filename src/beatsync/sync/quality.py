@@ -111,7 +111,7 @@ def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND
 
 
 def report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed) -> dict:
-    """Report entries measured on the result (see the module docstring)."""
+    """Report entries computed from the output frames (see the module docstring)."""
     from ..motion_beats import motion_positions
 
     out_fps = float(out_motion.fps)
