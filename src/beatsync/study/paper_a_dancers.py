@@ -337,11 +337,6 @@ def summary_table(table: Any, *, mode: str = "beats") -> Any:
     return t[cols + ["beats_motion_target", "beats_music_target"]].reset_index(drop=True)
 
 
-def _joint_speeds(motion: Any) -> np.ndarray:
-    pos = motion.positions()
-    return np.linalg.norm(np.diff(pos, axis=0), axis=-1) * motion.fps
-
-
 def _playback_speed(result: Any) -> np.ndarray:
     """Source seconds per output second between output frames, where the warp is live."""
     fps = result.motion.fps
@@ -362,20 +357,22 @@ def motion_table(
     speed, joint kinematics against the dancer's own, the joins, and the alignment
     scores of :func:`dancer_table` (after, random-offset control, own song).
 
-    Speeds and kinematics are measured here on the output frames (not read from the
-    sync report); joint speeds in m/s, accelerations in m/s^2, finite differences over
-    all joints and frames.
+    Speeds and kinematics are computed here from the output frames, with the sync
+    report's own functions (:func:`beatsync.sync.quality.joint_kinematics`), not read
+    from the report; finite differences over all joints and frames.
     """
     import pandas as pd
+
+    from ..sync.quality import joint_kinematics
 
     rows = []
     t = table[table["mode"] == mode].set_index("dancer")
     for name, pair in pairs.items():
         res = results[(name, mode)]
-        own_v = _joint_speeds(pair.motion)
-        out_v = _joint_speeds(res.motion)
-        own_a = np.linalg.norm(np.diff(pair.motion.positions(), 2, axis=0), axis=-1)
-        out_a = np.linalg.norm(np.diff(res.motion.positions(), 2, axis=0), axis=-1)
+        kin = joint_kinematics(
+            pair.motion.positions(), pair.motion.fps, res.motion.positions(), res.motion.fps
+        )
+        ratio, own_peak = kin["ratio"], kin["input"]["peak_joint_speed"]
         speed = _playback_speed(res)
         joins = [j.get("peak_joint_speed", np.nan) for j in res.report.get("joins", [])]
         used = res.report.get("beats_per_motion_beat_used", {})
@@ -388,11 +385,11 @@ def motion_table(
                 "speed min": float(speed.min()),
                 "speed median": float(np.median(speed)),
                 "speed max": float(speed.max()),
-                "p99 speed / own": float(np.percentile(out_v, 99) / np.percentile(own_v, 99)),
-                "p99 accel / own": float(np.percentile(out_a, 99) / np.percentile(own_a, 99)),
-                "peak / own peak": float(out_v.max() / own_v.max()),
+                "p99 speed / own": ratio["p99_joint_speed"],
+                "p99 accel / own": ratio["p99_joint_accel"],
+                "peak / own peak": ratio["peak_joint_speed"],
                 "joins": len(joins),
-                "join peak / own peak": float(np.max(joins) / own_v.max()) if joins else np.nan,
+                "join peak / own peak": float(np.max(joins) / own_peak) if joins else np.nan,
                 "after_motion": t.loc[name, "after_motion"],
                 "control_motion": t.loc[name, "after_control_motion"],
                 "own_motion": t.loc[name, "own_motion"],
