@@ -36,19 +36,10 @@ __all__ = [
 
 
 def beat_rms_db(y: Any, sr: float, beats: Any, *, amin: float = 1e-5) -> np.ndarray:
-    """Sound pressure level (RMS in dB re 1.0) of each interval between successive beats.
+    """Sound pressure level (RMS in dB re 1.0) of each interval between ``K+1`` beats [s].
 
-    Parameters
-    ----------
-    y : np.ndarray [shape=(n,)]
-    sr : float > 0 [Hz]
-    beats : np.ndarray [shape=(K+1,)] [s], inside the audio
-    amin : float > 0
-        RMS floor (silence reads ``20 log10(amin)`` dB, -100 dB by default).
-
-    Returns
-    -------
-    level : np.ndarray [shape=(K,)] [dB]
+    Returns ``K`` levels [dB]; ``amin`` floors the RMS (silence reads ``20 log10(amin)``,
+    -100 dB by default).
     """
     y, sr = check_audio(y, sr, allow_silent=True)
     beats = check_times(beats, name="music beats", duration=y.size / sr)
@@ -81,29 +72,11 @@ def track_music_beats(
     min_bpm: float | None = None,
     max_bpm: float | None = None,
 ) -> np.ndarray:
-    """Music beat times [s] from :func:`beatsync.beats.track_beats`.
+    """Music beat times [s] from :func:`beatsync.beats.track_beats` (``method``, a known
+    ``bpm``, the tempo range ``min_bpm``-``max_bpm``): at least two, strictly increasing.
 
-    Parameters
-    ----------
-    y : np.ndarray [shape=(n,)]
-        Mono audio.
-    sr : float > 0 [Hz]
-    bpm : float, optional [bpm]
-        Known tempo (20-400 BPM, :func:`beatsync.validation.check_bpm`).
-    method : {"psf", "librosa"}
-    min_bpm, max_bpm : float, optional [bpm]
-        Tempo range searched (default: :func:`beatsync.beats.track_beats`'s).
-
-    Returns
-    -------
-    beats : np.ndarray [s]
-        At least two beats, strictly increasing.
-
-    Raises
-    ------
-    ParameterError
-        Silence, audio too short for a pulse, a bad ``bpm``, or a signal in which
-        fewer than two beats were found.
+    A :class:`ParameterError` for silence, audio too short for a pulse, a bad ``bpm``, or
+    fewer than two beats found.
     """
     y, sr = check_audio(y, sr)
     if bpm is not None:

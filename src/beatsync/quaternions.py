@@ -2,10 +2,8 @@
 
 Quaternions are ``(..., 4)`` arrays with the scalar last, ``(x, y, z, w)``, as in
 :class:`scipy.spatial.transform.Rotation`. Forward kinematics and slerp convert one
-Euler triple per frame and joint; :meth:`Rotation.from_euler` costs about 3 us per
-rotation and :meth:`Rotation.__mul__` about as much, which made them the largest
-cost of composing and resampling motion. These vectorised forms give the same
-rotations (to rounding, checked against scipy in the tests) for a small fraction of that.
+Euler triple per frame and joint, where scipy's per-rotation objects were the largest
+cost; these vectorised forms give the same rotations (checked against scipy in the tests).
 """
 
 from __future__ import annotations
@@ -25,17 +23,8 @@ def quat_from_euler(angles_deg: np.ndarray, axes: str) -> np.ndarray:
     The BVH convention, and scipy's for upper-case axes: the rotation is
     ``R = R_axes[0](a0) @ R_axes[1](a1) @ ...`` (each later rotation about the axes
     already turned by the earlier ones).
-
-    Parameters
-    ----------
-    angles_deg : np.ndarray [shape=(n, len(axes))] [deg]
-    axes : str
-        One to three of ``X``, ``Y``, ``Z`` (case-insensitive: always intrinsic).
-
-    Returns
-    -------
-    q : np.ndarray [shape=(n, 4)]
-        Scalar last.
+    ``angles_deg`` is ``(n, len(axes))``; ``axes`` is one to three of ``X``, ``Y``, ``Z``
+    (case-insensitive: always intrinsic). Returns ``(n, 4)`` quaternions, scalar last.
 
     Examples
     --------
