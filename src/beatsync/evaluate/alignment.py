@@ -23,7 +23,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, warn
-from ..validation import beat_phase, check_fps, check_times, frames_to_time, time_to_frames
+from ..validation import (
+    beat_phase,
+    check_fps,
+    check_positive,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 
 __all__ = [
     "validate",
@@ -41,19 +48,15 @@ __all__ = [
 DEFAULT_SIGMA = 0.05
 
 
-def _check_sigma(sigma: Any) -> float:
-    try:
-        s = float(sigma)
-    except (TypeError, ValueError):
-        raise ParameterError(f"sigma={sigma!r} must be a number of seconds") from None
-    if not np.isfinite(s) or s <= 0:
-        raise ParameterError(f"sigma={sigma!r} must be a finite width > 0 [s]")
+def _checked(motion_beats: Any, music_beats: Any, sigma: Any):
+    """``(motion_beats, music_beats, sigma)`` validated (:func:`validate`, sigma [s])."""
+    s = check_positive(sigma, name="sigma", unit="s")
     if s >= 1.0:
         raise ParameterError(
             f"sigma={sigma!r} s is wider than a beat: sigma is in seconds, not frames "
             "(the papers' 3 frames at 60 fps is sigma=0.05)"
         )
-    return s
+    return *validate(motion_beats, music_beats), s
 
 
 def validate(motion_beats: Any, music_beats: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -98,8 +101,7 @@ def beat_alignment_motion(
     >>> beat_alignment_motion([0.5, 1.0], [0.0, 0.5, 1.0, 1.5])
     1.0
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     return _score(mb, yb, sigma, "motion beats")
 
 
@@ -115,8 +117,7 @@ def beat_alignment_music(
     >>> round(beat_alignment_music([0.5, 1.0], [0.0, 0.5, 1.0, 1.5]), 3)
     0.5
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     return _score(yb, mb, sigma, "music beats")
 
 
@@ -131,8 +132,7 @@ def alignment_scores(
     they were computed on and ``sigma_s``. Given a ``span`` [s], only beats inside it count
     (e.g. the time both the dance and the music play).
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     if span is not None:
         lo, hi = float(span[0]), float(span[1])
         if not hi > lo:
@@ -161,8 +161,7 @@ def offset_control(
     Each of ``n_trials`` shifts all motion beats by one offset uniform in ``[-T/2, T/2)``,
     ``T`` the median music beat period: the dance keeps its rhythm, its phase is random.
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     if yb.size < 2:
         raise ParameterError("offset_control needs at least 2 music beats to know the beat period")
     if int(n_trials) < 1:
