@@ -51,10 +51,11 @@ class MeterModel:
     ``half_time_s`` [s]: the comb filters' feedback half-time ``T0`` (paper: 3 s). The
     ``*_median_s`` [s] and ``*_sigma`` [natural-log units] of the log-normal period priors
     (paper medians: 0.18, 0.55, 2.1 s). ``ratio_weights``: ``w_l`` (l = 1..9) of the ratio
-    model for measure / tactus; ``tatum_ratio_weights`` for tactus / tatum, with ``w_3 =
-    0.5`` so that a "beat" of three sixteenths does not beat a waltz's own beat
-    (docs/tuning.md#tatum-ratio-weight). ``beta``: the log likelihood of a period is ``beta
-    * s(tau)``. ``min_tatum_s``, ``max_measure_s`` [s]: the shortest tatum and longest measure.
+    model for measure / tactus; ``tatum_ratio_weights`` for tactus / tatum, with
+    ``w_3 = 0.5`` so that a "beat" of three sixteenths does not beat a waltz's own beat
+    (docs/tuning.md#tatum-ratio-weight). ``beta``: the log likelihood of a period is
+    ``beta * s(tau)``. ``min_tatum_s``, ``max_measure_s`` [s]: the shortest tatum and
+    longest measure.
     """
 
     half_time_s: float = 3.0
@@ -216,8 +217,8 @@ def _resonator_lag_weights(
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(lag_w, gamma)``, cached per period grid and number of lags.
 
-    ``lag_w[i, k] = m_k sum_{b=0}^{n_fft/2} G_i(b) cos(2 pi b k / n_fft)`` with ``G_i =
-    |H_tau_i|^2`` below ``n_bins`` (``gamma`` above) and ``m_k`` 1 at lag 0, else 2, so
+    ``lag_w[i, k] = m_k sum_{b=0}^{n_fft/2} G_i(b) cos(2 pi b k / n_fft)`` with
+    ``G_i = |H_tau_i|^2`` below ``n_bins`` (``gamma`` above) and ``m_k`` 1 at lag 0, else 2, so
     that ``lag_w @ a`` is the resonators' energy for a window's autocorrelation ``a``. The
     sums over bins are an inverse real FFT, :data:`LAG_WEIGHT_ROWS` periods at a time;
     stored in float32.
@@ -357,11 +358,12 @@ def tactus_observation(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Log observation of each tactus period per window, tatum and measure maximised out.
 
-    The score of ``tB`` is ``beta s(tB) + log p(tB)`` plus ``max_tA [beta s(tA) + log p(tA)
-    + log g(tB / tA) - log Z_A(tB)]`` and the same for the measure with ``g(tC / tB)``;
-    ``Z`` normalises ``P(tA | tB)`` (and ``P(tC | tB)``) over tatum <= tactus <= measure.
-    Returns ``(log_obs, salience, measure)``, each (n_periods, n_windows): the observation,
-    the salience ``s`` at the tactus periods and the best measure period [s].
+    The score of ``tB`` is ``beta s(tB) + log p(tB)`` plus
+    ``max_tA [beta s(tA) + log p(tA) + log g(tB / tA) - log Z_A(tB)]`` and the same for
+    the measure with ``g(tC / tB)``; ``Z`` normalises ``P(tA | tB)`` (and ``P(tC | tB)``)
+    over tatum <= tactus <= measure. Returns ``(log_obs, salience, measure)``, each
+    (n_periods, n_windows): the observation, the salience ``s`` at the tactus periods and
+    the best measure period [s].
     """
     tatum, measure, g_a, g_c = _level_terms(
         np.ascontiguousarray(periods, dtype=np.float64).tobytes(), model
