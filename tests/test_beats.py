@@ -109,7 +109,7 @@ def test_known_bpm_override_and_range():
 def test_a_tempo_with_a_range_is_refused(method):
     # the range was ignored, even when the tempo lay outside it (the CLI refused it)
     y = click_track(beat_times(120, duration=5.0, start=0.3), sr=SR, duration=5.0)
-    with pytest.raises(ParameterError, match=r"bpm=120 fixes the tempo, and .*\(130, 200\)"):
+    with pytest.raises(ParameterError, match=r"bpm=120.*\(130, 200\)"):
         track_beats(y, SR, method=method, bpm=120, min_bpm=130, max_bpm=200)
     if method == "psf":  # (librosa's first numba compilation here crashed a fresh xdist run)
         assert track_beats(y, SR, bpm=120, min_bpm=40, max_bpm=240).beats.size
@@ -126,8 +126,8 @@ def test_frontend_parameters_accepted():
     "edges, match",
     [
         # band edges for another rate: no onsets, and a warning that blamed "a steady sound"
-        ((20000, 30000), r"band 1 \(20000-30000 Hz\) .* above 11025 Hz"),
-        ((0, 100, 100.5, 4000), r"band 2 \(100-100\.5 Hz\) .* narrower than one FFT bin"),
+        ((20000, 30000), r"band 1 \(20000-30000 Hz\).* 11025 Hz"),
+        ((0, 100, 100.5, 4000), r"band 2 \(100-100\.5 Hz\).*FFT bin"),
     ],
 )
 def test_band_edges_that_hold_no_frequency_are_refused(edges, match):
@@ -162,14 +162,14 @@ def test_librosa_method_scores_on_clean_clicks():
 def test_too_short_audio_is_refused(method, duration):
     # a 0.5 s click gave "109 BPM, 1 beat" (the tempo prior), exit 0
     y = click_track(beat_times(120, duration=duration, start=0.1), sr=SR, duration=duration)
-    with pytest.raises(ParameterError, match=rf"only {duration:.3f} s long.*at least 1\.5 s"):
+    with pytest.raises(ParameterError, match=rf"{duration:.3f} s.* 1\.5 s"):
         track_beats(y, SR, method=method)
 
 
 def test_short_audio_rule_with_known_bpm():
     y = click_track(beat_times(90, duration=1.8, start=0.1), sr=SR, duration=1.8)
     # 1.8 s passes the fixed minimum but is less than two beat periods at 50 BPM (2.4 s)
-    with pytest.raises(ParameterError, match=r"at least 2\.4 s \(two beat periods at the given"):
+    with pytest.raises(ParameterError, match=r" 2\.4 s.*bpm=50"):
         track_beats(y, SR, bpm=50.0)
     assert track_beats(y, SR, bpm=90.0).beats.size >= 2  # 1.33 s needed
     # exactly the minimum is accepted
@@ -192,7 +192,7 @@ def test_beat_tempo_known_answer():
 def test_check_audio_silence_threshold_and_allow_silent():
     quiet = 5e-7 * (-1.0) ** np.arange(100)  # above the silence threshold (1e-7)
     assert check_audio(quiet, SR)[0].dtype == np.float64
-    with pytest.raises(ParameterError, match="constant at 5e-07"):  # a DC offset: no sound
+    with pytest.raises(ParameterError, match="5e-07"):  # a DC offset: no sound
         check_audio(np.full(100, 5e-7), SR)
     with pytest.raises(ParameterError, match="silent"):
         check_audio(np.full(100, 5e-8), SR)
@@ -805,7 +805,7 @@ def test_default_front_end_is_cached_on_the_defaults_and_the_checked_rate(monkey
 
     for sr in (16000, np.int64(16000), np.float32(16000), 16000.0):
         assert onset.frontend_settings({}, sr) == onset.frontend_settings({"win_s": 0.023}, sr)
-    with pytest.raises(ParameterError, match="did you mean sr=44100"):
+    with pytest.raises(ParameterError, match="sr=44100"):
         onset.frontend_settings({}, 44.1)
     monkeypatch.setitem(onset.FRONTEND_DEFAULTS, "win_s", 0.046)
     assert onset.frontend_settings({}, 22050.0).win_length == 1014

@@ -107,13 +107,13 @@ def test_tempo_range_reaches_the_tracker():
 @pytest.mark.parametrize("bpm", [0.0, 2.0, 1200.0])
 def test_bpm_checked_like_the_tracker(bpm):
     y = np.random.default_rng(0).normal(size=4 * SR)
-    with pytest.raises(ParameterError, match="plausible range"):
+    with pytest.raises(ParameterError, match=f"bpm={bpm!r}"):
         track_music_beats(y, SR, bpm=bpm)
 
 
 def test_too_short_music_is_refused():
     y = np.random.default_rng(0).normal(size=SR // 2)  # 0.5 s
-    with pytest.raises(ParameterError, match="only 0.500 s long"):
+    with pytest.raises(ParameterError, match=r"0\.500 s"):
         track_music_beats(y, SR)
 
 

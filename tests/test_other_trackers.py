@@ -140,18 +140,18 @@ def test_librosa_range_without_a_tempo_step_is_refused(song):
     steps = librosa_tempo_steps(SR)
     assert not np.any((steps >= 185) & (steps <= 198))
     y, _ = song
-    with pytest.raises(ParameterError, match=r"185-198 BPM holds none .* 184\.6 and 198\.8 BPM"):
+    with pytest.raises(ParameterError, match=r"185-198 BPM.* 184\.6 and 198\.8 BPM"):
         trackers.track("librosa", y, SR, min_bpm=185, max_bpm=198)
-    with pytest.raises(ParameterError, match="holds none"):
+    with pytest.raises(ParameterError, match="185-198 BPM"):
         track_beats(y, SR, method="librosa", min_bpm=185, max_bpm=198)
     est = trackers.track("librosa", y, SR, min_bpm=180, max_bpm=200)  # holds two steps
     assert 180 <= 60.0 / np.median(np.diff(est)) <= 200
     from beatsync.beats.tracker import LIBROSA_MAX_TEMPO, librosa_tempo_prior
 
     top = steps[steps <= LIBROSA_MAX_TEMPO][-1]  # above the fastest step: one neighbour
-    with pytest.raises(ParameterError, match=rf"the nearest is {top:.1f} BPM: widen"):
+    with pytest.raises(ParameterError, match=rf"nearest is {top:.1f} BPM"):
         librosa_tempo_prior(top + 0.5, LIBROSA_MAX_TEMPO - 0.1, sr=SR)
-    with pytest.raises(ParameterError, match="it has none at this sample rate$"):
+    with pytest.raises(ParameterError, match=r"60-100 BPM.*none at this sample rate$"):
         librosa_tempo_prior(60, 100, sr=100)  # no tempo step at all
 
 
@@ -261,10 +261,10 @@ def test_missing_optional_package_says_how_to_install(monkeypatch):
     [
         (np.zeros(SR * 5, dtype=np.float32), SR, r"peak below 1e-07"),
         # a DC offset: ours made up one beat at the end, essentia's sixteen
-        (np.full(SR * 10, 0.5, dtype=np.float32), SR, r"constant at 0\.5 \(a DC offset"),
+        (np.full(SR * 10, 0.5, dtype=np.float32), SR, r"constant at 0\.5"),
         (np.array([], dtype=np.float32), SR, "zero samples"),
         # librosa returned one beat for 0.5 s, essentia's none
-        (np.random.default_rng(0).standard_normal(SR // 2), SR, r"only 0\.500 s long"),
+        (np.random.default_rng(0).standard_normal(SR // 2), SR, r"0\.500 s"),
         (np.full(SR * 5, np.nan, dtype=np.float32), SR, "110250 NaN"),
         (np.ones(SR * 5, dtype=np.float32), 0, "sr=0"),
     ],

@@ -1,10 +1,7 @@
-"""Band-limited audio resampling with soxr's high-quality filter.
-
-One implementation for the audio reader (:func:`beatsync.io.resample_audio`) and the
-beat tracker's analysis rate (:mod:`beatsync.beats.onset`). soxr's ``HQ`` quality is
-librosa's default ``res_type="soxr_hq"``: the samples are those of ``librosa.resample``,
-without importing librosa. soxr filters in single precision, so float64 input gives
-the same samples as its float32 cast.
+"""Band-limited audio resampling with soxr's high-quality filter, for the audio reader
+(:func:`beatsync.io.resample_audio`) and the tracker's analysis rate: the samples of
+``librosa.resample`` (``res_type="soxr_hq"``), without importing librosa. soxr filters in
+single precision, so float64 input gives the samples of its float32 cast.
 """
 
 from __future__ import annotations
@@ -29,12 +26,10 @@ def resample(
 ) -> np.ndarray:
     """Resample mono audio from ``orig_sr`` to ``target_sr`` [Hz] (float32).
 
-    ``n_out`` samples are returned (default ``ceil(n * target_sr / orig_sr)``, as
-    librosa does), trimmed or zero-padded at the end. Trusts its input (finite mono
-    audio, rates > 0): validate at the public entry. Audio louder than :data:`LOUDEST`
-    is filtered at a level lowered by a power of two, then raised again (the same
-    samples, scaled exactly); ``keep_level=False`` leaves it lowered, for a caller that
-    normalises (float64 audio beyond float32's range can only be returned so).
+    ``n_out`` samples (default ``ceil(n * target_sr / orig_sr)``, as librosa), trimmed or
+    zero-padded at the end. Trusts its input. Audio louder than :data:`LOUDEST` is filtered
+    at a level lowered by a power of two and raised again (exactly); ``keep_level=False``
+    leaves it lowered, for a caller that normalises.
     """
     import soxr  # noqa: PLC0415 (only where audio is resampled)
 

@@ -1,25 +1,20 @@
 """Every beat tracker by name, ours and the others a user would pick instead.
 
-Every method is a function ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``:
-mono audio ``y`` at ``sr`` [Hz] in, beat times [s] out (1-D ``float64``, strictly
-increasing), each with its published default settings. A tempo range narrows the
-tempi searched; a bound not given keeps the method's default (:func:`check_tempo_range`).
-Only ours keeps its beats inside the range: librosa's range bounds its tempo estimate,
-essentia's trackers take it as a preference (:func:`track` warns when the beats fall
-outside it). :data:`TRACKERS` names them:
+Every method is ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``: mono audio at
+``sr`` [Hz] in, beat times [s] out (1-D ``float64``, strictly increasing), with its
+published defaults. A tempo range narrows the tempi searched (:func:`check_tempo_range`);
+only ours keeps its beats inside it (:func:`track` warns otherwise). :data:`TRACKERS`:
 
-- ``"psf"``: ours, :func:`beatsync.beats.track_beats` (phase-slope onsets and a
-  tempo/phase HMM; paper A, section 4).
+- ``"psf"``: ours, :func:`beatsync.beats.track_beats` (paper A, section 4).
 - ``"librosa"``: :func:`librosa.beat.beat_track` (Ellis 2007, dynamic programming),
   hop 512.
-- ``"essentia-degara"``: essentia's ``BeatTrackerDegara`` (Degara et al. 2012,
-  a probabilistic model of beat periods), audio resampled to 44.1 kHz as it requires.
+- ``"essentia-degara"``: essentia's ``BeatTrackerDegara`` (Degara et al. 2012), at the
+  44.1 kHz it requires.
 - ``"essentia-multifeature"``: essentia's ``BeatTrackerMultiFeature`` (Zapata et al.
-  2014, a committee of five onset features), at 44.1 kHz.
+  2014), at 44.1 kHz.
 
 The essentia methods need the optional ``essentia`` package
-(``pip install 'beatsync[peers]'``; AGPL-3.0): without it :func:`available` lists them
-as missing and :func:`get` refuses them with that instruction.
+(``pip install 'beatsync[peers]'``; AGPL-3.0): :func:`get` refuses them without it.
 """
 
 from __future__ import annotations
@@ -57,17 +52,8 @@ ESSENTIA_TEMPO = {"min": (40, 180), "max": (60, 250), "default": (40, 208), "spa
 
 @dataclass(frozen=True)
 class Tracker:
-    """A beat-tracking method.
-
-    Attributes
-    ----------
-    name : str
-        Registry key (``--method`` of ``beatsync evaluate beats``).
-    description : str
-        One line: the algorithm and its reference.
-    track : callable ``(y, sr, *, min_bpm=None, max_bpm=None) -> beats [s]``
-    requires : str or None
-        The optional package it needs (``None``: always available).
+    """A beat-tracking method: its registry key (``--method``), a one-line description, its
+    ``track`` function and the optional package it ``requires`` (None: always available).
     """
 
     name: str
@@ -102,20 +88,15 @@ def track_psf(
 def track_librosa(
     y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
 ) -> np.ndarray:
-    """:func:`librosa.beat.beat_track` with its defaults (hop 512), times in seconds.
-
-    With a tempo range, a flat tempo prior inside it replaces librosa's log-normal one
-    (as ``track_beats(method="librosa", min_bpm=, max_bpm=)``).
+    """:func:`librosa.beat.beat_track` (hop 512); a tempo range replaces its log-normal tempo
+    prior with a flat one inside it (as ``track_beats(method="librosa")``).
     """
     import librosa
 
     from .beats.tracker import LIBROSA_HOP, librosa_tempo_prior
 
-    kwargs = {}
-    if min_bpm is not None or max_bpm is not None:
-        prior = librosa_tempo_prior(**_given(min_bpm, max_bpm), sr=sr)
-        if prior is not None:
-            kwargs["prior"] = prior
+    prior = librosa_tempo_prior(**_given(min_bpm, max_bpm), sr=sr)  # None: the default
+    kwargs = {} if prior is None else {"prior": prior}
     _, beats = librosa.beat.beat_track(
         y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
     )
@@ -125,13 +106,9 @@ def track_librosa(
 def prepare(name: str) -> None:
     """Compile what method ``name`` needs into its on-disk cache, in this process.
 
-    Call it in one process before several processes track with the method at once (the
-    workers of a cluster, parallel tests). librosa's beat tracker is built on numba
-    functions cached on disk; numba writes a generalised ufunc's cache as two files,
-    and processes compiling the same function at the same time can leave a pair written
-    by different processes, which crashes a later process with a segmentation fault
-    when it loads them (numba issue 10128). Compiled once first, the other processes
-    only read the cache. A no-op for the methods without a JIT cache (ours, essentia).
+    Call it once before several processes track with it at once: processes compiling
+    librosa's numba functions at the same time can pair cache files written by different
+    processes and crash a later one (numba issue 10128). A no-op for the other methods.
     """
     get(name)
     if name != "librosa":
@@ -146,13 +123,6 @@ def prepare(name: str) -> None:
     librosa.beat.beat_track(y=clicks, sr=sr, hop_length=LIBROSA_HOP, units="time")
 
 
-def _essentia_audio(y: np.ndarray, sr: float) -> np.ndarray:
-    y = np.asarray(y, dtype=np.float32)
-    if sr != ESSENTIA_SR:
-        y = resample_audio(y, sr, ESSENTIA_SR)
-    return np.ascontiguousarray(y, dtype=np.float32)
-
-
 def _essentia():
     import essentia
 
@@ -163,27 +133,30 @@ def _essentia():
     return es
 
 
-def _essentia_tempo(min_bpm: float | None, max_bpm: float | None) -> dict[str, int]:
-    params = {"minTempo": min_bpm, "maxTempo": max_bpm}
-    return {k: int(round(v)) for k, v in params.items() if v is not None}
+def _run_essentia(algorithm: str, y, sr, min_bpm, max_bpm):
+    """essentia's ``algorithm`` with its defaults (and a tempo range) on ``y`` at 44.1 kHz."""
+    tempo = {"minTempo": min_bpm, "maxTempo": max_bpm}
+    algo = getattr(_essentia(), algorithm)(
+        **{k: int(round(v)) for k, v in tempo.items() if v is not None}
+    )
+    y = np.asarray(y, dtype=np.float32)
+    if sr != ESSENTIA_SR:
+        y = resample_audio(y, sr, ESSENTIA_SR)
+    return algo(np.ascontiguousarray(y, dtype=np.float32))
 
 
 def track_essentia_degara(
     y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
 ) -> np.ndarray:
     """essentia ``BeatTrackerDegara`` with its defaults (at 44.1 kHz)."""
-    es = _essentia()
-    algo = es.BeatTrackerDegara(**_essentia_tempo(min_bpm, max_bpm))
-    return _as_beats(algo(_essentia_audio(y, sr)))
+    return _as_beats(_run_essentia("BeatTrackerDegara", y, sr, min_bpm, max_bpm))
 
 
 def track_essentia_multifeature(
     y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
 ) -> np.ndarray:
     """essentia ``BeatTrackerMultiFeature`` with its defaults (at 44.1 kHz)."""
-    es = _essentia()
-    algo = es.BeatTrackerMultiFeature(**_essentia_tempo(min_bpm, max_bpm))
-    ticks, _confidence = algo(_essentia_audio(y, sr))
+    ticks, _confidence = _run_essentia("BeatTrackerMultiFeature", y, sr, min_bpm, max_bpm)
     return _as_beats(ticks)
 
 
@@ -217,14 +190,7 @@ def available() -> dict[str, bool]:
 
 
 def get(name: str) -> Tracker:
-    """The method called ``name``.
-
-    Raises
-    ------
-    ParameterError
-        Unknown name (the message lists the names), or a method whose optional
-        package is not installed (the message says how to install it).
-    """
+    """The method called ``name``; refuses an unknown name or a missing optional package."""
     tracker = TRACKERS.get(name)
     if tracker is None:
         raise ParameterError(f"unknown beat-tracking method {name!r}; choose from {list(TRACKERS)}")
@@ -245,32 +211,10 @@ def check_tempo_range(
 ) -> dict[str, float]:
     """The tempo range [BPM] that method ``name`` will search, checked; ``{}`` if none.
 
-    A bound not given keeps the method's default: 40 and 240 BPM for ``psf`` and
-    ``librosa`` (within 20-400 BPM, as :func:`beatsync.beats.track_beats`; librosa
-    given a bound other than its default searches a flat prior from ``min_bpm`` to
-    ``max_bpm`` instead of its own log-normal one, and refuses at tracking time a range
-    holding none of its tempo steps, :func:`beatsync.beats.tracker.librosa_tempo_prior`),
-    and essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers,
-    ``min_bpm`` in 40-180 and ``max_bpm`` in 60-250, at least 20 apart).
-
-    Parameters
-    ----------
-    names : (str, str)
-        How the two bounds are named in the errors (e.g. the options ``--min-bpm``).
-
-    Returns
-    -------
-    dict
-        The bounds given, as floats (``min_bpm``, ``max_bpm``), for :func:`track`; a
-        bound equal to the method's default is left out (the same search as none).
-
-    Raises
-    ------
-    ParameterError
-        An unknown method, or a bound that is not a number, out of the method's range,
-        not whole for essentia, a ``min_bpm`` of 320 or more for librosa (it does not
-        search above 320 BPM), or a range that is empty (or, for essentia, narrower
-        than 20 BPM); the message names the option and the default it was set against.
+    A bound not given (or equal to the default) keeps the method's default: 40-240 BPM
+    within 20-400 for ``psf`` and ``librosa`` (which refuses a ``min_bpm`` of 320 or more),
+    essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers, at least 20
+    apart). ``names``: how the two bounds are named in the errors (e.g. ``--min-bpm``).
     """
     from .beats.tracker import LIBROSA_MAX_TEMPO
     from .validation import check_bpm
@@ -286,26 +230,21 @@ def check_tempo_range(
     if not given:
         return {}
     defaults = _default_range(tracker)
-    if tracker.requires == "essentia":
-        span = ESSENTIA_TEMPO["span"]
-        limits = {"min_bpm": ESSENTIA_TEMPO["min"], "max_bpm": ESSENTIA_TEMPO["max"]}
-    else:
-        span = 0
-        limits = {}
+    essentia = tracker.requires == "essentia"
+    span = ESSENTIA_TEMPO["span"] if essentia else 0
     label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
-    for key, value in given.items():
-        if key in limits:
-            a, b = limits[key]
-            if value != round(value) or not a <= value <= b:
-                hint = (
-                    f"round it to {round(value)}"
-                    if a <= round(value) <= b
-                    else "to search outside them, use psf or librosa"
-                )
-                raise ParameterError(
-                    f"{label[key]} {value:g}: {name} takes a whole number of BPM from {a} to "
-                    f"{b} (essentia's limits); {hint}"
-                )
+    for key, value in given.items() if essentia else ():
+        a, b = ESSENTIA_TEMPO[key[:3]]  # "min" or "max"
+        if value != round(value) or not a <= value <= b:
+            hint = (
+                f"round it to {round(value)}"
+                if a <= round(value) <= b
+                else "to search outside them, use psf or librosa"
+            )
+            raise ParameterError(
+                f"{label[key]} {value:g}: {name} takes a whole number of BPM from {a} to "
+                f"{b} (essentia's limits); {hint}"
+            )
     if name == "librosa" and given.get("min_bpm", 0.0) >= LIBROSA_MAX_TEMPO:
         raise ParameterError(
             f"{label['min_bpm']} {given['min_bpm']:g}: librosa's beat tracker does not search "
@@ -320,8 +259,7 @@ def check_tempo_range(
             f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}"
             f"{_one_bound_hint(given, label, defaults, name)}"
         )
-    # a bound equal to the method's default is the same search as no bound: record it
-    # as not given, so that a folder scored without it resumes with it and vice versa
+    # a bound equal to the default is the same search as none: recorded as not given
     return {k: v for k, v in given.items() if v != defaults[k]}
 
 
@@ -392,25 +330,10 @@ def track(
 ) -> np.ndarray:
     """Run the method ``name`` on ``y`` at ``sr`` [Hz]; return beat times [s].
 
-    ``min_bpm``/``max_bpm`` narrow the tempo range searched (:func:`check_tempo_range`);
-    a bound not given keeps the method's default.
-
-    Warns
-    -----
-    BeatsyncWarning
-        Given a range, the beats' median tempo lies more than
-        :data:`OUT_OF_RANGE_TOLERANCE` outside it: only ours keeps to the range; librosa's
-        bounds its tempo estimate, not the beats it then picks, and essentia's trackers
-        take it as a preference (outside it, their beats can differ from one call to the
-        next; MTG/essentia issue 1097).
-
-    Raises
-    ------
-    ParameterError
-        Unknown or unavailable method (:func:`get`); a tempo range the method does not
-        accept; empty, silent, constant or non-finite audio, ``sr <= 0``, or audio
-        shorter than 1.5 s (:func:`beatsync.beats.tracker.check_duration`): checked
-        here for every method, as ours does.
+    The audio is checked here for every method as ours checks it (and refused if shorter
+    than :data:`beatsync.beats.MIN_DURATION_S`). Warns when, given a range, the beats'
+    median tempo lies more than :data:`OUT_OF_RANGE_TOLERANCE` outside it (essentia's beats
+    can then differ from one call to the next; MTG/essentia issue 1097).
     """
     from .beats import check_audio
     from .beats.tracker import check_duration

@@ -1,46 +1,21 @@
 """The drum-pattern cue of the metrical level: a bass drum and a snare drum that
-alternate mark the beat.
+alternate mark the beat (Goto 2001, J. New Music Research 30(2), 159-171).
 
-Method: Goto (2001), "An audio-based real-time beat tracking system for music with or
-without drum-sounds", J. New Music Research 30(2), 159-171. Goto's system takes the
-interval between a bass drum and a snare drum that alternate as the beat period (its
-drum patterns: the bass drum on beats 1 and 3, the snare drum on 2 and 4). We score
-that alternation for every beat period of the tempo HMM's grid, per analysis window,
-beside the tactus observation of :mod:`beatsync.beats.metrical`. It settles the
-choice the metrical model leaves to its tactus prior: the same drum pattern at 60
-and at 180 BPM gets the same resonator evidence in beat units, and the prior put
-both an octave towards 110 BPM.
+The metrical model gives the same drum pattern at 60 and 180 BPM the same evidence in
+beat units, and its prior pulls both towards 110 BPM; this cue settles it:
 
-1. **Two envelopes** (:func:`drum_envelopes`): the energy between 30 and 150 Hz (the
-   bass drum's band, :data:`LOW_BAND_HZ`) and between 150 Hz and 5 kHz (the snare
-   drum's, :data:`MID_BAND_HZ`), from an STFT with 93 ms windows (:data:`N_FFT_S`, at
-   most 11.025 kHz) every 23 ms (:data:`HOP_S`); half-wave rectified differences
-   (energy that rises), interpolated to the onset signal's frame rate.
-2. **Alternation** (:func:`alternation_cue`): per window and period ``tau``, the
-   normalised cross-correlations of the two envelopes at lags ``+tau`` and ``-tau``
-   (a bass drum followed by a snare drum one period later, and the other way round),
-   minus their normalised autocorrelations at ``tau`` (each drum repeating every
-   period): ``A(tau) = (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``, each
-   term over the whole window's norms (so ``A`` shrinks by up to ``1 - tau / L``, a
-   quarter at the longest period scored). A drum pattern gives ``A`` near +0.7 at its
-   beat and near -0.7 at twice the beat (each drum repeats every two beats); click
-   tracks give about 0. Only periods with :data:`MIN_CYCLES` cycles in the window are
-   scored.
-3. **Evidence, never counter-evidence**: ``max(A - NOISE_LEVEL, 0)``. Drums that do not
-   alternate (a cha-cha's) are no evidence against a period, and an alternation no
-   stronger than noise's is none for it (:data:`NOISE_LEVEL`).
-4. **Weight** (:data:`DRUM_WEIGHT`): ``log_obs += DRUM_WEIGHT * max(A - NOISE_LEVEL, 0)``,
-   added to the tactus observation of every window before the tempo HMM decodes it.
+1. **Two envelopes** (:func:`drum_envelopes`): the rising energy of the bass drum's band
+   (:data:`LOW_BAND_HZ`) and of the snare drum's (:data:`MID_BAND_HZ`), from their own
+   STFT (the front end's 0-250 Hz band holds both), at the onset signal's frame rate.
+   Energy, not its log: on a log scale the decays count as much as the attacks.
+2. **Alternation** (:func:`alternation_cue`): per window and period ``tau``, ``A(tau) =
+   (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``, normalised cross- minus
+   autocorrelations of the two envelopes: near +0.7 at a drum pattern's beat, -0.7 at
+   twice it, 0 for clicks. Only periods with :data:`MIN_CYCLES` cycles are scored.
+3. **Evidence, never counter-evidence**: ``log_obs += DRUM_WEIGHT * max(A - NOISE_LEVEL,
+   0)`` before the tempo HMM decodes.
 
-Why a separate STFT: the front end's four bands (:mod:`.onset`, 23 ms windows, 43 Hz
-bins) put a bass drum and a snare drum's body in the same 0-250 Hz band. Why the
-energy and not its log: on a log scale the decays and the snare's tail in the low band
-count as much as the attacks, and the alternation fades.
-
-The bands and the window are a first choice (a bass drum's fundamental is 50-100 Hz,
-a snare drum's body about 200 Hz); :data:`NOISE_LEVEL` was set on noises and
-:data:`DRUM_WEIGHT` on the synthetic set. None of the bundled real recordings has drums
-that alternate, so the cue is silent on them. Calibrated: docs/tuning.md#drum-cue.
+Calibrated: docs/tuning.md#drum-cue.
 """
 
 from __future__ import annotations
@@ -88,17 +63,8 @@ BLOCK_FRAMES = 2048
 
 
 def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.ndarray:
-    """Rising energy of the bass-drum and snare-drum bands, shape (2, n_frames).
-
-    Parameters
-    ----------
-    y : np.ndarray [shape=(n,)]
-        Mono audio, finite, not all silent (validated by the caller).
-    sr : float > 0 [Hz]
-    fps : float > 0 [Hz]
-        Frame rate of the onset signal; frame ``k`` is at ``k / fps`` seconds.
-    n_frames : int
-        Frames of the onset signal.
+    """Rising energy of the bass-drum and snare-drum bands, shape (2, n_frames) at ``fps``
+    [Hz] (frame ``k`` at ``k / fps`` s); ``y`` validated by the caller.
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs)
 
@@ -124,9 +90,7 @@ def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.nd
         spec = scipy.fft.rfft(frames[a : a + BLOCK_FRAMES] * window, axis=1)
         energy[a : a + BLOCK_FRAMES] = (spec.real**2 + spec.imag**2) @ member
     energy = energy.T
-    # the energy itself, not its log: a drum's attack stands out of the sustained sounds
-    # of its band only in linear scale (log-compressed over 40 dB, the synthetic rock
-    # pattern at 60 BPM gave A -0.09 at its beat, linear +0.56)
+    # the energy, not its log (see the module docstring)
     rise = np.maximum(np.diff(energy, axis=1, prepend=energy[:, :1]), 0.0)
     times = np.arange(rise.shape[1]) * hop / sr
     target = np.arange(n_frames) / fps
@@ -140,10 +104,8 @@ def alternation_cue(
     stops: np.ndarray,
     periods: np.ndarray,
 ) -> np.ndarray:
-    """The alternation score ``A`` of each period per window, (n_periods, n_windows).
-
-    ``envelopes`` are the two of :func:`drum_envelopes`; windows with a silent band,
-    and periods with fewer than :data:`MIN_CYCLES` cycles in the window, score 0.
+    """``max(A - NOISE_LEVEL, 0)`` of each period per window, (n_periods, n_windows); windows
+    with a silent band and periods with fewer than :data:`MIN_CYCLES` cycles score 0.
     """
     import scipy.fft  # noqa: PLC0415
 

@@ -1,60 +1,27 @@
 """The metrical model: tatum, tactus (beat) and measure periods estimated jointly.
 
-Method: Klapuri, Eronen & Astola (2006), "Analysis of the meter of acoustic musical
-signals", IEEE Trans. Audio, Speech and Language Processing 14(1), 342-355, on our
-phase-slope onset signal (its four bands play the role of the paper's four accent
-bands).
+Klapuri, Eronen & Astola (2006), "Analysis of the meter of acoustic musical signals",
+IEEE Trans. Audio, Speech and Language Processing 14(1), 342-355, on our phase-slope
+onsets (its four bands play the paper's four accent bands):
 
-1. **Comb-filter resonators** (:func:`resonator_salience`). A comb filter with delay
-   ``tau`` and feedback ``alpha = 0.5 ** (tau / T0)`` (half-time ``T0`` = 3 s) resonates
-   with the part of a band's accent signal that is periodic with ``tau``. Its output
-   energy, divided by the input energy, is normalised by the filter's response to
-   white noise ``gamma = (1 - alpha)**2 / (1 - alpha**2)``:
-   ``r = (E_out / E_in - gamma) / (1 - gamma)`` (0: no periodicity, 1: all of the
-   energy periodic), and summed over the bands: the salience ``s(tau)``. We evaluate
-   the resonators' steady-state energy in the frequency domain, per analysis window
-   (Parseval: ``E_out = sum_w |V(w)|^2 |H_tau(w)|^2`` with
-   ``|H_tau(w)|^2 = (1 - alpha)^2 / (1 - 2 alpha cos(w tau) + alpha^2)``), which allows
-   fractional delays on the tempo HMM's log-spaced period grid. The sum over the
-   frequencies is taken in the lag domain, against the window's autocorrelation (the
-   same sum, at a fraction of the cost: :func:`resonator_salience`).
-2. **Probabilistic model** (:func:`tactus_observation`). Log-normal priors on the
-   tatum, tactus and measure periods (medians 0.18, 0.55 and 2.1 s, as in the paper)
-   and a ratio model ``g(x) = sum_l w_l N(x; l, 0.3)`` for tactus/tatum and
-   measure/tactus favouring the ratios of common meters (1, 2, 3, 4, then 6 and 8).
-   We weight a beat of three tatums half (``w_3 = 0.5`` for tactus/tatum; a bar of
-   three beats keeps ``w_3 = 1``), see :attr:`MeterModel.tatum_ratio_weights`.
-   The joint score of ``(tatum, tactus, measure)`` is the sum of the three
-   observations ``beta * s(tau)``, the three log priors and the two log ratio terms.
-   Tatum and measure are maximised out per window, leaving a tactus observation that
-   the tempo HMM (:mod:`beatsync.beats.tempo`, the paper's temporal transition
-   model with an added jump probability) decodes with Viterbi.
-3. **Meter** (:func:`estimate_meter`): beats per bar, the most frequent ratio of the
-   best measure period to the decoded tactus over the windows.
+1. **Comb-filter resonators** (:func:`resonator_salience`): delay ``tau``, feedback
+   ``alpha = 0.5 ** (tau / T0)`` (half-time ``T0`` = 3 s). The output over the input
+   energy, normalised by the response to white noise ``gamma = (1 - alpha)**2 / (1 -
+   alpha**2)``, ``r = (E_out / E_in - gamma) / (1 - gamma)`` (0: no periodicity, 1: all
+   of it periodic), summed over the bands is the salience ``s(tau)``. We take the
+   steady-state energy per 8-s window from the spectrum (Parseval, ``|H_tau(w)|^2 = (1 -
+   alpha)^2 / (1 - 2 alpha cos(w tau) + alpha^2)``), so delays may be fractional.
+2. **Probabilistic model** (:func:`tactus_observation`): log-normal priors on the
+   tatum, tactus and measure periods and a ratio model ``g(x) = sum_l w_l N(x; l, 0.3)``
+   for tactus/tatum and measure/tactus. The score of ``(tatum, tactus, measure)`` is
+   the sum of the observations ``beta * s(tau)``, the log priors and the log ratio
+   terms; tatum and measure are maximised out per window, and the tempo HMM
+   (:mod:`beatsync.beats.tempo`) decodes the tactus observation left.
+3. **Meter** (:func:`estimate_meter`): beats per bar.
 
-The paper's comb filters run on integer lags sample by sample; we take their
-steady-state energy per 8-s window.
-
-The spectrum of each window is zero-padded so that every resonator pass band (about
-0.074 Hz wide) spans :data:`BINS_PER_PASS_BAND` bins (:func:`resonator_fft_size`);
-coarser, the salience is jagged over the period grid and short clips are tapped at
-the wrong level.
-
-Known limit of the per-window evaluation: the Hann-windowed 8-s segment smears each
-spectral line over more than a resonator's pass band, so a perfectly periodic pattern
-gets a salience that falls with the period. The evidence alone therefore prefers the
-fastest pulse present; the tactus prior (and, for drums, the cue of
-:mod:`beatsync.beats.drums`) decides between levels an octave apart, and the bar of a
-slow 3/4 can lose to two beats. The tatum and measure grids (1 % steps) are not
-aligned with the tactus grid (0.5 %), so fast click tracks (160 BPM and above) can be
-tapped at half. None of the alternatives tried (resonators run in time, closed-form
-comb energies, other windows, aligned grids, other priors) did better over both the
-synthetic set and the real recordings.
-
-The observation exponent ``beta``, the prior widths and the ratio weights are our
-choices (:data:`METER_MODEL`), set on the synthetic test set; the tatum ratio weight
-``w_3`` was chosen on the whole songs of two waltzes. Calibrated:
-docs/tuning.md#metrical-model.
+``beta``, the prior widths, the ratio weights (:data:`METER_MODEL`), the spectral
+sampling and the known limits of the per-window evaluation (it prefers the fastest
+pulse present; the tactus prior and the drum cue decide): docs/tuning.md#metrical-model.
 """
 
 from __future__ import annotations
@@ -81,27 +48,14 @@ __all__ = [
 class MeterModel:
     """Constants of the metrical model (Klapuri et al. 2006, section IV).
 
-    Attributes
-    ----------
-    half_time_s : float [s]
-        Half-time ``T0`` of the comb filters' feedback (paper: 3 s).
-    tatum_median_s, tactus_median_s, measure_median_s : float [s]
-        Medians of the log-normal period priors (paper: 0.18, 0.55, 2.1 s).
-    tatum_sigma, tactus_sigma, measure_sigma : float
-        Their standard deviations in natural-log units.
-    ratio_weights : tuple of float
-        ``w_l`` of the ratio model for l = 1..9: measure / tactus.
-    tatum_ratio_weights : tuple of float
-        ``w_l`` for tactus / tatum. As ``ratio_weights`` but ``w_3 = 0.5``: a beat of
-        three tatums (compound meter) counts half, as the ratios 6 and 8 do, so that a
-        "beat" of three sixteenths, four to the bar, does not beat the waltz's own beat
-        (docs/tuning.md#tatum-ratio-weight).
-    ratio_sigma : float
-        Width of each Gaussian of the ratio model.
-    beta : float
-        Observation exponent: the log likelihood of a period is ``beta * s(tau)``.
-    min_tatum_s, max_measure_s : float [s]
-        Shortest tatum and longest measure considered.
+    ``half_time_s`` [s]: the comb filters' feedback half-time ``T0`` (paper: 3 s). The
+    ``*_median_s`` [s] and ``*_sigma`` [natural-log units] of the log-normal period priors
+    (paper medians: 0.18, 0.55, 2.1 s). ``ratio_weights``: ``w_l`` (l = 1..9) of the ratio
+    model for measure / tactus; ``tatum_ratio_weights`` for tactus / tatum, with
+    ``w_3 = 0.5`` so that a "beat" of three sixteenths does not beat a waltz's own beat
+    (docs/tuning.md#tatum-ratio-weight). ``beta``: the log likelihood of a period is
+    ``beta * s(tau)``. ``min_tatum_s``, ``max_measure_s`` [s]: the shortest tatum and
+    longest measure.
     """
 
     half_time_s: float = 3.0
@@ -118,8 +72,7 @@ class MeterModel:
     min_tatum_s: float = 0.08
     max_measure_s: float = 4.0
 
-    def __post_init__(self) -> None:
-        # tuples, so that the model can key the cache of its constant terms
+    def __post_init__(self) -> None:  # tuples: the model keys the cache of its terms
         for name in ("ratio_weights", "tatum_ratio_weights"):
             object.__setattr__(self, name, tuple(float(w) for w in getattr(self, name)))
 
@@ -142,40 +95,18 @@ def resonator_salience(
 ) -> np.ndarray:
     """Normalised comb-filter resonator energy summed over bands, (n_periods, n_windows).
 
-    Parameters
-    ----------
-    bands : np.ndarray [shape=(n_bands, n_frames)] or (n_sets, n_bands, n_frames)
-        Accent signal per band; with a leading axis, several sets of bands (the draws of
-        the pulse-clarity null) at once, and the result has shape
-        (n_periods, n_windows, n_sets).
-    fps : float [Hz]
-    starts, stops : sequence of int [frames]
-        Analysis windows.
-    periods : np.ndarray [s]
-        Comb delays (need not be whole frames).
-    half_time_s : float [s]
-        Feedback half-time ``T0``.
-    max_hz : float, optional [Hz]
-        Frequencies of the accent signal above this (where a smoothed accent signal
-        has almost no energy) pass every resonator with its mean gain ``gamma``
-        instead of being filtered one by one (saves time, changes nothing visible).
+    ``bands`` (n_bands, n_frames) are accent signals, or (n_sets, n_bands, n_frames) for
+    several sets at once (the draws of the pulse-clarity null; the result gets a last axis
+    of n_sets). ``periods`` [s] need not be whole frames. Above ``max_hz`` [Hz] (where a
+    smoothed accent signal has almost no energy) every resonator passes its mean gain
+    ``gamma`` instead of being filtered (saves time).
 
-    Notes
-    -----
-    The energy is the sum over the one-sided FFT bins ``b`` of the padded window's
-    power ``P(b)`` times ``|H_tau(b)|^2`` (:func:`resonator_fft_size`). It is computed
-    in the lag domain, which gives the same sum up to rounding at a fraction of the
-    cost: ``P(b)`` is the transform of the window's autocorrelation ``a(k)`` (``|k| <
-    L``, the window length), so the sum is ``sum_k a(k) c(k)`` with ``c(k) = sum_b
-    |H_tau(b)|^2 cos(2 pi b k / n_fft)`` (:func:`_resonator_lag_weights`, once per
-    period grid), and ``a`` needs an FFT of only ``2 L - 1`` points instead of the
-    ``n_fft`` of the fine spectral sampling.
-
-    The product ``sum_k a(k) c(k)`` is taken in float32 (the weights are computed in
-    float64 and stored in float32; each autocorrelation is first divided by its lag-0
-    value, so the salience stays independent of the accents' scale): each band's
-    energy ratio is off by about 1e-7 of its range, and the product's memory traffic
-    and the cached weights halve.
+    The energy ``sum_b P(b) |H_tau(b)|^2`` over the padded window's FFT bins
+    (:func:`resonator_fft_size`) is taken in the lag domain, ``sum_k a(k) c(k)`` with
+    ``a`` the window's autocorrelation (an FFT of ``2 L - 1`` points instead of ``n_fft``)
+    and ``c`` the cached lag weights (:func:`_resonator_lag_weights`). The product is taken
+    in float32 on autocorrelations divided by their lag-0 value (scale-free; about 1e-7 of
+    each band's range).
     """
     return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
 
@@ -189,10 +120,9 @@ def resonator_saliences(
     half_time_s: float,
     max_hz: float | None = None,
 ) -> list[np.ndarray]:
-    """:func:`resonator_salience` for several period grids, one per block (the tactus,
-    tatum and measure grids of :func:`tactus_observation`): the windows'
-    autocorrelations are computed once, and each grid's lag weights are cached on
-    their own (the pulse-clarity null reuses the tactus grid's)."""
+    """:func:`resonator_salience` for several period grids (tactus, tatum and measure): the
+    windows' autocorrelations are computed once, each grid's lag weights cached on their own.
+    """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs)
 
     bands = np.asarray(bands, dtype=np.float64)
@@ -205,9 +135,7 @@ def resonator_saliences(
     n_bins = n_fft // 2 + 1
     if max_hz is not None:
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
-    # the weights are cached for lags up to the next multiple of LAG_BUCKET: clips of
-    # other lengths under it share them (keyed by the exact length, every new clip
-    # length would compute three grids again)
+    # cached for lags up to the next multiple of LAG_BUCKET: clips under it share them
     n_lags = min(n_fft, -(-length // LAG_BUCKET) * LAG_BUCKET)
     weights = [
         _resonator_lag_weights(
@@ -227,8 +155,7 @@ def resonator_saliences(
     n_win = len(starts)
     total = np.empty((n_win, n_sets * n_bands))
     energies = [np.empty((w[0].shape[0], n_win, n_sets * n_bands)) for w in weights]
-    # windows in chunks: a whole song's windows at once would hold 10 minutes of audio
-    # in about 600 padded copies
+    # windows in chunks: a whole song's at once would hold about 600 padded copies
     for c0 in range(0, n_win, WINDOW_CHUNK):
         chunk = list(
             zip(starts[c0 : c0 + WINDOW_CHUNK], stops[c0 : c0 + WINDOW_CHUNK], strict=True)
@@ -240,8 +167,8 @@ def resonator_saliences(
         spec = scipy.fft.rfft(seg, axis=3)
         acf = scipy.fft.irfft(spec.real**2 + spec.imag**2, n=n_acf, axis=3)[..., :length]
         acf = acf.reshape(-1, length).T  # (lag, window x set x band)
-        # each column over its lag-0 value: the energy ratios below do not change, and
-        # the float32 product cannot overflow or lose precision for any input scale
+        # each column over its lag-0 value: the same ratios, and a float32 product safe
+        # at any input scale
         lag0 = acf[0]
         acf = acf / np.where(lag0 > 0, lag0, 1.0)
         total[c0 : c0 + len(chunk)] = (total_w @ acf).reshape(len(chunk), -1)
@@ -276,16 +203,9 @@ BINS_PER_PASS_BAND = 3
 
 
 def resonator_fft_size(length: int, fps: float, half_time_s: float) -> int:
-    """FFT length of the resonators' windows: fine enough to sample every pass band.
-
-    A comb filter of feedback half-time ``T0`` passes a band about
-    ``ln 2 / (pi T0)`` wide around each multiple of ``1 / tau`` (0.074 Hz for the
-    paper's 3 s, whatever the period). The window's spectrum is sampled at
-    :data:`BINS_PER_PASS_BAND` bins per pass band at least (zero padding), else the
-    salience of a period depends on whether its pass bands happen to fall on a bin,
-    and neighbouring periods of the grid get very different observations
-    (docs/tuning.md#spectral-sampling-of-the-resonators).
-    """
+    """FFT length of the resonators' windows: :data:`BINS_PER_PASS_BAND` bins at least in
+    each pass band, ``ln 2 / (pi T0)`` wide [Hz]
+    (docs/tuning.md#spectral-sampling-of-the-resonators)."""
     pass_band = np.log(2.0) / (np.pi * half_time_s)  # [Hz]
     need = max(length, 2, int(np.ceil(BINS_PER_PASS_BAND * fps / pass_band)))
     return int(2 ** np.ceil(np.log2(need)))
@@ -295,16 +215,13 @@ def resonator_fft_size(length: int, fps: float, half_time_s: float) -> int:
 def _resonator_lag_weights(
     periods_key: bytes, fps: float, n_fft: int, n_bins: int, half_time_s: float, n_lags: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Lag weights of the resonators' energy (cached per period grid and number of lags).
+    """``(lag_w, gamma)``, cached per period grid and number of lags.
 
-    With ``G(b) = |H_tau(b)|^2`` on the one-sided bins ``b < n_bins`` and ``gamma``
-    above, returns ``(lag_w, gamma)``: ``lag_w[i, k] = m_k c_i(k)`` with
-    ``c_i(k) = sum_{b=0}^{n_fft/2} G_i(b) cos(2 pi b k / n_fft)`` for lags
-    ``k < n_lags``, and ``m_k`` 1 at lag 0 and 2 elsewhere (the autocorrelation is
-    even), so that ``lag_w @ a`` is the resonators' energy ``sum_b P(b) G(b)`` for a
-    window's autocorrelation ``a``. The sums over bins are taken by an inverse real
-    FFT, a few periods at a time (the whole grid at once took twice as long), and
-    stored in float32 (see :func:`resonator_salience`).
+    ``lag_w[i, k] = m_k sum_{b=0}^{n_fft/2} G_i(b) cos(2 pi b k / n_fft)`` with
+    ``G_i = |H_tau_i|^2`` below ``n_bins`` (``gamma`` above) and ``m_k`` 1 at lag 0, else 2, so
+    that ``lag_w @ a`` is the resonators' energy for a window's autocorrelation ``a``. The
+    sums over bins are an inverse real FFT, :data:`LAG_WEIGHT_ROWS` periods at a time;
+    stored in float32.
     """
     import scipy.fft  # noqa: PLC0415
 
@@ -339,8 +256,7 @@ def _resonator_lag_weights(
 #: Periods whose lag weights :func:`_resonator_lag_weights` computes at once.
 LAG_WEIGHT_ROWS = 32
 
-#: Lags are cached in multiples of this: windows of 0-8 s at 172 frames/s fall in three
-#: sizes (512, 1024, 1536 lags), three grids each.
+#: Lags are cached in multiples of this (0-8 s windows at 172 frames/s: three sizes).
 LAG_BUCKET = 512
 
 
@@ -350,8 +266,9 @@ def _lag_multiplicity(n_lags: int) -> np.ndarray:
 
 
 def _bin_cosine_sums(n_fft: int, n_lags: int) -> np.ndarray:
-    """``sum_{b=0}^{n_fft/2} cos(2 pi b k / n_fft)`` for lags ``0 <= k < n_lags <= n_fft``:
-    ``n_fft/2 + 1`` at lag 0, else 1 at even and 0 at odd lags (a Dirichlet sum)."""
+    """``sum_{b=0}^{n_fft/2} cos(2 pi b k / n_fft)`` for lags ``k < n_lags <= n_fft``:
+    ``n_fft/2 + 1`` at lag 0, else 1 at even and 0 at odd lags.
+    """
     k = np.arange(n_lags)
     return np.where(k == 0, n_fft // 2 + 1.0, np.where(k % 2 == 0, 1.0, 0.0))
 
@@ -364,10 +281,8 @@ def _log_prior(periods: np.ndarray, median: float, sigma: float) -> np.ndarray:
 def ratio_weight(
     x: np.ndarray, model: MeterModel = METER_MODEL, *, tatum: bool = False
 ) -> np.ndarray:
-    """The ratio model ``g(x) = sum_l w_l N(x; l, sigma)`` (unnormalised Gaussians).
-
-    ``x`` is measure / tactus, or with ``tatum=True`` tactus / tatum (the weights of
-    :attr:`MeterModel.tatum_ratio_weights`).
+    """The ratio model ``g(x) = sum_l w_l N(x; l, sigma)`` (unnormalised Gaussians) of
+    measure / tactus, or with ``tatum=True`` of tactus / tatum.
     """
     x = np.asarray(x, dtype=np.float64)
     out = np.zeros_like(x)
@@ -395,11 +310,9 @@ def _log_conditional(
 
 @functools.lru_cache(maxsize=8)
 def _level_terms(periods_key: bytes, model: MeterModel):
-    """Tatum and measure grids and ``log P(level | tactus)`` for a tactus grid (cached).
-
-    Returns ``(tatum, measure, g_a, g_c)``: ``g_a[i, j]`` for tatum ``j`` under tactus
-    ``i`` (tatum <= tactus), ``g_c[i, k]`` for measure ``k`` (measure >= tactus); the
-    two log terms in float32.
+    """Tatum and measure grids and ``log P(level | tactus)`` for a tactus grid (cached):
+    ``(tatum, measure, g_a, g_c)``, ``g_a[i, j]`` for tatum ``j <=`` tactus ``i`` and
+    ``g_c[i, k]`` for measure ``k >=`` tactus ``i`` (float32).
     """
     periods = np.frombuffer(periods_key, dtype=np.float64)
     tatum = _level_grid(model.min_tatum_s, float(periods.max()))
@@ -425,10 +338,8 @@ def _tactus_terms(
     periods: np.ndarray,
     model: MeterModel,
 ) -> np.ndarray:
-    """``beta s(tB) + log p(tB)``; zeroes (in place) the salience of unobservable periods.
-
-    A beat period is observable only if the window holds at least four of its cycles
-    (a measure: two); longer periods count as unsupported.
+    """``beta s(tB) + log p(tB)``; zeroes (in place) the salience of a period with fewer than
+    :data:`MIN_BEAT_CYCLES` cycles in the window.
     """
     span = (np.asarray(stops) - np.asarray(starts)) / fps
     s_b[periods[:, None] > span[None, :] / MIN_BEAT_CYCLES] = 0.0
@@ -447,18 +358,12 @@ def tactus_observation(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Log observation of each tactus period per window, tatum and measure maximised out.
 
-    The score of a tactus period ``tB`` is ``beta s(tB) + log p(tB)`` plus, for the
-    tatum, ``max_tA [beta s(tA) + log p(tA) + log g(tB / tA) - log Z_A(tB)]`` and, for
-    the measure, the same with ``g(tC / tB)``; ``Z`` normalises ``P(tA | tB)`` (and
-    ``P(tC | tB)``) over the candidates (tatum <= tactus <= measure).
-
-    Returns
-    -------
-    log_obs : np.ndarray [shape=(n_periods, n_windows)]
-    salience : np.ndarray [shape=(n_periods, n_windows)]
-        Resonator salience ``s`` at the tactus periods.
-    measure : np.ndarray [shape=(n_periods, n_windows)] [s]
-        The best measure period for each tactus period and window.
+    The score of ``tB`` is ``beta s(tB) + log p(tB)`` plus
+    ``max_tA [beta s(tA) + log p(tA) + log g(tB / tA) - log Z_A(tB)]`` and the same for
+    the measure with ``g(tC / tB)``; ``Z`` normalises ``P(tA | tB)`` (and ``P(tC | tB)``)
+    over tatum <= tactus <= measure. Returns ``(log_obs, salience, measure)``, each
+    (n_periods, n_windows): the observation, the salience ``s`` at the tactus periods and
+    the best measure period [s].
     """
     tatum, measure, g_a, g_c = _level_terms(
         np.ascontiguousarray(periods, dtype=np.float64).tobytes(), model
@@ -467,9 +372,7 @@ def tactus_observation(
         bands, fps, starts, stops, [periods, tatum, measure], model.half_time_s, max_hz
     )
     log_b = _tactus_terms(s_b, fps, starts, stops, periods, model)
-    # the maximisation over tatum and measure in float32: 2.7 times faster than in
-    # float64; its rounding (about 1e-5 of a log likelihood) changed no score, tempo or
-    # meter of the bundled real recordings or the synthetic set
+    # the maximisation over tatum and measure in float32 (faster; rounding about 1e-5)
     obs_a = model.beta * s_a + _log_prior(tatum, model.tatum_median_s, model.tatum_sigma)[:, None]
     obs_c = (
         model.beta * s_c + _log_prior(measure, model.measure_median_s, model.measure_sigma)[:, None]
@@ -497,12 +400,8 @@ def beat_observation(
     model: MeterModel = METER_MODEL,
     max_hz: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The tactus terms alone: ``beta s(tB) + log p(tB)`` and ``s(tB)``, (n_periods, n_windows).
-
-    :func:`tactus_observation` without the tatum and measure; the pulse-clarity null
-    of :mod:`beatsync.beats.tracker` decodes with it. ``bands`` of shape
-    (n_sets, n_bands, n_frames) give both arrays a last axis of n_sets (see
-    :func:`resonator_salience`).
+    """The tactus terms alone, ``beta s(tB) + log p(tB)`` and ``s(tB)`` (for the pulse-clarity
+    null); sets of bands as in :func:`resonator_salience`.
     """
     s_b = resonator_salience(bands, fps, starts, stops, periods, model.half_time_s, max_hz)
     return _tactus_terms(s_b, fps, starts, stops, periods, model), s_b

@@ -1,27 +1,18 @@
 """Phase-slope (group-delay) onsets: the tracker's front end (paper A, eqs. 6-8).
 
-1. **Phase-slope function** (:func:`phase_slope`). For short frames, the average
-   group delay is computed without phase unwrapping as
-   ``sum_k Re(X_k conj(Y_k)) / sum_k |X_k|^2`` per frequency band, where ``X`` is the
-   STFT with window ``w`` and ``Y`` the STFT with the time-ramped window ``n w(n)``
-   (energy-weighted averaging over the band's bins). Relative to the frame centre it
-   is the phase slope: it crosses zero upwards when an impulse-like onset passes the
-   frame centre, and ``t_frame - psf`` locates the onset to sub-frame precision.
-2. **Onsets** (:func:`onset_strength_psf`): positive zero crossings of the phase
-   slope in each band, weighted by the band's (locally normalised) spectral flux
-   (eq. 6-7); bands combined with weights ``6 - c`` (c = 1..4, low bands count most).
+1. **Phase-slope function** (:func:`phase_slope`): per band, the average group delay
+   without phase unwrapping, ``sum_k Re(X_k conj(Y_k)) / sum_k |X_k|^2`` over the band's
+   bins, with ``X`` the STFT with window ``w`` and ``Y`` with ``n w(n)``. It crosses
+   zero upwards when an impulse-like onset passes the frame centre, which locates the
+   onset to a fraction of a frame.
+2. **Onsets** (:func:`onset_strength_psf`): positive zero crossings of each band's phase
+   slope, weighted by the band's locally normalised spectral flux (eqs. 6-7); bands
+   combined with weights ``6 - c`` (c = 1..4, low bands count most).
 
-The front-end settings (window, hop, FFT size, band edges) are not published in the
-paper; :data:`FRONTEND_DEFAULTS` are swept in
-``notebooks/paper_a_sec4_beat_tracking.ipynb``. numpy and scipy only (no
-JIT compilation on the first call).
-
-Known limit: a steady tone has onsets. In the bands without the tone, its leakage
-from the positive and the negative frequency interferes, and the phase slope there
-crosses zero at a steady rate; the flux at those crossings is small but not zero, and
-the tracker reads the periodic train as a pulse. No gate on band energy, energy rise
-or onset density separates it from the quiet onsets of real music
-(docs/tuning.md#front-end-phase-slope-onsets).
+:data:`FRONTEND_DEFAULTS` (not published in the paper) are swept in
+``notebooks/paper_a_sec4_beat_tracking.ipynb``. Known limit: a steady tone has onsets
+(its leakage makes the phase slope cross zero at a steady rate in the other bands;
+docs/tuning.md#front-end-phase-slope-onsets).
 """
 
 from __future__ import annotations
@@ -70,22 +61,8 @@ FRONTEND_DEFAULTS: dict[str, Any] = {
 
 @dataclass(frozen=True)
 class FrontEnd:
-    """Validated front-end settings in samples at the analysis rate.
-
-    Attributes
-    ----------
-    analysis_sr : float [Hz]
-        Rate the audio is analysed at (the input rate, or lower after resampling).
-    win_length : int [samples]
-        Analysis window.
-    hop_length : int [samples]
-        Hop between frames (at most half the window).
-    n_fft : int [samples]
-        FFT size (>= ``win_length``).
-    band_edges_hz : tuple of float [Hz]
-        Increasing band edges (``len - 1`` bands).
-    flux_norm_s : float >= 0 [s]
-        Window of the local mean removed from the flux (0: none).
+    """Validated front-end settings in samples at the analysis rate ``analysis_sr`` [Hz]
+    (the input rate, or lower after resampling); fields as :data:`FRONTEND_DEFAULTS`.
     """
 
     analysis_sr: float
@@ -104,14 +81,9 @@ class FrontEnd:
 def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     """Validate front-end parameters (keys of :data:`FRONTEND_DEFAULTS`) for input rate ``sr``.
 
-    Raises
-    ------
-    ParameterError
-        An implausible sample rate (:func:`beatsync.validation.check_sample_rate`), an
-        unknown key, non-positive window or hop, a hop over half the window, an FFT
-        shorter than the window, band edges that do not increase, or given band edges
-        with a band that holds no FFT bin at the analysis rate (above its Nyquist
-        frequency, or too narrow).
+    Refuses an unknown key, a window under 16 samples, a hop over half the window, an FFT
+    shorter than the window, band edges that do not increase, or given band edges with a
+    band that holds no FFT bin at the analysis rate.
     """
     sr = check_sample_rate(sr)
     if not params:  # the defaults (an empty dict, or None)
@@ -125,7 +97,7 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
 
 @functools.lru_cache(maxsize=16)
 def _default_frontend(sr: float, defaults: tuple) -> FrontEnd:
-    """The default front end at rate ``sr`` (cached: every call would validate it again)."""
+    """The default front end at rate ``sr`` (cached)."""
     return _frontend_settings({}, sr)
 
 
@@ -185,22 +157,10 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
 class OnsetSignal:
     """Output of :func:`onset_strength_psf`.
 
-    Attributes
-    ----------
-    envelope : np.ndarray [shape=(n_frames,)]
-        Band-weighted onset signal at the frame rate (impulses at the onsets).
-    bands : np.ndarray [shape=(n_bands, n_frames)]
-        Per-band onset signals (unweighted).
-    fps : float [Hz]
-        Frame rate.
-    onset_times : np.ndarray [s]
-        Sub-frame onset times (phase-slope zero crossings) of all bands.
-    onset_strengths : np.ndarray
-        Band-weighted strength of each onset.
-    band_weights : np.ndarray
-        Weight ``6 - c`` of each band (normalised to sum 1).
-    psf : np.ndarray [shape=(n_bands, n_frames)] [s]
-        Phase-slope function per band (NaN where the band is silent).
+    ``envelope`` (n_frames,): band-weighted onset impulses at ``fps`` [Hz]; ``bands``
+    (n_bands, n_frames): per band, unweighted; ``onset_times`` [s] (sub-frame) and
+    ``onset_strengths`` (band-weighted) of every onset; ``band_weights``: ``6 - c``
+    normalised to sum 1; ``psf`` (n_bands, n_frames) [s]: the phase slope (NaN where silent).
     """
 
     envelope: np.ndarray
@@ -212,25 +172,17 @@ class OnsetSignal:
     psf: np.ndarray = field(repr=False)
 
 
-# --------------------------------------------------------------------------- STFT
-
-
 def _hann(n: int) -> np.ndarray:
     """Periodic Hann window of ``n`` samples (the DFT-even form used for STFTs)."""
     return 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
 
 
-#: Frames per block of the front end: a block's spectra stay in cache, and no array of
-#: the whole song's spectra is allocated.
+#: Frames per block of the front end (a block's spectra stay in cache).
 BLOCK_FRAMES = 256
 
 
 def _frames(y32: np.ndarray, n_fft: int, hop: int) -> np.ndarray:
-    """Centred analysis frames, a view (n_frames, n_fft) of the zero-padded signal.
-
-    Frame ``m`` is centred on sample ``m * hop`` (zero padding of ``n_fft // 2`` at
-    both ends).
-    """
+    """Frames (n_frames, n_fft) of the zero-padded signal, frame ``m`` centred on ``m * hop``."""
     pad = n_fft // 2
     yp = np.zeros(y32.size + 2 * pad, dtype=y32.dtype)  # np.pad's zeros, without its overhead
     yp[pad : pad + y32.size] = y32
@@ -247,8 +199,9 @@ def _frame_window(window: np.ndarray, n_fft: int) -> np.ndarray:
 
 @functools.lru_cache(maxsize=8)
 def _stft_terms(sr: float, fe: FrontEnd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The front end's two frame windows (Hann, and Hann times the time ramp) and its
-    band membership matrix (:func:`_band_matrix`), cached per rate and settings."""
+    """The two frame windows (Hann, and Hann times the time ramp) and the band membership
+    matrix, cached per rate and settings.
+    """
     win, n_fft = fe.win_length, fe.n_fft
     w = _hann(win)
     ramp = np.arange(win) - (win - 1) / 2.0  # time ramp centred on the frame centre
@@ -275,14 +228,10 @@ def _band_matrix(sr: float, fe: FrontEnd) -> np.ndarray:
 
 
 def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = True):
-    """Phase slope, band energy, frame rate, STFT magnitude and band flux, per band.
-
-    Returns ``(psf, energy, fps, mag, flux, member)``: ``psf``, ``energy`` and the
+    """``(psf, energy, fps, mag, flux, member)`` per band: ``psf`` [s], ``energy`` and the
     spectral ``flux`` (mean half-wave rectified log-magnitude difference over the band's
-    bins) with shape (n_bands, n_frames); ``mag`` (frames x bins, None unless
-    ``keep_mag``); ``member`` the bins' band membership. Computed in blocks of
-    :data:`BLOCK_FRAMES` frames (the arithmetic of one pass, up to the rounding of the
-    matrix products).
+    bins) of shape (n_bands, n_frames); ``mag`` (frames x bins, unless not ``keep_mag``);
+    the bins' band membership. In blocks of :data:`BLOCK_FRAMES` frames.
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
 
@@ -307,8 +256,7 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
         m = np.sqrt(power)
         if mag is not None:
             mag[a:b] = m
-        # log(1 + 100 m): numpy's float32 log is vectorised, its log1p is not; in
-        # float32 both are within 5e-7 of the exact value
+        # log(1 + 100 m) by np.log in float32 (vectorised, unlike log1p)
         logmag = np.float32(100.0) * m
         logmag += np.float32(1.0)
         np.log(logmag, out=logmag)
@@ -335,39 +283,14 @@ def phase_slope(
     n_fft: int | None = None,
     band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
 ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
-    """Phase-slope function per band (energy-weighted average group delay).
+    """Phase-slope function per band: ``(psf, energy, fps, mag)``.
 
-    Parameters
-    ----------
-    y : np.ndarray [shape=(n,)]
-    sr : float > 0 [Hz]
-    win_s, hop_s : float > 0 [s]
-    n_fft : int, optional [samples]
-    band_edges_hz : sequence of float [Hz]
-
-    Returns
-    -------
-    psf : np.ndarray [shape=(n_bands, n_frames)] [s]
-        Frame centre time minus the band's energy centroid in time: negative before an
-        impulse reaches the frame centre, positive after. NaN where the band is silent.
-    energy : np.ndarray [shape=(n_bands, n_frames)]
-        Band energy ``sum |X|^2``.
-    fps : float [Hz]
-    mag : np.ndarray [shape=(n_bins, n_frames)]
-        STFT magnitude (for the spectral flux).
+    ``psf`` (n_bands, n_frames) [s]: frame centre minus the band's energy centroid in time
+    (negative before an impulse reaches the frame centre; NaN where the band is silent);
+    ``energy`` the band energy ``sum |X|^2``; ``mag`` (n_bins, n_frames) the STFT magnitude.
     """
-    y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
-    y = np.asarray(y, dtype=np.float64)
-    fe = frontend_settings(
-        {
-            "win_s": win_s,
-            "hop_s": hop_s,
-            "n_fft": n_fft,
-            "band_edges_hz": band_edges_hz,
-            "analysis_sr": None,
-        },
-        sr,
-    )
+    given = {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}
+    y, sr, fe = _validated(y, sr, {**given, "analysis_sr": None})
     psf, energy, fps, mag, _, _ = _phase_slope(y, sr, fe)
     return psf, energy, fps, mag.T
 
@@ -385,33 +308,11 @@ def onset_strength_psf(
 ) -> OnsetSignal:
     """Onset signal from positive zero crossings of the band phase-slope function.
 
-    Every positive zero crossing of band ``c``'s phase slope is an onset candidate;
-    its strength is the band's spectral flux (half-wave rectified log-magnitude
-    difference, minus its local mean over ``flux_norm_s``) around the crossing
-    (eq. 6-7). Bands are combined with weights ``6 - c``.
-
-    Parameters
-    ----------
-    y : np.ndarray [shape=(n,)]
-        Mono audio.
-    sr : float > 0 [Hz]
-    win_s : float > 0 [s]
-        Analysis window (default 23 ms).
-    hop_s : float > 0 [s]
-        Hop, at most ``win_s / 2`` (default 5.8 ms).
-    n_fft : int, optional [samples]
-    band_edges_hz : sequence of float [Hz]
-        Band edges (default 0, 250, 1000, 4000, 22050: four bands).
-    flux_norm_s : float >= 0 [s]
-        Window of the local mean removed from the flux (0: none).
-    analysis_sr : float > 0 [Hz] or None
-        Audio at a higher rate is first resampled to this rate (soxr), so that
-        the front end behaves the same for 22.05, 44.1 and 48 kHz input and costs
-        the same per second; None analyses at the input rate.
-
-    Returns
-    -------
-    OnsetSignal
+    Each crossing in band ``c`` is weighted by the band's spectral flux around it
+    (half-wave rectified log-magnitude difference minus its local mean over
+    ``flux_norm_s`` [s]; eqs. 6-7); bands combined with weights ``6 - c``. ``hop_s`` is at
+    most ``win_s / 2``. Audio above ``analysis_sr`` [Hz] is first resampled to it (soxr),
+    so that 22.05, 44.1 and 48 kHz input behave alike; None analyses at the input rate.
 
     Examples
     --------
@@ -421,35 +322,26 @@ def onset_strength_psf(
     >>> bool(abs(ons.onset_times[np.argmax(ons.onset_strengths)] - 0.5) < 0.01)
     True
     """
+    given = {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}
+    given.update(flux_norm_s=flux_norm_s, analysis_sr=analysis_sr)
+    return compute_onsets(*_validated(y, sr, given))
+
+
+def _validated(y, sr, params: dict[str, Any]) -> tuple[np.ndarray, float, FrontEnd]:
     y, sr = check_audio(y, sr, silence_peak=SILENCE_PEAK)
-    y = np.asarray(y, dtype=np.float64)
-    fe = frontend_settings(
-        {
-            "win_s": win_s,
-            "hop_s": hop_s,
-            "n_fft": n_fft,
-            "band_edges_hz": band_edges_hz,
-            "flux_norm_s": flux_norm_s,
-            "analysis_sr": analysis_sr,
-        },
-        sr,
-    )
-    return compute_onsets(y, sr, fe)
+    return np.asarray(y, dtype=np.float64), sr, frontend_settings(params, sr)
 
 
 def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     """:func:`onset_strength_psf` on validated input (``y`` finite mono, not silent)."""
     if fe.analysis_sr != sr:
-        # soxr's high-quality filter (far cheaper than an ideal low-pass by FFT over the
-        # whole signal), keeping round(n * ratio) samples
+        # soxr, keeping round(n * ratio) samples (float32; a very loud signal comes back
+        # lowered by a power of two, which the normalisation below removes)
         n_out = int(round(y.size * fe.analysis_sr / sr))
-        # float32; a very loud signal comes back lowered by a power of two, which the
-        # normalisation below removes
         y = resample(y, sr, fe.analysis_sr, n_out, keep_level=False)
         sr = fe.analysis_sr
-    # float32 samples are divided in float32: correctly rounded, the same as dividing in
-    # float64 and rounding to the front end's float32 (double rounding is innocuous for
-    # a division when the wider format has 2p + 2 bits), without the float64 copies
+    # float32 divided in float32: the same as in float64 rounded to float32 (double
+    # rounding is innocuous for a division), without the float64 copies
     y = y / np.max(np.abs(y))
     psf, _, fps, _, flux, _ = _phase_slope(y, sr, fe, keep_mag=False)
     n_bands, n_frames = psf.shape

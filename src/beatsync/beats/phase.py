@@ -1,27 +1,16 @@
 """Beat placement: the phase HMM for a given tempo curve, and snapping to onsets.
 
-The onset signal is correlated with a reference pulse train that follows the decoded
-tempo curve (eq. 8), in 4-beat windows every 0.25 s, for 64 phase offsets; a circular
-phase HMM decoded with Viterbi picks the offset. Each beat is then snapped to the
-nearby onset with the best strength x closeness (phase-slope zero crossings give the
-onset time to a fraction of a frame).
+The onset signal is correlated with a pulse train that follows the decoded tempo curve
+(eq. 8), in 4-beat windows every 0.25 s, for 64 phase offsets; a circular phase HMM
+decoded with Viterbi picks the offset, and each beat is snapped to the nearby onset with
+the best strength x closeness.
 
-The phase observation weights each band by its own **phase concentration** at the
-decoded tempo. In each tempo window (8 s, half-window hop) this is the length of the
-band's first circular moment over the beat cycle, per unit of onset strength: 1 if all
-of the band's onsets fall at one phase of the beat, near 0 if they fall at every phase.
-A band's weight averages its windows, weighted by its onset strength in each
-(:func:`band_phase_weights`), so a pause or a phase slip between windows does not
-cancel it out. It does not use paper A's weights ``6 - c`` (eq. 7, which
-:attr:`OnsetSignal.envelope` keeps).
-
-Why not fixed weights: on real music the lowest band (0-250 Hz) holds about half of
-the onset strength, yet its onsets can fall at every phase of the beat (a bass line
-between the beats). Weighted ``6 - c`` it pulls the phase onto the off-beat; with
-equal weights it still decides short clips. Weighted by its concentration, a band
-counts as much as it follows the beat. The weights need no constant and no
-annotation: they come from the audio and its decoded tempo. The choice was made on
-the two annotated recordings (docs/tuning.md#band-phase-weights).
+Each band is weighted by its **phase concentration** at the decoded tempo
+(:func:`band_phase_weights`), not paper A's ``6 - c`` (eq. 7, kept by
+:attr:`OnsetSignal.envelope`): the lowest band holds about half of the onset strength
+of real music, yet a bass line between the beats would pull the phase onto the
+off-beat. Weighted by its concentration, a band counts as much as it follows the beat
+(docs/tuning.md#band-phase-weights).
 """
 
 from __future__ import annotations
@@ -41,14 +30,11 @@ def band_phase_weights(
 ) -> np.ndarray:
     """Each band's phase concentration over the beat cycle, normalised to sum to 1.
 
-    In each window ``[a, b)`` (``starts``/``stops``; default: the whole signal) the
-    concentration of band ``c`` is ``|sum_n x_c(n) exp(2 pi i cycles(n))| / sum_n
-    x_c(n)``, where ``cycles`` is the integrated tempo [beats] per frame: 1 when all of
-    the band's onset strength falls at one phase of the beat, near 0 when many onsets
-    are spread over every phase (a band with only a few onsets can score high, but its
-    signal is small). A band's weight is the mean of its window concentrations,
-    weighted by its onset strength in each window, so a pause or a slip of the phase
-    between windows does not cancel it out. Equal weights if no band has any onset.
+    In each window ``[a, b)`` (default: the whole signal) band ``c`` has the concentration
+    ``|sum_n x_c(n) exp(2 pi i cycles(n))| / sum_n x_c(n)``, ``cycles`` the integrated tempo
+    [beats] per frame: 1 when all of its onset strength falls at one phase of the beat. A
+    band's weight is the mean over windows weighted by its onset strength in each (a pause
+    or a phase slip does not cancel it out); equal weights if no band has any onset.
     """
     n_bands = bands.shape[0]
     if starts is None:
@@ -79,9 +65,9 @@ def phase_hmm(
 ) -> np.ndarray:
     """Viterbi path of the beat phase (fraction of a beat) per window.
 
-    ``cycles`` is the integrated tempo [beats] per frame; beats are where
-    ``cycles + phase`` is an integer. The observation is the correlation of the onset
-    signal with a pulse train at those times (eq. 8), for each of ``n_phase`` phases.
+    Beats are where ``cycles + phase`` is an integer (``cycles``: the integrated tempo
+    [beats] per frame); the observation is the correlation of the onset signal with a
+    pulse train at those times (eq. 8).
     """
     frac = np.mod(cycles, 1.0)
     bins = np.rint(frac * n_phase).astype(np.int64) % n_phase
@@ -100,8 +86,7 @@ def phase_hmm(
 
 @functools.lru_cache(maxsize=8)
 def _phase_terms(n_phase: int, pulse_width: float, phase_sigma: float):
-    """The phase grid, the pulse kernel's spectrum and the log phase transitions of
-    :func:`phase_hmm` (cached: they took a third of its time on a short clip)."""
+    """The phase grid, pulse kernel spectrum and log transitions of :func:`phase_hmm` (cached)."""
     q = np.arange(n_phase) / n_phase
     dq = np.minimum(q, 1 - q)
     kernel = np.exp(-0.5 * (dq / pulse_width) ** 2)
@@ -118,10 +103,8 @@ def _phase_terms(n_phase: int, pulse_width: float, phase_sigma: float):
 def snap_to_onsets(
     beats, periods_at_beats, onset_times, onset_strengths, reach: float, min_rel: float
 ):
-    """Move each beat to the best onset within ``reach`` beat periods.
-
-    The best onset maximises strength times a Gaussian of its distance to the
-    predicted beat (standard deviation ``reach / 2`` periods); onsets weaker than
+    """Move each beat to the onset within ``reach`` beat periods with the best strength
+    times a Gaussian of its distance (sd ``reach / 2`` periods); onsets weaker than
     ``min_rel`` times the strongest are ignored.
     """
     if onset_times.size == 0 or beats.size == 0:
@@ -148,9 +131,8 @@ def place_beats(
 ):
     """Beats [s] for a tempo curve (period per tempo window), and the period at each beat.
 
-    The tempo per frame is step-wise between window centres (abrupt changes stay
-    abrupt); the phase is decoded in windows of 4 beats (1.5 s to ``tempo_win_s``),
-    so that it follows tempo changes quickly.
+    The tempo is step-wise between window centres; the phase is decoded in windows of 4
+    beats (1.5 s to ``tempo_win_s``), so that it follows tempo changes quickly.
     """
     fps = ons.fps
     n = ons.bands.shape[1]

@@ -1,13 +1,10 @@
 """Tempo: the tempo HMM over beat periods, and a plain-numpy Viterbi decoder.
 
-The tempo (beat period) is a hidden state per analysis window (8 s, 1 s hop). Its
-observation is a salience per candidate period (:mod:`beatsync.beats.metrical`
-gives the tactus salience of the metrical model); transitions are log-normal in the
-period ratio plus a small jump probability, so that an abrupt tempo change is
-followed rather than averaged away. Decoding is :func:`viterbi` (numpy, no JIT: our
-state spaces have a few hundred states and a few hundred steps); the tempo HMM uses
-:func:`viterbi_banded`, the same path from the band of transitions that differ from
-the uniform jump probability (+-39 states of 360 on the tracker's grid).
+The beat period is a hidden state per analysis window (8 s, 1 s hop), observed through
+the tactus salience of :mod:`beatsync.beats.metrical`; transitions are log-normal in
+the period ratio plus a small jump probability, so an abrupt tempo change is followed
+rather than averaged away. :func:`viterbi_banded` decodes only the band of transitions
+that differ from the uniform jump (the same path as :func:`viterbi`).
 """
 
 from __future__ import annotations
@@ -52,20 +49,8 @@ def period_grid(min_bpm: float, max_bpm: float, step: float = 0.005) -> np.ndarr
 def viterbi(
     log_obs: np.ndarray, log_trans: np.ndarray, log_init: np.ndarray | None = None
 ) -> np.ndarray:
-    """Most likely state sequence of an HMM, in the log domain.
-
-    Parameters
-    ----------
-    log_obs : np.ndarray [shape=(n_states, n_steps)]
-        Log observation likelihood of each state at each step.
-    log_trans : np.ndarray [shape=(n_states, n_states)]
-        ``log_trans[i, j]``: log probability of moving from state ``i`` to ``j``.
-    log_init : np.ndarray [shape=(n_states,)], optional
-        Log initial distribution (uniform if None).
-
-    Returns
-    -------
-    path : np.ndarray [shape=(n_steps,)], int
+    """Most likely state path of an HMM, log domain: ``log_obs`` (n_states, n_steps),
+    ``log_trans[i, j]`` from ``i`` to ``j``, ``log_init`` (uniform if None).
     """
     n_states, n_steps = log_obs.shape
     value = log_obs[:, 0] + (0.0 if log_init is None else log_init)
@@ -91,12 +76,9 @@ def _backtrack(back: np.ndarray, value: np.ndarray) -> np.ndarray:
 def _log_transitions(
     periods_key: bytes, trans_sigma: float, p_jump: float
 ) -> tuple[np.ndarray, int | None, tuple[np.ndarray, np.ndarray] | None]:
-    """Log transition matrix of the tempo HMM and its band (cached per period grid).
-
-    The band ``reach`` is the largest ``|i - j|`` whose log transition is not exactly
-    ``log(p_jump / n)``: further apart, the Gaussian part is lost in rounding next to
-    the jump probability. None when ``p_jump`` is 0 (no jump: no band). The third
-    value is :func:`viterbi_banded`'s band terms (:func:`_band`), None without a band.
+    """Log transition matrix of the tempo HMM, its band ``reach`` (the largest ``|i - j|``
+    whose log transition is not exactly ``log(p_jump / n)``; None without jumps) and
+    :func:`_band` of it (cached per period grid).
     """
     logp = np.log(np.frombuffer(periods_key, dtype=np.float64))
     d = logp[:, None] - logp[None, :]
@@ -121,20 +103,9 @@ def tempo_hmm(
     p_jump: float,
     log_prior: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Viterbi path (state index per window) of the tempo HMM.
-
-    Parameters
-    ----------
-    log_obs : np.ndarray [shape=(n_periods, n_windows)]
-        Log observation likelihood of each beat period per window.
-    periods : np.ndarray [s]
-        The period grid (log-spaced).
-    trans_sigma : float > 0
-        Standard deviation of the log period ratio between consecutive windows.
-    p_jump : float in [0, 1)
-        Probability of an abrupt change to any period.
-    log_prior : np.ndarray, optional
-        Log initial distribution over the periods.
+    """Viterbi path (state index per window) of the tempo HMM over the log-spaced ``periods``
+    [s]: ``trans_sigma`` is the sd of the log period ratio between windows, ``p_jump`` the
+    probability of an abrupt change to any period.
     """
     if log_obs.shape[1] == 1:  # one window (a clip shorter than it): no transition
         value = log_obs[:, 0] + (0.0 if log_prior is None else log_prior)
@@ -148,9 +119,9 @@ def tempo_hmm(
 
 
 def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(band, src)``: ``log_trans[src[j, d], j]`` for the predecessors ``src[j, d] =
-    j + d - reach`` of each state ``j`` (-inf outside the grid; ``src`` clipped to it).
-    Shape (n_states, 2 reach + 1): each state's predecessors in a contiguous row."""
+    """``(band, src)`` of shape (n_states, 2 reach + 1): ``log_trans[src[j, d], j]`` for the
+    predecessors ``src[j, d] = j + d - reach`` of each state (-inf outside the grid).
+    """
     n_states = log_trans.shape[0]
     offsets = np.arange(-reach, reach + 1)
     src = np.arange(n_states)[:, None] + offsets[None, :]  # predecessor i of j, (n, width)
@@ -174,12 +145,9 @@ def viterbi_banded(
 ) -> np.ndarray:
     """:func:`viterbi` for transitions that are a band plus a uniform jump.
 
-    ``log_trans[i, j]`` must equal ``log_jump`` exactly wherever ``|i - j| > reach``
-    (and be at least ``log_jump`` everywhere): the best predecessor of ``j`` is then the
-    best inside the band, or the best state overall jumping. Each step costs
-    ``(2 reach + 1) n`` instead of ``n**2``; the path is the dense decoder's (up to exact
-    ties). ``band_terms``: :func:`_band` of ``log_trans`` and ``reach``, if already at
-    hand.
+    ``log_trans[i, j]`` must equal ``log_jump`` wherever ``|i - j| > reach`` (and be at
+    least that everywhere): each step costs ``(2 reach + 1) n`` instead of ``n**2``, with
+    the dense decoder's path (up to exact ties). ``band_terms``: :func:`_band`, if at hand.
     """
     n_states, n_steps = log_obs.shape
     band, src = _band(log_trans, reach) if band_terms is None else band_terms

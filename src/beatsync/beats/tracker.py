@@ -1,16 +1,10 @@
 """The public beat tracker: :func:`track_beats` and its result :class:`BeatTrack`.
 
-Validation happens here, once (:mod:`beatsync.validation` helpers); the stage modules
-(:mod:`.onset`, :mod:`.tempo`, :mod:`.phase`, :mod:`.metrical`) trust their inputs.
-
-The no-clear-pulse warning compares the resonator salience along the decoded tempo
-path with a null: the same band onsets in random (seeded) order, observed and decoded
-the same way (:func:`pulse_clarity_null`). The null carries the audio's onset
-density, window lengths and the decoder's selection bias, so one ratio threshold
-serves 2 s clips and whole songs; a fixed salience threshold alone could not (a 5 s
-noise reaches the salience of the quietest real song). Its constants
-(:data:`MIN_PULSE_CLARITY`, :data:`MIN_PATH_SALIENCE`, :data:`CLEAR_PULSE`) were set on
-noises and the bundled real recordings.
+Validation happens here, once; the stage modules (:mod:`.onset`, :mod:`.tempo`,
+:mod:`.phase`, :mod:`.metrical`) trust their inputs. The no-clear-pulse warning compares
+the salience along the decoded tempo path with that of the same onsets in random order
+(:func:`pulse_clarity_null`), so one ratio serves 2 s clips and whole songs
+(docs/tuning.md#pulse-clarity).
 """
 
 from __future__ import annotations
@@ -64,23 +58,15 @@ __all__ = [
 #: Tempo range [bpm] that :func:`track_beats` searches unless told otherwise.
 DEFAULT_MIN_BPM = 40.0
 DEFAULT_MAX_BPM = 240.0
-#: Audio shorter than this is refused [s] (:func:`check_duration`): two beat periods
-#: at 80 BPM, three at 120 BPM. A shorter clip cannot show a pulse (two beat periods)
-#: at any but the fastest tempi, and the tracker would return a tempo made up by its
-#: prior. The madmom sample (2.8 s) passes.
+#: Audio shorter than this is refused [s]: two beat periods at 80 BPM (a shorter clip
+#: would get a tempo made up by the prior). The madmom sample (2.8 s) passes.
 MIN_DURATION_S = 1.5
-#: Pulse clarity is the mean resonator salience
-#: (:func:`beatsync.beats.metrical.resonator_salience`) along the decoded tempo path.
-#: Unless it reaches :data:`CLEAR_PULSE`, it is compared with the same measure on the
-#: audio's own onsets in random order (:func:`pulse_clarity_null`, the null); below
-#: ``MIN_PULSE_CLARITY`` times the null, or below :data:`MIN_PATH_SALIENCE`, a warning
-#: says the beats may be meaningless. Set between the ratios that noises and the
-#: bundled real recordings reach (docs/tuning.md#pulse-clarity).
+#: Below this ratio of the pulse clarity (mean salience along the tempo path) to the
+#: null's, or below :data:`MIN_PATH_SALIENCE`, the pulse is unclear and a warning says so.
 MIN_PULSE_CLARITY = 2.9
-#: Path salience below which the pulse is unclear whatever the null says (between a
-#: short noise that passes the ratio and the quietest real recording).
+#: Path salience below which the pulse is unclear whatever the null says.
 MIN_PATH_SALIENCE = 0.08
-#: Path salience above which the pulse is clear without the null (above every noise).
+#: Path salience above which the pulse is clear without the null.
 CLEAR_PULSE = 0.7
 #: How the no-clear-pulse warning ends: what a user who knows the tempo can do.
 KNOWN_TEMPO_HINT = "if you know the tempo, give it with bpm= (--bpm) and only the phase is tracked"
@@ -96,21 +82,9 @@ P_JUMP = 1e-4
 class BeatTrack:
     """Result of :func:`track_beats`.
 
-    Attributes
-    ----------
-    beats : np.ndarray [s]
-        Beat times, strictly increasing.
-    tempo : float [bpm]
-        Median of the tempo curve (NaN if no beat was found).
-    tempo_times : np.ndarray [s]
-        Centre of each tempo window.
-    tempo_curve : np.ndarray [bpm]
-        Tempo per window.
-    method : str
-        ``"psf"`` or ``"librosa"``.
-    beats_per_bar : int
-        Meter estimate: beats per bar from the metrical model (2, 3, 4, ...; 0 if
-        not estimated, e.g. by ``method="librosa"`` or when no beat was found).
+    ``beats`` [s] strictly increasing; ``tempo`` [bpm] the median of ``tempo_curve``
+    [bpm] (NaN without beats), one value per window centred at ``tempo_times`` [s];
+    ``beats_per_bar`` the meter (0 if not estimated: ``method="librosa"`` or no beats).
     """
 
     beats: np.ndarray
@@ -124,26 +98,14 @@ class BeatTrack:
 def check_audio(y: Any, sr: Any, *, allow_silent: bool = False) -> tuple[np.ndarray, float]:
     """Validate mono audio for the tracker; return ``(y float64, sr float)``.
 
-    :func:`beatsync.validation.check_audio` with the silence threshold :data:`SILENCE_PEAK`
-    (``allow_silent=True``: no silence check, e.g. to measure a level).
-
-    Raises
-    ------
-    ParameterError
-        Empty, multi-channel, non-finite or (unless ``allow_silent``) all-silent
-        audio, or an implausible ``sr``.
+    Silence is judged against :data:`SILENCE_PEAK` (not with ``allow_silent=True``).
     """
     arr, sr_f = _units_check_audio(y, sr, silence_peak=None if allow_silent else SILENCE_PEAK)
     return np.asarray(arr, dtype=np.float64), sr_f
 
 
 def mix_clicks(y: np.ndarray, sr: float, beats: np.ndarray) -> np.ndarray:
-    """The audio with a click on every beat, to listen to the beats (float32).
-
-    The audio is normalised to peak 0.8; each click is a 1 kHz tone decaying over
-    about 0.1 s at amplitude 0.5; the mix is scaled down only if it would clip.
-    Trusts its input (validated audio, beat times inside it).
-    """
+    """The audio (peak 0.8) with a 1 kHz click (0.5, 0.1 s) on every beat, float32."""
     y = np.asarray(y, dtype=np.float64)
     t = np.arange(int(0.1 * sr)) / sr
     click = np.sin(2 * np.pi * 1000.0 * t) * np.exp(-t / 0.02)
@@ -156,17 +118,8 @@ def mix_clicks(y: np.ndarray, sr: float, beats: np.ndarray) -> np.ndarray:
 
 
 def check_duration(n_samples: int, sr: float, *, bpm: float | None = None) -> float:
-    """Refuse audio too short to hold a pulse; return its duration [s].
-
-    Rule: the audio must last at least :data:`MIN_DURATION_S` (1.5 s, two beat
-    periods at 80 BPM) and, when the tempo is known (``bpm``), at least two beat
-    periods of it (``2 * 60 / bpm`` s).
-
-    Raises
-    ------
-    ParameterError
-        If the audio is shorter; the message gives its duration and the rule.
-    """
+    """Refuse audio shorter than :data:`MIN_DURATION_S` or two beat periods of a known
+    ``bpm``; return its duration [s]."""
     duration = float(frames_to_time(n_samples, fps=sr))
     need, why = MIN_DURATION_S, "the fixed minimum: two beat periods at 80 BPM"
     if bpm is not None and 2 * 60.0 / bpm > need:
@@ -181,19 +134,7 @@ def check_duration(n_samples: int, sr: float, *, bpm: float | None = None) -> fl
 
 
 def beat_tempo(beats: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Instantaneous tempo of each beat interval: ``60 / (b[i+1] - b[i])``.
-
-    Parameters
-    ----------
-    beats : np.ndarray [shape=(K,)] [s]
-        Strictly increasing beat times.
-
-    Returns
-    -------
-    starts : np.ndarray [shape=(K-1,)] [s]
-        Start ``b[i]`` of each interval (plot as steps with ``where="post"``).
-    bpm : np.ndarray [shape=(K-1,)] [bpm]
-        Tempo of each interval (empty for fewer than two beats).
+    """Start [s] and tempo ``60 / (b[i+1] - b[i])`` [bpm] of each beat interval.
 
     Examples
     --------
@@ -220,63 +161,26 @@ def track_beats(
     drum_weight: float = DRUM_WEIGHT,
     **frontend_params: Any,
 ) -> BeatTrack:
-    """Track the beats of a piece of music.
+    """Track the beats of mono audio ``y`` at ``sr`` [Hz].
 
-    Parameters
-    ----------
-    y : np.ndarray [shape=(n,)]
-        Mono audio, finite, not all silent.
-    sr : float > 0 [Hz]
-    method : {"psf", "librosa"}
-        ``"psf"``: phase-slope onsets, the metrical model of Klapuri et al. (2006)
-        decoded by the tempo HMM, and the phase HMM (paper A, section 4);
-        ``"librosa"``: :func:`librosa.beat.beat_track` (dynamic programming).
-    bpm : float, optional [bpm]
-        Known tempo: skips tempo estimation (the beat period is fixed).
-    min_bpm, max_bpm : float [bpm]
-        Tempo range searched (the metrical level is chosen inside it), within 20-400.
-    prior_period_s : float > 0 [s]
-        Median of the log-normal prior on the beat (tactus) period of the metrical
-        model (0.55 s = 109 BPM, Klapuri et al. 2006).
-    prior_sigma : float > 0
-        Standard deviation of that prior in natural-log units of the period.
-    tempo_win_s, tempo_hop_s : float > 0 [s]
-        Windows of the tempo HMM (8 s, 1 s hop).
-    time_varying : bool
-        Follow tempo changes (True) or force one tempo for the whole piece (False).
-    drum_weight : float >= 0
-        Weight of the drum-pattern cue in the choice of the metrical level: a bass
-        drum and a snare drum that alternate mark the beat (Goto 2001,
-        :mod:`beatsync.beats.drums`); 0 leaves it out.
-    **frontend_params
-        Phase-slope front end: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
-        ``flux_norm_s``, ``analysis_sr`` (see :func:`beatsync.beats.onset_strength_psf`).
+    ``method="psf"``: phase-slope onsets, the metrical model of Klapuri et al. (2006)
+    decoded by the tempo HMM, and the phase HMM (paper A, section 4); ``"librosa"``:
+    :func:`librosa.beat.beat_track`. A known ``bpm`` [bpm] skips tempo estimation;
+    otherwise tempi from ``min_bpm`` to ``max_bpm`` (within 20-400) are searched.
+    ``prior_period_s`` [s] and ``prior_sigma`` [natural-log units] are the median and
+    width of the log-normal prior on the beat period (0.55 s = 109 BPM, Klapuri et al.).
+    ``tempo_win_s``, ``tempo_hop_s`` [s]: the tempo HMM's windows; ``time_varying=False``
+    forces one tempo for the whole piece. ``drum_weight``: weight of the drum-pattern cue
+    of the metrical level (:mod:`beatsync.beats.drums`; 0 leaves it out).
+    ``frontend_params``: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
+    ``flux_norm_s``, ``analysis_sr`` (see :func:`beatsync.beats.onset_strength_psf`).
 
-    Returns
-    -------
-    BeatTrack
-
-    Raises
-    ------
-    ParameterError
-        Empty, silent or non-finite audio; audio too short for a pulse (shorter
-        than 1.5 s, or than two beat periods of a given ``bpm``, see
-        :func:`check_duration`); ``sr <= 0``; ``min_bpm >= max_bpm``; a ``bpm``,
-        ``min_bpm`` or ``max_bpm`` outside 20-400; a ``bpm`` with a range other
-        than the default (the range would be ignored); unknown method or front-end
-        parameter.
-
-    Warns
-    -----
-    BeatsyncWarning
-        If no onsets are found (no attack in any band): returns no beats. (A steady
-        tone does have onsets and gets beats without a warning: a known limit, see
-        :mod:`beatsync.beats.onset`.) If the pulse
-        is unclear (e.g. noise: the salience along the tempo path is less than
-        ``MIN_PULSE_CLARITY`` times that of the same onsets in random order, see
-        :func:`pulse_clarity_null`, or below ``MIN_PATH_SALIENCE``): returns the
-        beats found, and names the way out
-        (a known ``bpm``, with which only the phase is tracked).
+    Raises :class:`ParameterError` for empty, silent or non-finite audio, audio too short
+    for a pulse (:func:`check_duration`), a bad ``sr``, tempo bound or range, a ``bpm``
+    given with a range other than the default, an unknown method or front-end parameter.
+    Warns (:class:`~beatsync.errors.BeatsyncWarning`) when no onsets are found (no
+    beats) or when the pulse is unclear (:func:`pulse_clarity_null`; e.g. noise). A
+    steady tone has onsets and gets beats without a warning (see :mod:`.onset`).
 
     Examples
     --------
@@ -288,7 +192,7 @@ def track_beats(
     120
     """
     # float32 audio stays float32 for our tracker (its front end runs in float32: the
-    # same samples, without a float64 copy); any other type becomes float64, as always
+    # same samples, without a float64 copy); any other type becomes float64
     y, sr = _units_check_audio(y, sr, silence_peak=SILENCE_PEAK)
     if y.dtype != np.float32:
         y = np.asarray(y, dtype=np.float64)
@@ -325,26 +229,49 @@ def track_beats(
             f"{fe.analysis_sr:g} Hz"
         )
     ons = compute_onsets(y, sr, fe)
-    return _track_psf(
-        ons,
-        audio=(y, sr),
-        drum_weight=drum_weight,
-        duration=y.size / sr,
-        bpm=bpm,
-        min_bpm=min_bpm,
-        max_bpm=max_bpm,
-        prior_period_s=prior_period_s,
-        prior_sigma=prior_sigma,
-        tempo_win_s=tempo_win_s,
-        tempo_hop_s=tempo_hop_s,
-        time_varying=time_varying,
+    if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
+        warn("no onsets found in the audio (no attack in any band): no beats", stacklevel=2)
+        e = np.empty(0)
+        return BeatTrack(e, float("nan"), e, e, "psf")
+    duration = y.size / sr
+    model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
+    obs = observe(
+        ons, (y, sr), model=model, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm,
+        tempo_win_s=tempo_win_s, tempo_hop_s=tempo_hop_s, drum_weight=drum_weight,
+    )  # fmt: skip
+    centres, periods = obs.centres, obs.periods
+    if bpm is None:
+        log_obs = obs.log_obs
+        if not time_varying:
+            log_obs = np.repeat(log_obs.sum(axis=1, keepdims=True), centres.size, axis=1)
+        path = tempo_hmm(log_obs, periods, trans_sigma=TRANS_SIGMA, p_jump=P_JUMP)
+        clarity = float(np.mean(obs.salience[path, np.arange(path.size)]))
+        _warn_if_no_clear_pulse(ons, clarity, obs, model, duration, tempo_win_s)
+    else:
+        path = np.zeros(centres.size, dtype=np.int64)
+    period_w = periods[path]
+    beats_per_bar = estimate_meter(obs.measure[path, np.arange(path.size)], period_w)
+    beats, _ = place_beats(ons, period_w, centres, tempo_win_s, duration)
+    tempo_curve = 60.0 / period_w
+    if bpm is None and beats.size > 3:
+        # refine the grid tempo (0.5 % steps) with the median beat interval per window
+        ibi = np.diff(beats)
+        mid = (beats[1:] + beats[:-1]) / 2
+        reach = tempo_win_s / 2 if time_varying else np.inf  # one tempo: whole piece
+        for i, c in enumerate(centres):
+            sel = ibi[np.abs(mid - c) <= reach]
+            if sel.size >= 3:
+                est = 60.0 / np.median(sel)
+                if abs(np.log(est / tempo_curve[i])) < 0.05:  # same metrical level
+                    tempo_curve[i] = est
+    return BeatTrack(
+        beats.astype(np.float64),
+        float(np.median(tempo_curve)),
+        centres.astype(np.float64),
+        tempo_curve,
+        "psf",
+        beats_per_bar,
     )
-
-
-def _empty(method: str, msg: str) -> BeatTrack:
-    warn(msg, stacklevel=3)
-    e = np.empty(0)
-    return BeatTrack(e, float("nan"), e, e, method)
 
 
 class Observation(NamedTuple):
@@ -375,9 +302,8 @@ def observe(
 ) -> Observation:
     """The metrical model's tactus observation plus the drum cue, per tempo window.
 
-    The step of :func:`track_beats` before the tempo HMM (also what
-    ``benchmarks/calibrate_pulse_clarity.py`` decodes); inputs are trusted. A known
-    ``bpm`` gives a grid of one period and no drum cue (no level to choose).
+    Trusts its inputs (also decoded by ``benchmarks/calibrate_pulse_clarity.py``). A
+    known ``bpm`` gives a grid of one period and no drum cue.
     """
     fps = ons.fps
     n = ons.envelope.size
@@ -398,71 +324,6 @@ def observe(
     return Observation(starts, stops, centres, periods, max_hz, log_obs, salience, measure)
 
 
-def _track_psf(
-    ons: OnsetSignal,
-    *,
-    audio: tuple[np.ndarray, float],
-    drum_weight: float,
-    duration: float,
-    bpm,
-    min_bpm,
-    max_bpm,
-    prior_period_s,
-    prior_sigma,
-    tempo_win_s,
-    tempo_hop_s,
-    time_varying,
-) -> BeatTrack:
-    if ons.onset_times.size == 0 or not np.any(ons.envelope > 0):
-        return _empty("psf", "no onsets found in the audio (no attack in any band): no beats")
-    model = replace(METER_MODEL, tactus_median_s=prior_period_s, tactus_sigma=prior_sigma)
-    obs = observe(
-        ons, audio, model=model, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm,
-        tempo_win_s=tempo_win_s, tempo_hop_s=tempo_hop_s, drum_weight=drum_weight,
-    )  # fmt: skip
-    starts, stops, centres, periods, max_hz, log_obs, salience, measure = obs
-    if bpm is None:
-        if not time_varying:
-            log_obs = np.repeat(log_obs.sum(axis=1, keepdims=True), centres.size, axis=1)
-        path = tempo_hmm(log_obs, periods, trans_sigma=TRANS_SIGMA, p_jump=P_JUMP)
-        _warn_if_no_clear_pulse(
-            ons,
-            salience[path, np.arange(path.size)],
-            starts,
-            stops,
-            periods,
-            model,
-            max_hz,
-            duration=duration,
-            tempo_win_s=tempo_win_s,
-        )
-    else:
-        path = np.zeros(centres.size, dtype=np.int64)
-    period_w = periods[path]
-    beats_per_bar = estimate_meter(measure[path, np.arange(path.size)], period_w)
-    beats, _ = place_beats(ons, period_w, centres, tempo_win_s, duration)
-    tempo_curve = 60.0 / period_w
-    if bpm is None and beats.size > 3:
-        # refine the grid tempo (0.5 % steps) with the median beat interval per window
-        ibi = np.diff(beats)
-        mid = (beats[1:] + beats[:-1]) / 2
-        reach = tempo_win_s / 2 if time_varying else np.inf  # one tempo: whole piece
-        for i, c in enumerate(centres):
-            sel = ibi[np.abs(mid - c) <= reach]
-            if sel.size >= 3:
-                est = 60.0 / np.median(sel)
-                if abs(np.log(est / tempo_curve[i])) < 0.05:  # same metrical level
-                    tempo_curve[i] = est
-    return BeatTrack(
-        beats.astype(np.float64),
-        float(np.median(tempo_curve)),
-        centres.astype(np.float64),
-        tempo_curve,
-        "psf",
-        beats_per_bar,
-    )
-
-
 def pulse_clarity_null(
     ons: OnsetSignal,
     starts: np.ndarray,
@@ -473,13 +334,11 @@ def pulse_clarity_null(
 ) -> float:
     """Pulse clarity of the same onsets in random order: what no pulse looks like.
 
-    The band onset signals are permuted in time (one fixed permutation per draw,
-    seeded: the result is reproducible), smoothed, observed with the tactus terms of
-    the metrical model (:func:`beatsync.beats.metrical.beat_observation`: salience
-    and prior, without tatum and measure; all draws in one batch) and decoded by the
-    tempo HMM; the null is the mean path salience over the draws, enough draws for
-    :data:`NULL_AUDIO_S` seconds of shuffled audio (at most :data:`NULL_MAX_DRAWS`).
-    It has the onset density, window lengths and decoding bias of the audio.
+    The band onsets are permuted in time (seeded), observed with the tactus terms alone
+    (:func:`beatsync.beats.metrical.beat_observation`) and decoded by the tempo HMM; the
+    mean path salience over enough draws for :data:`NULL_AUDIO_S` of audio (at most
+    :data:`NULL_MAX_DRAWS`). It keeps the audio's onset density, window lengths and
+    decoding bias.
     """
     fps = ons.fps
     n = ons.bands.shape[1]
@@ -496,18 +355,13 @@ def pulse_clarity_null(
     return float(np.mean(values))
 
 
-def _warn_if_no_clear_pulse(
-    ons, path_salience, starts, stops, periods, model, max_hz, *, duration, tempo_win_s
-) -> None:
-    clarity = float(np.mean(path_salience))
+def _warn_if_no_clear_pulse(ons, clarity, obs, model, duration, tempo_win_s) -> None:
     if clarity >= CLEAR_PULSE:
         return
-    null = pulse_clarity_null(ons, starts, stops, periods, model, max_hz)
+    null = pulse_clarity_null(ons, obs.starts, obs.stops, obs.periods, model, obs.max_hz)
     if clarity < MIN_PULSE_CLARITY * null or clarity < MIN_PATH_SALIENCE:
         why = "noise, free rhythm or too short?"
-        if duration < tempo_win_s:
-            # clips shorter than the tempo window warn more often than whole songs
-            # (the short-clip table of benchmarks/bench_beats.py counts the warnings)
+        if duration < tempo_win_s:  # clips shorter than the tempo window warn more often
             why = (
                 f"the audio is only {duration:.2f} s long, shorter than the {tempo_win_s:g} s "
                 "tempo window: give a longer excerpt if you can (or it is noise or free "
@@ -521,7 +375,7 @@ def _warn_if_no_clear_pulse(
         warn(
             f"no clear pulse in the audio (pulse clarity {clarity:.2f}: {against}): {why} the "
             f"beats may be meaningless or at another metrical level; {KNOWN_TEMPO_HINT}",
-            stacklevel=4,
+            stacklevel=3,
         )
 
 
@@ -535,8 +389,7 @@ def _accents(bands: np.ndarray, fps: float) -> np.ndarray:
     return gaussian_smooth(bands, _accent_sigma(fps))
 
 
-#: librosa's beat tracker does not search above this tempo [BPM] (``beat_track``'s
-#: ``max_tempo``).
+#: librosa's beat tracker does not search above this tempo [BPM] (its ``max_tempo``).
 LIBROSA_MAX_TEMPO = 320.0
 
 #: Hop [samples] of the onset envelope when librosa tracks beats here (its default).
@@ -544,11 +397,10 @@ LIBROSA_HOP = 512
 
 
 def librosa_tempo_steps(sr: float, hop: int = LIBROSA_HOP) -> np.ndarray:
-    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], in ascending order.
+    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], ascending.
 
-    Its tempo is a lag of the 8 s onset autocorrelation: ``60 sr / (hop lag)`` BPM for
-    every whole lag (:func:`librosa.tempo_frequencies`), up to 320 BPM. At 22.05 kHz the
-    steps near 190 BPM are 13.5 BPM apart (184.6, 198.8).
+    One per whole lag of its 8 s onset autocorrelation, ``60 sr / (hop lag)``, below
+    320 BPM (13.5 BPM apart near 190 BPM at 22.05 kHz).
     """
     win = int(np.floor(8.0 * sr / hop))  # librosa.time_to_frames(ac_size=8, sr, hop)
     lags = np.arange(1, win)
@@ -563,18 +415,12 @@ def librosa_tempo_prior(
     sr: float | None = None,
     hop: int = LIBROSA_HOP,
 ):
-    """The tempo prior given to :func:`librosa.beat.beat_track` for a tempo range [BPM].
+    """The tempo prior for :func:`librosa.beat.beat_track`: ``None`` (librosa's own) for
+    the default range, else flat inside it (``scipy.stats.uniform``).
 
-    ``None`` (librosa's own log-normal prior) for the default range; a flat prior
-    inside a range the user narrowed (``scipy.stats.uniform``).
-
-    Raises
-    ------
-    ParameterError
-        A range that holds none of the tempi librosa can choose at ``sr``
-        (:func:`librosa_tempo_steps`; checked when ``sr`` is given), e.g. 185-198 BPM at
-        22.05 kHz or anything above 320 BPM: librosa would return a single beat at an
-        infinite tempo. The message names the nearest tempi it can choose.
+    Refuses (given ``sr``) a range holding none of :func:`librosa_tempo_steps`, e.g.
+    185-198 BPM at 22.05 kHz, or above 320 BPM: librosa would return one beat at an
+    infinite tempo. The message names the nearest tempi it can choose.
     """
     if (min_bpm, max_bpm) == (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
         return None

@@ -1,13 +1,7 @@
-"""Scores: metrics on arrays, mir_eval style (``validate``, the metrics, ``evaluate``).
-
-No module here runs a pipeline stage; :mod:`beatsync.study` runs them and calls these.
-
-- :mod:`beatsync.evaluate.beats`: beat tracking against annotations, every
-  ``mir_eval.beat`` metric with an explicit ``min_beat_time``; the tempo octave.
-- :mod:`beatsync.evaluate.alignment`: dance-music beat alignment, both published
-  scores (averaged over motion beats, or over music beats; Gaussian sigma in seconds).
-- :mod:`beatsync.evaluate.segmentation`: period boundaries against ground truth
-  (boundary error in frames, count error).
+"""Scores: metrics on arrays, mir_eval style (``validate``, the metrics, ``evaluate``);
+no stage runs here (:mod:`beatsync.study` runs them): beat tracking against annotations
+(:mod:`.beats`), dance-music beat alignment (:mod:`.alignment`), period boundaries
+(:mod:`.segmentation`) and the quality proxies of a composed dance (:mod:`.composition`).
 """
 
 from .alignment import (

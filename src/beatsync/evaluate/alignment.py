@@ -1,44 +1,19 @@
 """Dance-music beat alignment scores.
 
-Two incompatible scores are published under the name "beat alignment score"; both
-compare motion beats (kinematic beats of the dance) with music beats through a
-Gaussian of the distance to the nearest beat of the other kind, but they average
-over different sets:
+Two incompatible scores are published as "beat alignment score"; both take a Gaussian
+``exp(-d^2 / (2 sigma^2))`` of the distance ``d`` [s] to the nearest beat of the other
+kind, but average over different sets:
 
-- :func:`beat_alignment_motion` averages over **motion beats**: for every motion
-  beat, how close is the nearest music beat? This is the score as written in Li et
-  al. 2021 (AIST++ / FACT, "AI Choreographer", the BeatAlign equation over the
-  kinematic beats; their ``tools/calculate_beat_scores.py`` loops over the motion
-  beats too). It asks whether every accent of the dance falls on a beat; a dance
-  that skips beats is not penalised.
-- :func:`beat_alignment_music` averages over **music beats**: for every music beat,
-  how close is the nearest motion beat? This is the score of Siyao et al. 2022
-  (Bailando, "BAS"; their ``utils/beat_align_score.py`` loops over the music beats).
-  It asks whether every beat of the song is danced; a dance with many extra motion
-  beats is not penalised.
+- :func:`beat_alignment_motion` averages over **motion beats** (Li et al. 2021, AIST++
+  "BeatAlign"): does every accent of the dance fall on a beat? Skipped beats cost nothing.
+- :func:`beat_alignment_music` averages over **music beats** (Siyao et al. 2022,
+  Bailando "BAS"): is every beat of the song danced? Extra motion beats cost nothing.
 
-Both use ``exp(-d^2 / (2 sigma^2))`` with ``d`` the distance to the nearest beat
-[s]; the papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (default here).
-Every table of this project says which of the two it reports; :func:`alignment_scores`
-returns both.
-
-Motion beats are given as times (e.g. from :func:`beatsync.motion_beats.kinematic_beats`,
-local minima of smoothed joint speed); this module never runs a stage (mir_eval style:
-:func:`validate`, the metrics, and :func:`evaluate` returning all of them). Also here:
-:func:`beat_phase_consistency` (is the dance phase-locked to the music?),
-:func:`offset_control` (chance level by random offsets of the motion beats) and
-:func:`sync_residuals` (how far synchronised boundaries land from their beats).
-What runs the pipeline for the paper's tables is in :mod:`beatsync.study.paper_a_sync`.
-
-Data contract
--------------
-Beat times are 1-D float64 arrays in seconds, strictly increasing (as in
-``mir_eval.beat``). Scores lie in ``[0, 1]``; 1 means every beat of the averaged set
-sits exactly on a beat of the other set. Empty input is degenerate but legal: a
-:class:`~beatsync.errors.BeatsyncWarning` is issued and the score is 0.
-
-Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb`` (alignment before/after sync),
-``notebooks/paper_a_fig03_animation_frames.ipynb`` (residuals).
+The papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (the default). Every table
+says which score it reports; :func:`alignment_scores` returns both. Beat times are 1-D
+float64 seconds, strictly increasing (as in ``mir_eval.beat``); scores lie in ``[0, 1]``.
+Empty input is degenerate but legal: a warning, and the score is 0. No stage runs here
+(mir_eval style: :func:`validate`, the metrics, :func:`evaluate`).
 """
 
 from __future__ import annotations
@@ -48,7 +23,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, warn
-from ..validation import beat_phase, check_fps, check_times, frames_to_time, time_to_frames
+from ..validation import (
+    beat_phase,
+    check_fps,
+    check_positive,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 
 __all__ = [
     "validate",
@@ -66,46 +48,26 @@ __all__ = [
 DEFAULT_SIGMA = 0.05
 
 
-def _check_sigma(sigma: Any) -> float:
-    try:
-        s = float(sigma)
-    except (TypeError, ValueError):
-        raise ParameterError(f"sigma={sigma!r} must be a number of seconds") from None
-    if not np.isfinite(s) or s <= 0:
-        raise ParameterError(f"sigma={sigma!r} must be a finite width > 0 [s]")
+def _checked(motion_beats: Any, music_beats: Any, sigma: Any):
+    """``(motion_beats, music_beats, sigma)`` validated (:func:`validate`, sigma [s])."""
+    s = check_positive(sigma, name="sigma", unit="s")
     if s >= 1.0:
         raise ParameterError(
             f"sigma={sigma!r} s is wider than a beat: sigma is in seconds, not frames "
             "(the papers' 3 frames at 60 fps is sigma=0.05)"
         )
-    return s
+    return *validate(motion_beats, music_beats), s
 
 
 def validate(motion_beats: Any, music_beats: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Check both beat sequences (1-D increasing seconds); return them as float64.
-
-    Raises
-    ------
-    ParameterError
-        Not 1-D, NaN, negative or unsorted times.
-    """
+    """Check both beat sequences (1-D increasing seconds); return them as float64."""
     mb = check_times(motion_beats, name="motion_beats")
     yb = check_times(music_beats, name="music_beats")
     return mb, yb
 
 
 def nearest_distance(events: Any, reference: Any) -> np.ndarray:
-    """Distance [s] from each event to the nearest reference time.
-
-    Parameters
-    ----------
-    events : np.ndarray [shape=(n,)] [s], increasing
-    reference : np.ndarray [shape=(m,), m >= 1] [s], increasing
-
-    Returns
-    -------
-    d : np.ndarray [shape=(n,)] [s], >= 0
-    """
+    """Distance [s] from each event to the nearest of the increasing ``reference`` times."""
     e = np.asarray(events, dtype=np.float64)
     r = np.asarray(reference, dtype=np.float64)
     idx = np.searchsorted(r, e)
@@ -129,56 +91,33 @@ def _score(averaged: np.ndarray, other: np.ndarray, sigma: float, what: str) -> 
 def beat_alignment_motion(
     motion_beats: Any, music_beats: Any, *, sigma: float = DEFAULT_SIGMA
 ) -> float:
-    """Beat alignment averaged over motion beats (Li et al. 2021, AIST++ "BeatAlign").
+    """Beat alignment averaged over motion beats ``M`` (Li et al. 2021, AIST++ "BeatAlign").
 
-    ``(1/|M|) sum_{t in M} exp(-min_{b in B} (t - b)^2 / (2 sigma^2))`` with ``M`` the
-    motion beats and ``B`` the music beats.
-
-    Parameters
-    ----------
-    motion_beats : np.ndarray [shape=(n,)] [s]
-    music_beats : np.ndarray [shape=(m,)] [s]
-    sigma : float > 0 [s]
-        Gaussian width; 0.05 s = 3 frames at 60 fps.
-
-    Returns
-    -------
-    score : float in [0, 1]
+    ``(1/|M|) sum_{t in M} exp(-min_{b in B} (t - b)^2 / (2 sigma^2))``, ``B`` the music
+    beats, ``sigma`` [s].
 
     Examples
     --------
     >>> beat_alignment_motion([0.5, 1.0], [0.0, 0.5, 1.0, 1.5])
     1.0
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     return _score(mb, yb, sigma, "motion beats")
 
 
 def beat_alignment_music(
     motion_beats: Any, music_beats: Any, *, sigma: float = DEFAULT_SIGMA
 ) -> float:
-    """Beat alignment averaged over music beats (Siyao et al. 2022, Bailando "BAS").
+    """Beat alignment averaged over music beats ``B`` (Siyao et al. 2022, Bailando "BAS").
 
     ``(1/|B|) sum_{b in B} exp(-min_{t in M} (b - t)^2 / (2 sigma^2))``.
-
-    Parameters
-    ----------
-    motion_beats : np.ndarray [shape=(n,)] [s]
-    music_beats : np.ndarray [shape=(m,)] [s]
-    sigma : float > 0 [s]
-
-    Returns
-    -------
-    score : float in [0, 1]
 
     Examples
     --------
     >>> round(beat_alignment_music([0.5, 1.0], [0.0, 0.5, 1.0, 1.5]), 3)
     0.5
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     return _score(yb, mb, sigma, "music beats")
 
 
@@ -189,24 +128,11 @@ def alignment_scores(
     sigma: float = DEFAULT_SIGMA,
     span: tuple[float, float] | None = None,
 ) -> dict[str, float]:
-    """Both beat alignment scores, plus the beat counts they were computed on.
-
-    Parameters
-    ----------
-    motion_beats, music_beats : np.ndarray [s]
-    sigma : float > 0 [s]
-    span : (float, float), optional [s]
-        Keep only beats inside ``[span[0], span[1]]`` (e.g. the time both the dance
-        and the music play), so music after the dance ends is not counted as missed.
-
-    Returns
-    -------
-    dict
-        ``alignment_motion`` (averaged over motion beats), ``alignment_music``
-        (averaged over music beats), ``n_motion_beats``, ``n_music_beats``, ``sigma_s``.
+    """Both beat alignment scores (``alignment_motion``, ``alignment_music``), the beat counts
+    they were computed on and ``sigma_s``. Given a ``span`` [s], only beats inside it count
+    (e.g. the time both the dance and the music play).
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     if span is not None:
         lo, hi = float(span[0]), float(span[1])
         if not hi > lo:
@@ -230,20 +156,12 @@ def offset_control(
     n_trials: int = 200,
     seed: int = 0,
 ) -> dict[str, float]:
-    """Chance level: both scores with the motion beats shifted by random offsets.
+    """Chance level: mean and sd of both scores with the motion beats shifted by random offsets.
 
-    Each trial shifts all motion beats by one offset drawn uniformly from
-    ``[-T/2, T/2)``, ``T`` the median music beat period, so the rhythm of the dance is
-    kept but its phase relative to the music is random.
-
-    Returns
-    -------
-    dict
-        Mean and standard deviation over trials of ``alignment_motion`` and
-        ``alignment_music``, and ``n_trials``.
+    Each of ``n_trials`` shifts all motion beats by one offset uniform in ``[-T/2, T/2)``,
+    ``T`` the median music beat period: the dance keeps its rhythm, its phase is random.
     """
-    sigma = _check_sigma(sigma)
-    mb, yb = validate(motion_beats, music_beats)
+    mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     if yb.size < 2:
         raise ParameterError("offset_control needs at least 2 music beats to know the beat period")
     if int(n_trials) < 1:
@@ -267,22 +185,11 @@ def offset_control(
 
 
 def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
-    """How consistently motion beats fall at the same phase of the music's beat.
+    """How consistently motion beats fall at one phase of the music's beat, in [0, 1].
 
-    The phase of a motion beat is its fractional position inside the music beat
-    interval that contains it (0 on a beat, 0.5 half-way); the score is the length of
-    the mean phase vector, ``|mean exp(2 pi i phase)|`` (vector strength): 1 if every
-    motion beat sits at the same phase (phase-locked, whatever that phase is), near 0
-    if the phases are spread (a dance drifting against the music). Motion beats
-    outside the span of the music beats are ignored.
-
-    Unlike the two alignment scores this does not reward one particular phase:
-    synchronising period boundaries to beats (paper A) locks the phase of the dance
-    but the dancer's accents may sit anywhere inside the period.
-
-    Returns
-    -------
-    score : float in [0, 1]
+    The vector strength ``|mean exp(2 pi i phase)|`` of each motion beat's phase inside its
+    music beat interval (motion beats outside the music beats are ignored): 1 when
+    phase-locked at whatever phase, near 0 for a dance drifting against the music.
     """
     mb, yb = validate(motion_beats, music_beats)
     if yb.size < 2:
@@ -297,27 +204,10 @@ def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
 def sync_residuals(landed: Any, targets: Any, *, fps: float | None = None) -> dict[str, Any]:
     """How far synchronised events land from the beats they were meant for.
 
-    Parameters
-    ----------
-    landed : np.ndarray [shape=(n,)] [s]
-        Music time at which each event (period boundary, motion beat) is shown, e.g.
-        ``np.asarray(report["target_beats_s"]) + np.asarray(report["residual_ms"]) / 1e3``.
-    targets : np.ndarray [shape=(n,)] [s]
-        The beat (or beat plus phase offset) each event was meant for.
-    fps : float > 0, optional [Hz]
-        Frame rate of the synchronised motion: also the residual of the frame
-        nearest to each landing (what a viewer sees).
-
-    Returns
-    -------
-    dict
-        ``residual_ms`` (landed - target), ``max_abs_residual_ms``, and with ``fps``:
-        ``residual_nearest_frame_ms``, ``max_abs_residual_frames``.
-
-    Raises
-    ------
-    ParameterError
-        Different lengths, not times, a bad ``fps``.
+    ``landed`` [s]: the music time each event is shown at (e.g. ``target_beats_s +
+    residual_ms / 1e3`` of a sync report); ``targets`` [s]: the beat each was meant for.
+    Returns ``residual_ms`` and ``max_abs_residual_ms``, and given the motion's ``fps``
+    [Hz], ``residual_nearest_frame_ms`` and ``max_abs_residual_frames`` (what a viewer sees).
 
     Examples
     --------
@@ -346,20 +236,8 @@ def sync_residuals(landed: Any, targets: Any, *, fps: float | None = None) -> di
 def evaluate(
     motion_beats: Any, music_beats: Any, *, sigma: float = DEFAULT_SIGMA, **kwargs: Any
 ) -> dict[str, float]:
-    """Every alignment metric of motion beats against music beats.
-
-    Parameters
-    ----------
-    motion_beats, music_beats : np.ndarray [s]
-    sigma : float > 0 [s]
-    **kwargs
-        ``span`` for :func:`alignment_scores`.
-
-    Returns
-    -------
-    dict
-        :func:`alignment_scores` plus ``phase_consistency`` (NaN with fewer than two
-        music beats).
+    """:func:`alignment_scores` (``kwargs``: its ``span``) plus ``phase_consistency`` (NaN with
+    fewer than two music beats).
     """
     out: dict[str, float] = dict(alignment_scores(motion_beats, music_beats, sigma=sigma, **kwargs))
     yb = validate(motion_beats, music_beats)[1]

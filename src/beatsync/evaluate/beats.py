@@ -1,23 +1,11 @@
 """Beat-tracking scores on arrays, in the style of :mod:`mir_eval.beat`.
 
-Data contract
--------------
-Reference and estimated beats are 1-D arrays of times in seconds, strictly
-increasing and >= 0. :func:`validate` checks both and diagnoses the usual mistake
-(frame indices or milliseconds instead of seconds). ``min_beat_time`` [s] is always
-explicit: mir_eval's default (5 s) silently drops the first 5 s, which is most of a
-short clip.
-
-:func:`evaluate` validates both sequences and returns every metric of
-:func:`mir_eval.beat.evaluate` (:data:`METRICS`): F-measure, Cemgil (and its
-max-over-variants form), Goto, P-score, CMLc, CMLt, AMLc, AMLt and information gain.
-:func:`tempo_octave` names the metrical relation of the estimated tempo to the
-reference (correct, double, half, triple, third, other).
-
-This module never runs a tracker: :mod:`beatsync.study` does (test items in
-:mod:`~beatsync.study.paper_a_beats`, datasets of files in :mod:`~beatsync.study.beat_dataset`).
-
-Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
+Reference and estimated beats are 1-D times in seconds, strictly increasing, >= 0;
+:func:`validate` diagnoses the usual mistake (frame indices or milliseconds).
+``min_beat_time`` [s] is always explicit: mir_eval's default (5 s) silently drops most
+of a short clip. :func:`evaluate` returns every metric of :func:`mir_eval.beat.evaluate`
+(:data:`METRICS`); :func:`tempo_octave` names the metrical relation of the estimated
+tempo to the reference. No tracker runs here (:mod:`beatsync.study` runs them).
 """
 
 from __future__ import annotations
@@ -47,13 +35,11 @@ __all__ = [
 ]
 
 #: Beat sequences whose median interval exceeds this [s] are refused (not seconds):
-#: 3 s, the beat period at :data:`beatsync.validation.MIN_BPM` (20 BPM), the slowest
-#: tempo the tracker considers.
+#: the beat period at :data:`beatsync.validation.MIN_BPM`.
 MAX_BEAT_INTERVAL = 60.0 / MIN_BPM
 
-#: mir_eval's limit on beat times [s] (``mir_eval.beat.MAX_TIME``; its scores refuse a
-#: later beat), copied so that reading an annotation does not import mir_eval (with
-#: scipy.stats, slow to import in a process that only hands tracks to its workers).
+#: mir_eval's limit on beat times [s] (``mir_eval.beat.MAX_TIME``), copied so that
+#: reading an annotation does not import mir_eval (slow).
 MIR_EVAL_MAX_TIME = 30000.0
 
 
@@ -71,27 +57,21 @@ METRICS = (
     "Information gain",
 )
 
+#: Relations of :func:`octave_relation`: estimated over reference tempo.
+TEMPO_RATIOS = {"correct": 1.0, "double": 2.0, "half": 0.5, "triple": 3.0, "third": 1 / 3}
+
 #: Values of :func:`octave_relation` that are octave errors.
 OCTAVE_ERRORS = ("double", "half", "triple", "third")
 
 
 def diagnose_times(times: np.ndarray) -> str | None:
-    """Say what a sequence of increasing event times looks like if not seconds.
+    """What finite increasing event times look like if not seconds, or ``None``.
 
-    Parameters
-    ----------
-    times : np.ndarray [shape=(n,)]
-        Finite, increasing values (already checked by :func:`beatsync.validation.check_times`).
-
-    Returns
-    -------
-    str or None
-        ``None`` if the values are plausible beat times in seconds (a median spacing
-        of at most :data:`MAX_BEAT_INTERVAL`); otherwise a phrase naming what they look
-        like: ``"frame indices"`` (integers less than 150 apart: 40 BPM and faster at
-        100 frames/s), ``"milliseconds"`` (150-3000 apart: 20-400 BPM in ms),
-        ``"sample indices"`` (integers more than 3000 apart), or, for anything else,
-        ``"something slower than any beat (bars? a wrong unit?)"``.
+    ``None`` for plausible beat times (a median spacing of at most
+    :data:`MAX_BEAT_INTERVAL`, the last within mir_eval's limit); else ``"frame indices"``
+    (integers less than 150 apart), ``"milliseconds"`` (150-3000 apart), ``"sample
+    indices"`` (integers further apart), a recording too long for mir_eval, or something
+    slower than any beat.
     """
     if times.size == 0:
         return None
@@ -117,22 +97,15 @@ EMPTY_REFERENCE_TEXT = "the reference beats are empty"
 
 
 def validate(reference: Any, estimated: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Check reference and estimated beats; return them as ``float64`` arrays.
-
-    Raises
-    ------
-    ParameterError
-        Not 1-D, negative, non-finite, not strictly increasing; or values that look
-        like frame indices or milliseconds (the message says which).
+    """Check reference and estimated beats (1-D, >= 0, finite, strictly increasing, in
+    seconds: :func:`diagnose_times`); return them as ``float64`` arrays.
     """
     return _check(reference, "reference beats"), _check(estimated, "estimated beats")
 
 
 def not_seconds_detail(times: np.ndarray) -> str | None:
-    """Why increasing event times look like something other than seconds, or ``None``.
-
-    The text names the last time, the median spacing and what they look like
-    (:func:`diagnose_times`), for an error message.
+    """Why increasing event times look like something other than seconds (the last time, the
+    median spacing and :func:`diagnose_times`), for an error message; ``None`` if they do not.
     """
     looks = diagnose_times(times)
     if looks is None:
@@ -157,33 +130,10 @@ def evaluate(
     *,
     min_beat_time: float,
 ) -> dict[str, float]:
-    """Every metric of :func:`mir_eval.beat.evaluate`, on validated beat times.
+    """Every metric of :func:`mir_eval.beat.evaluate` (keys :data:`METRICS`, values in [0, 1]).
 
-    Parameters
-    ----------
-    reference : np.ndarray [shape=(n,)] [s]
-        Annotated beats, strictly increasing seconds.
-    estimated : np.ndarray [shape=(m,)] [s]
-        Estimated beats, strictly increasing seconds.
-    min_beat_time : float >= 0 [s], keyword-only, required
-        Beats before this time are ignored in both sequences (mir_eval uses 5 s by
-        default; use 0 for short clips).
-
-    Returns
-    -------
-    scores : dict
-        Keys :data:`METRICS`, values in [0, 1] (mir_eval normalises the information gain).
-
-    Raises
-    ------
-    ParameterError
-        Times not 1-D, negative, non-finite, not strictly increasing, or in
-        milliseconds or frames; ``min_beat_time`` negative or not finite.
-
-    Warns
-    -----
-    BeatsyncWarning
-        If either sequence is empty after trimming: every score is 0.
+    Beats before ``min_beat_time`` [s] are ignored in both sequences (0 for short clips).
+    Warns, and every score is 0, when either sequence is empty after trimming.
 
     Examples
     --------
@@ -216,30 +166,12 @@ def median_tempo(beats: Any) -> float:
 
 
 def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 0.08) -> str:
-    """Name the metrical relation of an estimated tempo to the reference.
-
-    Parameters
-    ----------
-    estimated_bpm, reference_bpm : float > 0 [bpm]
-    tol : float
-        Relative tolerance.
-
-    Returns
-    -------
-    str
-        ``"correct"``, ``"double"`` (estimate 2x), ``"half"``, ``"triple"``, ``"third"``
-        or ``"other"``.
-    """
+    """The relation (a key of :data:`TEMPO_RATIOS`, or ``"other"``) of an estimated tempo
+    to the reference [bpm], within the relative tolerance ``tol``."""
     if not (np.isfinite(estimated_bpm) and np.isfinite(reference_bpm)) or reference_bpm <= 0:
         return "other"
     r = estimated_bpm / reference_bpm
-    for name, target in (
-        ("correct", 1.0),
-        ("double", 2.0),
-        ("half", 0.5),
-        ("triple", 3.0),
-        ("third", 1 / 3),
-    ):
+    for name, target in TEMPO_RATIOS.items():
         if abs(r / target - 1.0) <= tol:
             return name
     return "other"
@@ -256,13 +188,8 @@ def count_other_tempo(octaves: Any) -> int:
 
 
 def tempo_octave(reference: Any, estimated: Any) -> dict[str, Any]:
-    """Median tempi of both beat sequences and their relation (:func:`octave_relation`).
-
-    Returns
-    -------
-    dict
-        ``tempo_ref`` and ``tempo_est`` [BPM] (NaN with fewer than two beats) and
-        ``octave``.
+    """Median tempi ``tempo_ref``, ``tempo_est`` [BPM] (NaN with fewer than two beats) and
+    their ``octave`` relation (:func:`octave_relation`).
     """
     ref, est = validate(reference, estimated)
     t_ref, t_est = median_tempo(ref), median_tempo(est)

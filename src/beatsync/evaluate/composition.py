@@ -1,32 +1,23 @@
 """Objective quality proxies of a composed dance (stand-ins for paper B's user study).
 
-Paper B's Table 2 is a user study; we cannot repeat it. These numbers are *proxies*
-for what viewers judged, not a replacement. Every function takes arrays (beat times,
-joint positions, intensities) computed by the caller (:mod:`beatsync.study.paper_b`
-runs the stages); nothing here runs a stage.
+Paper B's Table 2 is a user study we cannot repeat; these are *proxies* for what
+viewers judged. Every function takes arrays computed by the caller
+(:mod:`beatsync.study.paper_b` runs the stages). Times are in seconds; positions
+``(n_frames, n_joints, 3)`` [position unit] at ``fps`` [Hz].
 
-- **Beat alignment** (:mod:`beatsync.evaluate.alignment`): both published scores,
-  averaged over motion beats (Li et al. 2021) and over music beats (Siyao et al.
-  2022), Gaussian sigma 0.05 s, on the kinematic beats of the composed motion.
+- **Beat alignment** (:mod:`beatsync.evaluate.alignment`): both published scores on the
+  kinematic beats of the composed motion.
 - **Intensity correlation** (:func:`intensity_correlation`): Pearson r between the
-  composed motion's intensity per music beat interval (mean joint kinetic energy) and
-  the music level (RMS dB).
+  motion's intensity per music beat interval and the music level (RMS dB).
 - **Transition smoothness** (:func:`transition_jumps`): the largest frame-to-frame
-  change of joint velocity (mean over joints, :func:`velocity_change`) within
-  ``[T - 1 frame, T + blend]`` of each transition, divided by the median of that
-  change over the whole dance: 1 means a transition is as smooth as ordinary
-  movement, large values mean a visible jerk.
-- **Foot sliding** (:func:`foot_sliding`): mean horizontal speed [position unit / s]
-  of the feet while they are in contact with the floor (height below the foot's 5th
-  percentile plus 10 % of its height range), averaged over feet.
+  change of joint velocity (:func:`velocity_change`) within ``[T - 1 frame, T + blend]``
+  of each transition over its median over the whole dance (1: as smooth as ordinary
+  movement).
+- **Foot sliding** (:func:`foot_sliding`): mean horizontal foot speed during floor
+  contact (height below the foot's 5th percentile plus 10 % of its range).
 
-Physical plausibility (root speed and joint rotation speed against the library's) is
-part of the composition's own report (:mod:`beatsync.graph.plausibility`).
-
-Data contract: times in seconds (1-D, increasing); positions ``(n_frames, n_joints,
-3)`` [position unit] at ``fps`` [Hz].
-
-Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 4 (Table 2).
+Physical plausibility is part of the composition's own report
+(:mod:`beatsync.graph.plausibility`).
 """
 
 from __future__ import annotations
@@ -50,19 +41,8 @@ __all__ = [
 
 
 def intensity_correlation(motion_intensity: Any, music_level: Any) -> float:
-    """Pearson r between motion intensity and music level per music beat interval.
-
-    Parameters
-    ----------
-    motion_intensity : np.ndarray [shape=(K',)]
-        The composed motion's intensity per music beat interval (``K' <= K``: the
-        intervals the motion covers).
-    music_level : np.ndarray [shape=(K,)] [dB]
-
-    Returns
-    -------
-    r : float
-        NaN (with a warning for fewer than two intervals) when undefined.
+    """Pearson r between motion intensity (per music beat interval it covers) and music level
+    [dB]; NaN when undefined (with a warning for fewer than two intervals).
     """
     inten = np.asarray(motion_intensity, dtype=np.float64)
     level = np.asarray(music_level, dtype=np.float64)[: inten.size]
@@ -75,17 +55,7 @@ def intensity_correlation(motion_intensity: Any, music_level: Any) -> float:
 
 
 def velocity_change(positions: Any, *, fps: float) -> np.ndarray:
-    """Mean over joints of ``|v_{j+1} - v_j|`` between successive frames [unit / s].
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)]
-    fps : float > 0 [Hz]
-
-    Returns
-    -------
-    dv : np.ndarray [shape=(n_frames - 1,)]
-    """
+    """Mean over joints of ``|v_{j+1} - v_j|`` between successive frames [unit / s]."""
     pos = np.asarray(positions, dtype=np.float64)
     vel = np.gradient(pos, axis=0) * fps
     return np.linalg.norm(np.diff(vel, axis=0), axis=2).mean(axis=1)
@@ -132,13 +102,8 @@ def foot_joints(motion: Any) -> list[str]:
 
 
 def foot_sliding(foot_positions: Any, *, fps: float, up_axis: str = "y") -> float:
-    """Mean horizontal foot speed during floor contact [position unit / s].
-
-    Parameters
-    ----------
-    foot_positions : np.ndarray [shape=(n_frames, n_feet, 3)]
-    fps : float > 0 [Hz]
-    up_axis : {"y", "z"}
+    """Mean horizontal speed [position unit / s] of ``foot_positions`` (n_frames, n_feet, 3)
+    during floor contact.
     """
     pos = np.asarray(foot_positions, dtype=np.float64)
     up = "xyz".index(up_axis)
@@ -171,31 +136,11 @@ def quality_proxies(
 ) -> dict[str, float]:
     """Every proxy of one composed dance (mir_eval style ``evaluate``).
 
-    Parameters
-    ----------
-    motion_beats : np.ndarray [s]
-        Kinematic beats of the composed motion.
-    music_beats : np.ndarray [s]
-    span : (float, float) [s]
-        Time both the dance and the music play (beats outside are not scored).
-    positions, foot_positions : np.ndarray [shape=(n_frames, n, 3)]
-        All joints, and the feet, of the composed motion.
-    fps : float > 0 [Hz]
-    transition_times : np.ndarray [s]
-    motion_intensity, music_level : np.ndarray
-        Per music beat interval (see :func:`intensity_correlation`).
-    sigma : float > 0 [s]
-        Gaussian width of the beat-alignment scores.
-    blend : float >= 0 [s]
-        Transition blend length (window of the velocity-jump ratio).
-    up_axis : {"y", "z"}
-
-    Returns
-    -------
-    dict
-        ``alignment_motion``, ``alignment_music`` (beat alignment averaged over motion
-        beats / music beats), ``intensity_r``, ``transition_jump_mean``,
-        ``transition_jump_max``, ``foot_sliding``.
+    Beats outside ``span`` [s] (the time both the dance and the music play) are not scored;
+    ``motion_intensity`` and ``music_level`` are per music beat interval; ``sigma`` [s] is
+    the alignment scores' width and ``blend`` [s] the transitions' (the velocity-jump
+    window). Returns ``alignment_motion``, ``alignment_music``, ``intensity_r``,
+    ``transition_jump_mean``, ``transition_jump_max`` and ``foot_sliding``.
     """
     with silenced():
         al = alignment_scores(motion_beats, music_beats, sigma=sigma, span=span)

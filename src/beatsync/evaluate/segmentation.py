@@ -1,9 +1,5 @@
-"""Scores of a temporal segmentation against reference period boundaries.
-
-Data contract (mir_eval style): boundaries are 1-D arrays of frame indices (or any
-common time unit), increasing; ``reference`` is the ground truth, ``estimated`` what a
-segmentation found. No segmentation is run here (see
-:mod:`beatsync.study.paper_a_segmentation` for the pipelines of the notebook).
+"""Scores of a temporal segmentation against reference period boundaries (mir_eval style:
+1-D increasing frame indices, ``reference`` the ground truth; no segmentation runs here).
 """
 
 from __future__ import annotations
@@ -18,21 +14,10 @@ __all__ = ["boundary_errors"]
 def boundary_errors(estimated: Any, reference: Any, *, remove_offset: bool = False) -> dict:
     """Boundary error [frames] of estimated against reference boundary frames.
 
-    Each reference boundary inside the estimated span is matched to the nearest
-    estimated boundary.
-
-    Parameters
-    ----------
-    estimated, reference : array_like [frames]
-    remove_offset : bool
-        Subtract the median signed error first (for baselines whose boundaries sit at
-        another phase of the cycle, e.g. minima of one angle).
-
-    Returns
-    -------
-    dict
-        ``mean``, ``max`` [frames], ``n_matched``, ``count_error`` (estimated minus
-        reference number of periods) and ``offset`` [frames].
+    Each reference boundary inside the estimated span is matched to the nearest estimated
+    one. ``remove_offset`` subtracts the median signed error first (for baselines whose
+    boundaries sit at another phase of the cycle). Returns ``mean``, ``max`` [frames],
+    ``n_matched``, ``count_error`` (estimated minus reference count) and ``offset`` [frames].
     """
     est = np.asarray(estimated, dtype=np.float64)
     ref = np.asarray(reference, dtype=np.float64)

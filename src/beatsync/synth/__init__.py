@@ -1,9 +1,6 @@
-"""Synthetic signals with exact ground truth.
-
-- :mod:`beatsync.synth.motion`: periodic multi-channel joint-angle signals with known
-  period boundaries (paper A, sec. 3 experiments).
-- :mod:`beatsync.synth.audio`: click tracks and drum patterns with known beats
-  (the beat-tracking test set).
+"""Synthetic signals with exact ground truth: periodic joint-angle signals with known period
+boundaries (:mod:`.motion`), click tracks and drum patterns with known beats
+(:mod:`.audio`) and dance clips with known motion beats (:mod:`.library`).
 """
 
 from .audio import BeatTestItem, beat_times, click_track, drum_pattern, make_beat_test_set

@@ -1,25 +1,15 @@
 """Synthetic beat-tracking test signals with exact ground truth.
 
-Data contract
--------------
-- Audio is mono ``float32`` ``y`` with its sample rate ``sr`` [Hz].
-- Ground-truth beats are 1-D ``float64`` arrays in seconds, strictly increasing,
-  rendered sample-exactly: every beat is the onset of a click or of a drum hit.
-- Tempo is in BPM.
+Audio is mono ``float32`` at ``sr`` [Hz]; beats are 1-D ``float64`` seconds, strictly
+increasing, rendered sample-exactly (every beat is the onset of a click or a drum hit).
 
-The test set (:func:`make_beat_test_set`) crosses click tracks and drum patterns
-(kick on beats 1 and 3, snare on 2 and 4, hi-hat on every eighth note) at 60, 90,
-120, 150 and 180 BPM with five groups: ``clean``, ``drift`` (slow sinusoidal tempo
-drift of +-5 %), ``swing`` (off-beat eighths delayed to 2/3 of the beat),
-``noise`` (white noise at 10 dB SNR) and ``change`` (an abrupt tempo change halfway).
-It stands in for the paper's test music, which is not available.
-
-:func:`drum_song` renders a song for the motion-graph studies (paper B): the drum
-pattern of :func:`drum_pattern` at a constant tempo, with a gain that changes every
-``section_beats`` beats to a random level in ``level_range_db`` (seeded), so its
-intensity varies like verses and choruses. Its beats are exact.
-
-Notebook: ``notebooks/paper_a_sec4_beat_tracking.ipynb``; paper A, section 4.
+The test set (:func:`make_beat_test_set`) crosses click tracks and drum patterns (kick
+on beats 1 and 3, snare on 2 and 4, hi-hat on every eighth) at 60-180 BPM with five
+:data:`GROUPS`: ``clean``, ``drift`` (sinusoidal tempo drift of +-5 %), ``swing``
+(off-beat eighths at 2/3 of the beat), ``noise`` (white noise at 10 dB SNR) and
+``change`` (an abrupt tempo change halfway). It stands in for the paper's test music.
+:func:`drum_song` renders a song for paper B's studies: the drum pattern with a gain
+that changes every few beats, like verses and choruses.
 """
 
 from __future__ import annotations
@@ -62,24 +52,9 @@ KINDS = ("click", "drums")
 
 @dataclass(frozen=True)
 class BeatTestItem:
-    """One synthetic test signal with its exact beats.
-
-    Attributes
-    ----------
-    name : str
-        Unique name, e.g. ``"drums_120_swing"``.
-    group : str
-        One of :data:`GROUPS`.
-    kind : str
-        ``"click"`` or ``"drums"``.
-    y : np.ndarray [shape=(n,)], float32
-    sr : int [Hz]
-    beats : np.ndarray [s]
-        Ground-truth beat times.
-    bpm : float [bpm]
-        Nominal tempo (of the first half for the ``change`` group).
-    bpm_end : float [bpm]
-        Tempo of the second half (equal to ``bpm`` except in the ``change`` group).
+    """One synthetic test signal (``name`` e.g. ``"drums_120_swing"``) with its exact
+    ``beats`` [s]; ``bpm`` [bpm] is the tempo of the first half and ``bpm_end`` of the
+    second (equal but in the ``change`` group).
     """
 
     name: str
@@ -106,26 +81,11 @@ def beat_times(
     bpm_end: float | None = None,
     change_time: float | None = None,
 ) -> np.ndarray:
-    """Beat times of a tempo function, exactly.
+    """Beat times [s] of a tempo function, exactly.
 
-    The tempo is ``bpm * (1 + drift * sin(2 pi t / duration))`` (one slow cycle over
-    the clip), switching abruptly to ``bpm_end`` at ``change_time`` if given. Beats
-    are the times at which the integrated tempo (in beats) passes an integer.
-
-    Parameters
-    ----------
-    bpm : float [bpm]
-    duration : float > 0 [s]
-    start : float >= 0 [s]
-        Time of the first beat.
-    drift : float in [0, 0.5)
-        Relative amplitude of the sinusoidal tempo drift.
-    bpm_end : float, optional [bpm]
-    change_time : float, optional [s]
-
-    Returns
-    -------
-    beats : np.ndarray [s]
+    The tempo is ``bpm * (1 + drift * sin(2 pi t / duration))`` (``drift`` in [0, 0.5)),
+    switching abruptly to ``bpm_end`` at ``change_time`` (default: halfway) if given; the
+    first beat is at ``start`` [s], the others where the integrated tempo passes an integer.
     """
     bpm = check_bpm(bpm)
     duration = check_positive(duration, name="duration", unit="s")
@@ -199,22 +159,8 @@ def click_track(
     swing: float | None = None,
     click_freq: float = 1000.0,
 ) -> np.ndarray:
-    """Render a click at each beat (and optionally softer clicks off the beat).
-
-    Parameters
-    ----------
-    beats : np.ndarray [s]
-    sr : int > 0 [Hz]
-    duration : float > 0 [s]
-    swing : float in (0, 1), optional
-        If given, a softer, higher click (0.4 amplitude, two octaves up) is added at
-        ``beat + swing * interval`` between consecutive beats (0.5 straight eighths,
-        2/3 swung eighths).
-    click_freq : float > 0 [Hz]
-
-    Returns
-    -------
-    y : np.ndarray [shape=(round(duration * sr),)], float32
+    """A click at each beat (float32, ``round(duration * sr)`` samples); given ``swing``, a
+    softer click two octaves up at ``beat + swing * interval`` (0.5 straight, 2/3 swung).
     """
     beats, sr, duration = _check_common(beats, sr, duration)
     n = int(round(duration * sr))
@@ -236,27 +182,9 @@ def drum_pattern(
     offbeat_gain: float = 0.5,
     seed: int = 0,
 ) -> np.ndarray:
-    """Render a rock drum pattern on the given beats.
-
-    Kick on beats 1 and 3 (even beat indices), snare on 2 and 4, hi-hat on every
-    beat and, played softer (``offbeat_gain``, as drummers accent the beat), on the
-    off-beat eighth at ``beat + swing * interval``.
-
-    Parameters
-    ----------
-    beats : np.ndarray [s]
-    sr : int > 0 [Hz]
-    duration : float > 0 [s]
-    swing : float in (0, 1)
-        Position of the off-beat eighth inside the beat (0.5 straight, 2/3 swung).
-    offbeat_gain : float >= 0
-        Amplitude of the off-beat hi-hat relative to the on-beat one.
-    seed : int
-        Seed of the noise in the snare and hi-hat sounds.
-
-    Returns
-    -------
-    y : np.ndarray [shape=(round(duration * sr),)], float32
+    """A rock drum pattern on ``beats`` (float32): kick on beats 1 and 3, snare on 2 and 4,
+    hi-hat on every beat and, ``offbeat_gain`` softer, at ``beat + swing * interval``.
+    ``seed`` draws the noise of the snare and hi-hat.
     """
     beats, sr, duration = _check_common(beats, sr, duration)
     if not 0.0 < swing < 1.0:
@@ -279,25 +207,11 @@ def meter_pattern(
     duration: float,
     seed: int = 0,
 ) -> np.ndarray:
-    """Render a drum pattern in a meter, with eighth-note subdivisions and exact beats.
+    """A drum pattern in ``meter`` (:data:`METERS`) with eighth-note hi-hats (float32).
 
-    The first beat of every bar gets a kick (gain 1), the other beats a snare (0.6);
-    a hi-hat plays every eighth note: on the beats at gain 0.5, between them at 0.3
-    (``METERS[meter][1]`` eighths per beat: 2 in 2/4 and 3/4, 3 in 6/8). ``beats`` are
-    the beat (tactus) times: quarter notes in 2/4 and 3/4, dotted quarters in 6/8.
-
-    Parameters
-    ----------
-    beats : np.ndarray [s]
-    meter : {"2/4", "3/4", "6/8"}
-    sr : int > 0 [Hz]
-    duration : float > 0 [s]
-    seed : int
-        Seed of the noise in the snare and hi-hat sounds.
-
-    Returns
-    -------
-    y : np.ndarray [shape=(round(duration * sr),)], float32
+    A kick on the first beat of every bar, snares on the others, a hi-hat on every eighth
+    (softer between the beats). ``beats`` are the tactus: quarter notes in 2/4 and 3/4,
+    dotted quarters in 6/8.
     """
     if meter not in METERS:
         raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")
@@ -344,29 +258,11 @@ def make_beat_test_set(
     swing: float = 2 / 3,
     seed: int = 0,
 ) -> list[BeatTestItem]:
-    """Build the synthetic beat-tracking test set.
+    """The synthetic beat-tracking test set, in the order kinds x groups x bpms.
 
-    Parameters
-    ----------
-    sr : int > 0 [Hz]
-    duration : float > 0 [s]
-        Length of every item.
-    bpms : sequence of float [bpm]
-    kinds : sequence of {"click", "drums"}
-    groups : sequence of {"clean", "drift", "swing", "noise", "change"}
-    snr_db : float [dB]
-        SNR of the ``noise`` group.
-    drift : float
-        Relative amplitude of the tempo drift of the ``drift`` group (0.05 = +-5 %).
-    swing : float
-        Off-beat position of the ``swing`` group (2/3 = triplet swing).
-    seed : int
-        Seed of the first-beat offsets and of all noise.
-
-    Returns
-    -------
-    items : list of BeatTestItem
-        In the order kinds x groups x bpms.
+    ``snr_db`` [dB] is the ``noise`` group's SNR, ``drift`` the ``drift`` group's relative
+    amplitude, ``swing`` the ``swing`` group's off-beat position; ``seed`` draws the first
+    beats and all noise.
 
     Examples
     --------
@@ -416,17 +312,7 @@ def make_beat_test_set(
 
 @dataclass(frozen=True)
 class DrumSong:
-    """A synthetic song with exact beats and known loudness sections.
-
-    Attributes
-    ----------
-    y : np.ndarray float32
-    sr : int [Hz]
-    beats : np.ndarray [s]
-    bpm : float [bpm]
-    gain_db : np.ndarray [shape=(len(beats),)] [dB]
-        Gain applied from each beat on.
-    """
+    """A synthetic song with exact ``beats`` [s] and the gain [dB] applied from each beat on."""
 
     y: np.ndarray
     sr: int
@@ -450,24 +336,8 @@ def drum_song(
     seed: int = 0,
     start: float = 0.5,
 ) -> DrumSong:
-    """Render a drum song whose loudness changes every ``section_beats`` beats.
-
-    Parameters
-    ----------
-    duration : float > 0 [s]
-    bpm : float > 0 [bpm]
-    sr : int > 0 [Hz]
-    section_beats : int >= 1
-    level_range_db : (float, float) [dB]
-        Range of the random section gains (uniform, seeded), both <= 0 dB.
-    seed : int
-    start : float >= 0 [s]
-        Time of the first beat.
-
-    Returns
-    -------
-    DrumSong
-        The gain is constant between beats, with 5 ms ramps at changes (no clicks).
+    """A drum song whose loudness changes every ``section_beats`` beats, to a level drawn
+    uniformly (seeded) from ``level_range_db`` [dB] (both <= 0), with 5 ms ramps.
     """
     duration = check_positive(duration, name="duration", unit="s")
     bpm = check_bpm(bpm)

@@ -1,22 +1,15 @@
 """Synthetic dance clips with exact motion beats (tests and a second study library).
 
-A 17-joint BVH skeleton (root ``hip`` with 6 channels, spine, head, arms, legs with
-``lFoot``/``rFoot``) dances in place: every rotation channel, and the root's height,
+A 17-joint BVH skeleton dances in place: every rotation channel, and the root's height,
 moves from one extreme pose to the next once per beat along a half cosine,
 
     theta_j(t) = A_j * (s_k + (s_{k+1} - s_k) * (1 - cos(pi u)) / 2),  u = (t - t_k) / T,
 
-with ``s_k = (-1)^k a_k`` and ``a_k`` the loudness of the section containing beat
-``k``. All joint velocities vanish together at every beat ``t_k``, so the kinematic
-beats are exactly the beat times, and the motion intensity of an interval grows with
-``(s_{k+1} - s_k)^2``. Clips drawn with different seeds share the pose vocabulary
-(the extremes ``+-A a``), so a library of them has transitions.
-
-Stands in for paper B's second (Indian dance) library in
-``notebooks/paper_b_tab01_search_speed.ipynb``; used by ``tests/test_graph.py``.
-
-Data contract: returns a :class:`beatsync.motion.Motion` (degrees, metres, ``fps``)
-and its beat times in seconds.
+with ``s_k = (-1)^k a_k`` and ``a_k`` the loudness of beat ``k``'s section. All joint
+velocities vanish together at every beat, so the kinematic beats are exactly the beat
+times; clips drawn with different seeds share the pose vocabulary, so a library of them
+has transitions. Stands in for paper B's second (Indian dance) library. Returns a
+:class:`beatsync.motion.Motion` (degrees, metres) and its beat times [s].
 """
 
 from __future__ import annotations
@@ -77,34 +70,13 @@ def synthetic_dance(
     vocabulary_seed: int = 0,
     name: str | None = None,
 ) -> tuple[Motion, np.ndarray]:
-    """One synthetic dance clip and its exact beat times.
+    """One synthetic dance clip and its exact beat times [s] (on frame times, inside the clip).
 
-    Parameters
-    ----------
-    duration : float > 0 [s]
-    bpm : float > 0 [bpm]
-        Motion tempo (one extreme pose per beat).
-    fps : float > 0 [Hz]
-    seed : int
-        Draws the joint amplitudes ``A_j`` and the section loudness ``a_k``.
-    section_beats : int >= 1
-        Beats per loudness section.
-    level_range : (float, float)
-        Range of ``a_k`` (uniform).
-    start : float >= 0 [s]
-        First beat; the clip holds the first pose before it.
-    scale : float > 0
-        Length scale of the skeleton and root height (for scale-invariance tests).
-    n_moves : int >= 1
-        Size of the move vocabulary; each section dances one move (drawn by ``seed``).
-    vocabulary_seed : int
-        Draws the moves' joint amplitudes; clips with one vocabulary share poses.
-    name : str, optional
-
-    Returns
-    -------
-    (motion, beats) : Motion, np.ndarray [s]
-        Beats lie on frame times, inside the clip.
+    One extreme pose per beat at ``bpm``, from ``start`` [s] (the first pose held before).
+    ``seed`` draws each section's move and loudness ``a_k`` (uniform in ``level_range``) per
+    ``section_beats`` beats; ``vocabulary_seed`` draws the ``n_moves`` moves' joint
+    amplitudes (clips of one vocabulary share poses); ``scale`` scales the skeleton and the
+    root height.
     """
     fps = check_fps(fps)
     bpm = check_positive(bpm, name="bpm", unit="BPM")

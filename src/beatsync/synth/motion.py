@@ -1,20 +1,11 @@
 """Synthetic periodic multi-channel joint-angle signals with known period boundaries.
 
-Stands in for paper A's synthetic experiments (Panagiotakis et al., sec. 3): 29
-joint-angle channels at 25 Hz, n = 750 frames, every period a time-warped copy of
-one template cycle whose duration jitters within +-``jitter`` of the nominal period,
-with a small waveform change from period to period and additive white noise at a
-given SNR.
-
-Data contract
--------------
-- ``values`` are ``(n_frames, n_channels)`` degrees at ``fps`` [Hz], time first.
-- Ground-truth boundaries are returned as frame indices (``boundary_frames``) and as
-  times in seconds (``boundaries = boundary_frames / fps``, strictly increasing);
-  the first is frame 0 and the last is frame ``n_frames - 1``, the convention of
-  :func:`beatsync.segment.segment`.
-
-Notebook: ``notebooks/paper_a_fig02_segmentation.ipynb``.
+Stands in for paper A's synthetic experiments (sec. 3): 29 joint-angle channels at
+25 Hz, 750 frames, every period a time-warped copy of one template cycle whose
+duration jitters within +-``jitter`` of the nominal period, with a small waveform
+change from period to period and white noise at a given SNR. ``values`` are
+``(n_frames, n_channels)`` degrees; the boundaries are frame indices from 0 to
+``n_frames - 1`` (the convention of :func:`beatsync.segment.segment`) and times [s].
 """
 
 from __future__ import annotations
@@ -32,19 +23,8 @@ __all__ = ["SyntheticMotion", "periodic_motion"]
 
 @dataclass(frozen=True)
 class SyntheticMotion:
-    """A synthetic periodic motion and its ground truth.
-
-    Attributes
-    ----------
-    motion : Motion
-        Channels ``"ch00_angle"``, ``"ch01_angle"``, ... [deg].
-    boundaries : np.ndarray [s]
-        ``n_periods + 1`` true period boundaries, first 0, last ``(n_frames-1)/fps``.
-    boundary_frames : np.ndarray [frames], int64
-    clean : np.ndarray [shape=(n_frames, n_channels)]
-        The noiseless signal [deg].
-    period : float [s]
-        Nominal period ``(n_frames - 1) / (n_periods * fps)``.
+    """A synthetic periodic motion (channels ``"ch00_angle"``, ... [deg]), its ``n_periods +
+    1`` true boundaries [s] and frames, the noiseless signal and the nominal ``period`` [s].
     """
 
     motion: Motion
@@ -73,36 +53,12 @@ def periodic_motion(
 ) -> SyntheticMotion:
     """Generate a periodic joint-angle signal with known period boundaries.
 
-    Each channel ``c`` is ``offset_c + amp_c * f_c(phase)`` where ``f_c`` is a sum of
-    ``n_harmonics`` random harmonics of the cycle and the phase grows linearly by one
-    within every period (so a period of ``d`` frames is the template warped to ``d``
-    frames). Period durations are drawn uniformly within ``+-jitter`` of the nominal
-    period and rounded to whole frames (the rounding keeps them inside the band).
-
-    Parameters
-    ----------
-    n_frames : int >= 8 [frames]
-    n_channels : int >= 1
-    fps : float > 0 [Hz]
-    n_periods : int >= 2
-        Number of periods spanning frames ``0 .. n_frames-1``.
-    jitter : float in [0, 0.5) [fraction of the nominal period]
-        Maximal relative deviation of a period's duration (paper: within alpha).
-    variation : float >= 0 [fraction]
-        Per-period random change of every harmonic's amplitude and phase (waveform
-        variation between periods).
-    snr_db : float or None [dB]
-        Additive white Gaussian noise per channel at this signal-to-noise ratio
-        (signal variance over noise variance); ``None`` for no noise.
-    n_harmonics : int >= 1
-    n_constant : int >= 0
-        How many of the channels are exactly constant (to exercise the exclusion rule).
-    seed : int or None
-        Seed of ``np.random.default_rng``.
-
-    Returns
-    -------
-    SyntheticMotion
+    Each channel is ``offset_c + amp_c * f_c(phase)``, ``f_c`` a sum of ``n_harmonics``
+    random harmonics of the cycle and the phase rising linearly by one within every period.
+    Period durations are uniform within ``+-jitter`` (a fraction, < 0.5) of the nominal
+    period, in whole frames. ``variation`` changes every harmonic's amplitude and phase
+    from period to period; ``snr_db`` [dB] adds white noise (None: none); ``n_constant``
+    channels are exactly constant (to exercise the exclusion rule).
 
     Examples
     --------
