@@ -71,11 +71,12 @@ Beyond the paper (for real dances)
   the intervals): playback speed within 0.8-1.25 wherever the song allows (paper B's
   time-scale bound, :mod:`beatsync.graph.timescale`), and never faster than keeps the
   joints within the dancer's own peak speed; smooth from one interval to the next;
-  dance bars (``dance_beats_per_period`` motion beats) starting on the music's bar
-  lines; where no whole number of beats fits, an interval is merged with its
-  neighbour or lands on a half beat (the report counts both). The same smooth rate
-  of eq. 9 then lands them. ``beats_per_period=`` keeps one count for the median
-  interval and proportional counts for the others (:func:`beats_per_unit`).
+  dance bars (``dance_beats_per_period`` motion beats, else the dance's own phrase
+  when the motion shows it clearly) starting on the music's bar lines; where no whole
+  number of beats fits, an interval is merged with its neighbour or lands on a half beat
+  (the report counts both). The same smooth rate of eq. 9 then lands them.
+  ``beats_per_period=`` keeps one count for the median interval and proportional
+  counts for the others (:func:`beats_per_unit`).
   ``mode="auto"`` uses periods when the periodicity test accepts the motion and
   falls back to beats, with a warning, when it refuses.
 - ``boundaries=None``: the motion is segmented here; in ``mode="periods"`` by default

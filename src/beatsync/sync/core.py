@@ -65,7 +65,9 @@ class SyncResult:
         segments in beats mode, counted over all repetitions),
         ``beats_per_period`` (per motion beat in beats mode),
         ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
-        ``dance_beats_per_period``, ``motion_beats_per_period_counted``,
+        ``dance_beats_per_period``, ``dance_meter_rule`` (``"given"``, ``"estimated"``
+        or None) and ``dance_meter_found`` (the period and motion beats per period
+        :func:`estimate_dance_meter` found), ``motion_beats_per_period_counted``,
         ``beats_per_bar``, ``period_range_s``, ``first_beat``,
         ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
         ``beat_period_s``, ``delta_s``, ``rate_range`` (target/source),
@@ -240,6 +242,40 @@ def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
     return k if k >= 1 and freq.max() >= METER_AGREEMENT * counts.size else None
 
 
+#: phrase lengths searched for the dance's own meter, in motion beats (median interval)
+PHRASE_BEATS = (1.5, 8.5)
+
+
+def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict | None]:
+    """The dance's own phrase in motion beats ``mb`` [s], for ``dance_beats_per_period``
+    when the user gives none: ``(count or None, what was found)``.
+
+    Paper A's period ``T`` (:func:`beatsync.segment.core.estimate_period_count`, the
+    spectral peak: cheap on a long dance) over 1.5-8.5 median motion-beat intervals
+    ``b``; the phrase is ``N = round(T / b)`` motion beats. It is used only when every
+    ``N`` consecutive motion beats span ``T`` to within half an interval: the phrase
+    starts are every ``N``-th motion beat (:mod:`.counts`), so a single phrase of
+    another count would put every later one off its bar. None when that is not clear,
+    or without joint angles or positions to search.
+    """
+    from ..motion import segmentation_view
+    from ..segment.core import estimate_period_count
+
+    iv = np.diff(mb)
+    step = float(np.median(iv))
+    try:
+        view = segmentation_view(motion)
+        reach = (PHRASE_BEATS[0] * step, PHRASE_BEATS[1] * step)
+        n = estimate_period_count(view.values, fps=view.fps, period_range=reach, method="fft")
+    except ParameterError:  # too short for the range, or nothing to search
+        return None, None
+    period = float(motion.duration) / n  # >= the spectral peak's: a whole number fits
+    k = int(np.rint(period / step)) if period <= reach[1] else 0
+    spans = np.convolve(iv, np.ones(k), mode="valid")
+    clear = k >= 2 and iv.size >= 3 * k and np.all(np.abs(spans - period) <= 0.5 * step)
+    return (k if clear else None), {"period_s": period, "motion_beats": period / step}
+
+
 def synchronize(
     motion: Any,
     boundaries: Any,
@@ -300,7 +336,8 @@ def synchronize(
         it halved), and a warning says so when it cannot also respect
         ``beats_per_bar``; in ``mode="beats"`` every such group of motion beats starts
         on a bar line of the music where the speed band allows, and a loop holds
-        whole groups. The report's
+        whole groups; without it, beats mode estimates it from the motion and uses it
+        when it is clear (:func:`estimate_dance_meter`). The report's
         ``motion_beats_per_period_counted`` (kinematic beats per period) is a hint.
     first_beat : int >= 0
         Index of the beat the first boundary lands on.
@@ -412,6 +449,10 @@ def synchronize(
     unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
     counted = motion_beat_count(motion, events) if used_mode == "periods" else None
     whole_dance = used_mode == "beats" and override is None
+    meter_rule, meter_found = ("given" if dance else None), None
+    if whole_dance and dance is None:
+        dance, meter_found = estimate_dance_meter(motion, events)
+        meter_rule = "estimated" if dance else None
     if override is not None:
         count = BeatCount(override, "override", unit / beat_period)
     elif whole_dance:
@@ -477,6 +518,8 @@ def synchronize(
             "meter_fit": count.meter_fit,
             "meter_note": count.note,
             "dance_beats_per_period": dance,
+            "dance_meter_rule": meter_rule,
+            "dance_meter_found": meter_found,
             "motion_beats_per_period_counted": counted,
             "beats_per_bar": bar,
             "period_range_s": None if boundaries is not None else list(period_range),

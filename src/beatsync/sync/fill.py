@@ -25,12 +25,14 @@ Aligned and blended joins
     previous one ended, so a dancer who travels or turns goes on instead of jumping
     back. Within ``join / 2`` of a join the pose blends the ending pass's continuation
     (clip time ``e_b + d``, moved by ``M^(r-1)``) into the starting pass's lead
-    (``e_a + d``, moved by ``M^r``) with a raised-cosine weight, whose derivative
-    vanishes at both ends of the window: both motions carry their own velocity, so
-    the velocity is continuous and the blend adds only ``w'`` times the (small)
-    remaining pose difference. A skeleton's root is turned (its rotation channels and
-    its floor position) and moved; joint positions are rotated and translated. Rotation
-    channels are blended by slerp, positions linearly.
+    (``e_a + d``, moved by ``M^r``) with a weight of two raised-cosine half-ramps
+    (:func:`join_weight`), whose derivative vanishes at both ends of the window and at
+    the join: both motions carry their own velocity, so the velocity is continuous,
+    the blend adds only ``w'`` times the (small) remaining pose difference, and
+    nothing at the join itself (a motion beat, whose speed minimum stays put). A
+    skeleton's root is turned (its rotation channels and its floor position) and moved;
+    joint positions are rotated and translated. Rotation channels are blended by slerp,
+    positions linearly.
 
 Data contract: times in seconds of the clip (``e``) or of the looped timeline
 (``t``); positions ``(frames, joints, 3)`` with z up (position-only motion) or the
@@ -124,7 +126,7 @@ class LoopedClip:
                 a = np.where(near, self.last + d, a)
                 b = np.where(near, self.first + d, b)
                 u = np.clip((d + half) / (2.0 * half), 0.0, 1.0)
-                w = np.where(near, 0.5 - 0.5 * np.cos(np.pi * u), w)
+                w = np.where(near, join_weight(u), w)
                 ra = np.where(near, kk, ra)  # join kk ends repetition kk, starts kk + 1
                 rb = np.where(near, kk + 1.0, rb)
         return a, b, w, ra, rb
@@ -188,6 +190,14 @@ class LoopedClip:
                 values[:, idx] = rotation_to_euler(turned, order, reference=euler)
         values[:, cols] += off
         return values
+
+
+def join_weight(u: np.ndarray) -> np.ndarray:
+    """Blend weight over a join's window (phase ``u`` in [0, 1]): two raised-cosine
+    half-ramps, 0 -> 1/2 -> 1, so ``w'`` vanishes at both ends and at the join itself,
+    where the blend then adds no velocity and the landed speed minimum stays put."""
+    c = 0.25 * np.cos(2.0 * np.pi * u)
+    return np.where(u < 0.5, 0.25 - c, 0.75 + c)
 
 
 def _interp(pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
