@@ -115,6 +115,33 @@ def speed_figures(res, out_fps: float) -> dict:
     }
 
 
+def bas_diagnosis(res, beats: np.ndarray) -> dict:
+    """Where the music-beat score (BAS) goes: the landings planned (on whole beats, on
+    half beats, merged away), the output's motion beats as the scorer detects them
+    (:func:`beatsync.motion_beats.kinematic_beats`), how many landings have one within
+    0.1 s (two sigmas) and how far, and BAS if every landing were detected exactly
+    where it landed (the plan's own ceiling)."""
+    from beatsync.evaluate.alignment import DEFAULT_SIGMA, alignment_scores, nearest_distance
+    from beatsync.motion_beats import kinematic_beats
+
+    rep = res.report
+    targets = np.asarray(rep["target_beats_s"], dtype=np.float64)
+    span = (float(beats[0]), min(float(beats[-1]), float(res.motion.duration)))
+    seen = kinematic_beats(res.motion)
+    d = nearest_distance(targets, seen)
+    found = d <= 2 * DEFAULT_SIGMA
+    ideal = alignment_scores(targets, beats, span=span)["alignment_music"]
+    return {
+        "landings": int(targets.size),
+        "half": int(rep["n_half_beat_landings"]),
+        "merged": int(rep["n_merged_intervals"]),
+        "music_beats": int(np.count_nonzero((beats >= span[0]) & (beats <= span[1]))),
+        "found": int(found.sum()),
+        "median_ms": float(np.median(d[found]) * 1e3) if found.any() else float("nan"),
+        "ideal_music": float(ideal),
+    }
+
+
 def run_pairs() -> list[dict]:
     from beatsync.datasets import DANCE_PAIRS
     from beatsync.errors import BeatsyncWarning
@@ -174,6 +201,7 @@ def run_pairs() -> list[dict]:
                     "control": {k: after[f"control_{k}"] for k in ("motion", "music")},
                     "own": {k: own[k] for k in ("motion", "music")},
                     "warnings": [str(w.message)[:200] for w in caught],
+                    "diagnosis": bas_diagnosis(res, beats) if rep["mode"] == "beats" else None,
                 }
             )
             print(f"{dancer} -> {song}: {rows[-1]['speed']['in_band']:.2f} in band", flush=True)
@@ -223,6 +251,34 @@ def long_run(repeats: int, baseline_src: str | None) -> dict:
 
 def _ok(flag: bool) -> str:
     return "PASS" if flag else "FAIL"
+
+
+def diagnosis_table(rows: list[dict]) -> list[str]:
+    """Where the music-beat score goes, per pair (see :func:`bas_diagnosis`)."""
+    rows = [r for r in rows if r.get("diagnosis")]
+    if not rows:
+        return []
+    out = [
+        "",
+        "Where the music-beat score goes: landings planned (on half beats, merged "
+        "intervals whose middle motion beat is not pinned); the output's motion beats "
+        "within 0.1 s of a landing, as the scorer detects them, and their median "
+        "distance; the music-beat score if every landing were detected where it "
+        "landed (the plan's ceiling), and as scored.",
+        "",
+        "| dancer -> song | music beats | landings (half / merged) | found <= 0.1 s "
+        "(median) | music score: ceiling / scored / needed |",
+        "|---|---:|---|---|---|",
+    ]
+    for r in rows:
+        g = r["diagnosis"]
+        need = max(r["control"]["music"], r["own"]["music"]) + TARGETS["margin"]
+        out.append(
+            f"| {r['dancer']} -> {r['song']} | {g['music_beats']} | {g['landings']} "
+            f"({g['half']} / {g['merged']}) | {g['found']} ({g['median_ms']:.0f} ms) | "
+            f"{g['ideal_music']:.2f} / {r['after']['music']:.2f} / {need:.2f} |"
+        )
+    return out
 
 
 def markdown(labels: dict[str, dict]) -> list[str]:
@@ -285,6 +341,7 @@ def markdown(labels: dict[str, dict]) -> list[str]:
             )
         lines.append("")
         lines.append(f"{n_pass} of {len(data['rows'])} pairs meet every target.")
+        lines += diagnosis_table(data["rows"])
         if data.get("long"):
             lo = data["long"]
             base = ""

@@ -1,20 +1,16 @@
 """How many music beats a motion period (or motion beat) spans, and where accents sit.
 
-- :func:`beats_per_period`: the whole number ``m`` of music beats one motion period
-  spans. Without meters it is ``round(P / b)`` (paper A's reading). With meters it
-  respects both: the dance's own beats per period (a waltz step has 3 motion beats,
-  so it spans 3 or 6 music beats, never 5) and the music's beats per bar (``m``
-  divides the bar or is a whole number of bars). When no count fits both meters
-  within a factor of 2 of ``P / b``, the dance's meter wins and the report says the
-  meters do not fit.
-- :func:`beats_per_unit`: the count of every interval of a sequence of motion events
-  (periods, or the dancer's own motion beats in ``mode="beats"``): ``m`` for the
-  median interval, and a proportional whole number for the others (a missed motion
-  beat leaves an interval twice as long, which spans twice the beats).
-- :func:`accent_lag`: the mean lag of motion beats behind music beats, used by
-  ``synchronize(..., land="accents")`` to put the dancer's accents on the beats.
+- :func:`beats_per_period`: ``m = round(P / b)`` (paper A's reading); with meters, a
+  count that respects both the dance's (a multiple of its motion beats per period, or
+  that halved: a 3-beat waltz step spans 3 or 6 beats, never 5) and the music's
+  (dividing the bar or whole bars). When none fits both within x2 of ``P / b``, the
+  dance's wins and the report says the meters do not fit.
+- :func:`beats_per_unit`: ``m`` for the median interval and proportional whole counts
+  for the others (a missed motion beat leaves an interval twice as long).
+- :func:`accent_lag`: the mean lag of motion beats behind music beats, for
+  ``land="accents"``.
 
-All times are seconds; counts are whole numbers of beats.
+Times in seconds; counts in whole beats.
 """
 
 from __future__ import annotations
@@ -121,15 +117,8 @@ def beats_per_period(
     dance_beats_per_period: int | None = None,
     beats_per_bar: int | None = None,
 ) -> int:
-    """Number of music beats one motion period spans.
-
-    Rule: the count ``m`` nearest (on a log scale) to ``P / b``, ``P`` the mean motion
-    period and ``b`` the median inter-beat interval, among the counts that respect
-    the meters given: a multiple of the dance's beats per period (or that count
-    halved by powers of 2), and a divisor or multiple of the music's beats per bar.
-    Without meters, ``m = max(1, round(P / b))``: a 1 s salsa step on 120 BPM music
-    spans 2 beats. A 2.1 s waltz step of 3 motion beats on 120 BPM music in 3/4 spans
-    3 beats, never 4 or 5.
+    """Number of music beats one motion period spans (see the module docstring): the
+    count nearest ``P / b`` on a log scale among those that respect the meters given.
 
     Parameters
     ----------
