@@ -69,11 +69,30 @@ NOTES = [
     "than 0.03, so they were not kept. The loop's blend (0.6 s) and shortest span (half "
     "the clip's motion beats) were set beforehand. Only four dancers are bundled: these "
     "are development numbers, with no held-out pair.",
+    "- The loop join's weight (two half-ramps, flat at the join) and the dance's own "
+    "phrase (used without `--dance-beats` only when every phrase holds the same number of "
+    "motion beats) follow from the method, not from these pairs; see `docs/tuning.md`. No "
+    "bundled dancer's phrase is that clear, so the phrase estimate changes none of these "
+    "runs; the join weight moved DANCE_W_5's joined motion beats from 150-160 ms to "
+    "30-40 ms off the join.",
     "- The pairs that miss the alignment target miss it on the music-beat score (BAS, "
-    "averaged over music beats) only: the waltz dancers' motion beats are 1.0-1.8 s apart, "
-    "2-4 beats of the faster songs, so most music beats have no motion beat near them; "
-    "DANCE_W_5 with its own song already scores 0.20 there. On the motion-beat score every "
-    "pair is at least 0.19 above both references.",
+    "averaged over music beats) only; the table above shows where it goes. A music beat "
+    "scores only if a landing on a whole beat is found there again in the output, so a "
+    "plan's ceiling is its whole-beat landings over the music beats. The largest number "
+    "of whole-beat landings any plan can have with every interval within 0.8-1.25 and the "
+    "peak headroom (the same dynamic programme with that count as its only objective) is "
+    "20 of 59 beats (0.34) for DANCE_W_5 -> DANCE_C_4, 18 of 44 (0.41) for DANCE_W_5 -> "
+    "DANCE_R_3 and 17 of 59 (0.29) for DANCE_W_10 -> DANCE_C_4. The scorer finds the "
+    "waltz and rumba dancers' landings less well than the cha-cha dancer's (scored over "
+    "ceiling 0.68-0.84 against 0.91-0.96): many of their motion beats are shallow minima "
+    "of the joint speed that any change of playback speed moves or erases, the first "
+    "landing of DANCE_C_4's song (its first beat at 0.01 s) sits on the output's first "
+    "frame and the last on its last frame, where no minimum can be detected. At the best "
+    "rate DANCE_W_5 reaches on any song (0.76), DANCE_W_5 -> DANCE_C_4 cannot reach the 0.30 "
+    "it needs within the band (0.34 x 0.76 = 0.26), DANCE_W_5 -> DANCE_R_3 only with "
+    "a plan at its bound (0.41 x 0.76 = 0.31, giving up the speed preference and "
+    "smoothness), and DANCE_W_10 -> DANCE_C_4 is short by less than 0.01. On the "
+    "motion-beat score every pair is at least 0.19 above both references.",
     "",
 ]
 
@@ -278,7 +297,7 @@ def diagnosis_table(rows: list[dict]) -> list[str]:
             f"({g['half']} / {g['merged']}) | {g['found']} ({g['median_ms']:.0f} ms) | "
             f"{g['ideal_music']:.2f} / {r['after']['music']:.2f} / {need:.2f} |"
         )
-    return out
+    return out + [""]
 
 
 def markdown(labels: dict[str, dict]) -> list[str]:
