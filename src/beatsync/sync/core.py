@@ -47,47 +47,28 @@ METER_AGREEMENT = 0.6
 
 @dataclass(frozen=True)
 class SyncResult:
-    """Output of :func:`synchronize`.
+    """Output of :func:`synchronize`: the beat-synchronous ``motion`` at ``out_fps``
+    (frame ``k`` plays at music time ``k / out_fps``); ``warp_src_times`` [s], the source
+    time each output frame shows (in the looped timeline when the clip was repeated);
+    the ``warp`` itself (for plots); and the ``report``:
 
-    Attributes
-    ----------
-    motion : Motion
-        The beat-synchronous motion at ``out_fps``; frame ``k`` plays at music time
-        ``k / out_fps`` [s].
-    warp_src_times : np.ndarray [shape=(n_out,)] [s]
-        Source time shown by each output frame (non-decreasing), in the looped
-        timeline when ``fill="loop"`` repeated the clip (the clip's own time otherwise).
-    report : dict
-        ``mode`` (``"periods"`` or ``"beats"``, as used), ``mode_requested``,
-        ``mode_note`` (why ``auto`` fell back), ``land``, ``fill``, ``repetitions``,
-        ``input_frames``, ``output_frames``, ``input_fps``, ``output_fps``,
-        ``periods_available``, ``periods_used`` (intervals: periods, or motion-beat
-        segments in beats mode, counted over all repetitions),
-        ``beats_per_period`` (per motion beat in beats mode),
-        ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
-        ``dance_beats_per_period``, ``dance_meter_rule`` (``"given"``, ``"estimated"``
-        or None) and ``dance_meter_found`` (the period and motion beats per period
-        :func:`estimate_dance_meter` found), ``motion_beats_per_period_counted``,
-        ``beats_per_bar``, ``period_range_s``, ``first_beat``,
-        ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
-        ``beat_period_s``, ``delta_s``, ``rate_range`` (target/source),
-        ``tempo_ratio_range`` (playback speed, source/target), ``target_beats_s``,
-        ``boundaries_s``, ``residual_ms`` (one per boundary),
-        ``residual_nearest_frame_ms``, ``max_abs_residual_ms``,
-        ``max_abs_residual_frames``, ``lead_in_hold_frames``, ``n_scaled_periods``,
-        ``covered_s`` (music time span the dance covers); computed from the output frames
-        (:mod:`beatsync.sync.quality`): ``beats_per_motion_beat_used`` (count -> number
-        of intervals, halves allowed), ``n_merged_intervals``,
-        ``n_half_beat_landings``, ``phrases_on_bars`` (share of the dance bars, given
-        ``dance_beats_per_period``, that start on a bar line), ``playback_speed``
-        (``instantaneous`` and ``per_interval``: min, median, max, ``in_band`` share
-        of output time; ``band``; ``held_lead_in_s``), ``kinematics`` (p99 and peak
-        joint speed, p99 acceleration of input and output, and their ratios; None
-        without joint positions), ``loop`` (span, blend, turn per pass, pose
-        distance) and ``joins`` (music time and peak joint speed of each),
-        ``speed_warning``.
-    warp : TimeWarp
-        The warp itself (for plots).
+    - what was used and why: ``mode``, ``mode_requested``, ``mode_note``, ``land``,
+      ``fill``, ``repetitions``, ``beats_per_period`` (the count used most in beats
+      mode), ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
+      ``dance_beats_per_period`` with ``dance_meter_rule`` (``"given"``,
+      ``"estimated"`` or None) and ``dance_meter_found``,
+      ``motion_beats_per_period_counted``, ``beats_per_bar``, ``period_range_s``,
+      ``first_beat``, ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
+      ``beat_period_s``, ``delta_s``;
+    - frames and intervals: ``input_frames``, ``output_frames``, ``input_fps``,
+      ``output_fps``, ``periods_available``, ``periods_used`` (over all repetitions),
+      ``covered_s``, ``lead_in_hold_frames``, ``n_scaled_periods``, ``rate_range``
+      (target/source), ``tempo_ratio_range`` (playback speed);
+    - landings: ``boundaries_s`` (source, looped timeline) and ``target_beats_s``,
+      ``residual_ms`` (realised warp) and ``residual_nearest_frame_ms``, their maxima;
+    - from the output frames (:mod:`.quality`): ``beats_per_motion_beat_used``,
+      ``n_merged_intervals``, ``n_half_beat_landings``, ``phrases_on_bars``,
+      ``playback_speed``, ``kinematics``, ``loop``, ``joins``, ``speed_warning``.
     """
 
     motion: Any

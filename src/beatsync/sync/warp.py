@@ -115,24 +115,10 @@ def time_warp(
     end: float | None = None,
     delta: float | None = None,
 ) -> TimeWarp:
-    """Integrate the blended, boundary-corrected rate into a time warp.
-
-    Parameters
-    ----------
-    boundaries : np.ndarray [shape=(p+1,), p >= 1] [s]
-        Source period boundaries, strictly increasing.
-    targets : np.ndarray [shape=(p+1,)] [s]
-        Music times the boundaries must land on, strictly increasing.
-    start, end : float, optional [s]
-        Source span to cover before the first / after the last boundary, at the rate
-        the blended curve has there (default: no extension).
-    delta : float > 0, optional [s]
-        Gaussian width of eq. 9; default the mean period ``mean(diff(boundaries))``.
-
-    Returns
-    -------
-    TimeWarp
-        ``warp.to_target(boundaries) == targets`` to rounding.
+    """Integrate the blended, boundary-corrected rate into a time warp that lands every
+    boundary [s] on its target [s] (to rounding), covering ``start`` / ``end`` [s]
+    before the first / after the last boundary at the rate there; ``delta`` [s] is eq.
+    9's width (default the mean period).
 
     Raises
     ------
