@@ -74,7 +74,8 @@ NOTES = [
     "motion beats) follow from the method, not from these pairs; see `docs/tuning.md`. No "
     "bundled dancer's phrase is that clear, so the phrase estimate changes none of these "
     "runs; the join weight moved DANCE_W_5's joined motion beats from 150-160 ms to "
-    "30-40 ms off the join.",
+    "30-40 ms off the join (music-beat score on DANCE_C_4's song +0.02, on DANCE_R_3's "
+    "+0.01, on DANCE_W_10's -0.01).",
     "- The pairs that miss the alignment target miss it on the music-beat score (BAS, "
     "averaged over music beats) only; the table above shows where it goes. A music beat "
     "scores only if a landing on a whole beat is found there again in the output, so a "
@@ -82,7 +83,9 @@ NOTES = [
     "of whole-beat landings any plan can have with every interval within 0.8-1.25 and the "
     "peak headroom (the same dynamic programme with that count as its only objective) is "
     "20 of 59 beats (0.34) for DANCE_W_5 -> DANCE_C_4, 18 of 44 (0.41) for DANCE_W_5 -> "
-    "DANCE_R_3 and 17 of 59 (0.29) for DANCE_W_10 -> DANCE_C_4. The scorer finds the "
+    "DANCE_R_3 and 17 of 59 (0.29) for DANCE_W_10 -> DANCE_C_4; within the band the "
+    "counts aim at (0.84-1.19, `MARGIN`) 20, 16 and 15, and the plans have 19, 15 and 15: "
+    "they are within one landing of it. The scorer finds the "
     "waltz and rumba dancers' landings less well than the cha-cha dancer's (scored over "
     "ceiling 0.68-0.84 against 0.91-0.96): many of their motion beats are shallow minima "
     "of the joint speed that any change of playback speed moves or erases, the first "
