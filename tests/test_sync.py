@@ -760,6 +760,18 @@ def test_dance_meter_is_estimated_when_clear_and_the_users_wins():
     assert given.report["dance_beats_per_period"] == 4
 
 
+def test_dance_meter_without_a_period_in_range_is_none():
+    # the arm turns every 0.6 s and its bone angles repeat at every turn: no phrase of
+    # 1.5-8.5 motion beats to find
+    from beatsync.motion_beats import kinematic_beats
+    from beatsync.sync.core import estimate_dance_meter
+
+    m = _arm_positions(seconds=12.0)
+    assert estimate_dance_meter(m, kinematic_beats(m))[0] is None
+    r = synchronize(m, None, np.arange(0.3, 14.0, 0.6), mode="beats").report
+    assert r["dance_meter_rule"] is None and r["dance_beats_per_period"] is None
+
+
 def test_dance_meter_of_a_real_waltz_is_not_clear():
     # the waltz dancer's period is its bar (3 beats of its song, 2.14 s), but its speed
     # minima mark 1 to 3 of the bar's steps: no count of motion beats holds every bar

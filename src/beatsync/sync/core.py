@@ -249,10 +249,12 @@ def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict 
     except ParameterError:  # too short for the range, or nothing to search
         return None, None
     period = float(motion.duration) / n  # >= the spectral peak's: a whole number fits
-    k = int(np.rint(period / step)) if period <= reach[1] else 0
+    found = {"period_s": period, "motion_beats": period / step}
+    k = int(np.rint(period / step))
+    if period > reach[1] or k < 2 or iv.size < 3 * k:  # no period in range, or too few
+        return None, found
     spans = np.convolve(iv, np.ones(k), mode="valid")
-    clear = k >= 2 and iv.size >= 3 * k and np.all(np.abs(spans - period) <= 0.5 * step)
-    return (k if clear else None), {"period_s": period, "motion_beats": period / step}
+    return (k if np.all(np.abs(spans - period) <= 0.5 * step) else None), found
 
 
 def synchronize(
