@@ -112,12 +112,10 @@ def plan_counts(
         Each event's index within its dance (its index in the clip, for a looped
         timeline); phrase starts are those ``% dance == 0``. Default ``arange``.
     band : (float, float)
-        Playback speeds outside which steps are heavily charged (aimed at narrowed by
-        ``MARGIN``).
+        Playback speeds outside which steps are heavily charged (narrowed by ``MARGIN``).
     max_speed : np.ndarray [shape=(P,)], optional
-        Fastest playback of each interval that keeps its joints no faster than the
-        dancer's own peak (the peak joint speed of the clip over the interval's);
-        it lowers the band's top for the intervals with the fastest moments.
+        Each interval's fastest playback that keeps its joints within the dancer's own
+        peak: it lowers the band's top for the intervals with the fastest moments.
 
     Returns
     -------

@@ -59,29 +59,12 @@ MIN_SPAN = 0.5
 
 @dataclass(frozen=True)
 class LoopedClip:
-    """A clip's span ``[first, last]`` repeated ``repetitions`` times in a looped timeline.
-
-    Attributes
-    ----------
-    events : np.ndarray [s]
-        Events in the looped timeline.
-    event_index : np.ndarray [int]
-        Each looped event's index among the clip's events.
-    first, last : float [s]
-        ``e_a`` and ``e_b``: the clip times where a repetition starts and ends.
-    length : float [s]
-        ``L = e_b - e_a``.
-    repetitions : int >= 1
-    join : float [s]
-        Width of the blended window around each join.
-    angle : float [rad]
-        Rotation about the vertical axis from one pass to the next.
-    shift : np.ndarray [shape=(2,)] or None
-        Translation on the floor from one pass to the next, on the floor axes of
-        :func:`beatsync.graph.distance.ground_axes` (x, y for joint positions; z, x
-        for a skeleton's root); None: no positions.
-    distance : float
-        Pose distance at the join (motion-graph distance, position unit).
+    """A clip's span ``[first, last]`` [s] (``e_a``, ``e_b``; ``length`` ``L``) repeated
+    ``repetitions`` times: the looped timeline's ``events`` [s] and each one's
+    ``event_index`` in the clip; ``join`` [s], the blend width at each join; ``angle``
+    [rad] and ``shift`` (position unit, on the floor axes of
+    :func:`beatsync.graph.distance.ground_axes`; None without positions), the floor
+    transform from one pass to the next; ``distance``, the pose distance at the join.
     """
 
     events: np.ndarray
@@ -327,26 +310,9 @@ def loop_events(
     shift: np.ndarray | None = None,
     distance: float = float("nan"),
 ) -> LoopedClip:
-    """Repeat the span ``events[a] .. events[b]`` until the timeline holds ``n_needed``
-    intervals.
-
-    Parameters
-    ----------
-    events : np.ndarray [shape=(P+1,), P >= 1] [s]
-        The clip's events (checked, increasing).
-    n_needed : int >= 1
-        Intervals (periods or beat segments) the looped timeline must hold.
-    join : float >= 0 [s]
-        Width of the blended window around each join.
-    span : (int, int), optional
-        ``(a, b)``: indices of the loop's first and last events; default the whole clip.
-    angle, shift, distance
-        The floor transform from one pass to the next (:func:`choose_loop`).
-
-    Returns
-    -------
-    LoopedClip
-    """
+    """Repeat the span ``events[a] .. events[b]`` (``span``, default the whole clip) until
+    the looped timeline holds ``n_needed`` intervals; ``join`` [s] is the blend width,
+    ``angle``, ``shift`` and ``distance`` the floor transform of :func:`choose_loop`."""
     a, b = (0, events.size - 1) if span is None else span
     head = events[: b + 1]
     per = b - a

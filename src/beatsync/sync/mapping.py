@@ -38,21 +38,9 @@ METER_REACH = 2.0
 
 @dataclass(frozen=True)
 class BeatCount:
-    """A choice of beats per period (or per motion beat) and why.
-
-    Attributes
-    ----------
-    m : int >= 1
-        Music beats per period (or per motion beat).
-    rule : str
-        How ``m`` was chosen (``"override"``, ``"round(P / b)"``, ``"meter"``).
-    ideal : float
-        ``P / b``: motion period over music beat period.
-    meter_fit : bool or None
-        Whether ``m`` respects both meters; None when no meter was known.
-    note : str
-        Why the meters do not fit (empty otherwise).
-    """
+    """A choice of ``m`` beats per period (or motion beat), the ``rule`` that chose it,
+    the ``ideal`` ratio ``P / b``, whether it respects both meters (``meter_fit``, None
+    without meters) and the ``note`` saying why they do not fit."""
 
     m: int
     rule: str
@@ -120,27 +108,9 @@ def beats_per_period(
     """Number of music beats one motion period spans (see the module docstring): the
     count nearest ``P / b`` on a log scale among those that respect the meters given.
 
-    Parameters
-    ----------
-    mean_period : float > 0 [s]
-        Mean duration of one motion period (e.g. ``Segmentation.mean_period``).
-    beats : np.ndarray [shape=(n,), n >= 2] [s]
-        Music beat times.
-    override : int >= 1, optional
-        Use this count instead of the rule.
-    dance_beats_per_period : int >= 1, optional
-        Motion beats in one period of the dance (3 for a waltz step).
-    beats_per_bar : int >= 1, optional
-        The music's meter (3 for a waltz, 4 for most pop).
-
-    Returns
-    -------
-    m : int >= 1 [beats]
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two beats, a non-positive period, a bad override or meter.
+    ``mean_period`` [s] is ``P``; ``beats`` [s] (at least 2) give ``b``, their median
+    interval; ``override`` replaces the rule; ``dance_beats_per_period`` (3 for a waltz
+    step) and ``beats_per_bar`` are the meters. ParameterError on a bad value.
 
     Examples
     --------
@@ -178,26 +148,10 @@ def beats_per_unit(intervals: np.ndarray, m: int) -> np.ndarray:
 
 
 def accent_lag(motion_beats: Any, music_beats: Any) -> float:
-    """Mean lag of the motion beats behind the music beats [s], in ``(-T/2, T/2]``.
-
-    The circular mean of the motion beats' phases inside their beat intervals, times
-    the median beat period ``T``. Synchronising with ``phase_offset=-lag`` moves the
-    dancer's accents onto the beats (what ``synchronize(..., land="accents")`` does).
-
-    Parameters
-    ----------
-    motion_beats : np.ndarray [shape=(n,)] [s]
-        E.g. :func:`beatsync.motion_beats.kinematic_beats` of a synchronised motion.
-    music_beats : np.ndarray [shape=(m,), m >= 2] [s]
-
-    Returns
-    -------
-    lag : float [s]
-
-    Raises
-    ------
-    ParameterError
-        Fewer than 2 music beats, or no motion beat inside the music's beats.
+    """Mean lag [s] of ``motion_beats`` [s] behind ``music_beats`` [s] (at least 2), in
+    ``(-T/2, T/2]``: the circular mean of their phases in the beat intervals, times the
+    median beat period ``T``. ``phase_offset=-lag`` puts the accents on the beats
+    (``land="accents"``). ParameterError when no motion beat falls inside the beats.
 
     Examples
     --------
