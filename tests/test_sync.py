@@ -689,6 +689,33 @@ def test_report_tells_the_counts_speeds_and_kinematics_used(rumba_on_a_waltz):
     )
 
 
+def test_join_weight_is_flat_at_the_join():
+    from beatsync.sync.fill import join_weight
+
+    u = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    np.testing.assert_allclose(join_weight(u), [0.0, 0.25, 0.5, 0.75, 1.0])
+    h = 1e-6  # no slope at both ends of the window and at the join (u = 1/2)
+    slope = (join_weight(u[[0, 2, 4]] + h) - join_weight(u[[0, 2, 4]] - h)) / (2 * h)
+    np.testing.assert_allclose(slope, 0.0, atol=1e-5)
+
+
+def test_real_dancer_loop_join_keeps_its_motion_beat():
+    # the real waltz dancer looped onto 40 s of 87 BPM: each join is one of its motion
+    # beats (a speed minimum); the blend must not move it away from the join
+    from beatsync import datasets
+    from beatsync.motion_beats import kinematic_beats
+
+    dancer = datasets.load_dance_pair("DANCE_W_5").motion
+    beats = np.arange(0.3, 40.0, 60.0 / 87.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        res = synchronize(dancer, None, beats, mode="beats", fill="loop", beats_per_bar=3)
+    seen = kinematic_beats(res.motion)
+    joins = np.array([j["time_s"] for j in res.report["joins"]])
+    assert joins.size
+    assert np.abs(seen[:, None] - joins[None, :]).min(axis=0).max() <= 0.06
+
+
 def test_speed_warning_names_a_tempo_that_fits():
     # 10 motion beats 0.5 s apart and a song of 2 beats 3 s apart: no count fits
     m = _arm_positions(fps=25.0, seconds=6.0, beat_times=np.arange(0.0, 6.0, 0.5))
@@ -713,6 +740,48 @@ def test_dance_meter_puts_the_dance_bars_on_bar_lines():
     bar = 3 * 60.0 / 87.0
     on_bar = np.abs(((np.asarray(r["target_beats_s"]) - beats[0]) / bar + 0.5) % 1.0 - 0.5) < 1e-6
     assert on_bar.mean() > 1.0 / 3.0 + 0.1  # more than the share of beats that are bar lines
+
+
+def test_dance_meter_is_estimated_when_clear_and_the_users_wins():
+    # standing in place, the knee bends and straightens once a period of 1.8 s: two
+    # motion beats (the turns of the knee) per period, on a 4/4 song of 0.45 s beats
+    m = _periodic_motion(period=1.8, duration=20.0, fps=25.0)
+    values = m.values.copy()
+    values[:, 0] = 0.0
+    m = m.with_values(values)
+    beats = np.arange(0.3, 30.0, 0.45)
+    r = synchronize(m, None, beats, mode="beats", fill="loop", beats_per_bar=4).report
+    assert r["dance_meter_rule"] == "estimated" and r["dance_beats_per_period"] == 2
+    assert r["dance_meter_found"]["period_s"] == pytest.approx(1.8, rel=0.05)
+    # a phrase start every 4 beats would be on a bar line by chance half the time
+    assert r["phrases_on_bars"] >= 0.8
+    given = synchronize(m, None, beats, mode="beats", beats_per_bar=4, dance_beats_per_period=4)
+    assert given.report["dance_meter_rule"] == "given"
+    assert given.report["dance_beats_per_period"] == 4
+
+
+def test_dance_meter_without_a_period_in_range_is_none():
+    # the arm turns every 0.6 s and its bone angles repeat at every turn: no phrase of
+    # 1.5-8.5 motion beats to find
+    from beatsync.motion_beats import kinematic_beats
+    from beatsync.sync.core import estimate_dance_meter
+
+    m = _arm_positions(seconds=12.0)
+    assert estimate_dance_meter(m, kinematic_beats(m))[0] is None
+    r = synchronize(m, None, np.arange(0.3, 14.0, 0.6), mode="beats").report
+    assert r["dance_meter_rule"] is None and r["dance_beats_per_period"] is None
+
+
+def test_dance_meter_of_a_real_waltz_is_not_clear():
+    # the waltz dancer's period is its bar (3 beats of its song, 2.14 s), but its speed
+    # minima mark 1 to 3 of the bar's steps: no count of motion beats holds every bar
+    from beatsync import datasets
+    from beatsync.motion_beats import kinematic_beats
+    from beatsync.sync.core import estimate_dance_meter
+
+    dancer = datasets.load_dance_pair("DANCE_W_5").motion
+    count, found = estimate_dance_meter(dancer, kinematic_beats(dancer))
+    assert count is None and found["period_s"] == pytest.approx(3 * 0.712, rel=0.05)
 
 
 def test_loop_of_a_turning_skeleton_carries_its_heading_on():

@@ -47,45 +47,28 @@ METER_AGREEMENT = 0.6
 
 @dataclass(frozen=True)
 class SyncResult:
-    """Output of :func:`synchronize`.
+    """Output of :func:`synchronize`: the beat-synchronous ``motion`` at ``out_fps``
+    (frame ``k`` plays at music time ``k / out_fps``); ``warp_src_times`` [s], the source
+    time each output frame shows (in the looped timeline when the clip was repeated);
+    the ``warp`` itself (for plots); and the ``report``:
 
-    Attributes
-    ----------
-    motion : Motion
-        The beat-synchronous motion at ``out_fps``; frame ``k`` plays at music time
-        ``k / out_fps`` [s].
-    warp_src_times : np.ndarray [shape=(n_out,)] [s]
-        Source time shown by each output frame (non-decreasing), in the looped
-        timeline when ``fill="loop"`` repeated the clip (the clip's own time otherwise).
-    report : dict
-        ``mode`` (``"periods"`` or ``"beats"``, as used), ``mode_requested``,
-        ``mode_note`` (why ``auto`` fell back), ``land``, ``fill``, ``repetitions``,
-        ``input_frames``, ``output_frames``, ``input_fps``, ``output_fps``,
-        ``periods_available``, ``periods_used`` (intervals: periods, or motion-beat
-        segments in beats mode, counted over all repetitions),
-        ``beats_per_period`` (per motion beat in beats mode),
-        ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
-        ``dance_beats_per_period``, ``motion_beats_per_period_counted``,
-        ``beats_per_bar``, ``period_range_s``, ``first_beat``,
-        ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
-        ``beat_period_s``, ``delta_s``, ``rate_range`` (target/source),
-        ``tempo_ratio_range`` (playback speed, source/target), ``target_beats_s``,
-        ``boundaries_s``, ``residual_ms`` (one per boundary),
-        ``residual_nearest_frame_ms``, ``max_abs_residual_ms``,
-        ``max_abs_residual_frames``, ``lead_in_hold_frames``, ``n_scaled_periods``,
-        ``covered_s`` (music time span the dance covers); computed from the output frames
-        (:mod:`beatsync.sync.quality`): ``beats_per_motion_beat_used`` (count -> number
-        of intervals, halves allowed), ``n_merged_intervals``,
-        ``n_half_beat_landings``, ``phrases_on_bars`` (share of the dance bars, given
-        ``dance_beats_per_period``, that start on a bar line), ``playback_speed``
-        (``instantaneous`` and ``per_interval``: min, median, max, ``in_band`` share
-        of output time; ``band``; ``held_lead_in_s``), ``kinematics`` (p99 and peak
-        joint speed, p99 acceleration of input and output, and their ratios; None
-        without joint positions), ``loop`` (span, blend, turn per pass, pose
-        distance) and ``joins`` (music time and peak joint speed of each),
-        ``speed_warning``.
-    warp : TimeWarp
-        The warp itself (for plots).
+    - what was used and why: ``mode``, ``mode_requested``, ``mode_note``, ``land``,
+      ``fill``, ``repetitions``, ``beats_per_period`` (the count used most in beats
+      mode), ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
+      ``dance_beats_per_period`` with ``dance_meter_rule`` (``"given"``,
+      ``"estimated"`` or None) and ``dance_meter_found``,
+      ``motion_beats_per_period_counted``, ``beats_per_bar``, ``period_range_s``,
+      ``first_beat``, ``phase_offset_s``, ``accent_lag_s``, ``mean_motion_period_s``,
+      ``beat_period_s``, ``delta_s``;
+    - frames and intervals: ``input_frames``, ``output_frames``, ``input_fps``,
+      ``output_fps``, ``periods_available``, ``periods_used`` (over all repetitions),
+      ``covered_s``, ``lead_in_hold_frames``, ``n_scaled_periods``, ``rate_range``
+      (target/source), ``tempo_ratio_range`` (playback speed);
+    - landings: ``boundaries_s`` (source, looped timeline) and ``target_beats_s``,
+      ``residual_ms`` (realised warp) and ``residual_nearest_frame_ms``, their maxima;
+    - from the output frames (:mod:`.quality`): ``beats_per_motion_beat_used``,
+      ``n_merged_intervals``, ``n_half_beat_landings``, ``phrases_on_bars``,
+      ``playback_speed``, ``kinematics``, ``loop``, ``joins``, ``speed_warning``.
     """
 
     motion: Any
@@ -152,12 +135,10 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     Raises
     ------
     NotPeriodicError
-        The motion is not shown to be periodic or is too short to tell, or its periods
-        cannot be searched while its joints move (no joint angles to test, as for a
-        marker set other than the MoCap Toolbox's, or joint angles that never change):
-        its own motion beats may still sync it.
+        Not shown periodic, too short to tell, or no joint angles to search while its
+        joints move: its own motion beats may still sync it.
     ParameterError
-        Bad settings (``alpha``, ``period_range``), or a dancer whose joints do not move.
+        Bad ``alpha`` or ``period_range``, or a dancer whose joints do not move.
     """
     from ..motion import segmentation_view
     from ..segment.checks import check_alpha, check_period_range
@@ -240,6 +221,42 @@ def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
     return k if k >= 1 and freq.max() >= METER_AGREEMENT * counts.size else None
 
 
+#: phrase lengths searched for the dance's own meter, in motion beats (median interval)
+PHRASE_BEATS = (1.5, 8.5)
+
+
+def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict | None]:
+    """The dance's own phrase in motion beats ``mb`` [s], for ``dance_beats_per_period``
+    when the user gives none: ``(count or None, what was found)``.
+
+    Paper A's period ``T`` (:func:`beatsync.segment.core.estimate_period_count`, the
+    spectral peak: cheap on a long dance) over 1.5-8.5 median motion-beat intervals
+    ``b``; the phrase is ``N = round(T / b)`` motion beats. It is used only when every
+    ``N`` consecutive motion beats span ``T`` to within half an interval: the phrase
+    starts are every ``N``-th motion beat (:mod:`.counts`), so a single phrase of
+    another count would put every later one off its bar. None when that is not clear,
+    or without joint angles or positions to search.
+    """
+    from ..motion import segmentation_view
+    from ..segment.core import estimate_period_count
+
+    iv = np.diff(mb)
+    step = float(np.median(iv))
+    try:
+        view = segmentation_view(motion)
+        reach = (PHRASE_BEATS[0] * step, PHRASE_BEATS[1] * step)
+        n = estimate_period_count(view.values, fps=view.fps, period_range=reach, method="fft")
+    except ParameterError:  # too short for the range, or nothing to search
+        return None, None
+    period = float(motion.duration) / n  # >= the spectral peak's: a whole number fits
+    found = {"period_s": period, "motion_beats": period / step}
+    k = int(np.rint(period / step))
+    if period > reach[1] or k < 2 or iv.size < 3 * k:  # no period in range, or too few
+        return None, found
+    spans = np.convolve(iv, np.ones(k), mode="valid")
+    return (k if np.all(np.abs(spans - period) <= 0.5 * step) else None), found
+
+
 def synchronize(
     motion: Any,
     boundaries: Any,
@@ -257,51 +274,39 @@ def synchronize(
     phase_offset: float = 0.0,
     period_range: tuple[float, float] | None = None,
 ) -> SyncResult:
-    """Resample a dance so that its periods (or its own motion beats) land on music beats.
-
-    Paper A, section 5: every motion period is mapped to a whole number of
-    consecutive music beats, its rate set so it lasts as long as those beats, the
-    rates blended smoothly (eq. 9) and integrated into a time warp on which the
-    motion is resampled (slerp for rotations, linear for positions). The output's
-    time 0 is the music's time 0.
+    """Resample a dance so that its periods (or its own motion beats) land on music beats
+    (paper A, section 5; see :mod:`beatsync.sync`). The output's time 0 is the music's.
 
     Parameters
     ----------
     motion : beatsync.motion.Motion
-        Source dance: BVH joint angles, marker positions or joint positions, ``fps`` [Hz].
+        BVH joint angles, marker positions or joint positions, ``fps`` [Hz].
     boundaries : np.ndarray [shape=(p+1,), p >= 1] [s] or None
-        Period boundaries in the source's time (``segment(motion).boundaries``).
-        None: segment here (``mode="periods"``/``"auto"``) with ``period_range``.
+        Period boundaries in the source's time; None: segment here with ``period_range``.
     beats : np.ndarray [shape=(n,), n >= 2] [s]
-        Music beat times (e.g. ``track_beats(y, sr).beats``).
+        Music beat times.
     mode : {"periods", "beats", "auto"}
-        ``"periods"``: paper A (periods on groups of beats). ``"beats"``: warp the
-        dancer's own kinematic beats (:func:`beatsync.motion_beats.kinematic_beats`)
-        onto the music's beats, a whole number of beats per motion beat, with the
-        same smooth rate; for dances that are not strictly periodic (figures vary).
-        ``"auto"``: periods when the motion is periodic, else beats, with a
+        Paper A's periods on groups of beats; the dancer's own kinematic beats on the
+        music's beats, counts chosen for the whole dance (for dances whose figures
+        vary); or periods when the motion is periodic, else beats with a
         :class:`~beatsync.errors.BeatsyncWarning` and ``report["mode_note"]``.
     land : {"boundaries", "accents"}
-        What lands on the beats: the period boundaries, or the dancer's accents
-        (the motion is synchronised, the mean lag of its kinematic beats behind the
-        music beats measured, and synchronised again with ``phase_offset=-lag``).
+        Land the boundaries, or the dancer's accents (synchronise, measure the mean lag
+        of the kinematic beats behind the beats, synchronise again without it).
     fill : {"stop", "loop"}
-        ``"stop"``: the output ends with the clip's last period that fits (paper A).
-        ``"loop"``: whole periods (or beat segments) are repeated, with blended joins,
-        so the dance covers the song up to its last beat; ``report["repetitions"]``.
+        End with the clip's last period that fits (paper A), or repeat a span with
+        blended joins until the dance covers the song to its last beat.
     beats_per_period : int >= 1, optional
-        Beats one period (or one motion beat) spans; default chosen by
-        :func:`beatsync.sync.beats_per_period` from the tempo ratio and the meters.
+        Beats one period (or motion beat) spans; default :func:`beats_per_period`'s
+        rule (periods) or the whole-dance counts (beats).
     beats_per_bar : int >= 1, optional
-        The music's meter (e.g. ``track.beats_per_bar``); respected when choosing.
+        The music's meter.
     dance_beats_per_period : int >= 1, optional
-        The dance's meter: beats of one period of the dance (3 for a waltz step, 6
-        for a waltz box). In ``mode="periods"`` the count then is a multiple of it (or
-        it halved), and a warning says so when it cannot also respect
-        ``beats_per_bar``; in ``mode="beats"`` every such group of motion beats starts
-        on a bar line of the music where the speed band allows, and a loop holds
-        whole groups. The report's
-        ``motion_beats_per_period_counted`` (kinematic beats per period) is a hint.
+        The dance's meter (3 for a waltz step). Periods: the count is a multiple of it
+        (or it halved), with a warning when ``beats_per_bar`` cannot also be kept.
+        Beats: every such group of motion beats starts on a bar line where the speed
+        band allows and a loop holds whole groups; without it, the dance's own phrase
+        is used when it is clear (:func:`estimate_dance_meter`).
     first_beat : int >= 0
         Index of the beat the first boundary lands on.
     out_fps : float > 0, optional [Hz]
@@ -311,14 +316,11 @@ def synchronize(
     phase_offset : float [s]
         Land the boundaries this long after their beats (negative: before).
     period_range : (float, float) [s], optional
-        Shortest and longest period when segmenting here (``boundaries=None``).
-        Default in ``mode="periods"``: one to eight of the music's beats
-        (``PERIOD_BEATS``), so real dance cycles (a waltz box is 6 beats, about 4 s)
-        are found. Default in ``mode="auto"``: paper A's 0.25-1.25 s
-        (``AUTO_PERIOD_RANGE``): periods are used for dances periodic at the step
-        level; longer, varying figures (ballroom) go to ``"beats"``, which on the four
-        real Dance-with-Melody dancers aligned their motion beats with a new song
-        clearly better (see :mod:`beatsync.study.paper_a_dancers`).
+        Periods searched when segmenting here: default one to eight of the music's
+        beats (``PERIOD_BEATS``: real dance cycles) in ``"periods"``, paper A's
+        0.25-1.25 s (``AUTO_PERIOD_RANGE``) in ``"auto"``, so ballroom figures go to
+        ``"beats"``, which aligned the real dancers with a new song clearly better
+        (:mod:`beatsync.study.paper_a_dancers`).
 
     Returns
     -------
@@ -328,20 +330,15 @@ def synchronize(
     ------
     ParameterError
         Boundaries outside the motion (frames instead of seconds?), fewer than two
-        boundaries (not periodic) in ``mode="periods"``, no motion beats in
-        ``mode="beats"``, fewer than two music beats, music too short for one period
-        after ``first_beat``, an unknown mode/land/fill, ``land="accents"`` together
+        boundaries or music beats, no motion beats in ``"beats"``, music too short for
+        one period after ``first_beat``, an unknown mode/land/fill, ``land="accents"``
         with a ``phase_offset``, a bad ``period_range``, meter or ``out_fps``.
     NotPeriodicError
-        (a ``ParameterError``) ``mode="periods"`` without ``boundaries``, on a motion
-        that segmentation does not show periodic (:func:`motion_periods`): its own motion
-        beats can sync it (``mode="beats"``; ``mode="auto"`` falls back to them).
+        ``mode="periods"`` without ``boundaries`` on a motion segmentation does not
+        show periodic (:func:`motion_periods`); ``"beats"`` or ``"auto"`` can sync it.
 
     Examples
     --------
-    >>> res = synchronize(motion, seg.boundaries, track.beats)  # doctest: +SKIP
-    >>> res.report["max_abs_residual_ms"]  # doctest: +SKIP
-    0.0
     >>> res = synchronize(dancer, None, track.beats, mode="auto", fill="loop")  # doctest: +SKIP
     >>> res.report["mode"], res.report["repetitions"]  # doctest: +SKIP
     ('beats', 3)
@@ -412,6 +409,10 @@ def synchronize(
     unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
     counted = motion_beat_count(motion, events) if used_mode == "periods" else None
     whole_dance = used_mode == "beats" and override is None
+    meter_rule, meter_found = ("given" if dance else None), None
+    if whole_dance and dance is None:
+        dance, meter_found = estimate_dance_meter(motion, events)
+        meter_rule = "estimated" if dance else None
     if override is not None:
         count = BeatCount(override, "override", unit / beat_period)
     elif whole_dance:
@@ -477,6 +478,8 @@ def synchronize(
             "meter_fit": count.meter_fit,
             "meter_note": count.note,
             "dance_beats_per_period": dance,
+            "dance_meter_rule": meter_rule,
+            "dance_meter_found": meter_found,
             "motion_beats_per_period_counted": counted,
             "beats_per_bar": bar,
             "period_range_s": None if boundaries is not None else list(period_range),

@@ -1,46 +1,28 @@
 """Beat counts for the whole dance: how many music beats every motion-beat interval spans.
 
-In ``mode="beats"`` every interval between the dancer's motion beats ``e_i`` lands on
-the music's beats. Choosing each interval's count on its own (``round(interval /
-beat)``) makes neighbouring intervals play at very different speeds; here the counts
-are chosen jointly, by dynamic programming over the intervals (Viterbi), as paper B
-chooses the time-scaling of its composed intervals (:mod:`beatsync.graph.timescale`,
-whose bound ``DEFAULT_SCALE_BOUND`` and half-beat grid :func:`music_grid` are reused).
+Chosen jointly by dynamic programming over the intervals (Viterbi), as paper B chooses
+the time-scaling of its composed intervals (:mod:`beatsync.graph.timescale`, whose
+speed bound and half-beat grid are reused), instead of ``round(interval / beat)`` one
+interval at a time, which plays neighbours at very different speeds.
 
-Grid and states
-    The music's beats from ``first_beat`` on and their midpoints form a half-beat grid
-    ``g_0 .. g_K`` (``K`` = twice the beats left). Event ``i`` is placed on grid point
-    ``k_i``; an interval covers ``c = k_{i+1} - k_i`` half beats, ``1 <= c <= C``. The
-    state after placing an event is ``(k, c, merged)``: where it lands, the count of
-    the interval that led there (so the speed change can be charged) and whether that
-    step merged two intervals.
+Event ``i`` lands on point ``k_i`` of the half-beat grid (the beats from the first on
+and their midpoints); a step covers ``1 <= c <= MAX_HALF_BEATS`` half beats, from one
+interval to the next or, merging two intervals no whole count fits, to the one after
+(the middle motion beat is then not pinned). States ``(k, c, merged)`` keep the last
+step's count so that its speed change can be charged. Cost of a path:
 
-Steps
-    - one interval ``i -> i + 1`` over ``c`` half beats, or
-    - a *merge*: two intervals ``i -> i + 2`` over ``c`` half beats (the middle motion
-      beat is then not pinned to a beat), for intervals no whole number of beats fits.
+- speed ``s = source / music duration``: ``(log s)^2`` per second inside the band
+  (narrowed by ``MARGIN``), plus ``W_OUT`` and ``W_EXCESS`` times the squared log
+  distance to it per second outside, so speeds outside 0.8-1.25 go only where
+  nothing else fits;
+- ``W_CHANGE (log s_i - log s_{i-1})^2`` between consecutive steps;
+- ``W_HALF`` per event on a half beat, ``W_MERGE`` per merge;
+- with the dance's meter ``N`` and the music's bar, ``W_BAR`` per phrase start (every
+  ``N``-th motion beat) off a bar line.
 
-Cost of a path (all terms summed; weights are module constants)
-    - speed: each step plays at local speed ``s = source / music duration``; it costs
-      its music duration times ``(log s)^2`` inside ``DEFAULT_SCALE_BOUND`` and, outside
-      it, ``W_OUT`` per second plus ``W_EXCESS`` per second times the log distance to the
-      band (squared): speeds outside 0.8-1.25 are used only where nothing else fits;
-    - smoothness: ``W_CHANGE (log s_i - log s_{i-1})^2`` between consecutive steps;
-    - half beats: ``W_HALF`` for every event landing between two beats (odd ``k``);
-    - merges: ``W_MERGE`` per merge;
-    - bars: with the dance's meter ``N`` (``--dance-beats``: motion beats per dance bar),
-      every ``N``-th motion beat (a phrase start) off the music's bar lines costs
-      ``W_BAR``. Without it the first event starts the song's bar and nothing more
-      is asked.
-
-End
-    ``fill="loop"``: the path ends on the song's last beat (``k = K``), after any
-    number of intervals (the looped timeline provides enough). ``fill="stop"``: it
-    ends with the clip's last interval, or on the last beat if the clip is longer.
-
-Data contract: times in seconds (events in the source's, possibly looped, timeline;
-beats in the music's); counts in half beats inside, in beats (halves allowed) in the
-result.
+``fill="loop"`` ends on the song's last beat after any number of intervals;
+``fill="stop"`` with the clip's last interval (or on the last beat if the song ends
+first). Times in seconds; counts in half beats inside, in beats in the result.
 """
 
 from __future__ import annotations
@@ -77,27 +59,10 @@ MARGIN = 1.05
 
 @dataclass(frozen=True)
 class CountPlan:
-    """The placed events of a whole dance.
-
-    Attributes
-    ----------
-    event_index : np.ndarray [int]
-        Indices (into the events given) of the events pinned to the grid, in order.
-    grid_index : np.ndarray [int]
-        Their half-beat grid points.
-    targets : np.ndarray [s]
-        Their music times.
-    beats : np.ndarray [float]
-        Music beats each used interval spans (halves allowed).
-    n_merged : int
-        Steps that cover two intervals.
-    n_half : int
-        Events landing between two beats.
-    phrases_on_bars : float or None
-        Share of the placed phrase starts (dance bars) on a bar line of the music;
-        None without both meters.
-    cost : float
-    """
+    """The placed events of a whole dance: indices (into the events given) of those
+    pinned, their half-beat ``grid_index`` and music ``targets`` [s], the ``beats`` each
+    step spans (halves allowed), the numbers of merges and half-beat landings, the
+    path's cost, and the share of phrase starts on bar lines (None without meters)."""
 
     event_index: np.ndarray
     grid_index: np.ndarray
@@ -147,12 +112,10 @@ def plan_counts(
         Each event's index within its dance (its index in the clip, for a looped
         timeline); phrase starts are those ``% dance == 0``. Default ``arange``.
     band : (float, float)
-        Playback speeds outside which steps are heavily charged (aimed at narrowed by
-        ``MARGIN``).
+        Playback speeds outside which steps are heavily charged (narrowed by ``MARGIN``).
     max_speed : np.ndarray [shape=(P,)], optional
-        Fastest playback of each interval that keeps its joints no faster than the
-        dancer's own peak (the peak joint speed of the clip over the interval's);
-        it lowers the band's top for the intervals with the fastest moments.
+        Each interval's fastest playback that keeps its joints within the dancer's own
+        peak: it lowers the band's top for the intervals with the fastest moments.
 
     Returns
     -------

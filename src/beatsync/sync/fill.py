@@ -25,12 +25,14 @@ Aligned and blended joins
     previous one ended, so a dancer who travels or turns goes on instead of jumping
     back. Within ``join / 2`` of a join the pose blends the ending pass's continuation
     (clip time ``e_b + d``, moved by ``M^(r-1)``) into the starting pass's lead
-    (``e_a + d``, moved by ``M^r``) with a raised-cosine weight, whose derivative
-    vanishes at both ends of the window: both motions carry their own velocity, so
-    the velocity is continuous and the blend adds only ``w'`` times the (small)
-    remaining pose difference. A skeleton's root is turned (its rotation channels and
-    its floor position) and moved; joint positions are rotated and translated. Rotation
-    channels are blended by slerp, positions linearly.
+    (``e_a + d``, moved by ``M^r``) with a weight of two raised-cosine half-ramps
+    (:func:`join_weight`), whose derivative vanishes at both ends of the window and at
+    the join: both motions carry their own velocity, so the velocity is continuous,
+    the blend adds only ``w'`` times the (small) remaining pose difference, and
+    nothing at the join itself (a motion beat, whose speed minimum stays put). A
+    skeleton's root is turned (its rotation channels and its floor position) and moved;
+    joint positions are rotated and translated. Rotation channels are blended by slerp,
+    positions linearly.
 
 Data contract: times in seconds of the clip (``e``) or of the looped timeline
 (``t``); positions ``(frames, joints, 3)`` with z up (position-only motion) or the
@@ -57,29 +59,12 @@ MIN_SPAN = 0.5
 
 @dataclass(frozen=True)
 class LoopedClip:
-    """A clip's span ``[first, last]`` repeated ``repetitions`` times in a looped timeline.
-
-    Attributes
-    ----------
-    events : np.ndarray [s]
-        Events in the looped timeline.
-    event_index : np.ndarray [int]
-        Each looped event's index among the clip's events.
-    first, last : float [s]
-        ``e_a`` and ``e_b``: the clip times where a repetition starts and ends.
-    length : float [s]
-        ``L = e_b - e_a``.
-    repetitions : int >= 1
-    join : float [s]
-        Width of the blended window around each join.
-    angle : float [rad]
-        Rotation about the vertical axis from one pass to the next.
-    shift : np.ndarray [shape=(2,)] or None
-        Translation on the floor from one pass to the next, on the floor axes of
-        :func:`beatsync.graph.distance.ground_axes` (x, y for joint positions; z, x
-        for a skeleton's root); None: no positions.
-    distance : float
-        Pose distance at the join (motion-graph distance, position unit).
+    """A clip's span ``[first, last]`` [s] (``e_a``, ``e_b``; ``length`` ``L``) repeated
+    ``repetitions`` times: the looped timeline's ``events`` [s] and each one's
+    ``event_index`` in the clip; ``join`` [s], the blend width at each join; ``angle``
+    [rad] and ``shift`` (position unit, on the floor axes of
+    :func:`beatsync.graph.distance.ground_axes`; None without positions), the floor
+    transform from one pass to the next; ``distance``, the pose distance at the join.
     """
 
     events: np.ndarray
@@ -124,7 +109,7 @@ class LoopedClip:
                 a = np.where(near, self.last + d, a)
                 b = np.where(near, self.first + d, b)
                 u = np.clip((d + half) / (2.0 * half), 0.0, 1.0)
-                w = np.where(near, 0.5 - 0.5 * np.cos(np.pi * u), w)
+                w = np.where(near, join_weight(u), w)
                 ra = np.where(near, kk, ra)  # join kk ends repetition kk, starts kk + 1
                 rb = np.where(near, kk + 1.0, rb)
         return a, b, w, ra, rb
@@ -188,6 +173,14 @@ class LoopedClip:
                 values[:, idx] = rotation_to_euler(turned, order, reference=euler)
         values[:, cols] += off
         return values
+
+
+def join_weight(u: np.ndarray) -> np.ndarray:
+    """Blend weight over a join's window (phase ``u`` in [0, 1]): two raised-cosine
+    half-ramps, 0 -> 1/2 -> 1, so ``w'`` vanishes at both ends and at the join itself,
+    where the blend then adds no velocity and the landed speed minimum stays put."""
+    c = 0.25 * np.cos(2.0 * np.pi * u)
+    return np.where(u < 0.5, 0.25 - c, 0.75 + c)
 
 
 def _interp(pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
@@ -317,26 +310,9 @@ def loop_events(
     shift: np.ndarray | None = None,
     distance: float = float("nan"),
 ) -> LoopedClip:
-    """Repeat the span ``events[a] .. events[b]`` until the timeline holds ``n_needed``
-    intervals.
-
-    Parameters
-    ----------
-    events : np.ndarray [shape=(P+1,), P >= 1] [s]
-        The clip's events (checked, increasing).
-    n_needed : int >= 1
-        Intervals (periods or beat segments) the looped timeline must hold.
-    join : float >= 0 [s]
-        Width of the blended window around each join.
-    span : (int, int), optional
-        ``(a, b)``: indices of the loop's first and last events; default the whole clip.
-    angle, shift, distance
-        The floor transform from one pass to the next (:func:`choose_loop`).
-
-    Returns
-    -------
-    LoopedClip
-    """
+    """Repeat the span ``events[a] .. events[b]`` (``span``, default the whole clip) until
+    the looped timeline holds ``n_needed`` intervals; ``join`` [s] is the blend width,
+    ``angle``, ``shift`` and ``distance`` the floor transform of :func:`choose_loop`."""
     a, b = (0, events.size - 1) if span is None else span
     head = events[: b + 1]
     per = b - a

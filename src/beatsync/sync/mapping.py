@@ -1,20 +1,16 @@
 """How many music beats a motion period (or motion beat) spans, and where accents sit.
 
-- :func:`beats_per_period`: the whole number ``m`` of music beats one motion period
-  spans. Without meters it is ``round(P / b)`` (paper A's reading). With meters it
-  respects both: the dance's own beats per period (a waltz step has 3 motion beats,
-  so it spans 3 or 6 music beats, never 5) and the music's beats per bar (``m``
-  divides the bar or is a whole number of bars). When no count fits both meters
-  within a factor of 2 of ``P / b``, the dance's meter wins and the report says the
-  meters do not fit.
-- :func:`beats_per_unit`: the count of every interval of a sequence of motion events
-  (periods, or the dancer's own motion beats in ``mode="beats"``): ``m`` for the
-  median interval, and a proportional whole number for the others (a missed motion
-  beat leaves an interval twice as long, which spans twice the beats).
-- :func:`accent_lag`: the mean lag of motion beats behind music beats, used by
-  ``synchronize(..., land="accents")`` to put the dancer's accents on the beats.
+- :func:`beats_per_period`: ``m = round(P / b)`` (paper A's reading); with meters, a
+  count that respects both the dance's (a multiple of its motion beats per period, or
+  that halved: a 3-beat waltz step spans 3 or 6 beats, never 5) and the music's
+  (dividing the bar or whole bars). When none fits both within x2 of ``P / b``, the
+  dance's wins and the report says the meters do not fit.
+- :func:`beats_per_unit`: ``m`` for the median interval and proportional whole counts
+  for the others (a missed motion beat leaves an interval twice as long).
+- :func:`accent_lag`: the mean lag of motion beats behind music beats, for
+  ``land="accents"``.
 
-All times are seconds; counts are whole numbers of beats.
+Times in seconds; counts in whole beats.
 """
 
 from __future__ import annotations
@@ -42,21 +38,9 @@ METER_REACH = 2.0
 
 @dataclass(frozen=True)
 class BeatCount:
-    """A choice of beats per period (or per motion beat) and why.
-
-    Attributes
-    ----------
-    m : int >= 1
-        Music beats per period (or per motion beat).
-    rule : str
-        How ``m`` was chosen (``"override"``, ``"round(P / b)"``, ``"meter"``).
-    ideal : float
-        ``P / b``: motion period over music beat period.
-    meter_fit : bool or None
-        Whether ``m`` respects both meters; None when no meter was known.
-    note : str
-        Why the meters do not fit (empty otherwise).
-    """
+    """A choice of ``m`` beats per period (or motion beat), the ``rule`` that chose it,
+    the ``ideal`` ratio ``P / b``, whether it respects both meters (``meter_fit``, None
+    without meters) and the ``note`` saying why they do not fit."""
 
     m: int
     rule: str
@@ -121,37 +105,12 @@ def beats_per_period(
     dance_beats_per_period: int | None = None,
     beats_per_bar: int | None = None,
 ) -> int:
-    """Number of music beats one motion period spans.
+    """Number of music beats one motion period spans (see the module docstring): the
+    count nearest ``P / b`` on a log scale among those that respect the meters given.
 
-    Rule: the count ``m`` nearest (on a log scale) to ``P / b``, ``P`` the mean motion
-    period and ``b`` the median inter-beat interval, among the counts that respect
-    the meters given: a multiple of the dance's beats per period (or that count
-    halved by powers of 2), and a divisor or multiple of the music's beats per bar.
-    Without meters, ``m = max(1, round(P / b))``: a 1 s salsa step on 120 BPM music
-    spans 2 beats. A 2.1 s waltz step of 3 motion beats on 120 BPM music in 3/4 spans
-    3 beats, never 4 or 5.
-
-    Parameters
-    ----------
-    mean_period : float > 0 [s]
-        Mean duration of one motion period (e.g. ``Segmentation.mean_period``).
-    beats : np.ndarray [shape=(n,), n >= 2] [s]
-        Music beat times.
-    override : int >= 1, optional
-        Use this count instead of the rule.
-    dance_beats_per_period : int >= 1, optional
-        Motion beats in one period of the dance (3 for a waltz step).
-    beats_per_bar : int >= 1, optional
-        The music's meter (3 for a waltz, 4 for most pop).
-
-    Returns
-    -------
-    m : int >= 1 [beats]
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two beats, a non-positive period, a bad override or meter.
+    ``mean_period`` [s] is ``P``; ``beats`` [s] (at least 2) give ``b``, their median
+    interval; ``override`` replaces the rule; ``dance_beats_per_period`` (3 for a waltz
+    step) and ``beats_per_bar`` are the meters. ParameterError on a bad value.
 
     Examples
     --------
@@ -189,26 +148,10 @@ def beats_per_unit(intervals: np.ndarray, m: int) -> np.ndarray:
 
 
 def accent_lag(motion_beats: Any, music_beats: Any) -> float:
-    """Mean lag of the motion beats behind the music beats [s], in ``(-T/2, T/2]``.
-
-    The circular mean of the motion beats' phases inside their beat intervals, times
-    the median beat period ``T``. Synchronising with ``phase_offset=-lag`` moves the
-    dancer's accents onto the beats (what ``synchronize(..., land="accents")`` does).
-
-    Parameters
-    ----------
-    motion_beats : np.ndarray [shape=(n,)] [s]
-        E.g. :func:`beatsync.motion_beats.kinematic_beats` of a synchronised motion.
-    music_beats : np.ndarray [shape=(m,), m >= 2] [s]
-
-    Returns
-    -------
-    lag : float [s]
-
-    Raises
-    ------
-    ParameterError
-        Fewer than 2 music beats, or no motion beat inside the music's beats.
+    """Mean lag [s] of ``motion_beats`` [s] behind ``music_beats`` [s] (at least 2), in
+    ``(-T/2, T/2]``: the circular mean of their phases in the beat intervals, times the
+    median beat period ``T``. ``phase_offset=-lag`` puts the accents on the beats
+    (``land="accents"``). ParameterError when no motion beat falls inside the beats.
 
     Examples
     --------

@@ -65,25 +65,9 @@ def restore_bone_lengths(
     src_b: np.ndarray | None = None,
     w: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Set every bone of resampled positions back to its interpolated source length.
-
-    Parameters
-    ----------
-    out_pos : np.ndarray [shape=(k, n_joints, 3)]
-        Linearly resampled positions (checked by the caller).
-    src_pos : np.ndarray [shape=(n, n_joints, 3)]
-        The source positions at ``fps``.
-    bones : np.ndarray [shape=(n_bones, 2)], int
-    fps : float > 0 [Hz]
-        Source frame rate.
-    src_a : np.ndarray [shape=(k,)] [s]
-        Source time of each output frame.
-    src_b, w : np.ndarray [shape=(k,)], optional
-        Second source time and its weight where two poses were blended (loop joins).
-
-    Returns
-    -------
-    np.ndarray [shape=(k, n_joints, 3)]
+    """Set every bone of resampled positions ``out_pos`` ``(k, joints, 3)`` back to its
+    source length (``src_pos`` at ``fps``), interpolated at the source times ``src_a``
+    [s] and, where two poses were blended at a loop join, at ``src_b`` with weight ``w``.
     """
     tree = bone_tree(bones, src_pos.shape[1])
     if not tree:

@@ -43,25 +43,10 @@ def blended_rate(
     *,
     delta: float,
 ) -> np.ndarray:
-    """Gaussian-blended playback rate (paper A, eq. 9, our reading).
-
-    ``r(t) = sum_i w_i(t) r_i / sum_i w_i(t)``, ``w_i(t) = exp(-(t - c_i)^2 / (2 delta^2))``.
-
-    Parameters
-    ----------
-    t : np.ndarray [shape=(n,)] [s]
-        Source times at which to evaluate the rate.
-    centres : np.ndarray [shape=(p,)] [s]
-        Centre of each period in source time.
-    rates : np.ndarray [shape=(p,)] [dimensionless]
-        Per-period rate ``target / source``.
-    delta : float > 0 [s]
-        Width of the Gaussian weights (default in :func:`time_warp`: the mean period).
-
-    Returns
-    -------
-    r : np.ndarray [shape=(n,)]
-    """
+    """Gaussian-blended rate (paper A, eq. 9, our reading) at source times ``t`` [s]:
+    ``r(t) = sum_i w_i(t) r_i / sum_i w_i(t)``, ``w_i(t) = exp(-(t - c_i)^2 / (2 delta^2))``
+    with ``c_i`` the period centres [s], ``r_i`` the per-period rates (target / source)
+    and ``delta`` [s] the Gaussian width."""
     t = np.asarray(t, dtype=np.float64)
     c = np.asarray(centres, dtype=np.float64)
     r = np.asarray(rates, dtype=np.float64)
@@ -92,23 +77,11 @@ def blended_rate(
 class TimeWarp:
     """A monotonic, piecewise-linear map from source time to music time.
 
-    Attributes
-    ----------
-    src : np.ndarray [shape=(k,)] [s]
-        Knots in the source motion's time, strictly increasing.
-    tgt : np.ndarray [shape=(k,)] [s]
-        Music time of each knot, strictly increasing.
-    boundaries : np.ndarray [shape=(p+1,)] [s]
-        Source period boundaries used.
-    targets : np.ndarray [shape=(p+1,)] [s]
-        Music beat each boundary is mapped to.
-    period_rates : np.ndarray [shape=(p,)]
-        ``r_i`` per period (target / source).
-    rate : np.ndarray [shape=(k,)]
-        Corrected continuous rate ``r~`` at the knots.
-    n_scaled : int
-        Periods whose correction fell back to scaling (rate jumps at their ends).
-    delta : float [s]
+    Knots ``src`` [s] (source, increasing) and ``tgt`` [s] (music, increasing); the
+    ``boundaries`` [s] used and the ``targets`` [s] they land on; ``period_rates``
+    ``r_i`` (target / source) and the corrected continuous ``rate`` at the knots;
+    ``n_scaled``, the periods whose correction fell back to scaling (the rate jumps
+    at their ends); ``delta`` [s], eq. 9's width.
     """
 
     src: np.ndarray
@@ -142,24 +115,10 @@ def time_warp(
     end: float | None = None,
     delta: float | None = None,
 ) -> TimeWarp:
-    """Integrate the blended, boundary-corrected rate into a time warp.
-
-    Parameters
-    ----------
-    boundaries : np.ndarray [shape=(p+1,), p >= 1] [s]
-        Source period boundaries, strictly increasing.
-    targets : np.ndarray [shape=(p+1,)] [s]
-        Music times the boundaries must land on, strictly increasing.
-    start, end : float, optional [s]
-        Source span to cover before the first / after the last boundary, at the rate
-        the blended curve has there (default: no extension).
-    delta : float > 0, optional [s]
-        Gaussian width of eq. 9; default the mean period ``mean(diff(boundaries))``.
-
-    Returns
-    -------
-    TimeWarp
-        ``warp.to_target(boundaries) == targets`` to rounding.
+    """Integrate the blended, boundary-corrected rate into a time warp that lands every
+    boundary [s] on its target [s] (to rounding), covering ``start`` / ``end`` [s]
+    before the first / after the last boundary at the rate there; ``delta`` [s] is eq.
+    9's width (default the mean period).
 
     Raises
     ------
