@@ -1,12 +1,6 @@
 """The baselines of paper B's comparison: the multi-stage search and the random walk.
 
-See :mod:`beatsync.graph.search` for the objective and the rules both follow (the
-same feasibility under ``scale_bound``, ``steps`` and ``node_mask`` as the DP).
-
-- :func:`conventional_search`: in the spirit of Shiratori et al. 2006, segment by
-  segment, rhythm filter then intensity match; bounded by a candidate cap.
-- :func:`random_walk`: the control.
-
+Both follow the objective and feasibility rules of :mod:`beatsync.graph.search`.
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 4.
 """
 
@@ -57,31 +51,16 @@ def conventional_search(
 ) -> SearchResult:
     """Multi-stage segment-by-segment search (after Shiratori et al. 2006).
 
-    Parameters
-    ----------
-    graph : WeightedMotionGraph
-    music_z : np.ndarray [shape=(G,)]
-        Z-scored music intensity per grid interval.
-    music_durations : np.ndarray [shape=(G,)] [s]
-        Duration of each grid interval (the rhythm to match).
-    segment_beats : int >= 1
-        Music segment length [grid intervals] (8 = two 4/4 bars).
-    rhythm_sigma : float > 0
-        Width of the rhythm match ``exp(-log(d_motion/d_music)^2 / (2 sigma^2))``.
-    rhythm_threshold : float in [0, 1)
-        Stage 1: a candidate's rhythm match must exceed it at every beat. A segment
-        without any such candidate falls back to all candidates (counted in
-        ``info["rhythm_fallbacks"]``).
-    max_candidates : int >= 1
-        Cap on partial candidate sequences per depth (the best by rhythm are kept);
-        ``info["capped_segments"]`` counts the segments where it bit.
-    lam : float >= 0
-    scale_bound, steps, node_mask
-        As in :func:`dp_search` (the same feasibility rule).
-
-    Returns
-    -------
-    SearchResult
+    The music is cut into segments of ``segment_beats`` grid intervals (8: two 4/4
+    bars). For each in turn, graph paths continuing the previous segment are enumerated
+    breadth-first, each interval taking the feasible step whose time-scale is nearest 1;
+    stage 1 keeps those whose rhythm match ``exp(-log(d_motion/d_music)^2 / (2
+    rhythm_sigma^2))`` exceeds ``rhythm_threshold`` at every beat (else all, counted in
+    ``info["rhythm_fallbacks"]``), at most ``max_candidates`` per depth (the best by
+    rhythm; ``info["capped_segments"]``); stage 2 takes the best intensity match per grid
+    interval. Dead ends are avoided with
+    :func:`beatsync.graph.timescale.completion_table`. ``music_durations`` [s] is needed
+    (the rhythm); the other arguments as in :func:`dp_search`.
     """
     music_z, lam, _, md, bound, steps, mask = prepare_search(
         graph, music_z, lam, 0.0, music_durations, scale_bound, steps, node_mask
@@ -224,8 +203,8 @@ class _Ctx:
 def _enumerate(ctx, first, first_w, s0, s1, floor, cap, indptr, succ, sw):
     """Breadth-first enumeration of candidate sequences covering grid s0..s1 (or beyond).
 
-    Returns ``((nodes, ends, n_candidates) or None, complete)``: the chosen sequence's
-    nodes and end boundaries, and whether the candidate cap never bit.
+    Returns ``((nodes, ends, n_candidates) or None, complete)``: the chosen sequence and
+    whether the candidate cap never bit.
     """
     st, r = ctx.step(first, np.full(first.size, s0))
     keep = (st > 0) & (r > floor) if floor > 0 else st > 0
@@ -299,20 +278,11 @@ def random_walk(
     steps: Any = (1,),
     node_mask: Any = None,
 ) -> SearchResult:
-    """A random path covering ``n_intervals`` grid intervals (control).
+    """A random path covering ``n_intervals`` grid intervals (control; costs are NaN).
 
-    The start node, every next node and every step are drawn uniformly among those
-    from which the song can still be completed within the bounds (no dead ends).
-
-    Parameters
-    ----------
-    music_durations, scale_bound, steps, node_mask
-        As in :func:`dp_search` (the same feasibility rule).
-
-    Returns
-    -------
-    SearchResult
-        Costs are NaN (no music is used); ``transitions`` is set.
+    The start node, every next node and every step are drawn uniformly among those from
+    which the song can still be completed within the bounds (arguments as in
+    :func:`dp_search`).
     """
     if not isinstance(graph, WeightedMotionGraph):
         raise ParameterError("graph must be a WeightedMotionGraph")

@@ -1,12 +1,9 @@
 """End-to-end composition: music beats and intensity -> path -> synthesized dance.
 
-:func:`compose` takes music beats [s] and the music level per beat interval (RMS in
-dB, :func:`beatsync.music.beat_rms_db`), z-scores the level, searches the graph with
-the chosen method (``"dp"`` proposed, ``"conventional"`` baseline, ``"random"``
-control) and synthesizes the motion. :func:`compose_music` starts from audio.
-
-Data contract: beats in seconds (1-D float64, strictly increasing); levels one per
-beat interval; the output motion starts at music time 0.
+:func:`compose` z-scores the music level per beat interval (RMS [dB],
+:func:`beatsync.music.beat_rms_db`), plans the tempo, searches the graph and
+synthesizes the motion; :func:`compose_music` starts from audio. The output motion
+starts at music time 0.
 
 Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
@@ -44,28 +41,12 @@ __all__ = ["Composition", "compose", "compose_music", "check_music_beats"]
 
 @dataclass(frozen=True, eq=False)
 class Composition:
-    """A composed dance.
+    """A composed dance (frame ``j`` of ``motion`` plays at ``j / motion.fps`` s of the music).
 
-    Attributes
-    ----------
-    motion : Motion
-        Frame ``j`` plays at ``j / motion.fps`` seconds of the music.
-    search : SearchResult
-    synthesis : SynthesisResult
-    music_beats : np.ndarray [s]
-    music_level : np.ndarray [dB] (one per interval)
-    music_z : np.ndarray (z-scored level per beat interval)
-    timings : dict [s]
-        ``search_s`` and ``synthesis_s``.
-    tempo : TempoPlan
-        Eligible clips (and why), multiplicities, scale bound.
-    plausibility : dict
-        Root and joint rotation speed percentiles against the library's, time-scale
-        factors (:func:`beatsync.graph.plausibility.plausibility`).
-    warnings : list of str
-        Plausibility warnings (also issued as :class:`BeatsyncWarning`).
-    anchors : np.ndarray [s]
-        Music times on which the path's motion beats land (beats or half beats).
+    ``music_level`` [dB] and ``music_z`` (z-scored) are per beat interval; ``timings``
+    [s] holds ``search_s`` and ``synthesis_s``; ``plausibility`` the speeds against the
+    library's (:func:`beatsync.graph.plausibility.plausibility`) and ``warnings`` its
+    warnings; ``anchors`` [s] the music times on which the path's motion beats land.
     """
 
     motion: Motion
@@ -116,18 +97,8 @@ def _counts(steps: np.ndarray, plan: TempoPlan | None) -> dict[str, int]:
 
 
 def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
-    """The one check of music beats on the compose path: seconds, increasing, at least two.
-
-    Parameters
-    ----------
-    beats : array_like [s]
-    duration : float, optional [s]
-        Length of the audio the beats belong to (beats after it are refused).
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two beats, non-finite, not increasing, or after the audio.
+    """The one check of music beats on the compose path: seconds, increasing, at least two
+    (and none after ``duration`` [s], the audio's length, if given).
     """
     n = 0 if beats is None else int(np.asarray(beats).size)
     if n < 2:
@@ -155,49 +126,28 @@ def compose(
     tempo_select: bool = True,
     **search_kwargs: Any,
 ) -> Composition:
-    """Compose a dance for the given music beats and levels.
+    """Compose a dance for the given music beats [s] and levels [dB] (one per beat interval).
 
     Parameters
     ----------
-    graph : WeightedMotionGraph
-    music_beats : np.ndarray [shape=(K+1,)] [s]
-    music_level : np.ndarray [shape=(K,)] [dB]
-        Music intensity per beat interval; z-scored here.
     method : {"dp", "conventional", "random"}
     lam : float >= 0
         Factor on transition weights.
-    fps : float, optional [Hz]
-        Output rate (default the library's).
-    blend : float [s]
-        Transition blend length.
-    end_time : float, optional [s]
-        Output length (default the last beat).
+    fps, blend, end_time, warp
+        Of the output, as in :func:`beatsync.graph.synthesis.synthesize`.
     seed : int
         Random walk seed.
-    warp : {"pchip", "linear"}
-        Time warp inside runs (see :func:`beatsync.graph.synthesis.synthesize`).
     scale_bound : (float, float) or None
         Bound on every interval's time-scale factor (music / natural duration),
         enforced by every method; ``None``: unbounded (paper B as written).
     multiplicity : "auto" or sequence of float
-        Music beats one motion-beat interval may cover (``0.5`` = two intervals per
-        beat); ``"auto"`` chooses from the tempo ratio
-        (:func:`beatsync.graph.timescale.choose_multiplicity`). With
-        ``scale_bound=None`` and ``"auto"`` every interval covers one beat.
+        Music beats one motion-beat interval may cover (``0.5``: two intervals per beat);
+        ``"auto"`` chooses from the tempo ratio, or one beat when ``scale_bound=None``.
     tempo_select : bool
-        Use only the clips of the tempo sub-group(s) that suit the song (True), or
-        the whole library.
+        Use only the clips of the tempo sub-group(s) that suit the song, or all.
     **search_kwargs
-        Passed to the search: ``tempo_weight``, ``start`` (DP); ``segment_beats``
-        [beats], ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
-        (conventional).
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two music beats, level/beat count mismatch, bad options, or no
-        dance within the bound (the message names the library's and the song's tempi
-        and the bound to relax).
+        ``tempo_weight``, ``start`` (DP); ``segment_beats`` [beats], ``rhythm_sigma``,
+        ``rhythm_threshold``, ``max_candidates`` (conventional).
 
     Warns
     -----
@@ -299,7 +249,7 @@ def compose_music(
 ) -> Composition:
     """Compose a dance for audio: track beats (or use ``beats`` [s]), measure levels, compose.
 
-    The output lasts as long as the audio (the last interval's warp continues).
+    The output lasts as long as the audio.
     """
     from ..music import beat_rms_db, track_music_beats
 

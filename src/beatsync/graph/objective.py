@@ -1,12 +1,9 @@
 """The objective of the motion-graph searches, their result and their input checks.
 
-See :mod:`beatsync.graph.search` for the objective ``E``; this module holds what the
-DP (:mod:`beatsync.graph.search`) and the baselines (:mod:`beatsync.graph.baselines`)
-share: :class:`SearchResult`, the validation of their inputs (once, at each public
-entry), the grid times and :func:`path_cost`.
-
-Data contract: music intensities and durations are 1-D arrays over the ``G`` grid
-intervals; durations in seconds; paths are node ids, boundaries grid indices.
+What the DP (:mod:`beatsync.graph.search`, where the objective ``E`` is defined) and
+the baselines (:mod:`beatsync.graph.baselines`) share; inputs are validated once, at
+each public entry. Music values are 1-D over the ``G`` grid intervals (durations [s]);
+paths are node ids, boundaries grid indices.
 """
 
 from __future__ import annotations
@@ -45,15 +42,12 @@ class SearchResult:
     boundaries : np.ndarray [shape=(P + 1,)] int
         Grid boundary where each interval starts (and the last ends: ``G``).
     transitions : np.ndarray [shape=(P,)] bool
-        True where interval ``i`` is entered through a transition edge (``i >= 1``).
+        True where interval ``i`` is entered through a transition edge.
     scales : np.ndarray [shape=(P,)]
-        Time-scale factor of each interval (music / natural duration); NaN when the
-        music durations are unknown.
+        Time-scale factor of each interval (NaN without music durations).
     cost, intensity_cost, transition_cost, tempo_cost : float
         The objective ``E`` and its parts (NaN for the random walk).
-    method : str
     search_time : float [s]
-    info : dict
     """
 
     path: np.ndarray
@@ -151,19 +145,9 @@ def path_cost(
     boundaries: Any = None,
     scale_bound: Any = None,
 ) -> tuple[float, float, float, float, np.ndarray]:
-    """Objective ``E`` of a given path (and its parts); refuses infeasible paths.
-
-    Parameters
-    ----------
-    boundaries : array_like of int, optional
-        Grid boundaries of the intervals (default one grid interval each).
-    scale_bound : (float, float), optional
-        Refuse intervals whose time-scale factor lies outside it.
-
-    Returns
-    -------
-    (total, intensity, transition, tempo, transitions)
-        ``transitions`` is the boolean array of :class:`SearchResult`.
+    """Objective ``E`` of a given path and its parts ``(total, intensity, transition, tempo,
+    transitions)``; refuses infeasible paths. ``boundaries`` default to one grid interval
+    each.
     """
     music_z, lam, tw, md, bound, _, _ = prepare_search(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, (1,), None

@@ -1,30 +1,22 @@
 """Synthesis of a composed dance from a graph path (paper B, section 3.5).
 
-Every chosen interval (from beat frame ``f_k`` to the next beat frame of its clip) is
-time-warped linearly onto its music beat interval ``[b_k, b_{k+1}]``, so each motion
-beat lands exactly on its music beat: source time
-``s(t) = f_k / fps + (t - b_k) / (b_{k+1} - b_k) * (f_{k+1} - f_k) / fps``.
-Output frames are sampled from the source clips with
+Every chosen interval (beat frame ``f_k`` to the next beat frame of its clip) is
+time-warped onto its music beat interval ``[b_k, b_{k+1}]``, so each motion beat lands
+exactly on its music beat: source time
+``s(t) = f_k / fps + (t - b_k) / (b_{k+1} - b_k) * (f_{k+1} - f_k) / fps``
+(or a monotone cubic through the same points); frames are sampled with
 :func:`beatsync.rotations.sample_motion` (slerp on rotations).
 
-Runs of intervals that follow each other in one clip are played as they were
-captured. At a transition (from beat frame ``a`` of one clip to beat frame ``m`` of
-another, or of the same clip) the new run is placed with the rigid floor-plane
-transform (rotation about the vertical axis, translation on the floor) that puts its
-root at ``m`` where the previous run's root is at ``a``, with the same heading, so the
-dancer does not jump (Kovar et al. 2002). Over the first ``blend`` seconds (about
-1/3 s) after the transition the old run, continued past ``a`` at the new interval's
-rate, is blended into the new one with smooth-step weights
-(:func:`beatsync.rotations.blend_values`: slerp on rotations, linear on positions).
-At the beat itself the pose is the old run's beat frame, a beat frame.
+Runs of intervals that follow each other in one clip play as captured. At a
+transition (beat frame ``a`` to beat frame ``m``) the new run is placed with the rigid
+floor-plane transform that puts its root at ``m`` where the previous run's root is at
+``a``, with the same heading (Kovar et al. 2002); over the first ``blend`` seconds the
+old run, continued past ``a``, is blended into the new one with smooth-step weights
+(:func:`beatsync.rotations.blend_values`). The first interval's warp extends back to
+``start_time`` and the last one's on to ``end_time``.
 
-Before the first music beat the first interval's warp is extended backwards (the
-source clip's lead-in, held at its first frame), and after the last beat the last
-interval's warp continues until ``end_time``.
-
-Data contract: music beats in seconds, strictly increasing; the result is a
-:class:`beatsync.motion.Motion` with the library's skeleton at ``fps`` [Hz]; frame
-``j`` plays at ``j / fps`` seconds of the music.
+The result has the library's skeleton at ``fps`` [Hz]; frame ``j`` plays at
+``j / fps`` seconds of the music.
 
 Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
 """
@@ -58,18 +50,9 @@ __all__ = ["SynthesisResult", "synthesize", "synthesize_core", "beat_warp", "smo
 class SynthesisResult:
     """A composed motion and where each output frame came from.
 
-    Attributes
-    ----------
-    motion : Motion
-    source_clip : np.ndarray [shape=(n_frames,)] int
-        Clip index of the run each output frame belongs to.
-    source_time : np.ndarray [shape=(n_frames,)] [s]
-        Time in that clip.
-    transition_times : np.ndarray [s]
-        Music beats at which a transition starts (blend from there for ``blend`` s).
-    beat_source_times : np.ndarray [shape=(K+1,)] [s]
-        Source time the warp assigns to every music beat (a beat frame time).
-    info : dict
+    ``source_clip`` and ``source_time`` [s]: the clip and time each output frame was
+    sampled from; ``transition_times`` [s]: music beats where a transition (and its
+    blend) starts; ``beat_source_times`` [s]: the source time of every music beat.
     """
 
     motion: Motion
@@ -89,20 +72,11 @@ def smoothstep(x: np.ndarray) -> np.ndarray:
 def beat_warp(
     music_beats: np.ndarray, src_start: np.ndarray, src_end: np.ndarray, times: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Piecewise-linear warp from music time to source time.
+    """Piecewise-linear warp from music time to source time: ``(k, s)`` per time.
 
-    Parameters
-    ----------
-    music_beats : np.ndarray [shape=(K+1,)] [s]
-    src_start, src_end : np.ndarray [shape=(K,)] [s]
-        Source times of the beat frames that start and end each interval.
-    times : np.ndarray [s]
-        Music times to map.
-
-    Returns
-    -------
-    (k, s) : interval index of each time (clipped to 0..K-1) and its source time [s].
-        ``s(b_k) = src_start[k]`` exactly; ``s(b_{k+1}) -> src_end[k]``.
+    ``src_start``, ``src_end`` [s] are the source times of the beat frames that start and
+    end each interval; ``k`` is the interval of each time (clipped to 0..K-1) and ``s``
+    its source time, with ``s(b_k) = src_start[k]`` exactly.
     """
     k_n = src_start.size
     k = np.clip(np.searchsorted(music_beats, times, side="right") - 1, 0, k_n - 1)
@@ -153,25 +127,18 @@ def synthesize(
 
     Parameters
     ----------
-    graph : WeightedMotionGraph
     path : array_like [shape=(K,)] int
         Interval nodes (from a search) for the ``K = len(music_beats) - 1`` intervals.
-    music_beats : array_like [shape=(K+1,)] [s]
     fps : float > 0 [Hz], optional
         Output frame rate; default the library's.
-    blend : float >= 0 [s]
+    blend : float in [0, 5] [s]
         Transition blend length (capped at the interval's duration).
     start_time, end_time : float [s]
         Span of the output (default from 0 to the last music beat).
     warp : {"pchip", "linear"}
-        Time warp inside a run of consecutive intervals: piecewise linear (the rate
-        jumps at every beat) or a monotone cubic (PCHIP) through the same beat
-        correspondences (continuous rate). Both put every motion beat exactly on its
+        Time warp inside a run of intervals: piecewise linear (the rate jumps at every
+        beat) or a monotone cubic (continuous rate); both put every motion beat on its
         music beat.
-
-    Returns
-    -------
-    SynthesisResult
     """
     beats = check_times(music_beats, name="music beats")
     path = np.asarray(path, dtype=np.int64)
