@@ -1,33 +1,20 @@
 """Music-driven dance composition over weighted motion graphs (paper B).
 
 Xu, Takagi, Kawada, "Automatic composition of motion capture animation for music
-synchronization". Modules:
+synchronization". A motion library becomes a :class:`WeightedMotionGraph` whose nodes
+are beat frames (:mod:`~beatsync.graph.build`, eq. 1 in
+:mod:`~beatsync.graph.distance`); a song is planned by tempo
+(:mod:`~beatsync.graph.timescale`), searched (:mod:`~beatsync.graph.search`, the DP;
+:mod:`~beatsync.graph.baselines`; shared :mod:`~beatsync.graph.objective`),
+synthesized (:mod:`~beatsync.graph.synthesis`) and checked for speed
+(:mod:`~beatsync.graph.plausibility`); :mod:`~beatsync.graph.compose` runs the chain
+and :mod:`~beatsync.graph.cache` keeps built graphs on disk. Quality proxies are in
+:mod:`beatsync.evaluate.composition`, synthetic dances in
+:mod:`beatsync.synth.library`, the study in :mod:`beatsync.study.paper_b`.
 
-- :mod:`~beatsync.graph.build`: a motion library becomes a :class:`WeightedMotionGraph`
-  whose nodes are beat frames; :mod:`~beatsync.graph.distance`: the frame distance
-  of eq. 1 (stable floor-aligned point-cloud distance).
-- :mod:`~beatsync.graph.timescale`: tempo-matched composition (clip tempi, tempo
-  sub-groups, beat multiplicity, the time-scale bound).
-- :mod:`~beatsync.graph.search`: the DP over the music's beats (and the dispatcher);
-  :mod:`~beatsync.graph.baselines`: the multi-stage search and the random walk;
-  :mod:`~beatsync.graph.objective`: their shared objective, result and checks.
-- :mod:`~beatsync.graph.synthesis`: the chosen intervals time-warped onto the music and
-  blended at transitions.
-- :mod:`~beatsync.graph.plausibility`: root and joint rotation speeds against the
-  library's.
-- :mod:`~beatsync.graph.compose`: the public entry that runs the whole chain;
-  :mod:`~beatsync.graph.cache`: built graphs kept on disk.
-
-Outside this stage: quality proxies are metrics in
-:mod:`beatsync.evaluate.composition`, synthetic dances live in
-:mod:`beatsync.synth.library`, and the paper-B notebooks call
-:mod:`beatsync.study.paper_b`.
-
-Data contract: event times in seconds (1-D float64, strictly increasing); motions
-are :class:`beatsync.motion.Motion` with one skeleton structure per library.
-
-Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb`` (paper B Table 1) and
-``notebooks/paper_b_tab02_quality_proxies.ipynb`` (proxies for paper B Table 2).
+Event times are seconds (1-D float64, strictly increasing). Notebooks:
+``notebooks/paper_b_tab01_search_speed.ipynb`` (paper B Table 1) and
+``notebooks/paper_b_tab02_quality_proxies.ipynb`` (proxies for Table 2).
 """
 
 from .build import (

@@ -284,8 +284,6 @@ def random_walk(
     which the song can still be completed within the bounds (arguments as in
     :func:`dp_search`).
     """
-    if not isinstance(graph, WeightedMotionGraph):
-        raise ParameterError("graph must be a WeightedMotionGraph")
     k_n = int(n_intervals)
     if k_n < 1:
         raise ParameterError(f"n_intervals={n_intervals!r} must be >= 1")

@@ -26,7 +26,7 @@ from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
 from .plausibility import plausibility
 from .search import METHODS, dp_core
-from .synthesis import SynthesisResult, synthesize_core
+from .synthesis import SynthesisResult, check_blend_warp, synthesize_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
     TempoPlan,
@@ -169,14 +169,10 @@ def compose(
     if bound is None and mult == "auto":
         mult = (1.0,)
     fps = check_fps(graph.clips[0].fps if fps is None else fps)
-    blend = float(blend)
-    if not np.isfinite(blend) or blend < 0 or blend > 5:
-        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
+    blend = check_blend_warp(blend, warp)
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > 0:
         raise ParameterError(f"end_time={end_time!r} must be > 0 [s]")
-    if warp not in ("pchip", "linear"):
-        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
     plan = plan_tempo(
         graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
     )
@@ -211,30 +207,28 @@ def _search(graph, z, md, method, lam, seed, plan, kwargs):
     """Run one search on the song's grid under the tempo plan (inputs validated here)."""
     kwargs = dict(kwargs)
     sub = plan.subdivision
+    tw = 0.0
     if method == "conventional":
-        seg = kwargs.pop("segment_beats", 8)
-        opts = check_conventional_options(seg, **kwargs)
-        z, lam, _, md, bound, steps, mask = prepare_search(
-            graph, z, lam, 0.0, md, plan.bound, plan.steps, plan.node_mask
-        )
+        opts = check_conventional_options(kwargs.pop("segment_beats", 8), **kwargs)
         opts["seg"] = opts["seg"] * sub
-        return conventional_core(graph, z, md, lam, bound, steps, mask, **opts, subdivision=sub)
-    if method == "random":
+    elif method == "random":
         if kwargs:
             raise ParameterError(f"the random walk takes no options {sorted(kwargs)}")
-        _, _, _, md, bound, steps, mask = prepare_search(
-            graph, z, 0.0, 0.0, md, plan.bound, plan.steps, plan.node_mask
-        )
-        return random_core(graph, z.size, seed, md, bound, steps, mask, subdivision=sub)
-    start = kwargs.pop("start", "any")
-    tw = kwargs.pop("tempo_weight", 0.0)
-    if kwargs:
-        raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
-    if start not in ("any", "clip_start"):
-        raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
+        lam = 0.0
+    else:
+        start = kwargs.pop("start", "any")
+        tw = kwargs.pop("tempo_weight", 0.0)
+        if kwargs:
+            raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
+        if start not in ("any", "clip_start"):
+            raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, z, lam, tw, md, plan.bound, plan.steps, plan.node_mask
     )
+    if method == "conventional":
+        return conventional_core(graph, z, md, lam, bound, steps, mask, **opts, subdivision=sub)
+    if method == "random":
+        return random_core(graph, z.size, seed, md, bound, steps, mask, subdivision=sub)
     return dp_core(graph, z, lam, tw, md, bound, steps, mask, start=start, subdivision=sub)
 
 

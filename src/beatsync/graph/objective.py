@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..validation import check_finite
+from ..validation import check_finite, check_positive
 from .build import WeightedMotionGraph
 from .timescale import check_scale_bound
 
@@ -98,12 +98,8 @@ def prepare_search(
     if not isinstance(graph, WeightedMotionGraph):
         raise ParameterError("graph must be a WeightedMotionGraph (see beatsync.graph.build_graph)")
     music_z = check_music(music_z, "music intensity")
-    v = float(lam)
-    if not np.isfinite(v) or v < 0:
-        raise ParameterError(f"lam={lam!r} (transition cost factor) must be finite and >= 0")
-    tw = float(tempo_weight)
-    if not np.isfinite(tw) or tw < 0:
-        raise ParameterError(f"tempo_weight={tempo_weight!r} must be finite and >= 0")
+    v = check_positive(lam, name="lam", unit="transition cost factor", allow_zero=True)
+    tw = check_positive(tempo_weight, name="tempo_weight", unit="cost", allow_zero=True)
     md = None
     if music_durations is not None:
         md = check_music(music_durations, "music_durations")

@@ -39,7 +39,7 @@ _CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
 
 
 def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
-    """``root_speed`` ``(n - 1,)`` and ``rotation_speed`` ``(n - 1, n_rot_joints)`` [per s]."""
+    """Root speed [unit / s] ``(n - 1,)`` and joint rotation speeds [deg / s] ``(n - 1, J)``."""
     pos = np.asarray(motion.positions(), dtype=np.float64)
     root = np.linalg.norm(np.diff(pos[:, 0, :], axis=0), axis=1) * motion.fps
     triples = motion.rotation_triples() if getattr(motion, "skeleton", None) else []

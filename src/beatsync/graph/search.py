@@ -129,7 +129,6 @@ def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", sub
     arg_arrive = np.zeros((g_n + 1, n), dtype=np.int32)
     arg_step = np.zeros((g_n + 1, n), dtype=np.int16)
     rows = np.arange(n)
-    d = np.full(n, np.inf)
     for k in range(1, g_n + 1):
         d = np.full(n, np.inf)
         for s in steps:

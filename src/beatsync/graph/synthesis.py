@@ -43,7 +43,14 @@ from ..validation import check_fps, check_times, frames_to_time, time_to_frames
 from .build import WeightedMotionGraph
 from .distance import ground_axes
 
-__all__ = ["SynthesisResult", "synthesize", "synthesize_core", "beat_warp", "smoothstep"]
+__all__ = [
+    "SynthesisResult",
+    "synthesize",
+    "synthesize_core",
+    "check_blend_warp",
+    "beat_warp",
+    "smoothstep",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,15 +160,21 @@ def synthesize(
         raise ParameterError("path contains nodes that do not start an interval")
     template = graph.clips[0]
     fps = check_fps(template.fps if fps is None else fps)
-    blend = float(blend)
-    if not np.isfinite(blend) or blend < 0 or blend > 5:
-        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
+    blend = check_blend_warp(blend, warp)
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > start_time >= 0:
         raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
+
+
+def check_blend_warp(blend: Any, warp: Any) -> float:
+    """The blend length [s] as a float in [0, 5], and ``warp`` one of "pchip", "linear"."""
+    blend = float(blend)
+    if not np.isfinite(blend) or blend < 0 or blend > 5:
+        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
     if warp not in ("pchip", "linear"):
         raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
-    return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
+    return blend
 
 
 def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
