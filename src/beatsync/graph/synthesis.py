@@ -92,7 +92,7 @@ def beat_warp(
     return k, s
 
 
-def _root_layout(template: Motion, up: int) -> tuple[list[int], tuple[int, int, int], str]:
+def _root_layout(template: Motion) -> tuple[list[int], tuple[int, int, int], str]:
     skel = template.skeleton
     root = skel.joints[0].name
     pos_cols = []
@@ -182,7 +182,7 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     template = graph.clips[0]
     up = "xyz".index(graph.params.get("up_axis", "y"))
     g0, g1 = ground_axes(up)
-    pos_cols, rot_cols, order = _root_layout(template, up)
+    pos_cols, rot_cols, order = _root_layout(template)
     rot_cols = list(rot_cols)
 
     k_n = path.size
@@ -202,8 +202,6 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     run_of = run_id[k_of]
     if warp == "pchip":
         s_of = _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_of)
-    n_out = t.size
-    values = np.empty((n_out, template.n_channels))
 
     # rigid floor transforms per run: yaw angle and ground translation
     n_runs = int(run_id[-1]) + 1
@@ -215,28 +213,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         v = graph.clips[clip].values[frame]  # beat frames lie on frames: no sampling
         return v[pos_cols], euler_to_rotation(v[rot_cols][None, :], order)
 
-    def place(r: int, p: np.ndarray) -> np.ndarray:
-        rot = Rotation.from_rotvec(yaw[r] * _unit(up))
-        out = rot.apply(p)
-        out[..., g0] += shift[r, g0]
-        out[..., g1] += shift[r, g1]
-        return out
-
+    axis = np.eye(3)[up]  # the vertical axis
     for r in range(1, n_runs):
         k = run_first_k[r]
         # previous run ends on beat frame a (= next_node[path[k-1]]) of its clip
         a = graph.next_node[path[k - 1]]
-        ca = graph.node_clip[a]
-        pa, ra = raw_root(ca, graph.node_frame[a])
+        pa, ra = raw_root(graph.node_clip[a], graph.node_frame[a])
         pb, rb = raw_root(clip_of[k], graph.node_frame[path[k]])
-        ha = _heading(Rotation.from_rotvec(yaw[r - 1] * _unit(up)) * ra, up)[0]
-        hb = _heading(rb, up)[0]
-        yaw[r] = ha - hb
-        target = place(r - 1, pa)
-        moved = Rotation.from_rotvec(yaw[r] * _unit(up)).apply(pb)
-        shift[r] = 0.0
-        shift[r, g0] = target[g0] - moved[g0]
-        shift[r, g1] = target[g1] - moved[g1]
+        turn = Rotation.from_rotvec(yaw[r - 1] * axis)
+        yaw[r] = _heading(turn * ra, up)[0] - _heading(rb, up)[0]
+        target = turn.apply(pa)
+        target[[g0, g1]] += shift[r - 1, [g0, g1]]
+        moved = Rotation.from_rotvec(yaw[r] * axis).apply(pb)
+        shift[r, [g0, g1]] = target[[g0, g1]] - moved[[g0, g1]]
 
     def transformed(runs: np.ndarray, clips: np.ndarray, s: np.ndarray) -> np.ndarray:
         """Samples of the given clips at source times, placed by their runs' transforms."""
@@ -249,10 +238,9 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
             return v
         vm = v[moved]
         rm = runs[moved]
-        turn = Rotation.from_rotvec(yaw[rm][:, None] * _unit(up)[None, :])
+        turn = Rotation.from_rotvec(yaw[rm][:, None] * axis[None, :])
         p = turn.apply(vm[:, pos_cols])
-        p[:, g0] += shift[rm, g0]
-        p[:, g1] += shift[rm, g1]
+        p[:, [g0, g1]] += shift[rm][:, [g0, g1]]
         vm[:, pos_cols] = p
         rot = Rotation.from_quat(
             quat_multiply(turn.as_quat(), quat_from_euler(vm[:, rot_cols], order))
@@ -261,7 +249,7 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         v[moved] = vm
         return v
 
-    values[:] = transformed(run_of, clip_of[k_of], s_of)
+    values = transformed(run_of, clip_of[k_of], s_of)
 
     # blends after every transition (windows never overlap: one per music interval)
     trans_times = beats[:-1][trans]
@@ -326,9 +314,3 @@ def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
         inside = (run_id[k_of] == r) & (t >= x[0]) & (t <= x[-1])
         s[inside] = PchipInterpolator(x, y)(t[inside])
     return s
-
-
-def _unit(up: int) -> np.ndarray:
-    v = np.zeros(3)
-    v[up] = 1.0
-    return v
