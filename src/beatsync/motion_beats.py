@@ -104,14 +104,12 @@ def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
             if isinstance(j, (int, np.integer)):
                 if not 0 <= int(j) < pos.shape[1]:
                     raise ParameterError(f"joint index {j} out of range 0..{pos.shape[1] - 1}")
-                idx.append(int(j))
-            else:
-                if j not in names:
-                    raise ParameterError(
-                        f"joint {j!r} not in the motion; known joints: {', '.join(names[:12])}"
-                        + (" ..." if len(names) > 12 else "")
-                    )
-                idx.append(names.index(j))
+            elif j not in names:
+                raise ParameterError(
+                    f"joint {j!r} not in the motion; known joints: {', '.join(names[:12])}"
+                    + (" ..." if len(names) > 12 else "")
+                )
+            idx.append(int(j) if isinstance(j, (int, np.integer)) else names.index(j))
         if not idx:
             raise ParameterError("joints is empty: give at least one joint name or None for all")
         pos = pos[:, idx, :]
@@ -296,13 +294,7 @@ def kinematic_beats(
     rel_prominence: float = 0.02,
     window: float = 0.5,
 ) -> np.ndarray:
-    """Motion beat times of a clip [s] (see the module docstring for the methods).
-
-    Examples
-    --------
-    >>> from beatsync import datasets                                  # doctest: +SKIP
-    >>> kinematic_beats(datasets.load_salsa("60_01"))[:3]              # doctest: +SKIP
-    """
+    """Motion beat times of a clip [s] (see the module docstring for the methods)."""
     pos = motion_positions(motion, joints=joints)
     frames = kinematic_beat_frames(
         pos,

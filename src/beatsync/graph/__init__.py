@@ -33,7 +33,6 @@ from .search import (
     dp_search,
     path_cost,
     random_walk,
-    search,
 )
 from .synthesis import SynthesisResult, beat_warp, synthesize
 
@@ -47,7 +46,6 @@ __all__ = [
     "check_th",
     "transition_weight",
     "METHODS",
-    "search",
     "SearchResult",
     "conventional_search",
     "dp_search",

@@ -410,11 +410,7 @@ def build_graph(
         raise ParameterError(f"up_axis={up_axis!r} must be 'y' (BVH) or 'z'")
     up = "xyz".index(up_axis)
     for name, val in (("window", window), ("rd_unit", rd_unit)):
-        try:
-            ok = np.isfinite(float(val)) and 0 < float(val) <= 10
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
+        if check_positive(val, name=name, unit="s") > 10:
             raise ParameterError(f"{name}={val!r} must be a duration in (0, 10] [s]")
     if beats is not None and len(beats) != len(clips):
         raise ParameterError(

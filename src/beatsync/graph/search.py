@@ -46,7 +46,6 @@ from .timescale import no_path_error, span_feasible
 
 __all__ = [
     "METHODS",
-    "search",
     "SearchResult",
     "dp_search",
     "dp_core",
@@ -55,7 +54,7 @@ __all__ = [
     "path_cost",
 ]
 
-#: Search methods of :func:`search`.
+#: Search methods of :func:`beatsync.graph.compose.compose`.
 METHODS = ("dp", "conventional", "random")
 
 
@@ -170,30 +169,3 @@ def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", sub
     return make_result(
         graph, path[::-1], bnd[::-1], music_z, lam, tw, md, bound, "dp", elapsed, {"start": start}
     )
-
-
-# --------------------------------------------------------------------------- dispatch
-
-
-def search(
-    graph: WeightedMotionGraph,
-    music_z: Any,
-    music_durations: Any,
-    *,
-    method: str = "dp",
-    lam: float = 1.0,
-    seed: int = 0,
-    **kwargs: Any,
-) -> SearchResult:
-    """Search a path with ``method``: :func:`dp_search`, :func:`conventional_search` or
-    :func:`random_walk`.
-    """
-    if method == "dp":
-        return dp_search(graph, music_z, lam=lam, music_durations=music_durations, **kwargs)
-    if method == "conventional":
-        return conventional_search(graph, music_z, music_durations, lam=lam, **kwargs)
-    if method == "random":
-        return random_walk(
-            graph, len(music_z), seed=seed, music_durations=music_durations, **kwargs
-        )
-    raise ParameterError(f"method={method!r} is not one of {METHODS}")

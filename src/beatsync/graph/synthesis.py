@@ -49,7 +49,6 @@ __all__ = [
     "synthesize_core",
     "check_blend_warp",
     "beat_warp",
-    "smoothstep",
 ]
 
 
@@ -68,12 +67,6 @@ class SynthesisResult:
     transition_times: np.ndarray
     beat_source_times: np.ndarray
     info: dict = field(default_factory=dict)
-
-
-def smoothstep(x: np.ndarray) -> np.ndarray:
-    """``3 x^2 - 2 x^3`` on ``[0, 1]`` (zero slope at both ends)."""
-    x = np.clip(np.asarray(x, dtype=np.float64), 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
 
 
 def beat_warp(
@@ -267,7 +260,8 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         runs.append(np.full(sel.size, run_id[k] - 1))
         clips.append(np.full(sel.size, graph.node_clip[a]))
         s_old.append(node_t[a] + (t[sel] - beats[k]) * rate)
-        weights.append(smoothstep((t[sel] - beats[k]) / length))
+        x = np.clip((t[sel] - beats[k]) / length, 0.0, 1.0)
+        weights.append(x * x * (3.0 - 2.0 * x))  # smooth step: zero slope at both ends
     if idx:
         sel = np.concatenate(idx)
         old = transformed(np.concatenate(runs), np.concatenate(clips), np.concatenate(s_old))
