@@ -75,26 +75,15 @@ def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class WeightedMotionGraph:
-    """A weighted motion graph over the beat frames of a motion library.
+    """A weighted motion graph over the beat frames of a motion library (module docstring).
 
-    Attributes
-    ----------
-    node_clip, node_frame : np.ndarray [shape=(N,)] int
-        Clip index and beat frame [frames] of each node.
-    next_node : np.ndarray [shape=(N,)] int
-        The following beat node of the same clip (forward edge), -1 at a clip's last beat.
-    intensity : np.ndarray [shape=(N,)] [(position unit / s)^2]
-        Motion intensity of the interval starting at each node (NaN at last beats);
-        ``z_intensity`` the same z-scored over the library.
-    trans_src, trans_dst, trans_rd, trans_weight : np.ndarray [shape=(E,)]
-        Directed transition edges (each two-way edge in both directions), their ``rd``
-        and eq. 2 weight.
-    speed_scale : float [position unit / s]
-        ``v_typ`` of the rd normalisation.
-    min_rd : float
-        Smallest ``rd`` between two distinct beat frames (to suggest a TH).
-    params : dict
-        All construction parameters (for caching and reports).
+    Per node ``(N,)``: ``node_clip``, ``node_frame`` [frames], ``next_node`` (the next beat
+    node of its clip, -1 at a clip's last beat), ``intensity`` [(unit / s)^2] and
+    ``z_intensity`` of the interval it starts (NaN at last beats). Per directed transition
+    ``(E,)`` (each two-way edge twice): ``trans_src``, ``trans_dst``, ``trans_rd``,
+    ``trans_weight``. ``speed_scale``: ``v_typ`` [unit / s]; ``min_rd``: the smallest
+    ``rd`` between two beat frames (to suggest a TH); ``params``: the construction
+    parameters.
     """
 
     clips: tuple
@@ -380,26 +369,15 @@ def build_graph(
 ) -> WeightedMotionGraph:
     """Build the weighted motion graph of a motion library (paper B, section 3.2).
 
-    Parameters
-    ----------
-    th : float > 0
-        TH of eq. 1 on the scale-free distance ``rd`` (paper: 3.0).
-    weight_rule : {"paper", "rd"}
-        Eq. 2 as written (``max(rd, 2)``) or the plain ``rd``.
-    beats : sequence of array_like [s], optional
-        Beat times per clip, each put on its nearest frame (beats after a clip's last
-        frame are refused, beats on one frame merged with a warning); default kinematic
-        beats (``beat_method``, ``smooth``, ``min_interval``, see
-        :func:`beatsync.motion_beats.kinematic_beats`).
-    joints : sequence of str, optional
-        Joints used for beats, intensities and distances; default all.
-    window, rd_unit : float > 0 [s]
-        Length of the frame window compared by eq. 1; time unit of ``rd``.
-    up_axis : {"y", "z"}
-        Vertical axis of the data (BVH: y).
-    require_transitions : bool
-        Raise if no pair of beat frames has ``rd < th`` (the message gives the smallest
-        ``rd``, to suggest a threshold).
+    ``th``: TH of eq. 1 (paper: 3.0); ``weight_rule``: eq. 2 as written (``"paper"``) or
+    the plain ``rd``; ``beats``: beat times [s] per clip, each put on its nearest frame
+    (after a clip's last frame: refused; two on one frame: merged with a warning), by
+    default kinematic beats (``beat_method``, ``smooth``, ``min_interval``:
+    :func:`beatsync.motion_beats.kinematic_beats`); ``joints``: for beats, intensities and
+    distances (default all); ``window`` [s]: the frames compared by eq. 1; ``rd_unit``
+    [s]: the time unit of ``rd``; ``up_axis``: the vertical axis (BVH: y);
+    ``require_transitions``: refuse a graph without transitions (naming the smallest
+    ``rd``).
     """
     t0 = time.perf_counter()
     clips = check_library(clips)

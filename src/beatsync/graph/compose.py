@@ -128,32 +128,17 @@ def compose(
 ) -> Composition:
     """Compose a dance for the given music beats [s] and levels [dB] (one per beat interval).
 
-    Parameters
-    ----------
-    method : {"dp", "conventional", "random"}
-    lam : float >= 0
-        Factor on transition weights.
-    fps, blend, end_time, warp
-        Of the output, as in :func:`beatsync.graph.synthesis.synthesize`.
-    seed : int
-        Random walk seed.
-    scale_bound : (float, float) or None
-        Bound on every interval's time-scale factor (music / natural duration),
-        enforced by every method; ``None``: unbounded (paper B as written).
-    multiplicity : "auto" or sequence of float
-        Music beats one motion-beat interval may cover (``0.5``: two intervals per beat);
-        ``"auto"`` chooses from the tempo ratio, or one beat when ``scale_bound=None``.
-    tempo_select : bool
-        Use only the clips of the tempo sub-group(s) that suit the song, or all.
-    **search_kwargs
-        ``tempo_weight``, ``start`` (DP); ``segment_beats`` [beats], ``rhythm_sigma``,
-        ``rhythm_threshold``, ``max_candidates`` (conventional).
-
-    Warns
-    -----
-    BeatsyncWarning
-        The result's 99th-percentile root or joint rotation speed exceeds the fastest
-        library clip's by more than 25 % (:mod:`beatsync.graph.plausibility`).
+    ``method``: ``"dp"`` (proposed), ``"conventional"`` (baseline) or ``"random"``
+    (control, seeded by ``seed``); ``lam``: factor on transition weights; ``fps``,
+    ``blend``, ``end_time``, ``warp``: of the output
+    (:func:`beatsync.graph.synthesis.synthesize`). ``scale_bound``: bound on every
+    interval's time-scale factor, ``None`` unbounded (paper B as written);
+    ``multiplicity``: music beats one motion interval may cover (``"auto"``: from the
+    tempo ratio, one beat when unbounded); ``tempo_select``: only the clips of the tempo
+    sub-group(s) that suit the song. ``search_kwargs``: ``tempo_weight``, ``start`` (DP),
+    ``segment_beats``, ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
+    (conventional). A result whose 99th-percentile root or joint rotation speed exceeds
+    the library's fastest clip's by more than 25 % warns (:mod:`.plausibility`).
     """
     beats = check_music_beats(music_beats)
     level = check_finite(music_level, name="music level")

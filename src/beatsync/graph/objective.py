@@ -35,19 +35,11 @@ __all__ = [
 class SearchResult:
     """A path through the graph for ``G`` music grid intervals.
 
-    Attributes
-    ----------
-    path : np.ndarray [shape=(P,)] int
-        Interval node played during each motion interval.
-    boundaries : np.ndarray [shape=(P + 1,)] int
-        Grid boundary where each interval starts (and the last ends: ``G``).
-    transitions : np.ndarray [shape=(P,)] bool
-        True where interval ``i`` is entered through a transition edge.
-    scales : np.ndarray [shape=(P,)]
-        Time-scale factor of each interval (NaN without music durations).
-    cost, intensity_cost, transition_cost, tempo_cost : float
-        The objective ``E`` and its parts (NaN for the random walk).
-    search_time : float [s]
+    ``path`` ``(P,)``: the interval node of each motion interval; ``boundaries``
+    ``(P + 1,)``: the grid boundary where each starts (and the last ends, ``G``);
+    ``transitions`` ``(P,)``: entered through a transition edge; ``scales`` ``(P,)``:
+    time-scale factors (NaN without music durations); ``cost``, ``intensity_cost``,
+    ``transition_cost``, ``tempo_cost``: ``E`` and its parts (NaN for the random walk).
     """
 
     path: np.ndarray

@@ -73,29 +73,13 @@ def dp_search(
     steps: Any = (1,),
     node_mask: Any = None,
 ) -> SearchResult:
-    """Globally optimal path by dynamic programming (paper B, eqs. 3-6).
+    """Globally optimal path by dynamic programming (paper B, eqs. 3-6, module docstring).
 
-    Parameters
-    ----------
-    music_z : np.ndarray [shape=(G,)]
-        Z-scored music intensity per grid interval.
-    lam : float >= 0
-        Factor on the transition weights.
-    start : {"any", "clip_start"}
-        Start at any interval node, or only at the first beat frame of each clip.
-    tempo_weight : float >= 0
-        Weight of the tempo term (0 as in the paper).
-    music_durations : np.ndarray [shape=(G,)] [s], optional
-        Needed for ``tempo_weight > 0`` and ``scale_bound``.
-    scale_bound : (float, float), optional
-        Bound on every interval's time-scale factor (music / natural duration).
-    steps : sequence of int >= 1
-        Grid intervals one motion interval may cover.
-    node_mask : np.ndarray [shape=(N,)] bool, optional
-        Nodes the path may use.
-
-    ``search_time`` of the result counts the DP only (the graph is built offline). No
-    path within the bounds raises a ParameterError naming both tempi and the bound.
+    ``music_z`` ``(G,)``: z-scored music intensity per grid interval; ``start``: at any
+    interval node, or only at each clip's first beat frame (``"clip_start"``);
+    ``music_durations`` [s] ``(G,)``: needed for ``tempo_weight > 0`` and
+    ``scale_bound``; ``steps``: grid intervals one motion interval may cover;
+    ``node_mask`` ``(N,)``: nodes the path may use. ``search_time`` counts the DP only.
     """
     music_z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, steps, node_mask

@@ -125,20 +125,10 @@ def synthesize(
 ) -> SynthesisResult:
     """Concatenate, warp and blend the chosen intervals into one motion.
 
-    Parameters
-    ----------
-    path : array_like [shape=(K,)] int
-        Interval nodes (from a search) for the ``K = len(music_beats) - 1`` intervals.
-    fps : float > 0 [Hz], optional
-        Output frame rate; default the library's.
-    blend : float in [0, 5] [s]
-        Transition blend length (capped at the interval's duration).
-    start_time, end_time : float [s]
-        Span of the output (default from 0 to the last music beat).
-    warp : {"pchip", "linear"}
-        Time warp inside a run of intervals: piecewise linear (the rate jumps at every
-        beat) or a monotone cubic (continuous rate); both put every motion beat on its
-        music beat.
+    ``path`` ``(K,)``: interval nodes for the ``K = len(music_beats) - 1`` intervals;
+    ``fps``: default the library's; ``blend`` [s]: capped at the interval's duration;
+    ``start_time``, ``end_time`` [s]: default 0 and the last beat; ``warp``: piecewise
+    linear (the rate jumps at every beat) or monotone cubic (continuous rate).
     """
     beats = check_times(music_beats, name="music beats")
     path = np.asarray(path, dtype=np.int64)

@@ -75,20 +75,10 @@ SHORT_CLIP_MAX_ENERGY = 0.5
 
 @dataclass(frozen=True)
 class Segmentation:
-    """Result of :func:`segment`.
-
-    Attributes
-    ----------
-    boundaries : np.ndarray [s]
-        ``n_periods + 1`` strictly increasing times within ``[0, (n_frames - 1) / fps]``.
-    energy : float
-        E of the optimum (sum over consecutive period pairs and channels of 1 - r).
-    channels : tuple of str
-        Channels used (after selection and constant-channel exclusion).
-    period_method : str
-        ``"energy"``, ``"fft"`` or ``"given"``.
-    search_decimation : int >= 1
-        Time decimation factor of the search (1: exact search at full rate).
+    """Result of :func:`segment`: ``boundaries`` [s] (``n_periods + 1``, increasing, within
+    ``[0, (n_frames - 1) / fps]``), ``energy`` E of the optimum, the ``channels`` used (after
+    selection and exclusion), ``period_method`` (``"energy"``, ``"fft"`` or ``"given"``) and
+    ``search_decimation`` (1: the exact search at full rate).
     """
 
     boundaries: np.ndarray
