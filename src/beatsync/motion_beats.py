@@ -1,25 +1,21 @@
 """Motion beats and motion intensity of dance clips (paper B, section 3.1).
 
-Paper B builds its motion graph on the *beat frames* of every clip of a library and
-weights the forward edge between two successive beat frames by the *motion
-intensity* of that interval.
+Paper B builds its motion graph on the *beat frames* of every clip and weights the
+edge between two successive beat frames by the *motion intensity* of that interval.
 
-- **Kinematic beats** (``method="speed"``, the default): local minima of the mean
-  joint speed, smoothed with a Gaussian of standard deviation ``smooth`` [s]. Dancers
-  mark the beat by stopping or reversing a movement (Shiratori et al. 2004, Kim et al.
-  2003). Minima closer than ``min_interval`` [s] are thinned (the deeper one kept),
-  and minima less prominent than ``rel_prominence`` times the median smoothed speed
-  are dropped (flat plateaus).
-- **PCA beats** (``method="pca"``, paper B's earlier work and Kim et al. 2003): the
-  extrema (turning points) of the smoothed projection of each frame on the first
-  principal axis of root-relative joint positions over a ``window`` [s].
-- **Motion intensity** of a beat interval: the mean kinetic energy of the joints,
-  ``0.5 * mean_j |v_j|^2`` (unit mass), averaged over ``[beat_i, beat_{i+1})``
-  [(position unit / s)^2].
+- **Kinematic beats** (``method="speed"``): local minima of the mean joint speed,
+  Gaussian-smoothed (sigma ``smooth`` [s]): dancers mark the beat by stopping or
+  reversing a movement (Shiratori et al. 2004, Kim et al. 2003). Minima closer than
+  ``min_interval`` [s] are thinned and those less prominent than ``rel_prominence``
+  times the median speed dropped (flat plateaus).
+- **PCA beats** (``method="pca"``, Kim et al. 2003): the extrema of each frame's
+  projection on the first principal axis of root-relative joint positions over a
+  ``window`` [s].
+- **Motion intensity**: the joints' mean kinetic energy ``0.5 * mean_j |v_j|^2`` (unit
+  mass) over ``[beat_i, beat_{i+1})`` [(position unit / s)^2].
 
-Motions have a skeleton (joint positions by forward kinematics) or are marker tables
-of ``<marker>_x/_y/_z`` triples; the array functions take positions ``(n_frames,
-n_joints, 3)`` and ``fps`` [Hz]. Beat times are seconds on frame times.
+Motions have a skeleton or are marker tables of ``<marker>_x/_y/_z`` triples; the
+array functions take positions ``(n_frames, n_joints, 3)``. Beats lie on frame times.
 
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 """
@@ -56,9 +52,6 @@ __all__ = [
 ]
 
 _METHODS = ("speed", "pca")
-
-
-# --------------------------------------------------------------------------- helpers
 
 
 def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
@@ -157,9 +150,6 @@ def zscore(x: Any, *, name: str = "values") -> np.ndarray:
     return (arr - arr.mean()) / sd
 
 
-# --------------------------------------------------------------------------- curves
-
-
 def kinetic_energy(positions: Any, *, fps: float) -> np.ndarray:
     """Per-frame mean kinetic energy of the joints, ``0.5 * mean_j |v_j|^2`` [(unit / s)^2].
 
@@ -222,9 +212,6 @@ def pca_curve(
     if smooth > 0:
         proj = gaussian_filter1d(proj, sigma=smooth * fps, mode="nearest")
     return proj
-
-
-# --------------------------------------------------------------------------- beats
 
 
 def kinematic_beat_frames(
@@ -308,9 +295,6 @@ def kinematic_beats(
     return frames_to_time(frames, fps=motion.fps)
 
 
-# --------------------------------------------------------------------------- intensity
-
-
 def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.ndarray:
     """Mean :func:`kinetic_energy` over frames ``[b_i, b_{i+1})`` of successive beat frames."""
     energy = kinetic_energy(positions, fps=fps)
@@ -348,9 +332,6 @@ def beat_interval_intensity(motion: Any, beat_times: Any, *, joints: Any = None)
     pos = motion_positions(motion, joints=joints)
     frames = time_to_frames(beats, fps=fps)
     return interval_intensity(pos, frames, fps=fps)
-
-
-# --------------------------------------------------------------------------- tempo
 
 
 def motion_tempo(

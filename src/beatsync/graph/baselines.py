@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from ..validation import as_float, as_int, check_positive
 from .build import WeightedMotionGraph
 from .objective import (
     SearchResult,
@@ -84,23 +85,15 @@ def check_conventional_options(
     max_candidates: Any = 20000,
 ) -> dict[str, Any]:
     """Validate the options of the multi-stage search (keys of :func:`conventional_core`)."""
-    try:
-        seg, cap = int(segment_beats), int(max_candidates)
-        sigma, thr = float(rhythm_sigma), float(rhythm_threshold)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            "segment_beats and max_candidates must be whole numbers, rhythm_sigma and "
-            "rhythm_threshold numbers"
-        ) from None
-    if seg < 1:
-        raise ParameterError(f"segment_beats={segment_beats!r} must be >= 1")
-    if not sigma > 0:
-        raise ParameterError(f"rhythm_sigma={rhythm_sigma!r} must be > 0")
+    thr = as_float(rhythm_threshold, name="rhythm_threshold")
     if not 0 <= thr < 1:
         raise ParameterError(f"rhythm_threshold={rhythm_threshold!r} must lie in [0, 1)")
-    if cap < 1:
-        raise ParameterError(f"max_candidates={max_candidates!r} must be >= 1")
-    return {"seg": seg, "sigma": sigma, "thr": thr, "cap": cap}
+    return {
+        "seg": as_int(segment_beats, name="segment_beats", unit="beats", minimum=1),
+        "sigma": check_positive(rhythm_sigma, name="rhythm_sigma", unit="log-duration"),
+        "thr": thr,
+        "cap": as_int(max_candidates, name="max_candidates", minimum=1),
+    }
 
 
 def conventional_core(
@@ -263,9 +256,6 @@ def _enumerate(ctx, first, first_w, s0, s1, floor, cap, indptr, succ, sw):
         idx = int(parent[idx])
         depth -= 1
     return (seq[::-1], seq_ends[::-1], n_cand), complete
-
-
-# --------------------------------------------------------------------------- random walk
 
 
 def random_walk(

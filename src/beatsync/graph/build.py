@@ -1,31 +1,23 @@
 """Construction of the weighted motion graph of paper B (section 3.2, eqs. 1-2).
 
-- **Nodes** are the beat frames of every clip of a library (kinematic beats,
-  :mod:`beatsync.motion_beats`, or given beats); all clips share one skeleton
-  structure and frame rate.
-- **Forward edges** join successive beat frames of one clip, each with the *motion
-  intensity* of its interval (:func:`beatsync.motion_beats.interval_intensity`),
-  z-scored over the library. A node that starts a forward edge is an *interval node*.
-- **Transition edges** join two similar beat frames ``i != j`` (either direction,
-  across or within clips) when ``rd(i, j) < TH`` (eq. 1, ``TH = 3.0``), weighted by
-  eq. 2 as written: ``w2 = rd if rd > 2 else 2`` (``weight_rule="paper"``), or
-  ``w2 = rd`` (``weight_rule="rd"``).
+Nodes are the beat frames of every clip of a library (one skeleton structure and
+frame rate). *Forward edges* join successive beat frames of a clip, with the motion
+intensity of their interval (:func:`beatsync.motion_beats.interval_intensity`),
+z-scored over the library; a node that starts one is an *interval node*. *Transition
+edges* join two beat frames ``i != j`` (either direction, across or within clips) with
+``rd(i, j) < TH`` (eq. 1, ``TH = 3.0``), weighted by eq. 2 as written,
+``w2 = rd if rd > 2 else 2`` (``weight_rule="paper"``), or ``w2 = rd`` (``"rd"``).
 
-The frame distance ``rd`` (eq. 1)
----------------------------------
-After Kovar, Gleicher and Pighin (2002, "Motion graphs"), each beat frame is the point
-cloud of all joint positions over a ``window`` [s] around it, and ``D`` [position
-unit] is the RMS distance of two clouds after the best rotation about the vertical
-axis and translation on the floor (:mod:`beatsync.graph.distance`). ``D`` is made
-scale-free::
+The frame distance ``rd`` (eq. 1): after Kovar, Gleicher and Pighin (2002), ``D``
+[position unit] is the RMS distance of the point clouds of all joints over a
+``window`` [s] around each frame after the best rotation about the vertical axis and
+translation on the floor (:mod:`beatsync.graph.distance`), made scale-free::
 
     rd = D / (v_typ * rd_unit),
 
 with ``v_typ`` [position unit / s] the median aligned distance between consecutive
-frames times ``fps`` (the library's typical speed) and ``rd_unit = 0.1`` s: ``rd``
-counts tenths of a second of typical movement, so ``rd < 3`` accepts pose jumps of
-at most what the dancer covers in 0.3 s, about the 1/3 s over which transitions are
-blended.
+frames times ``fps`` and ``rd_unit = 0.1`` s: ``rd < 3`` accepts pose jumps of at most
+what the dancer typically covers in 0.3 s, about the 1/3 s of a transition's blend.
 
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 """
@@ -70,9 +62,6 @@ def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
     return rd.copy()
 
 
-# --------------------------------------------------------------------------- graph
-
-
 @dataclass(frozen=True, eq=False)
 class WeightedMotionGraph:
     """A weighted motion graph over the beat frames of a motion library (module docstring).
@@ -104,7 +93,6 @@ class WeightedMotionGraph:
     build_time: float = 0.0
     _cache: dict = field(default_factory=dict, repr=False)
 
-    # -- sizes -------------------------------------------------------------
     @property
     def n_nodes(self) -> int:
         return int(self.node_clip.size)
@@ -162,7 +150,6 @@ class WeightedMotionGraph:
             self._cache["speeds"] = library_profile(self.clips)
         return self._cache["speeds"]
 
-    # -- successor structure for searches ------------------------------------
     def successors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Edges between interval nodes: ``(src, dst, weight)``.
 
@@ -232,7 +219,6 @@ class WeightedMotionGraph:
         self._cache["csr"] = out
         return out
 
-    # -- (de)serialisation of the arrays (for the on-disk cache) -------------
     def to_arrays(self) -> dict[str, np.ndarray]:
         out = {k: getattr(self, k) for k in _ARRAYS}
         out["scalars"] = np.array([self.th, self.speed_scale, self.min_rd, self.build_time])
@@ -284,9 +270,6 @@ class WeightedMotionGraph:
             params={**self.params, "weight_rule": weight_rule},
             _cache=self._kept_cache(),
         )
-
-
-# --------------------------------------------------------------------------- checks
 
 
 def check_library(clips: Any) -> tuple:

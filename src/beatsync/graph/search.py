@@ -58,9 +58,6 @@ __all__ = [
 METHODS = ("dp", "conventional", "random")
 
 
-# --------------------------------------------------------------------------- DP
-
-
 def dp_search(
     graph: WeightedMotionGraph,
     music_z: Any,

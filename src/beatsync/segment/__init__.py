@@ -35,25 +35,18 @@ count estimated the optimum minimises ``E / (p - 1)`` (Dinkelbach iteration), si
 
 Documented rules (choices the paper leaves open; calibration in ``docs/tuning.md``)
 -----------------------------------------------------------------------------------
-- A channel whose std is at most ``CONSTANT_REL_STD`` (1e-3) of the largest selected
-  one (or 1e-9) is dropped; a period with variance below 1e-6 of its channel's is
-  flat (cost ~1).
-- Period range: the paper's 0.25-1.25 s by default (``DEFAULT_PERIOD_RANGE``);
-  ``DANCE_PERIOD_RANGE`` (0.25-6.25 s) or :func:`period_range_from_beat` for dance
-  figures. A range wider than a factor 5 is searched in tiers, shortest first; the
-  first tier whose optimum is periodic gives the shortest repeating cycle.
-- A clip shorter than ``MIN_CLIP_PERIODS`` (3) of the range's shortest period is
-  refused; with the count estimated, one shorter than 3 of its own period must have a
-  mean Pearson distance below ``SHORT_CLIP_MAX_ENERGY`` (0.5).
-- Not periodic: mean Pearson distance per channel and pair ``E / (C (p - 1))`` at
-  least ``MAX_NORMALISED_ENERGY`` (1.0), or :func:`periodicity_contrast` below
-  ``MIN_PERIODICITY_CONTRAST`` (0.05).
-- Free ends: the first boundary lies in the lead-in ``t_0 < lo``, the last in the tail
-  ``t_p >= n - lo`` (``lo``: shortest allowed period); an exact tiling is recovered
-  with ``t_0 = 0`` and ``t_p = n - 1``.
-- Memory: above :data:`SEARCH_MEMORY_BUDGET` (512 MiB) the search runs on the signal
-  decimated by the smallest factor that fits, then every boundary is refined at full
-  rate (:attr:`Segmentation.search_decimation`).
+- Near-constant channels are dropped (``CONSTANT_REL_STD``); a flat period costs ~1.
+- Period range: the paper's by default (``DEFAULT_PERIOD_RANGE``), wider for dance
+  figures (``DANCE_PERIOD_RANGE``, :func:`period_range_from_beat`); a range wider than
+  a factor 5 is searched in tiers, shortest first: the first periodic tier wins.
+- Clip length: at least ``MIN_CLIP_PERIODS`` of the range's shortest period; shorter
+  than that of its own period needs ``SHORT_CLIP_MAX_ENERGY``.
+- Not periodic: ``E / (C (p - 1))`` at least ``MAX_NORMALISED_ENERGY``, or
+  :func:`periodicity_contrast` below ``MIN_PERIODICITY_CONTRAST``.
+- Free ends: ``t_0`` in the lead-in (``t_0 < lo``, the shortest allowed period) and
+  ``t_p`` in the tail (``t_p >= n - lo``); an exact tiling gives ``0`` and ``n - 1``.
+- Above :data:`SEARCH_MEMORY_BUDGET` the search runs decimated in time, then every
+  boundary is refined at full rate (:attr:`Segmentation.search_decimation`).
 """
 
 from .channels import CONSTANT_REL_STD, select_channels
