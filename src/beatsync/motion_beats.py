@@ -57,40 +57,11 @@ _METHODS = ("speed", "pca")
 def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     """World joint positions of a motion, ``(n_frames, n_joints, 3)`` [position unit].
 
-    From :meth:`Motion.positions`, or reshaped from a marker table's ``<name>_x/_y/_z``
-    channels; ``joints``: names or indices to keep (default all, end sites included).
+    From :meth:`Motion.positions` (forward kinematics, or a position-only motion's
+    ``<name>_x/_y/_z`` triples); ``joints``: names or indices to keep (default all).
     """
-    pos = None
-    if hasattr(motion, "positions"):
-        # skeletal (forward kinematics) and position-only motions give joint positions
-        try:
-            pos = np.asarray(motion.positions(), dtype=np.float64)
-            names = list(getattr(motion, "joint_names", []))
-        except ParameterError:
-            if getattr(motion, "skeleton", None) is not None:
-                raise
-            pos = None
-    if pos is None:
-        channels = list(getattr(motion, "channels", ()))
-        vals = np.asarray(getattr(motion, "values", np.empty((0, 0))), dtype=np.float64)
-        if len(channels) == 0 or len(channels) % 3 != 0:
-            raise ParameterError(
-                f"motion {getattr(motion, 'name', '')!r} has no skeleton and its "
-                f"{len(channels)} channels are not <marker>_x/_y/_z triples: joint "
-                "positions are needed (read a BVH, or a marker table)"
-            )
-        names = []
-        for i in range(0, len(channels), 3):
-            trio = channels[i : i + 3]
-            stems = {c.rsplit("_", 1)[0] for c in trio}
-            axes = [c.rsplit("_", 1)[-1].lower() for c in trio]
-            if len(stems) != 1 or axes != ["x", "y", "z"]:
-                raise ParameterError(
-                    f"channels {trio} are not a <marker>_x/_y/_z triple; motion beats need "
-                    "joint positions (a BVH with a skeleton, or marker positions)"
-                )
-            names.append(stems.pop())
-        pos = vals.reshape(vals.shape[0], -1, 3)
+    pos = np.asarray(motion.positions(), dtype=np.float64)
+    names = motion.joint_names
     if joints is not None:
         idx = []
         for j in joints:
