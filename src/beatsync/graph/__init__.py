@@ -1,19 +1,12 @@
 """Music-driven dance composition over weighted motion graphs (paper B).
 
 Xu, Takagi, Kawada, "Automatic composition of motion capture animation for music
-synchronization". A motion library becomes a :class:`WeightedMotionGraph` whose nodes
-are beat frames (:mod:`~beatsync.graph.build`, eq. 1 in
-:mod:`~beatsync.graph.distance`); a song is planned by tempo
-(:mod:`~beatsync.graph.timescale`), searched (:mod:`~beatsync.graph.search`, the DP;
-:mod:`~beatsync.graph.baselines`; shared :mod:`~beatsync.graph.objective`),
-synthesized (:mod:`~beatsync.graph.synthesis`) and checked for speed
-(:mod:`~beatsync.graph.plausibility`); :mod:`~beatsync.graph.compose` runs the chain
-and :mod:`~beatsync.graph.cache` keeps built graphs on disk. Quality proxies are in
-:mod:`beatsync.evaluate.composition`, synthetic dances in
-:mod:`beatsync.synth.library`, the study in :mod:`beatsync.study.paper_b`.
-
-Event times are seconds (1-D float64, strictly increasing). Notebooks:
-``notebooks/paper_b_tab01_search_speed.ipynb`` (paper B Table 1) and
+synchronization". A library becomes a :class:`WeightedMotionGraph` of beat frames
+(:mod:`.build`, :mod:`.distance`); a song is planned by tempo (:mod:`.timescale`),
+searched (:mod:`.search`, :mod:`.baselines`, :mod:`.objective`), synthesized
+(:mod:`.synthesis`) and checked for speed (:mod:`.plausibility`); :mod:`.compose` runs
+the chain, :mod:`.cache` keeps built graphs. Times are seconds. Notebooks:
+``notebooks/paper_b_tab01_search_speed.ipynb`` (Table 1) and
 ``notebooks/paper_b_tab02_quality_proxies.ipynb`` (proxies for Table 2).
 """
 

@@ -134,8 +134,6 @@ def conventional_core(
                 capped += int(not ok_cap)
                 break
             fallbacks += 1
-        if best is None:  # cannot happen: alive nodes always complete
-            raise RuntimeError(f"the multi-stage search found no candidate at grid {s0}")
         nodes, ends, n_cand = best
         n_candidates.append(n_cand)
         path.extend(nodes)

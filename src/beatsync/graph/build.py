@@ -163,21 +163,15 @@ class WeightedMotionGraph:
         u = np.flatnonzero(isint)
         a = self.next_node[u]
         keep = isint[a]
-        src = [u[keep]]
-        dst = [a[keep]]
-        w = [np.zeros(int(keep.sum()))]
         # transitions: for every edge a -> v, every u with next_node[u] == a
         prev = np.full(self.n_nodes, -1)
-        prev[self.next_node[u]] = u
+        prev[a] = u
         p = prev[self.trans_src]
         ok = (p >= 0) & isint[self.trans_dst]
-        src.append(p[ok])
-        dst.append(self.trans_dst[ok])
-        w.append(self.trans_weight[ok])
         out = (
-            np.concatenate(src).astype(np.int64),
-            np.concatenate(dst).astype(np.int64),
-            np.concatenate(w).astype(np.float64),
+            np.concatenate([u[keep], p[ok]]).astype(np.int64),
+            np.concatenate([a[keep], self.trans_dst[ok]]).astype(np.int64),
+            np.concatenate([np.zeros(int(keep.sum())), self.trans_weight[ok]]).astype(np.float64),
         )
         self._cache["succ"] = out
         return out
@@ -395,9 +389,7 @@ def build_graph(
             warn(f"clip {c.name!r} has {fr.size} beat(s): it contributes no interval", stacklevel=2)
         frames_list.append(np.asarray(fr, dtype=np.int64))
 
-    node_clip = np.concatenate(
-        [np.full(f.size, i, dtype=np.int64) for i, f in enumerate(frames_list)]
-    )
+    node_clip = np.repeat(np.arange(len(clips), dtype=np.int64), [f.size for f in frames_list])
     node_frame = np.concatenate(frames_list)
     n = node_frame.size
     next_node = np.full(n, -1, dtype=np.int64)

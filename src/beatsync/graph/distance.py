@@ -45,9 +45,8 @@ def point_clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.nda
 def center_on_floor(c: np.ndarray, up: int) -> np.ndarray:
     """Clouds with their mean subtracted on the two floor axes (heights kept)."""
     c = c.copy()
-    for ax in range(3):
-        if ax != up:
-            c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
+    for ax in ground_axes(up):
+        c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
     return c
 
 
@@ -135,5 +134,4 @@ def typical_speed(
             a, b = point_clouds(pos, ff, half), point_clouds(pos, ff + 1, half)
             d = aligned_pair_distance(a, b, up=up)
             vals.append(d * fps)
-    v = float(np.median(np.concatenate(vals))) if vals else 0.0
-    return v
+    return float(np.median(np.concatenate(vals))) if vals else 0.0

@@ -141,10 +141,7 @@ def path_cost(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, (1,), None
     )
     path = np.asarray(path, dtype=np.int64)
-    if boundaries is None:
-        bnd = np.arange(path.size + 1)
-    else:
-        bnd = np.asarray(boundaries, dtype=np.int64)
+    bnd = np.arange(path.size + 1) if boundaries is None else np.asarray(boundaries, dtype=np.int64)
     if bnd.shape != (path.size + 1,) or bnd[0] != 0 or bnd[-1] != music_z.size:
         raise ParameterError(
             f"path has {path.size} nodes and boundaries {bnd.size} for {music_z.size} music "
@@ -167,8 +164,7 @@ def path_cost_core(graph, path, bnd, music_z, lam, tw, md, bound):
     inten += float(cs2[-1])
     tempo = 0.0
     if md is not None:
-        t = grid_times(md, music_z.size)
-        scales = (t[bnd[1:]] - t[bnd[:-1]]) / graph.interval_duration()[path]
+        scales = interval_scales(graph, path, bnd, md, music_z.size)
         if bound is not None:
             bad = (scales < bound[0] * (1 - 1e-9)) | (scales > bound[1] * (1 + 1e-9))
             if bad.any():

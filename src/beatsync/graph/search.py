@@ -18,14 +18,9 @@ The tempo term is 0 by default. In all three searches alike, ``scale_bound = (lo
 makes an interval whose time-scale factor ``d_music / d_motion`` lies outside
 ``[lo, hi]`` infeasible, and ``node_mask`` restricts them to part of the graph.
 
-- :func:`dp_search` (proposed): DP over the grid boundaries,
-  ``D_k(v) = min_{s in steps} c(v, k - s, k) + min_u (D_{k-s}(u) + lam w(u, v))``,
-  linear in the music; the exact optimum of ``E``.
-- :func:`conventional_search` (baseline after Shiratori et al. 2006): segment by
-  segment, candidates enumerated breadth-first with a rhythm filter, then the best
-  intensity match (:mod:`beatsync.graph.baselines`).
-- :func:`random_walk` (control): uniform choice among the successors and steps that
-  can still complete the song.
+:func:`dp_search` (proposed) is exact and linear in the music:
+``D_k(v) = min_{s in steps} c(v, k - s, k) + min_u (D_{k-s}(u) + lam w(u, v))``. The
+baseline and the control are in :mod:`beatsync.graph.baselines`.
 
 Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb`` (times),
 ``notebooks/paper_b_tab02_quality_proxies.ipynb`` (quality); paper B sections 3.3-3.4.

@@ -2,21 +2,16 @@
 
 Every chosen interval (beat frame ``f_k`` to the next beat frame of its clip) is
 time-warped onto its music beat interval ``[b_k, b_{k+1}]``, so each motion beat lands
-exactly on its music beat: source time
+exactly on its music beat:
 ``s(t) = f_k / fps + (t - b_k) / (b_{k+1} - b_k) * (f_{k+1} - f_k) / fps``
-(or a monotone cubic through the same points); frames are sampled with
-:func:`beatsync.rotations.sample_motion` (slerp on rotations).
-
-Runs of intervals that follow each other in one clip play as captured. At a
-transition (beat frame ``a`` to beat frame ``m``) the new run is placed with the rigid
-floor-plane transform that puts its root at ``m`` where the previous run's root is at
-``a``, with the same heading (Kovar et al. 2002); over the first ``blend`` seconds the
-old run, continued past ``a``, is blended into the new one with smooth-step weights
-(:func:`beatsync.rotations.blend_values`). The first interval's warp extends back to
-``start_time`` and the last one's on to ``end_time``.
-
-The result has the library's skeleton at ``fps`` [Hz]; frame ``j`` plays at
-``j / fps`` seconds of the music.
+(or a monotone cubic through the same points), sampled with
+:func:`beatsync.rotations.sample_motion`. Runs of consecutive intervals of one clip
+play as captured; at a transition (beat frame ``a`` to ``m``) the new run is placed by
+the rigid floor-plane transform that puts its root at ``m`` where the old run's is at
+``a``, same heading (Kovar et al. 2002), and the old run, continued past ``a``, is
+blended into it over ``blend`` seconds with smooth-step weights
+(:func:`beatsync.rotations.blend_values`). The first and last intervals' warps extend
+to ``start_time`` and ``end_time``; frame ``j`` plays at ``j / fps`` s of the music.
 
 Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
 """

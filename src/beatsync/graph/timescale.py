@@ -2,26 +2,20 @@
 
 Paper B builds its graphs per sub-group of motions that "share a range of tempos" and
 selects one "according to the music genre and music tempo", so that a motion beat
-interval is never squeezed into a music beat of a very different length. This module
-makes those choices explicit; the searches enforce them.
+interval is never squeezed into a music beat of a very different length; this module
+makes those choices explicit and the searches enforce them.
 
-- **Clip tempo**: beat induction from the clip's beat frames
-  (:func:`beatsync.motion_beats.motion_tempo`).
-- **Tempo sub-groups**: clips sorted by tempo, grouped greedily so that a group spans
-  at most ``hi / lo`` of the scale bound. A group is *eligible* for a song when some
-  multiplicity brings its central tempo within the bound; if none is, the closest
-  group is used and the report says so.
-- **Beat multiplicity** ``m``: music beats per motion-beat interval, from the ratio
-  ``rho = song BPM / library BPM``: the two rungs of ``(1, 2, 3, 4)`` that bracket
-  ``rho``, or the one within 5 % of it, or ``(1/2, 1)`` when the library is more than
-  ``1 / lo`` times faster than the music (the search then runs on half beats). Each
-  interval picks its own multiplicity within that set.
-- **Time-scale factor** of an interval: music duration / natural duration (``> 1``:
-  played slower); every interval must lie within ``scale_bound`` (default
-  ``(0.8, 1.25)``).
-
-The *grid* is the music beats, or the beats and their midpoints (half beats);
-``steps`` count grid intervals per motion interval.
+- **Clip tempo**: :func:`beatsync.motion_beats.motion_tempo` of its beat frames.
+- **Tempo sub-groups**: clips sorted by tempo, grouped greedily to span at most
+  ``hi / lo`` of the scale bound; a group is *eligible* for a song when some
+  multiplicity brings its central tempo within the bound (else the closest one is
+  used, and the report says so).
+- **Beat multiplicity** ``m``: music beats per motion interval, from ``rho = song BPM /
+  library BPM``: the rungs of ``(1, 2, 3, 4)`` that bracket ``rho``, or the one within
+  5 % of it, or ``(1/2, 1)`` (the grid is then half beats) when the library is more
+  than ``1 / lo`` times faster than the music; each interval picks within that set.
+- **Time-scale factor**: music / natural duration of an interval (``> 1``: slower);
+  every interval must lie within ``scale_bound`` (default ``(0.8, 1.25)``).
 
 Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.1.
 """
@@ -35,7 +29,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion_beats import motion_tempo
-from ..validation import check_range
+from ..validation import check_interval
 
 __all__ = [
     "DEFAULT_SCALE_BOUND",
@@ -63,13 +57,7 @@ def check_scale_bound(bound: Any, *, name: str = "scale_bound") -> tuple[float, 
     """``None`` (unbounded) or ``(lo, hi)`` with ``0 < lo <= 1 <= hi``."""
     if bound is None:
         return None
-    try:
-        lo, hi = bound
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"{name}={bound!r} must be two numbers (lo, hi), e.g. (0.8, 1.25), or None"
-        ) from None
-    lo, hi = check_range(lo, hi, name=name, unit="time-scale factor")
+    lo, hi = check_interval(bound, name=name, unit="time-scale factor")
     if not lo <= 1.0 <= hi:
         raise ParameterError(
             f"{name}=({lo:g}, {hi:g}) must contain 1 (an interval played at its own speed); "

@@ -299,26 +299,15 @@ def segment_values(
 ) -> Segmentation:
     """Globally optimal segmentation of a periodic multi-channel signal (paper A, sec. 3).
 
-    Parameters
-    ----------
-    values : np.ndarray [shape=(n_frames, n_channels)]
-        Joint angles (any unit; each channel is z-scored, which leaves r unchanged),
-        already unwrapped (:func:`segment` does it for BVH rotations).
-    alpha : float in (0, 0.5)
-        Allowed relative deviation of every period from the nominal period (eq. 3).
-    n_periods : int >= 2, optional
-        Number of periods (e.g. from the music); overrides ``period_method``.
-    period_range : (float, float) [s]
-        Shortest and longest period when estimating the count (default the paper's
-        0.25-1.25 s); wider than a factor 5: searched in tiers, shortest first.
-    period_method : {"energy", "fft", "given"}
-        How to get the count when ``n_periods`` is None (see :func:`estimate_period_count`).
-
-    Raises
-    ------
-    NotPeriodicError
-        (a ``ParameterError``) a clip that is not periodic or too short to tell; its own
-        motion beats can still sync it (:func:`beatsync.sync.synchronize`, ``mode="beats"``).
+    ``values`` ``(n_frames, n_channels)``: joint angles, any unit (channels are z-scored,
+    which leaves r unchanged), already unwrapped (:func:`segment` does it for BVH
+    rotations); ``alpha``: allowed relative deviation of every period from the nominal
+    one (eq. 3); ``n_periods``: the count if known (overrides ``period_method``);
+    ``period_range`` [s]: shortest and longest period when the count is estimated
+    (``period_method``, see :func:`estimate_period_count`), in tiers of a factor 5,
+    shortest first. A clip that is not periodic, or too short to tell, raises
+    :class:`NotPeriodicError` (its own motion beats can still sync it:
+    :func:`beatsync.sync.synchronize`, ``mode="beats"``).
 
     Examples
     --------
