@@ -105,9 +105,7 @@ def _check_seconds(value: Any, *, name: str, allow_zero: bool = True) -> float:
 
 
 def zscore(x: Any, *, name: str = "values") -> np.ndarray:
-    """Standard score ``(x - mean) / std`` of a 1-D array; zeros (with a
-    :class:`BeatsyncWarning`) if it is constant.
-    """
+    """``(x - mean) / std`` of a 1-D array; zeros with a :class:`BeatsyncWarning` if constant."""
     arr = check_finite(x, name=name)
     if arr.ndim != 1:
         raise ParameterError(f"{name} must be 1-D, got shape {arr.shape}")
@@ -122,10 +120,7 @@ def zscore(x: Any, *, name: str = "values") -> np.ndarray:
 
 
 def kinetic_energy(positions: Any, *, fps: float) -> np.ndarray:
-    """Per-frame mean kinetic energy of the joints, ``0.5 * mean_j |v_j|^2`` [(unit / s)^2].
-
-    Unit mass per joint; velocities by central differences.
-    """
+    """Per-frame mean kinetic energy ``0.5 * mean_j |v_j|^2`` [(unit / s)^2] (unit masses)."""
     pos, fps = _check_positions(positions, fps)
     vel = np.gradient(pos, axis=0) * fps
     return 0.5 * np.mean(np.sum(vel * vel, axis=2), axis=1)
@@ -314,20 +309,17 @@ def motion_tempo(
 ) -> float:
     """Tempo of a dance from its motion beats [s], by beat induction [BPM].
 
-    Kinematic beats miss beats (the dancer holds a pose) more often than they add them,
-    so successive motion beats are whole numbers of beat periods apart. The period ``P``
-    best explains every interval ``d_i`` as ``n_i P`` with the smallest ``n_i`` (Dixon
-    2001's inter-onset clustering; paper B's [XTY10] does the same)::
+    Kinematic beats miss beats (a held pose) more often than they add them, so
+    successive motion beats are whole numbers ``n_i`` of beat periods ``P`` apart. As in
+    Dixon 2001's inter-onset clustering (and paper B's [XTY10]), over a log-spaced grid of
+    periods in ``[60 / max_bpm, 60 / min_bpm]``::
 
         score(P) = sum_i max_{n >= 1} exp(-log(d_i / (n P))^2 / (2 tolerance^2)) / n,
 
-    on a log-spaced grid of periods in ``[60 / max_bpm, 60 / min_bpm]`` (the 1/n weight
-    makes the fundamental win over its sub-multiples); the best is refined to
-    ``sum d_i / sum n_i`` over the intervals it explains (within twice the tolerance).
-    ``tolerance`` is in log-duration (0.08: about 8 % timing deviation).
+    (the 1/n weight makes the fundamental win over its sub-multiples; ``tolerance`` in
+    log-duration); the best is refined to ``sum d_i / sum n_i`` over the intervals it
+    explains within twice the tolerance.
 
-    Examples
-    --------
     >>> motion_tempo([0.0, 0.5, 1.0, 2.0, 2.5])  # one missed beat
     120.0
     """

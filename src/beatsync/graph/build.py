@@ -141,9 +141,7 @@ class WeightedMotionGraph:
         return {k: v for k, v in self._cache.items() if k == "speeds"}
 
     def speed_reference(self) -> dict:
-        """Root and joint rotation speed percentiles of every clip (computed once, see
-        :func:`beatsync.graph.plausibility.library_profile`).
-        """
+        """Per-clip speed percentiles (:func:`.plausibility.library_profile`), computed once."""
         if "speeds" not in self._cache:
             from .plausibility import library_profile
 
@@ -168,19 +166,15 @@ class WeightedMotionGraph:
         prev[a] = u
         p = prev[self.trans_src]
         ok = (p >= 0) & isint[self.trans_dst]
-        out = (
+        self._cache["succ"] = (
             np.concatenate([u[keep], p[ok]]).astype(np.int64),
             np.concatenate([a[keep], self.trans_dst[ok]]).astype(np.int64),
             np.concatenate([np.zeros(int(keep.sum())), self.trans_weight[ok]]).astype(np.float64),
         )
-        self._cache["succ"] = out
-        return out
+        return self._cache["succ"]
 
     def predecessor_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Dense ``(N, max_in)`` predecessor table ``(pred, weight, is_trans)`` for the DP.
-
-        Padding points at node 0 with weight +inf.
-        """
+        """Dense ``(N, max_in)`` table ``(pred, weight, is_trans)`` for the DP (padding: inf)."""
         if "pred" in self._cache:
             return self._cache["pred"]
         src, dst, w = self.successors()
@@ -197,9 +191,8 @@ class WeightedMotionGraph:
         pred[dst, col] = src
         weight[dst, col] = w
         is_trans[dst, col] = self.next_node[src] != dst
-        out = (pred, weight, is_trans)
-        self._cache["pred"] = out
-        return out
+        self._cache["pred"] = (pred, weight, is_trans)
+        return self._cache["pred"]
 
     def successor_lists(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """CSR successor lists over all nodes: ``(indptr, dst, weight)``."""
@@ -209,9 +202,8 @@ class WeightedMotionGraph:
         order = np.lexsort((dst, src))
         src, dst, w = src[order], dst[order], w[order]
         indptr = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=self.n_nodes))])
-        out = (indptr, dst, w)
-        self._cache["csr"] = out
-        return out
+        self._cache["csr"] = (indptr, dst, w)
+        return self._cache["csr"]
 
     def to_arrays(self) -> dict[str, np.ndarray]:
         out = {k: getattr(self, k) for k in _ARRAYS}
@@ -234,9 +226,7 @@ class WeightedMotionGraph:
         )
 
     def with_threshold(self, th: float) -> WeightedMotionGraph:
-        """The graph keeping only the transitions with ``rd < th`` (``th`` <= this TH), without
-        recomputing the distances.
-        """
+        """The graph with only the transitions ``rd < th <= TH``, without recomputing distances."""
         th = check_th(th)
         if th > self.th:
             raise ParameterError(

@@ -34,9 +34,7 @@ def cache_dir() -> Path:
 
 
 def graph_source_hash() -> str:
-    """SHA-256 of the source of the modules that determine a graph (build, motion beats,
-    BVH reading, forward kinematics, validation).
-    """
+    """SHA-256 of the source of the modules that determine a graph."""
     from .. import motion, motion_beats, validation
     from ..io import bvh, sha256_file
     from . import build

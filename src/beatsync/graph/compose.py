@@ -67,7 +67,6 @@ class Composition:
 
     def report(self) -> dict:
         """A JSON-ready summary (path as clip/beat-frame pairs, costs, timings)."""
-        g = self.synthesis.info.get("graph_summary", {})
         return {
             "method": self.search.method,
             "n_beats": int(self.music_beats.size),
@@ -81,7 +80,7 @@ class Composition:
             "duration_s": self.motion.n_frames / self.motion.fps,
             "fps": self.motion.fps,
             "transition_times_s": self.synthesis.transition_times,
-            "graph": g,
+            "graph": self.synthesis.info.get("graph_summary", {}),
             "tempo": self.tempo.report() if self.tempo is not None else None,
             "multiplicity_used": _counts(np.diff(self.search.boundaries), self.tempo),
             "plausibility": self.plausibility,
@@ -97,9 +96,7 @@ def _counts(steps: np.ndarray, plan: TempoPlan | None) -> dict[str, int]:
 
 
 def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
-    """The one check of music beats on the compose path: seconds, increasing, at least two
-    (and none after ``duration`` [s], the audio's length, if given).
-    """
+    """The one check of music beats [s] on the compose path (``duration``: the audio's)."""
     n = 0 if beats is None else int(np.asarray(beats).size)
     if n < 2:
         raise ParameterError(
@@ -226,10 +223,7 @@ def compose_music(
     bpm: float | None = None,
     **kwargs: Any,
 ) -> Composition:
-    """Compose a dance for audio: track beats (or use ``beats`` [s]), measure levels, compose.
-
-    The output lasts as long as the audio.
-    """
+    """Compose a dance for audio (as long as the audio): beats tracked or given [s], levels."""
     from ..music import beat_rms_db, track_music_beats
 
     y_arr = np.asarray(y)

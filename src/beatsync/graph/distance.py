@@ -32,10 +32,7 @@ __all__ = [
 
 
 def point_clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.ndarray:
-    """Point clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` around each frame.
-
-    Frames ``f - half .. f + half`` of ``positions`` (clipped at the clip ends).
-    """
+    """Clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` of frames ``f - half .. f + half``."""
     n = positions.shape[0]
     idx = np.clip(frames[:, None] + np.arange(-half, half + 1)[None, :], 0, n - 1)
     c = positions[idx]  # (m, w, J, 3)

@@ -133,10 +133,7 @@ def path_cost(
     boundaries: Any = None,
     scale_bound: Any = None,
 ) -> tuple[float, float, float, float, np.ndarray]:
-    """Objective ``E`` of a given path and its parts ``(total, intensity, transition, tempo,
-    transitions)``; refuses infeasible paths. ``boundaries`` default to one grid interval
-    each.
-    """
+    """``(E, intensity, transition, tempo, transitions)`` of a path; refuses infeasible ones."""
     music_z, lam, tw, md, bound, _, _ = prepare_search(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, (1,), None
     )

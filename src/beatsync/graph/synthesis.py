@@ -136,8 +136,7 @@ def synthesize(
         )
     if np.any(path < 0) or np.any(path >= graph.n_nodes) or not graph.is_interval[path].all():
         raise ParameterError("path contains nodes that do not start an interval")
-    template = graph.clips[0]
-    fps = check_fps(template.fps if fps is None else fps)
+    fps = check_fps(graph.clips[0].fps if fps is None else fps)
     blend = check_blend_warp(blend, warp)
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > start_time >= 0:

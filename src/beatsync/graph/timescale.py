@@ -147,10 +147,7 @@ def plan_tempo(
     multiplicity: Any = "auto",
     tempo_select: bool = True,
 ) -> TempoPlan:
-    """Choose the eligible clips and the multiplicities for a song (trusts its inputs).
-
-    ``tempo_select=False``: every clip is eligible, the tempo is only reported.
-    """
+    """Eligible clips and multiplicities for a song (``tempo_select=False``: every clip)."""
     song_bpm = float(60.0 / np.median(np.diff(music_beats)))
     tempi = clip_tempi(graph)
     width = scale_bound[1] / scale_bound[0] if scale_bound is not None else np.inf

@@ -68,18 +68,14 @@ def _is_default_channel(name: str) -> bool:
 def select_channels(
     names: Sequence[str], channels: str | Sequence[str] = "default"
 ) -> tuple[str, ...]:
-    """Choose the channels the segmentation uses.
+    """Choose the channels the segmentation uses: ``"default"``, ``"all"`` or exactly the names.
 
-    ``channels="default"``: rotation channels of the main limb and spine joints (CMU:
-    abdomen chest neck rShldr rForeArm rThigh rShin rFoot and their left twins; iClone:
-    ``CC_Base_Waist/Spine01/*_Upperarm/*_Forearm/*_Thigh/*_Calf/*_Foot``; no twist bones,
-    hands, toes, face, nor the root's global orientation), plus every ``*_angle`` channel
-    (marker-derived angles); if nothing matches, all channels with a
-    :class:`BeatsyncWarning`. ``"all"``: every channel (constant ones are dropped later).
-    A sequence: exactly those names.
+    ``"default"``: rotation channels of the main limb and spine joints (CMU: abdomen chest
+    neck rShldr rForeArm rThigh rShin rFoot and their left twins; iClone: ``CC_Base_Waist``,
+    ``Spine01``, ``*_Upperarm``, ``*_Forearm``, ``*_Thigh``, ``*_Calf``, ``*_Foot``; never
+    twist bones, hands, toes, face or the root), and every ``*_angle`` channel; if none
+    matches, all channels with a :class:`BeatsyncWarning`.
 
-    Examples
-    --------
     >>> select_channels(["hip_Xposition", "hip_Zrotation", "rShin_Xrotation", "rHand_Xrotation"])
     ('rShin_Xrotation',)
     """

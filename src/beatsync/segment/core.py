@@ -348,12 +348,10 @@ def segment(
 ) -> Segmentation:
     """Split a periodic motion into its periods, globally optimally (paper A, sec. 3).
 
-    ``motion`` holds joint angles (BVH rotations [deg]) or marker-derived ``*_angle``
-    channels (:func:`beatsync.motion.marker_angles`); ``channels`` as in
-    :func:`~beatsync.segment.select_channels`; the rest as in :func:`segment_values`.
+    ``motion``: joint angles (BVH rotations [deg]) or marker-derived ``*_angle`` channels;
+    ``channels`` as in :func:`~beatsync.segment.select_channels`; the rest as in
+    :func:`segment_values`.
 
-    Examples
-    --------
     >>> from beatsync.synth.motion import periodic_motion
     >>> s = periodic_motion(n_frames=300, n_periods=10, seed=1)
     >>> seg = segment(s.motion, n_periods=10)
@@ -417,13 +415,11 @@ def estimate_period_count(
 def period_range_from_beat(
     beat_period: float, *, beats: tuple[float, float] = (1.0, 8.0)
 ) -> tuple[float, float]:
-    """Period range [s] of a dance to music with this beat period: ``beats`` beats.
+    """Period range [s] of a dance to music of this beat period [s]: ``beats`` beats.
 
-    A dance cycle lasts a whole number of beats, from one step per beat to a figure of a
-    few bars (a waltz box: 6 beats; a salsa basic: 8). ``beat_period`` [s] is 60 / BPM.
+    A dance cycle lasts a whole number of beats, from a step per beat to a figure of a
+    few bars (a waltz box: 6 beats; a salsa basic: 8).
 
-    Examples
-    --------
     >>> period_range_from_beat(0.5)
     (0.5, 4.0)
     """
