@@ -81,10 +81,10 @@ def _bad_files(tmp_path):
 @pytest.mark.parametrize(
     "key,extra,match",
     [
-        ("missing", ["--fps", "25"], "does not exist"),
+        ("missing", ["--fps", "25"], "nope.bvh"),
         ("trunc", [], "no MOTION section"),
         ("nan", ["--fps", "25"], "NaN"),
-        ("short", ["--fps", "25"], "shorter than 3 periods"),
+        ("short", ["--fps", "25"], "clip of 10 frames"),
         ("noise", ["--fps", "25"], "not periodic"),
         ("pirouette", [], "not periodic"),
         ("good", ["--fps", "0"], "fps"),

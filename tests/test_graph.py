@@ -143,7 +143,7 @@ def test_different_skeletons_named(library):
     joints[1] = type(joints[1])("torso", 0, joints[1].offset, joints[1].channels)
     sk = type(other)(tuple(joints))
     m = Motion(clips[0].values, clips[0].fps, sk.channel_names(), sk, "odd_clip")
-    with pytest.raises(ParameterError, match="odd_clip.*different skeletons|different skeletons"):
+    with pytest.raises(ParameterError, match="odd_clip"):
         build_graph([clips[0], m])
 
 
@@ -153,7 +153,7 @@ def test_given_beats_after_last_frame_refused(library):
     last = (m.n_frames - 1) / m.fps
     # Motion.duration (n / fps) is one frame after the last frame: refused, not clipped
     bad = np.concatenate([beats[0][:-1], [m.duration]])
-    with pytest.raises(ParameterError, match="after the clip's last frame"):
+    with pytest.raises(ParameterError, match=f"end at {m.duration:g} s"):
         build_graph([m], beats=[bad], require_transitions=False)
     ok = np.concatenate([beats[0][:-1], [last]])
     g = build_graph([m], beats=[ok], require_transitions=False)
@@ -187,7 +187,7 @@ def test_bad_threshold(library, th):
 
 def test_no_transitions_suggests_threshold():
     m1, b1 = synthetic_dance(duration=5, seed=0, vocabulary_seed=0, n_moves=1)
-    with pytest.raises(ParameterError, match=r"no transition edges.*smallest rd.*--th"):
+    with pytest.raises(ParameterError, match="TH=1e-06"):
         build_graph([m1], beats=[b1], th=1e-6)
 
 
@@ -262,7 +262,7 @@ def test_conventional_and_random_are_feasible(graph):
 
 
 def test_search_bad_inputs(graph):
-    with pytest.raises(ParameterError, match="at least two beats"):
+    with pytest.raises(ParameterError, match="music intensity"):
         dp_search(graph, np.empty(0))
     with pytest.raises(ParameterError):
         dp_search(graph, [0.0, np.nan])
@@ -372,13 +372,13 @@ def test_root_alignment_no_jump_on_floor():
 
 def test_synthesize_bad_inputs(graph):
     path = dp_search(graph, [0.0, 1.0, -1.0]).path
-    with pytest.raises(ParameterError, match="path has"):
+    with pytest.raises(ParameterError, match="path has 3 nodes for 1"):
         synthesize(graph, path, [0.5, 1.0])
     with pytest.raises(ParameterError):
         synthesize(graph, path, [0.5, 1.0, 0.9, 2.0])
     with pytest.raises(ParameterError, match="fewer than two"):
         synthesize(graph, path[:0], [0.5])
-    with pytest.raises(ParameterError, match="warp"):
+    with pytest.raises(ParameterError, match="cubic"):
         synthesize(graph, path, [0.5, 1.0, 1.5, 2.0], warp="cubic")
 
 
@@ -434,9 +434,9 @@ def test_compose_and_quality(graph):
     assert 0.0 <= q["alignment_motion"] <= 1.0 and 0.0 <= q["alignment_music"] <= 1.0
     assert -1.0 <= q["intensity_r"] <= 1.0
     assert q["foot_sliding"] >= 0
-    with pytest.raises(ParameterError, match="at least two"):
+    with pytest.raises(ParameterError, match="1 beat"):
         compose(graph, [0.5], [])
-    with pytest.raises(ParameterError, match="one per interval"):
+    with pytest.raises(ParameterError, match="music_level"):
         compose(graph, beats, level[:-1])
 
 
@@ -503,5 +503,5 @@ def test_with_threshold_equals_a_build_at_that_threshold(library):
     np.testing.assert_array_equal(cut.trans_src, g3.trans_src)
     np.testing.assert_allclose(cut.trans_weight, g3.trans_weight)
     np.testing.assert_array_equal(cut.successors()[1], g3.successors()[1])
-    with pytest.raises(ParameterError, match="larger than the TH"):
+    with pytest.raises(ParameterError, match="TH=5 "):
         g3.with_threshold(5.0)

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pytest
 
 from beatsync.errors import BeatsyncWarning, ParameterError
+from beatsync.motion import Motion
 from beatsync.motion_beats import (
     beat_interval_intensity,
     interval_intensity,
@@ -18,17 +17,6 @@ from beatsync.motion_beats import (
 )
 
 FPS = 60.0
-
-
-@dataclass(frozen=True)
-class MarkerMotion:
-    """A minimal marker table (no skeleton), enough for motion_beats."""
-
-    values: np.ndarray
-    fps: float
-    channels: tuple
-    skeleton: None = None
-    name: str = "markers"
 
 
 def oscillator(freq=1.0, dur=4.0, fps=FPS, phase=0.0, amp=0.3):
@@ -42,7 +30,7 @@ def oscillator(freq=1.0, dur=4.0, fps=FPS, phase=0.0, amp=0.3):
 def as_markers(pos, fps=FPS):
     n, j, _ = pos.shape
     ch = tuple(f"m{i}_{a}" for i in range(j) for a in "xyz")
-    return MarkerMotion(values=pos.reshape(n, -1), fps=fps, channels=ch)
+    return Motion(pos.reshape(n, -1), fps, ch, None, "markers")
 
 
 def test_speed_beats_at_turning_points():
@@ -150,7 +138,7 @@ def test_too_short_and_nan_positions():
 
 
 def test_unknown_joint_name():
-    with pytest.raises(ParameterError, match="not in the motion"):
+    with pytest.raises(ParameterError, match="nose"):
         kinematic_beats(as_markers(oscillator()), joints=["nose"])
 
 
@@ -168,7 +156,6 @@ def test_salsa_beats_plausible():
 
 
 def test_position_only_motion_uses_its_joint_positions():
-    from beatsync.motion import Motion
     from beatsync.motion_beats import motion_positions
 
     t = np.arange(240) / 60.0

@@ -224,7 +224,7 @@ def test_channel_selection_modes():
     assert select_channels(names) == ("knee_L_angle", "knee_R_angle")
     assert select_channels(names, "all") == tuple(names)
     assert select_channels(names, ["Head_FL_x"]) == ("Head_FL_x",)
-    with pytest.raises(ParameterError, match="not found"):
+    with pytest.raises(ParameterError, match="knee_X"):
         select_channels(names, ["knee_X"])
     with pytest.raises(ParameterError):
         select_channels(names, "some")
@@ -270,23 +270,23 @@ def _with_inf():
         (_vals(), {"fps": float("nan")}, "fps"),
         (_vals(), {"alpha": 0.0}, "alpha"),
         (_vals(), {"alpha": 0.5}, "alpha"),
-        (_vals(), {"alpha": 10.0}, "percentage"),
+        (_vals(), {"alpha": 10.0}, "alpha=10.0"),
         (_vals(), {"alpha": -0.1}, "alpha"),
         (_vals(), {"period_range": (1.25, 0.25)}, "reversed"),
         (_vals(), {"period_range": (0.0, 1.0)}, "> 0"),
-        (_vals()[:12], {}, "shorter than 3 periods of the shortest"),
-        (_vals()[:19], {}, "shorter than 3 periods of the shortest"),
-        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "shorter than 3 periods"),
+        (_vals()[:12], {}, "clip of 12 frames"),
+        (_vals()[:19], {}, "clip of 19 frames"),
+        (_vals(), {"fps": 2500.0, "period_range": (0.25, 1.25)}, "fps=2500"),
         (_vals(), {"period_range": (0.25, 1.25, 2.0)}, "two numbers"),
         (_vals(), {"period_range": (0.25, 0.06)}, "reversed"),
         (_vals(), {"n_periods": 10, "period_method": "wavelet"}, "period_method"),
         (_vals(), {"n_periods": 1}, "n_periods"),
         (_vals(), {"n_periods": 2.5}, "n_periods"),
-        (_vals(), {"n_periods": 200}, "too short"),
+        (_vals(), {"n_periods": 200}, "200 periods in 300 frames"),
         (_vals(), {"period_method": "wavelet"}, "period_method"),
-        (_vals(), {"period_method": "given"}, "needs n_periods"),
+        (_vals(), {"period_method": "given"}, "period_method='given'"),
         (np.ones((300, 4)), {}, "constant"),
-        (np.zeros((2, 300, 4)), {}, "2-D"),
+        (np.zeros((2, 300, 4)), {}, r"\(2, 300, 4\)"),
         (np.random.default_rng(0).standard_normal((300, 4)), {}, "not periodic"),
         (np.random.default_rng(1).standard_normal((300, 29)), {}, "not periodic"),
     ],
@@ -321,7 +321,7 @@ def test_clip_shorter_than_three_own_periods_is_refused():
     start = int(10.0 * m.fps)
     clip = m.slice_frames(start, start + int(m.fps))  # 1 s
     # too short to tell: a NotPeriodicError, so mode "auto" falls back to motion beats
-    with pytest.raises(NotPeriodicError, match=r"holds only 2\.\d periods of its estimated"):
+    with pytest.raises(NotPeriodicError, match=r"only 2\.\d periods"):
         segment(clip)
     # the same dance, long enough, is segmented at its period
     longer = m.slice_frames(start, start + int(16 * m.fps))
@@ -341,7 +341,7 @@ def test_short_clip_of_clearly_alike_periods_is_kept():
 
 
 def test_channel_name_count_mismatch():
-    with pytest.raises(ParameterError, match="transposed"):
+    with pytest.raises(ParameterError, match="2 channel names for"):
         segment_values(_vals(), fps=25.0, channel_names=["a", "b"])
 
 
@@ -434,7 +434,7 @@ def test_fixed_count_dp_equals_brute_force(seed):
         e_bf, f_bf = _brute_force_count(x, lo, hi, count)
         assert count_fits(n, lo, hi, count) == (f_bf is not None)
         if f_bf is None:
-            with pytest.raises(RuntimeError, match="do not fit"):
+            with pytest.raises(RuntimeError, match=f"{count} periods of {lo}-{hi}"):
                 shortest_path_count(cost, n, lo, hi, count)
             continue
         frames, energy = shortest_path_count(cost, n, lo, hi, count)
@@ -449,7 +449,7 @@ def test_given_count_is_honoured_or_refused():
     """True count 10: n_periods=12 used to return 10 periods silently."""
     s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
     assert segment_values(s.motion.values, fps=25.0, n_periods=10).n_periods == 10
-    with pytest.raises(ParameterError, match="n_periods=12 was given"):
+    with pytest.raises(ParameterError, match="n_periods=12"):
         segment_values(s.motion.values, fps=25.0, n_periods=12)
     seg = segment_values(s.motion.values, fps=25.0, n_periods=9, alpha=0.2)
     assert seg.n_periods == 9
@@ -514,7 +514,7 @@ def test_undecimatable_period_is_refused(monkeypatch):
     assert search_decimation(300, lo, hi, 29, 10, budget=1) is None
     s = periodic_motion(n_frames=300, n_periods=10, snr_db=30, seed=1)
     monkeypatch.setattr(segment_core, "SEARCH_MEMORY_BUDGET", 1)
-    with pytest.raises(ParameterError, match="lower --fps"):
+    with pytest.raises(ParameterError, match=r"band \d+-\d+"):
         segment_values(s.motion.values, fps=25.0, n_periods=10)
 
 
@@ -539,7 +539,7 @@ def test_period_range_from_beat():
 @pytest.mark.parametrize(
     "beat,kw,match",
     [
-        (120.0, {}, "tempo in BPM"),  # a tempo, not a beat period
+        (120.0, {}, "beat_period=120.0"),  # a tempo, not a beat period
         (0.0, {}, r"beat_period=0.0 must be in \[0.15, 3\]"),
         (float("nan"), {}, "finite"),
         ("fast", {}, "not a number"),

@@ -1,36 +1,21 @@
 """Motion beats and motion intensity of dance clips (paper B, section 3.1).
 
-Paper B (Xu, Takagi, Kawada) builds its weighted motion graph on the *beat frames*
-of every clip of a motion library, and weights the forward edge between two
-successive beat frames by the *motion intensity* of that interval.
+Paper B builds its motion graph on the *beat frames* of every clip and weights the
+edge between two successive beat frames by the *motion intensity* of that interval.
 
-Definitions used here
----------------------
-- **Kinematic beats** (``method="speed"``, the default): local minima of the mean
-  joint speed, smoothed with a Gaussian of standard deviation ``smooth`` [s]. Dancers
-  mark the beat by stopping or reversing a movement, so the whole body slows down on
-  the beat (Shiratori et al. 2004, Kim et al. 2003). Minima closer than
-  ``min_interval`` [s] are thinned (the deeper one is kept), and minima whose
-  prominence is below ``rel_prominence`` times the median smoothed speed are dropped
-  (flat plateaus give spurious minima).
-- **PCA beats** (``method="pca"``, paper B's earlier work and Kim et al. 2003): a
-  short-term principal component analysis of root-relative joint positions over a
-  sliding window of ``window`` [s]; the projection of each frame on the first
-  principal axis (sign kept consistent between neighbouring windows) is smoothed
-  and its extrema (both minima and maxima: the turning points of the dominant
-  movement) are the beats.
-- **Motion intensity** of a beat interval: the mean kinetic energy of the joints,
-  ``0.5 * mean_j |v_j|^2`` (unit mass per joint), averaged over the frames of the
-  interval ``[beat_i, beat_{i+1})`` [(position unit)^2 / s^2].
+- **Kinematic beats** (``method="speed"``): local minima of the mean joint speed,
+  Gaussian-smoothed (sigma ``smooth`` [s]): dancers mark the beat by stopping or
+  reversing a movement (Shiratori et al. 2004, Kim et al. 2003). Minima closer than
+  ``min_interval`` [s] are thinned and those less prominent than ``rel_prominence``
+  times the median speed dropped (flat plateaus).
+- **PCA beats** (``method="pca"``, Kim et al. 2003): the extrema of each frame's
+  projection on the first principal axis of root-relative joint positions over a
+  ``window`` [s].
+- **Motion intensity**: the joints' mean kinetic energy ``0.5 * mean_j |v_j|^2`` (unit
+  mass) over ``[beat_i, beat_{i+1})`` [(position unit / s)^2].
 
-Data contract
--------------
-- Input: a :class:`beatsync.motion.Motion` with a skeleton (world joint positions by
-  forward kinematics, :meth:`Motion.positions`) or a marker table whose channels are
-  ``<marker>_x/_y/_z`` triples. The array-level functions take positions
-  ``(n_frames, n_joints, 3)`` and ``fps`` [Hz] directly.
-- Output: beat times, 1-D float64 seconds, strictly increasing, always on frame
-  times (``frame / fps``); intensities one per interval between successive beats.
+Motions have a skeleton or are marker tables of ``<marker>_x/_y/_z`` triples; the
+array functions take positions ``(n_frames, n_joints, 3)``. Beats lie on frame times.
 
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 """
@@ -44,7 +29,14 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.signal import find_peaks
 
 from .errors import ParameterError, warn
-from .validation import check_finite, check_fps, check_times, frames_to_time, time_to_frames
+from .validation import (
+    check_finite,
+    check_fps,
+    check_positive,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 
 __all__ = [
     "kinematic_beats",
@@ -62,72 +54,26 @@ __all__ = [
 _METHODS = ("speed", "pca")
 
 
-# --------------------------------------------------------------------------- helpers
-
-
 def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     """World joint positions of a motion, ``(n_frames, n_joints, 3)`` [position unit].
 
-    Uses :meth:`Motion.positions` (forward kinematics for a skeleton, the stored joint
-    positions for a position-only motion); a plain marker table without such a method
-    (channels ``<name>_x``, ``<name>_y``, ``<name>_z``) is reshaped.
-
-    Parameters
-    ----------
-    motion : Motion
-    joints : sequence of str or int, optional
-        Joint (or marker) names or indices to keep; default all (end sites included).
-
-    Raises
-    ------
-    ParameterError
-        No skeleton and no marker triples, unknown joint names, NaN gaps.
+    From :meth:`Motion.positions` (forward kinematics, or a position-only motion's
+    ``<name>_x/_y/_z`` triples); ``joints``: names or indices to keep (default all).
     """
-    pos = None
-    if hasattr(motion, "positions"):
-        # skeletal (forward kinematics) and position-only motions give joint positions
-        try:
-            pos = np.asarray(motion.positions(), dtype=np.float64)
-            names = list(getattr(motion, "joint_names", []))
-        except ParameterError:
-            if getattr(motion, "skeleton", None) is not None:
-                raise
-            pos = None
-    if pos is None:
-        channels = list(getattr(motion, "channels", ()))
-        vals = np.asarray(getattr(motion, "values", np.empty((0, 0))), dtype=np.float64)
-        if len(channels) == 0 or len(channels) % 3 != 0:
-            raise ParameterError(
-                f"motion {getattr(motion, 'name', '')!r} has no skeleton and its "
-                f"{len(channels)} channels are not <marker>_x/_y/_z triples: joint "
-                "positions are needed (read a BVH, or a marker table)"
-            )
-        names = []
-        for i in range(0, len(channels), 3):
-            trio = channels[i : i + 3]
-            stems = {c.rsplit("_", 1)[0] for c in trio}
-            axes = [c.rsplit("_", 1)[-1].lower() for c in trio]
-            if len(stems) != 1 or axes != ["x", "y", "z"]:
-                raise ParameterError(
-                    f"channels {trio} are not a <marker>_x/_y/_z triple; motion beats need "
-                    "joint positions (a BVH with a skeleton, or marker positions)"
-                )
-            names.append(stems.pop())
-        pos = vals.reshape(vals.shape[0], -1, 3)
+    pos = np.asarray(motion.positions(), dtype=np.float64)
+    names = motion.joint_names
     if joints is not None:
         idx = []
         for j in joints:
             if isinstance(j, (int, np.integer)):
                 if not 0 <= int(j) < pos.shape[1]:
                     raise ParameterError(f"joint index {j} out of range 0..{pos.shape[1] - 1}")
-                idx.append(int(j))
-            else:
-                if j not in names:
-                    raise ParameterError(
-                        f"joint {j!r} not in the motion; known joints: {', '.join(names[:12])}"
-                        + (" ..." if len(names) > 12 else "")
-                    )
-                idx.append(names.index(j))
+            elif j not in names:
+                raise ParameterError(
+                    f"joint {j!r} not in the motion; known joints: {', '.join(names[:12])}"
+                    + (" ..." if len(names) > 12 else "")
+                )
+            idx.append(int(j) if isinstance(j, (int, np.integer)) else names.index(j))
         if not idx:
             raise ParameterError("joints is empty: give at least one joint name or None for all")
         pos = pos[:, idx, :]
@@ -149,12 +95,7 @@ def _check_positions(positions: Any, fps: Any) -> tuple[np.ndarray, float]:
 
 
 def _check_seconds(value: Any, *, name: str, allow_zero: bool = True) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}={value!r} must be a number of seconds") from None
-    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        raise ParameterError(f"{name}={value!r} must be a finite duration >= 0 [s]")
+    v = check_positive(value, name=name, unit="s", allow_zero=allow_zero)
     if v > 60:
         raise ParameterError(
             f"{name}={value!r} s is implausibly long; it is in seconds (did you give frames "
@@ -164,11 +105,7 @@ def _check_seconds(value: Any, *, name: str, allow_zero: bool = True) -> float:
 
 
 def zscore(x: Any, *, name: str = "values") -> np.ndarray:
-    """Standard score ``(x - mean) / std`` of a 1-D array; all zeros if ``std == 0``.
-
-    A constant input (e.g. a single interval) is legal but carries no contrast: a
-    :class:`BeatsyncWarning` is issued and zeros are returned.
-    """
+    """``(x - mean) / std`` of a 1-D array; zeros with a :class:`BeatsyncWarning` if constant."""
     arr = check_finite(x, name=name)
     if arr.ndim != 1:
         raise ParameterError(f"{name} must be 1-D, got shape {arr.shape}")
@@ -182,34 +119,15 @@ def zscore(x: Any, *, name: str = "values") -> np.ndarray:
     return (arr - arr.mean()) / sd
 
 
-# --------------------------------------------------------------------------- curves
-
-
 def kinetic_energy(positions: Any, *, fps: float) -> np.ndarray:
-    """Per-frame mean kinetic energy of the joints, ``0.5 * mean_j |v_j|^2``.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
-    fps : float > 0 [Hz]
-
-    Returns
-    -------
-    energy : np.ndarray [shape=(n_frames,)] [(position unit / s)^2]
-        Unit mass per joint; velocities by central differences.
-    """
+    """Per-frame mean kinetic energy ``0.5 * mean_j |v_j|^2`` [(unit / s)^2] (unit masses)."""
     pos, fps = _check_positions(positions, fps)
     vel = np.gradient(pos, axis=0) * fps
     return 0.5 * np.mean(np.sum(vel * vel, axis=2), axis=1)
 
 
 def speed_curve(positions: Any, *, fps: float, smooth: float = 0.1) -> np.ndarray:
-    """Mean joint speed per frame, Gaussian-smoothed (sigma ``smooth`` [s]).
-
-    Returns
-    -------
-    speed : np.ndarray [shape=(n_frames,)] [position unit / s]
-    """
+    """Mean joint speed per frame [unit / s], Gaussian-smoothed (sigma ``smooth`` [s])."""
     pos, fps = _check_positions(positions, fps)
     smooth = _check_seconds(smooth, name="smooth")
     vel = np.gradient(pos, axis=0) * fps
@@ -222,17 +140,11 @@ def speed_curve(positions: Any, *, fps: float, smooth: float = 0.1) -> np.ndarra
 def pca_curve(
     positions: Any, *, fps: float, window: float = 0.5, smooth: float = 0.1
 ) -> np.ndarray:
-    """Projection of each frame on the first principal axis of a sliding window.
+    """Projection of each frame on the first principal axis of a sliding window [unit].
 
-    Joint positions are made root-relative (joint 0 subtracted), flattened to
-    ``3 * n_joints`` features; for the window of ``window`` [s] centred on each frame
-    the first principal axis is found (eigenvector of the window's Gram matrix), its
-    sign aligned with the previous window's axis, and the centred frame projected on
-    it. The curve is then Gaussian-smoothed (sigma ``smooth`` [s]).
-
-    Returns
-    -------
-    curve : np.ndarray [shape=(n_frames,)] [position unit]
+    Joint positions relative to joint 0; for the ``window`` [s] around each frame the
+    first principal axis (eigenvector of the window's Gram matrix), its sign aligned with
+    the previous window's; then Gaussian-smoothed (sigma ``smooth`` [s]).
     """
     pos, fps = _check_positions(positions, fps)
     window = _check_seconds(window, name="window", allow_zero=False)
@@ -268,9 +180,6 @@ def pca_curve(
     return proj
 
 
-# --------------------------------------------------------------------------- beats
-
-
 def kinematic_beat_frames(
     positions: Any,
     *,
@@ -281,37 +190,18 @@ def kinematic_beat_frames(
     rel_prominence: float = 0.02,
     window: float = 0.5,
 ) -> np.ndarray:
-    """Beat frames of joint positions (array-level version of :func:`kinematic_beats`).
+    """Beat frames (int64, increasing) of joint positions: :func:`kinematic_beats` on arrays.
 
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
-    fps : float > 0 [Hz]
-    method : {"speed", "pca"}
-    smooth : float >= 0 [s]
-        Gaussian sigma of the curve smoothing.
-    min_interval : float >= 0 [s]
-        Minimum distance between two beats.
-    rel_prominence : float >= 0
-        Minimum prominence of an extremum, relative to the median absolute value
-        (speed) or the median absolute deviation (pca) of the curve.
-    window : float > 0 [s]
-        PCA window length (``method="pca"`` only).
-
-    Returns
-    -------
-    frames : np.ndarray [shape=(n_beats,)] int64 [frames], strictly increasing.
+    ``rel_prominence``: minimum prominence of an extremum, relative to the median
+    absolute value (speed) or the median absolute deviation (pca) of the curve.
     """
     if method not in _METHODS:
         raise ParameterError(f"method={method!r} is not one of {_METHODS}")
     pos, fps = _check_positions(positions, fps)
     min_interval = _check_seconds(min_interval, name="min_interval")
-    try:
-        rel_prominence = float(rel_prominence)
-    except (TypeError, ValueError):
-        raise ParameterError(f"rel_prominence={rel_prominence!r} must be a number >= 0") from None
-    if not np.isfinite(rel_prominence) or rel_prominence < 0:
-        raise ParameterError(f"rel_prominence={rel_prominence!r} must be a number >= 0")
+    rel_prominence = check_positive(
+        rel_prominence, name="rel_prominence", unit="fraction of the curve's scale", allow_zero=True
+    )
     distance = max(1, int(time_to_frames(min_interval, fps=fps, mode="round")))
     if method == "speed":
         curve = speed_curve(pos, fps=fps, smooth=smooth)
@@ -357,40 +247,7 @@ def kinematic_beats(
     rel_prominence: float = 0.02,
     window: float = 0.5,
 ) -> np.ndarray:
-    """Motion beat times of a clip [s].
-
-    Parameters
-    ----------
-    motion : Motion
-        With a skeleton (forward kinematics) or a marker-position table.
-    method : {"speed", "pca"}
-        ``"speed"`` (default): local minima of the smoothed mean joint speed.
-        ``"pca"``: extrema of a short-term PCA projection (paper B's earlier work).
-    smooth : float >= 0 [s]
-        Gaussian sigma of the smoothing.
-    min_interval : float >= 0 [s]
-        Minimum distance between beats.
-    joints : sequence of str, optional
-        Joints used; default all.
-    rel_prominence : float >= 0
-        See :func:`kinematic_beat_frames`.
-    window : float > 0 [s]
-        PCA window (``method="pca"``).
-
-    Returns
-    -------
-    beats : np.ndarray [shape=(n_beats,)] [s], on frame times, strictly increasing.
-
-    Raises
-    ------
-    ParameterError
-        Unknown method, negative durations, fewer than 3 frames, no positions.
-
-    Examples
-    --------
-    >>> from beatsync import datasets                                  # doctest: +SKIP
-    >>> kinematic_beats(datasets.load_salsa("60_01"))[:3]              # doctest: +SKIP
-    """
+    """Motion beat times of a clip [s] (see the module docstring for the methods)."""
     pos = motion_positions(motion, joints=joints)
     frames = kinematic_beat_frames(
         pos,
@@ -404,23 +261,8 @@ def kinematic_beats(
     return frames_to_time(frames, fps=motion.fps)
 
 
-# --------------------------------------------------------------------------- intensity
-
-
 def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.ndarray:
-    """Mean joint kinetic energy per interval between successive beat frames.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
-    beat_frames : array_like of int [frames], strictly increasing, inside the clip
-    fps : float > 0 [Hz]
-
-    Returns
-    -------
-    intensity : np.ndarray [shape=(len(beat_frames) - 1,)] [(position unit / s)^2]
-        Mean of :func:`kinetic_energy` over frames ``[b_i, b_{i+1})``.
-    """
+    """Mean :func:`kinetic_energy` over frames ``[b_i, b_{i+1})`` of successive beat frames."""
     energy = kinetic_energy(positions, fps=fps)
     bf = np.asarray(beat_frames)
     if bf.ndim != 1:
@@ -448,24 +290,7 @@ def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.nd
 
 
 def beat_interval_intensity(motion: Any, beat_times: Any, *, joints: Any = None) -> np.ndarray:
-    """Motion intensity of each interval between successive motion beats.
-
-    Parameters
-    ----------
-    motion : Motion
-    beat_times : array_like [s], strictly increasing, within the clip
-    joints : sequence of str, optional
-
-    Returns
-    -------
-    intensity : np.ndarray [shape=(len(beat_times) - 1,)] [(position unit / s)^2]
-        Mean kinetic energy of the joints (unit mass) over ``[beat_i, beat_{i+1})``.
-
-    Raises
-    ------
-    ParameterError
-        Beat times not seconds, outside the clip, or closer than one frame.
-    """
+    """Motion intensity of each interval between successive motion beats [s] of a clip."""
     fps = check_fps(motion.fps)
     n = int(motion.values.shape[0]) if hasattr(motion, "values") else None
     duration = float(frames_to_time(n - 1, fps=fps)) if n else None
@@ -475,9 +300,6 @@ def beat_interval_intensity(motion: Any, beat_times: Any, *, joints: Any = None)
     return interval_intensity(pos, frames, fps=fps)
 
 
-# --------------------------------------------------------------------------- tempo
-
-
 def motion_tempo(
     beat_times: Any,
     *,
@@ -485,41 +307,19 @@ def motion_tempo(
     max_bpm: float = 240.0,
     tolerance: float = 0.08,
 ) -> float:
-    """Tempo of a dance from its motion beats, by beat induction [BPM].
+    """Tempo of a dance from its motion beats [s], by beat induction [BPM].
 
-    Kinematic beats miss beats (the dancer holds a pose) more often than they add
-    them, so successive motion beats are whole numbers of beat periods apart. The
-    period ``P`` is the one that best explains every interval ``d_i`` as ``n_i P``
-    with the smallest ``n_i`` (Dixon 2001's inter-onset clustering; paper B's
-    [XTY10] estimates a motion's tempo from its beats the same way)::
+    Kinematic beats miss beats (a held pose) more often than they add them, so
+    successive motion beats are whole numbers ``n_i`` of beat periods ``P`` apart. As in
+    Dixon 2001's inter-onset clustering (and paper B's [XTY10]), over a log-spaced grid of
+    periods in ``[60 / max_bpm, 60 / min_bpm]``::
 
         score(P) = sum_i max_{n >= 1} exp(-log(d_i / (n P))^2 / (2 tolerance^2)) / n,
 
-    on a log-spaced grid of periods in ``[60 / max_bpm, 60 / min_bpm]``; the 1/n
-    weight makes the fundamental win over its sub-multiples. The best grid period is
-    then refined to ``sum d_i / sum n_i`` over the intervals it explains (within
-    twice the tolerance), which averages out beats rounded to frames.
+    (the 1/n weight makes the fundamental win over its sub-multiples; ``tolerance`` in
+    log-duration); the best is refined to ``sum d_i / sum n_i`` over the intervals it
+    explains within twice the tolerance.
 
-    Parameters
-    ----------
-    beat_times : array_like [s]
-        Motion beats of one clip, strictly increasing, at least two.
-    min_bpm, max_bpm : float > 0 [BPM]
-        Tempo search range.
-    tolerance : float > 0
-        Width of the match in log-duration (0.08: about 8 % timing deviation).
-
-    Returns
-    -------
-    bpm : float [BPM]
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two beats, bad range or tolerance.
-
-    Examples
-    --------
     >>> motion_tempo([0.0, 0.5, 1.0, 2.0, 2.5])  # one missed beat
     120.0
     """

@@ -1,12 +1,6 @@
 """The baselines of paper B's comparison: the multi-stage search and the random walk.
 
-See :mod:`beatsync.graph.search` for the objective and the rules both follow (the
-same feasibility under ``scale_bound``, ``steps`` and ``node_mask`` as the DP).
-
-- :func:`conventional_search`: in the spirit of Shiratori et al. 2006, segment by
-  segment, rhythm filter then intensity match; bounded by a candidate cap.
-- :func:`random_walk`: the control.
-
+Both follow the objective and feasibility rules of :mod:`beatsync.graph.search`.
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 4.
 """
 
@@ -18,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from ..validation import as_float, as_int, check_positive
 from .build import WeightedMotionGraph
 from .objective import (
     SearchResult,
@@ -57,31 +52,16 @@ def conventional_search(
 ) -> SearchResult:
     """Multi-stage segment-by-segment search (after Shiratori et al. 2006).
 
-    Parameters
-    ----------
-    graph : WeightedMotionGraph
-    music_z : np.ndarray [shape=(G,)]
-        Z-scored music intensity per grid interval.
-    music_durations : np.ndarray [shape=(G,)] [s]
-        Duration of each grid interval (the rhythm to match).
-    segment_beats : int >= 1
-        Music segment length [grid intervals] (8 = two 4/4 bars).
-    rhythm_sigma : float > 0
-        Width of the rhythm match ``exp(-log(d_motion/d_music)^2 / (2 sigma^2))``.
-    rhythm_threshold : float in [0, 1)
-        Stage 1: a candidate's rhythm match must exceed it at every beat. A segment
-        without any such candidate falls back to all candidates (counted in
-        ``info["rhythm_fallbacks"]``).
-    max_candidates : int >= 1
-        Cap on partial candidate sequences per depth (the best by rhythm are kept);
-        ``info["capped_segments"]`` counts the segments where it bit.
-    lam : float >= 0
-    scale_bound, steps, node_mask
-        As in :func:`dp_search` (the same feasibility rule).
-
-    Returns
-    -------
-    SearchResult
+    The music is cut into segments of ``segment_beats`` grid intervals (8: two 4/4
+    bars). For each in turn, graph paths continuing the previous segment are enumerated
+    breadth-first, each interval taking the feasible step whose time-scale is nearest 1;
+    stage 1 keeps those whose rhythm match ``exp(-log(d_motion/d_music)^2 / (2
+    rhythm_sigma^2))`` exceeds ``rhythm_threshold`` at every beat (else all, counted in
+    ``info["rhythm_fallbacks"]``), at most ``max_candidates`` per depth (the best by
+    rhythm; ``info["capped_segments"]``); stage 2 takes the best intensity match per grid
+    interval. Dead ends are avoided with
+    :func:`beatsync.graph.timescale.completion_table`. ``music_durations`` [s] is needed
+    (the rhythm); the other arguments as in :func:`dp_search`.
     """
     music_z, lam, _, md, bound, steps, mask = prepare_search(
         graph, music_z, lam, 0.0, music_durations, scale_bound, steps, node_mask
@@ -105,23 +85,15 @@ def check_conventional_options(
     max_candidates: Any = 20000,
 ) -> dict[str, Any]:
     """Validate the options of the multi-stage search (keys of :func:`conventional_core`)."""
-    try:
-        seg, cap = int(segment_beats), int(max_candidates)
-        sigma, thr = float(rhythm_sigma), float(rhythm_threshold)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            "segment_beats and max_candidates must be whole numbers, rhythm_sigma and "
-            "rhythm_threshold numbers"
-        ) from None
-    if seg < 1:
-        raise ParameterError(f"segment_beats={segment_beats!r} must be >= 1")
-    if not sigma > 0:
-        raise ParameterError(f"rhythm_sigma={rhythm_sigma!r} must be > 0")
+    thr = as_float(rhythm_threshold, name="rhythm_threshold")
     if not 0 <= thr < 1:
         raise ParameterError(f"rhythm_threshold={rhythm_threshold!r} must lie in [0, 1)")
-    if cap < 1:
-        raise ParameterError(f"max_candidates={max_candidates!r} must be >= 1")
-    return {"seg": seg, "sigma": sigma, "thr": thr, "cap": cap}
+    return {
+        "seg": as_int(segment_beats, name="segment_beats", unit="beats", minimum=1),
+        "sigma": check_positive(rhythm_sigma, name="rhythm_sigma", unit="log-duration"),
+        "thr": thr,
+        "cap": as_int(max_candidates, name="max_candidates", minimum=1),
+    }
 
 
 def conventional_core(
@@ -162,8 +134,6 @@ def conventional_core(
                 capped += int(not ok_cap)
                 break
             fallbacks += 1
-        if best is None:  # cannot happen: alive nodes always complete
-            raise RuntimeError(f"the multi-stage search found no candidate at grid {s0}")
         nodes, ends, n_cand = best
         n_candidates.append(n_cand)
         path.extend(nodes)
@@ -224,8 +194,8 @@ class _Ctx:
 def _enumerate(ctx, first, first_w, s0, s1, floor, cap, indptr, succ, sw):
     """Breadth-first enumeration of candidate sequences covering grid s0..s1 (or beyond).
 
-    Returns ``((nodes, ends, n_candidates) or None, complete)``: the chosen sequence's
-    nodes and end boundaries, and whether the candidate cap never bit.
+    Returns ``((nodes, ends, n_candidates) or None, complete)``: the chosen sequence and
+    whether the candidate cap never bit.
     """
     st, r = ctx.step(first, np.full(first.size, s0))
     keep = (st > 0) & (r > floor) if floor > 0 else st > 0
@@ -286,9 +256,6 @@ def _enumerate(ctx, first, first_w, s0, s1, floor, cap, indptr, succ, sw):
     return (seq[::-1], seq_ends[::-1], n_cand), complete
 
 
-# --------------------------------------------------------------------------- random walk
-
-
 def random_walk(
     graph: WeightedMotionGraph,
     n_intervals: int,
@@ -299,23 +266,12 @@ def random_walk(
     steps: Any = (1,),
     node_mask: Any = None,
 ) -> SearchResult:
-    """A random path covering ``n_intervals`` grid intervals (control).
+    """A random path covering ``n_intervals`` grid intervals (control; costs are NaN).
 
-    The start node, every next node and every step are drawn uniformly among those
-    from which the song can still be completed within the bounds (no dead ends).
-
-    Parameters
-    ----------
-    music_durations, scale_bound, steps, node_mask
-        As in :func:`dp_search` (the same feasibility rule).
-
-    Returns
-    -------
-    SearchResult
-        Costs are NaN (no music is used); ``transitions`` is set.
+    The start node, every next node and every step are drawn uniformly among those from
+    which the song can still be completed within the bounds (arguments as in
+    :func:`dp_search`).
     """
-    if not isinstance(graph, WeightedMotionGraph):
-        raise ParameterError("graph must be a WeightedMotionGraph")
     k_n = int(n_intervals)
     if k_n < 1:
         raise ParameterError(f"n_intervals={n_intervals!r} must be >= 1")

@@ -1,47 +1,23 @@
 """Construction of the weighted motion graph of paper B (section 3.2, eqs. 1-2).
 
-Nodes, edges and weights
-------------------------
-- **Nodes** are the beat frames of every clip of a motion library (kinematic beats,
-  :mod:`beatsync.motion_beats`, or beats given by the caller).
-- **Forward edges** join successive beat frames of the same clip. Each carries the
-  *motion intensity* of its interval, the mean kinetic energy of the joints
-  (:func:`beatsync.motion_beats.interval_intensity`), z-scored over all intervals of
-  the library. A node that starts a forward edge is an *interval node*.
-- **Transition edges** join two similar beat frames ``i != j`` (in either direction,
-  across or within clips) when ``rd(i, j) < TH`` (eq. 1, ``TH = 3.0``), weighted by
-  eq. 2 as written in the paper: ``w2 = rd if rd > 2 else 2`` (``weight_rule="paper"``:
-  every transition costs at least 2), or ``w2 = rd`` (``weight_rule="rd"``).
+Nodes are the beat frames of every clip of a library (one skeleton structure and
+frame rate). *Forward edges* join successive beat frames of a clip, with the motion
+intensity of their interval (:func:`beatsync.motion_beats.interval_intensity`),
+z-scored over the library; a node that starts one is an *interval node*. *Transition
+edges* join two beat frames ``i != j`` (either direction, across or within clips) with
+``rd(i, j) < TH`` (eq. 1, ``TH = 3.0``), weighted by eq. 2 as written,
+``w2 = rd if rd > 2 else 2`` (``weight_rule="paper"``), or ``w2 = rd`` (``"rd"``).
 
-The frame distance ``rd`` (eq. 1), defined here
------------------------------------------------
-Following Kovar, Gleicher and Pighin (2002, "Motion graphs"), each beat frame ``f``
-is represented by the point cloud of all joint positions (end sites included) over a
-window of frames ``f - h .. f + h`` (``window`` [s] long, clipped at the clip ends).
-Two clouds are compared after the rigid 2-D transform (rotation about the vertical
-axis, translation on the floor) that best aligns them (closed form, computed stably:
-:mod:`beatsync.graph.distance`). ``D`` is the RMS joint distance [position unit]
-after aligning root position and heading.
-
-``D`` has the units of the data, so a fixed ``TH`` would mean different things on
-different libraries. We make it scale-free::
+The frame distance ``rd`` (eq. 1): after Kovar, Gleicher and Pighin (2002), ``D``
+[position unit] is the RMS distance of the point clouds of all joints over a
+``window`` [s] around each frame after the best rotation about the vertical axis and
+translation on the floor (:mod:`beatsync.graph.distance`), made scale-free::
 
     rd = D / (v_typ * rd_unit),
 
-where ``v_typ`` [position unit / s] is the median over all frames of the library of
-the same aligned window distance between consecutive frames, times ``fps`` (the
-typical speed of the whole body's point cloud), and ``rd_unit = 0.1`` s. ``rd`` thus
-counts how many tenths of a second of typical movement separate the two poses, and
-``rd < TH = 3`` accepts transitions whose pose jump is at most what the dancer
-typically covers in 0.3 s, about the 1/3 s over which transitions are blended. (With
-``rd_unit = 1 / fps``, i.e. "relative to the frame-to-frame distance", the CMU salsa
-library has a single pair below 3: see ``notebooks/paper_b_tab01_search_speed.ipynb``.)
-
-Data contract
--------------
-Clips are :class:`beatsync.motion.Motion` with the same skeleton structure (joint
-names, parents, channels; bone lengths may differ). Beat times are seconds; node
-frames are integer frames of their clip.
+with ``v_typ`` [position unit / s] the median aligned distance between consecutive
+frames times ``fps`` and ``rd_unit = 0.1`` s: ``rd < 3`` accepts pose jumps of at most
+what the dancer typically covers in 0.3 s, about the 1/3 s of a transition's blend.
 
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B section 3.
 """
@@ -71,6 +47,9 @@ __all__ = [
 ]
 
 WEIGHT_RULES = ("paper", "rd")
+# the graph's arrays, as stored in the on-disk cache
+_ARRAYS = ("node_clip", "node_frame", "next_node", "intensity", "z_intensity",
+           "trans_src", "trans_dst", "trans_rd", "trans_weight")  # fmt: skip
 
 
 def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
@@ -83,43 +62,17 @@ def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
     return rd.copy()
 
 
-# --------------------------------------------------------------------------- graph
-
-
 @dataclass(frozen=True, eq=False)
 class WeightedMotionGraph:
-    """A weighted motion graph over the beat frames of a motion library.
+    """A weighted motion graph over the beat frames of a motion library (module docstring).
 
-    Attributes
-    ----------
-    clips : tuple of Motion
-        The library (same skeleton structure).
-    node_clip : np.ndarray [shape=(N,)] int
-        Clip index of each node.
-    node_frame : np.ndarray [shape=(N,)] int [frames]
-        Beat frame of each node in its clip.
-    next_node : np.ndarray [shape=(N,)] int
-        The following beat node of the same clip (forward edge), -1 at a clip's last beat.
-    intensity : np.ndarray [shape=(N,)] [(position unit / s)^2]
-        Motion intensity of the interval starting at each node; NaN at last beats.
-    z_intensity : np.ndarray [shape=(N,)]
-        ``intensity`` z-scored over all intervals of the library; NaN at last beats.
-    trans_src, trans_dst : np.ndarray [shape=(E,)] int
-        Directed transition edges (every two-way edge appears in both directions).
-    trans_rd : np.ndarray [shape=(E,)]
-        Scale-free distance ``rd`` of each transition (eq. 1, see module docstring).
-    trans_weight : np.ndarray [shape=(E,)]
-        Eq. 2 weight of each transition under ``weight_rule``.
-    th : float
-        Transition threshold TH on ``rd``.
-    weight_rule : str
-    speed_scale : float [position unit / s]
-        ``v_typ`` of the rd normalisation.
-    min_rd : float
-        Smallest ``rd`` between two distinct beat frames (to suggest a TH).
-    params : dict
-        All construction parameters (for caching and reports).
-    build_time : float [s]
+    Per node ``(N,)``: ``node_clip``, ``node_frame`` [frames], ``next_node`` (the next beat
+    node of its clip, -1 at a clip's last beat), ``intensity`` [(unit / s)^2] and
+    ``z_intensity`` of the interval it starts (NaN at last beats). Per directed transition
+    ``(E,)`` (each two-way edge twice): ``trans_src``, ``trans_dst``, ``trans_rd``,
+    ``trans_weight``. ``speed_scale``: ``v_typ`` [unit / s]; ``min_rd``: the smallest
+    ``rd`` between two beat frames (to suggest a TH); ``params``: the construction
+    parameters.
     """
 
     clips: tuple
@@ -140,7 +93,6 @@ class WeightedMotionGraph:
     build_time: float = 0.0
     _cache: dict = field(default_factory=dict, repr=False)
 
-    # -- sizes -------------------------------------------------------------
     @property
     def n_nodes(self) -> int:
         return int(self.node_clip.size)
@@ -189,24 +141,19 @@ class WeightedMotionGraph:
         return {k: v for k, v in self._cache.items() if k == "speeds"}
 
     def speed_reference(self) -> dict:
-        """Root and joint rotation speed percentiles of every clip (computed once).
-
-        See :func:`beatsync.graph.plausibility.library_profile`.
-        """
+        """Per-clip speed percentiles (:func:`.plausibility.library_profile`), computed once."""
         if "speeds" not in self._cache:
             from .plausibility import library_profile
 
             self._cache["speeds"] = library_profile(self.clips)
         return self._cache["speeds"]
 
-    # -- successor structure for searches ------------------------------------
     def successors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Edges between interval nodes: ``(src, dst, weight)``.
 
-        After playing the interval of node ``u`` the dancer stands on beat frame
-        ``a = next_node[u]``; the next interval is ``a``'s own (weight 0, "continue")
-        or that of any ``v`` with a transition edge ``a -> v`` (weight ``w2``).
-        Only interval nodes appear as ``src`` and ``dst``.
+        After playing ``u``'s interval the dancer stands on beat frame ``a = next_node[u]``;
+        the next interval is ``a``'s own (weight 0, "continue") or that of any ``v`` with a
+        transition edge ``a -> v`` (weight ``w2``).
         """
         if "succ" in self._cache:
             return self._cache["succ"]
@@ -214,34 +161,20 @@ class WeightedMotionGraph:
         u = np.flatnonzero(isint)
         a = self.next_node[u]
         keep = isint[a]
-        src = [u[keep]]
-        dst = [a[keep]]
-        w = [np.zeros(int(keep.sum()))]
         # transitions: for every edge a -> v, every u with next_node[u] == a
         prev = np.full(self.n_nodes, -1)
-        prev[self.next_node[u]] = u
+        prev[a] = u
         p = prev[self.trans_src]
         ok = (p >= 0) & isint[self.trans_dst]
-        src.append(p[ok])
-        dst.append(self.trans_dst[ok])
-        w.append(self.trans_weight[ok])
-        out = (
-            np.concatenate(src).astype(np.int64),
-            np.concatenate(dst).astype(np.int64),
-            np.concatenate(w).astype(np.float64),
+        self._cache["succ"] = (
+            np.concatenate([u[keep], p[ok]]).astype(np.int64),
+            np.concatenate([a[keep], self.trans_dst[ok]]).astype(np.int64),
+            np.concatenate([np.zeros(int(keep.sum())), self.trans_weight[ok]]).astype(np.float64),
         )
-        self._cache["succ"] = out
-        return out
+        return self._cache["succ"]
 
     def predecessor_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Dense padded predecessor table for the DP.
-
-        Returns
-        -------
-        pred : np.ndarray [shape=(N, max_in)] int (padding points at node 0)
-        weight : np.ndarray [shape=(N, max_in)] (padding is +inf)
-        is_trans : np.ndarray [shape=(N, max_in)] bool
-        """
+        """Dense ``(N, max_in)`` table ``(pred, weight, is_trans)`` for the DP (padding: inf)."""
         if "pred" in self._cache:
             return self._cache["pred"]
         src, dst, w = self.successors()
@@ -258,9 +191,8 @@ class WeightedMotionGraph:
         pred[dst, col] = src
         weight[dst, col] = w
         is_trans[dst, col] = self.next_node[src] != dst
-        out = (pred, weight, is_trans)
-        self._cache["pred"] = out
-        return out
+        self._cache["pred"] = (pred, weight, is_trans)
+        return self._cache["pred"]
 
     def successor_lists(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """CSR successor lists over all nodes: ``(indptr, dst, weight)``."""
@@ -270,40 +202,21 @@ class WeightedMotionGraph:
         order = np.lexsort((dst, src))
         src, dst, w = src[order], dst[order], w[order]
         indptr = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=self.n_nodes))])
-        out = (indptr, dst, w)
-        self._cache["csr"] = out
-        return out
+        self._cache["csr"] = (indptr, dst, w)
+        return self._cache["csr"]
 
-    # -- (de)serialisation of the arrays (for the on-disk cache) -------------
     def to_arrays(self) -> dict[str, np.ndarray]:
-        return {
-            "node_clip": self.node_clip,
-            "node_frame": self.node_frame,
-            "next_node": self.next_node,
-            "intensity": self.intensity,
-            "z_intensity": self.z_intensity,
-            "trans_src": self.trans_src,
-            "trans_dst": self.trans_dst,
-            "trans_rd": self.trans_rd,
-            "trans_weight": self.trans_weight,
-            "scalars": np.array([self.th, self.speed_scale, self.min_rd, self.build_time]),
-            "weight_rule": np.array(self.weight_rule),
-        }
+        out = {k: getattr(self, k) for k in _ARRAYS}
+        out["scalars"] = np.array([self.th, self.speed_scale, self.min_rd, self.build_time])
+        out["weight_rule"] = np.array(self.weight_rule)
+        return out
 
     @classmethod
     def from_arrays(cls, arrays: dict[str, Any], clips: Sequence[Any], params: dict) -> Any:
         th, speed, min_rd, build_time = (float(x) for x in np.asarray(arrays["scalars"]))
         return cls(
             clips=tuple(clips),
-            node_clip=np.asarray(arrays["node_clip"]),
-            node_frame=np.asarray(arrays["node_frame"]),
-            next_node=np.asarray(arrays["next_node"]),
-            intensity=np.asarray(arrays["intensity"]),
-            z_intensity=np.asarray(arrays["z_intensity"]),
-            trans_src=np.asarray(arrays["trans_src"]),
-            trans_dst=np.asarray(arrays["trans_dst"]),
-            trans_rd=np.asarray(arrays["trans_rd"]),
-            trans_weight=np.asarray(arrays["trans_weight"]),
+            **{k: np.asarray(arrays[k]) for k in _ARRAYS},
             th=th,
             weight_rule=str(np.asarray(arrays["weight_rule"])),
             speed_scale=speed,
@@ -313,11 +226,7 @@ class WeightedMotionGraph:
         )
 
     def with_threshold(self, th: float) -> WeightedMotionGraph:
-        """The graph keeping only the transitions with ``rd < th`` (``th`` <= this TH).
-
-        A graph built once with a large TH gives the graphs of every smaller TH
-        without recomputing the distances.
-        """
+        """The graph with only the transitions ``rd < th <= TH``, without recomputing distances."""
         th = check_th(th)
         if th > self.th:
             raise ParameterError(
@@ -347,22 +256,10 @@ class WeightedMotionGraph:
         )
 
 
-# --------------------------------------------------------------------------- checks
-
-
 def check_library(clips: Any) -> tuple:
-    """Validate a motion library: non-empty, BVH clips with one skeleton structure.
-
-    Raises
-    ------
-    ParameterError
-        Empty library, a clip without skeleton, or clips whose skeletons differ
-        (the message names both clips and the first differing joint).
-    """
-    if clips is None:
-        raise ParameterError("the motion library is empty: give at least one BVH clip")
-    clips = tuple(clips)
-    if len(clips) == 0:
+    """Validate a motion library: non-empty, BVH clips with one skeleton and frame rate."""
+    clips = () if clips is None else tuple(clips)
+    if not clips:
         raise ParameterError("the motion library is empty: give at least one BVH clip")
     for c in clips:
         if getattr(c, "skeleton", None) is None:
@@ -393,19 +290,7 @@ def check_library(clips: Any) -> tuple:
 
 
 def check_th(th: Any, *, name: str = "TH") -> float:
-    """Return the transition threshold ``th`` as a float, refusing non-numbers and ``<= 0``.
-
-    Parameters
-    ----------
-    th : float > 0
-        TH of eq. 1 on the scale-free distance ``rd``.
-    name : str
-        How the caller calls it in error messages (the CLI passes ``"--th"``).
-
-    Raises
-    ------
-    ParameterError
-    """
+    """The transition threshold ``th`` (eq. 1) as a float > 0; ``name`` as the caller calls it."""
     try:
         return check_positive(th, name=name, unit="scale-free distance rd")
     except ParameterError as exc:
@@ -451,47 +336,15 @@ def build_graph(
 ) -> WeightedMotionGraph:
     """Build the weighted motion graph of a motion library (paper B, section 3.2).
 
-    Parameters
-    ----------
-    clips : sequence of Motion
-        BVH clips with the same skeleton structure.
-    th : float > 0
-        TH of eq. 1 on the scale-free distance ``rd`` (paper: 3.0).
-    weight_rule : {"paper", "rd"}
-        Eq. 2 as written (``max(rd, 2)``) or the plain ``rd``.
-    beats : sequence of array_like [s], optional
-        Beat times per clip; default kinematic beats (``beat_method``, ``smooth``,
-        ``min_interval``, see :func:`beatsync.motion_beats.kinematic_beats`). Each
-        time becomes its nearest frame; times after a clip's last frame
-        ``(n_frames - 1) / fps`` are refused, and beats that round to the same frame
-        are merged with a :class:`~beatsync.errors.BeatsyncWarning`.
-    joints : sequence of str, optional
-        Joints used for beats, intensities and distances; default all.
-    window : float > 0 [s]
-        Length of the frame window compared by eq. 1.
-    rd_unit : float > 0 [s]
-        Time unit of ``rd`` (see module docstring).
-    up_axis : {"y", "z"}
-        Vertical axis of the data (BVH: y).
-    require_transitions : bool
-        Raise if no pair of beat frames has ``rd < th``.
-
-    Returns
-    -------
-    WeightedMotionGraph
-
-    Raises
-    ------
-    ParameterError
-        Empty library, different skeletons, TH <= 0, given beats after a clip's last
-        frame, no intervals, no transitions (with the smallest ``rd`` found, to
-        suggest a threshold).
-
-    Warns
-    -----
-    BeatsyncWarning
-        Given beats of a clip that round to the same frame (merged into one node), a
-        clip with fewer than two beats.
+    ``th``: TH of eq. 1 (paper: 3.0); ``weight_rule``: eq. 2 as written (``"paper"``) or
+    the plain ``rd``; ``beats``: beat times [s] per clip, each put on its nearest frame
+    (after a clip's last frame: refused; two on one frame: merged with a warning), by
+    default kinematic beats (``beat_method``, ``smooth``, ``min_interval``:
+    :func:`beatsync.motion_beats.kinematic_beats`); ``joints``: for beats, intensities and
+    distances (default all); ``window`` [s]: the frames compared by eq. 1; ``rd_unit``
+    [s]: the time unit of ``rd``; ``up_axis``: the vertical axis (BVH: y);
+    ``require_transitions``: refuse a graph without transitions (naming the smallest
+    ``rd``).
     """
     t0 = time.perf_counter()
     clips = check_library(clips)
@@ -502,11 +355,7 @@ def build_graph(
         raise ParameterError(f"up_axis={up_axis!r} must be 'y' (BVH) or 'z'")
     up = "xyz".index(up_axis)
     for name, val in (("window", window), ("rd_unit", rd_unit)):
-        try:
-            ok = np.isfinite(float(val)) and 0 < float(val) <= 10
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
+        if check_positive(val, name=name, unit="s") > 10:
             raise ParameterError(f"{name}={val!r} must be a duration in (0, 10] [s]")
     if beats is not None and len(beats) != len(clips):
         raise ParameterError(
@@ -530,9 +379,7 @@ def build_graph(
             warn(f"clip {c.name!r} has {fr.size} beat(s): it contributes no interval", stacklevel=2)
         frames_list.append(np.asarray(fr, dtype=np.int64))
 
-    node_clip = np.concatenate(
-        [np.full(f.size, i, dtype=np.int64) for i, f in enumerate(frames_list)]
-    )
+    node_clip = np.repeat(np.arange(len(clips), dtype=np.int64), [f.size for f in frames_list])
     node_frame = np.concatenate(frames_list)
     n = node_frame.size
     next_node = np.full(n, -1, dtype=np.int64)

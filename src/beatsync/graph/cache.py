@@ -1,20 +1,12 @@
 """On-disk cache of built motion graphs (opt-out, keyed by content, parameters and code).
 
-Building a :class:`~beatsync.graph.build.WeightedMotionGraph` costs seconds (forward
-kinematics, beat frames, all-pairs distances); searching it costs milliseconds. Built
-graphs are therefore stored as ``graph-<key>.npz`` in :func:`cache_dir`:
-``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else
-``~/.cache/beatsync``. Deleting the folder is always safe.
-
-An entry is keyed (:func:`graph_cache_key`) by the SHA-256 of the library files'
-content in their order, every graph parameter, the package version, the cache layout
-version and the source code of the modules that determine a graph
-(:func:`graph_source_hash`), so editing a clip, a parameter or the graph code (also
-in an editable install, where the version does not move) rebuilds the graph. A
-damaged entry is rebuilt; an unwritable folder is not an error.
-
-The cache is used by ``beatsync compose`` (on by default, ``--no-cache`` bypasses
-it). Library code and tests pass ``use_cache=False`` or their own folder.
+Building a graph costs seconds, searching it milliseconds, so ``beatsync compose``
+stores built graphs as ``graph-<key>.npz`` in :func:`cache_dir` (``--no-cache``
+bypasses it). The key covers the library files' content, every graph parameter, the
+package and cache layout versions and the source of the modules that determine a
+graph, so an edit to any of them (also in an editable install) rebuilds it. Deleting
+the folder is always safe; a damaged entry is rebuilt; an unwritable folder is not an
+error.
 """
 
 from __future__ import annotations
@@ -42,13 +34,7 @@ def cache_dir() -> Path:
 
 
 def graph_source_hash() -> str:
-    """SHA-256 of the source of the modules that determine a graph.
-
-    :mod:`beatsync.graph.build` and :mod:`beatsync.motion_beats` (beat frames,
-    intensities, distances) and the foundation they rest on: BVH reading
-    (:mod:`beatsync.io.bvh`), forward kinematics (:mod:`beatsync.motion`) and
-    :mod:`beatsync.validation`.
-    """
+    """SHA-256 of the source of the modules that determine a graph."""
     from .. import motion, motion_beats, validation
     from ..io import bvh, sha256_file
     from . import build
@@ -83,22 +69,9 @@ def load_or_build(
 ) -> tuple[WeightedMotionGraph, bool, Path | None]:
     """The graph of ``clips`` (read from ``files``), from the cache or built (and stored).
 
-    Parameters
-    ----------
-    files : sequence of Path
-        The library files, in the order of ``clips`` (their content is hashed).
-    clips : sequence of Motion
-    params : dict
-        ``th`` and ``weight_rule`` (passed to :func:`build_graph`) and anything else
-        that changes how the clips were read (e.g. ``fps``); all of it is hashed.
-    use_cache : bool
-        False: build, neither read nor write the cache.
-    folder : Path, optional
-        Cache folder (default :func:`cache_dir`).
-
-    Returns
-    -------
-    (graph, from_cache, cache_file)
+    ``params`` holds ``th`` and ``weight_rule`` (passed to :func:`build_graph`) and
+    anything else that changed how the clips were read (e.g. ``fps``); all of it is
+    hashed. Returns ``(graph, from_cache, cache_file)``.
     """
     from .. import io
 

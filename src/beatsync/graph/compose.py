@@ -1,12 +1,9 @@
 """End-to-end composition: music beats and intensity -> path -> synthesized dance.
 
-:func:`compose` takes music beats [s] and the music level per beat interval (RMS in
-dB, :func:`beatsync.music.beat_rms_db`), z-scores the level, searches the graph with
-the chosen method (``"dp"`` proposed, ``"conventional"`` baseline, ``"random"``
-control) and synthesizes the motion. :func:`compose_music` starts from audio.
-
-Data contract: beats in seconds (1-D float64, strictly increasing); levels one per
-beat interval; the output motion starts at music time 0.
+:func:`compose` z-scores the music level per beat interval (RMS [dB],
+:func:`beatsync.music.beat_rms_db`), plans the tempo, searches the graph and
+synthesizes the motion; :func:`compose_music` starts from audio. The output motion
+starts at music time 0.
 
 Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
@@ -29,7 +26,7 @@ from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
 from .plausibility import plausibility
 from .search import METHODS, dp_core
-from .synthesis import SynthesisResult, synthesize_core
+from .synthesis import SynthesisResult, check_blend_warp, synthesize_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
     TempoPlan,
@@ -44,28 +41,12 @@ __all__ = ["Composition", "compose", "compose_music", "check_music_beats"]
 
 @dataclass(frozen=True, eq=False)
 class Composition:
-    """A composed dance.
+    """A composed dance (frame ``j`` of ``motion`` plays at ``j / motion.fps`` s of the music).
 
-    Attributes
-    ----------
-    motion : Motion
-        Frame ``j`` plays at ``j / motion.fps`` seconds of the music.
-    search : SearchResult
-    synthesis : SynthesisResult
-    music_beats : np.ndarray [s]
-    music_level : np.ndarray [dB] (one per interval)
-    music_z : np.ndarray (z-scored level per beat interval)
-    timings : dict [s]
-        ``search_s`` and ``synthesis_s``.
-    tempo : TempoPlan
-        Eligible clips (and why), multiplicities, scale bound.
-    plausibility : dict
-        Root and joint rotation speed percentiles against the library's, time-scale
-        factors (:func:`beatsync.graph.plausibility.plausibility`).
-    warnings : list of str
-        Plausibility warnings (also issued as :class:`BeatsyncWarning`).
-    anchors : np.ndarray [s]
-        Music times on which the path's motion beats land (beats or half beats).
+    ``music_level`` [dB] and ``music_z`` (z-scored) are per beat interval; ``timings``
+    [s] holds ``search_s`` and ``synthesis_s``; ``plausibility`` the speeds against the
+    library's (:func:`beatsync.graph.plausibility.plausibility`) and ``warnings`` its
+    warnings; ``anchors`` [s] the music times on which the path's motion beats land.
     """
 
     motion: Motion
@@ -86,7 +67,6 @@ class Composition:
 
     def report(self) -> dict:
         """A JSON-ready summary (path as clip/beat-frame pairs, costs, timings)."""
-        g = self.synthesis.info.get("graph_summary", {})
         return {
             "method": self.search.method,
             "n_beats": int(self.music_beats.size),
@@ -100,7 +80,7 @@ class Composition:
             "duration_s": self.motion.n_frames / self.motion.fps,
             "fps": self.motion.fps,
             "transition_times_s": self.synthesis.transition_times,
-            "graph": g,
+            "graph": self.synthesis.info.get("graph_summary", {}),
             "tempo": self.tempo.report() if self.tempo is not None else None,
             "multiplicity_used": _counts(np.diff(self.search.boundaries), self.tempo),
             "plausibility": self.plausibility,
@@ -116,19 +96,7 @@ def _counts(steps: np.ndarray, plan: TempoPlan | None) -> dict[str, int]:
 
 
 def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
-    """The one check of music beats on the compose path: seconds, increasing, at least two.
-
-    Parameters
-    ----------
-    beats : array_like [s]
-    duration : float, optional [s]
-        Length of the audio the beats belong to (beats after it are refused).
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two beats, non-finite, not increasing, or after the audio.
-    """
+    """The one check of music beats [s] on the compose path (``duration``: the audio's)."""
     n = 0 if beats is None else int(np.asarray(beats).size)
     if n < 2:
         raise ParameterError(
@@ -155,55 +123,19 @@ def compose(
     tempo_select: bool = True,
     **search_kwargs: Any,
 ) -> Composition:
-    """Compose a dance for the given music beats and levels.
+    """Compose a dance for the given music beats [s] and levels [dB] (one per beat interval).
 
-    Parameters
-    ----------
-    graph : WeightedMotionGraph
-    music_beats : np.ndarray [shape=(K+1,)] [s]
-    music_level : np.ndarray [shape=(K,)] [dB]
-        Music intensity per beat interval; z-scored here.
-    method : {"dp", "conventional", "random"}
-    lam : float >= 0
-        Factor on transition weights.
-    fps : float, optional [Hz]
-        Output rate (default the library's).
-    blend : float [s]
-        Transition blend length.
-    end_time : float, optional [s]
-        Output length (default the last beat).
-    seed : int
-        Random walk seed.
-    warp : {"pchip", "linear"}
-        Time warp inside runs (see :func:`beatsync.graph.synthesis.synthesize`).
-    scale_bound : (float, float) or None
-        Bound on every interval's time-scale factor (music / natural duration),
-        enforced by every method; ``None``: unbounded (paper B as written).
-    multiplicity : "auto" or sequence of float
-        Music beats one motion-beat interval may cover (``0.5`` = two intervals per
-        beat); ``"auto"`` chooses from the tempo ratio
-        (:func:`beatsync.graph.timescale.choose_multiplicity`). With
-        ``scale_bound=None`` and ``"auto"`` every interval covers one beat.
-    tempo_select : bool
-        Use only the clips of the tempo sub-group(s) that suit the song (True), or
-        the whole library.
-    **search_kwargs
-        Passed to the search: ``tempo_weight``, ``start`` (DP); ``segment_beats``
-        [beats], ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
-        (conventional).
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two music beats, level/beat count mismatch, bad options, or no
-        dance within the bound (the message names the library's and the song's tempi
-        and the bound to relax).
-
-    Warns
-    -----
-    BeatsyncWarning
-        The result's 99th-percentile root or joint rotation speed exceeds the fastest
-        library clip's by more than 25 % (:mod:`beatsync.graph.plausibility`).
+    ``method``: ``"dp"`` (proposed), ``"conventional"`` (baseline) or ``"random"``
+    (control, seeded by ``seed``); ``lam``: factor on transition weights; ``fps``,
+    ``blend``, ``end_time``, ``warp``: of the output
+    (:func:`beatsync.graph.synthesis.synthesize`). ``scale_bound``: bound on every
+    interval's time-scale factor, ``None`` unbounded (paper B as written);
+    ``multiplicity``: music beats one motion interval may cover (``"auto"``: from the
+    tempo ratio, one beat when unbounded); ``tempo_select``: only the clips of the tempo
+    sub-group(s) that suit the song. ``search_kwargs``: ``tempo_weight``, ``start`` (DP),
+    ``segment_beats``, ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
+    (conventional). A result whose 99th-percentile root or joint rotation speed exceeds
+    the library's fastest clip's by more than 25 % warns (:mod:`.plausibility`).
     """
     beats = check_music_beats(music_beats)
     level = check_finite(music_level, name="music level")
@@ -219,14 +151,10 @@ def compose(
     if bound is None and mult == "auto":
         mult = (1.0,)
     fps = check_fps(graph.clips[0].fps if fps is None else fps)
-    blend = float(blend)
-    if not np.isfinite(blend) or blend < 0 or blend > 5:
-        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
+    blend = check_blend_warp(blend, warp)
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > 0:
         raise ParameterError(f"end_time={end_time!r} must be > 0 [s]")
-    if warp not in ("pchip", "linear"):
-        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
     plan = plan_tempo(
         graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
     )
@@ -261,30 +189,28 @@ def _search(graph, z, md, method, lam, seed, plan, kwargs):
     """Run one search on the song's grid under the tempo plan (inputs validated here)."""
     kwargs = dict(kwargs)
     sub = plan.subdivision
+    tw = 0.0
     if method == "conventional":
-        seg = kwargs.pop("segment_beats", 8)
-        opts = check_conventional_options(seg, **kwargs)
-        z, lam, _, md, bound, steps, mask = prepare_search(
-            graph, z, lam, 0.0, md, plan.bound, plan.steps, plan.node_mask
-        )
+        opts = check_conventional_options(kwargs.pop("segment_beats", 8), **kwargs)
         opts["seg"] = opts["seg"] * sub
-        return conventional_core(graph, z, md, lam, bound, steps, mask, **opts, subdivision=sub)
-    if method == "random":
+    elif method == "random":
         if kwargs:
             raise ParameterError(f"the random walk takes no options {sorted(kwargs)}")
-        _, _, _, md, bound, steps, mask = prepare_search(
-            graph, z, 0.0, 0.0, md, plan.bound, plan.steps, plan.node_mask
-        )
-        return random_core(graph, z.size, seed, md, bound, steps, mask, subdivision=sub)
-    start = kwargs.pop("start", "any")
-    tw = kwargs.pop("tempo_weight", 0.0)
-    if kwargs:
-        raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
-    if start not in ("any", "clip_start"):
-        raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
+        lam = 0.0
+    else:
+        start = kwargs.pop("start", "any")
+        tw = kwargs.pop("tempo_weight", 0.0)
+        if kwargs:
+            raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
+        if start not in ("any", "clip_start"):
+            raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, z, lam, tw, md, plan.bound, plan.steps, plan.node_mask
     )
+    if method == "conventional":
+        return conventional_core(graph, z, md, lam, bound, steps, mask, **opts, subdivision=sub)
+    if method == "random":
+        return random_core(graph, z.size, seed, md, bound, steps, mask, subdivision=sub)
     return dp_core(graph, z, lam, tw, md, bound, steps, mask, start=start, subdivision=sub)
 
 
@@ -297,10 +223,7 @@ def compose_music(
     bpm: float | None = None,
     **kwargs: Any,
 ) -> Composition:
-    """Compose a dance for audio: track beats (or use ``beats`` [s]), measure levels, compose.
-
-    The output lasts as long as the audio (the last interval's warp continues).
-    """
+    """Compose a dance for audio (as long as the audio): beats tracked or given [s], levels."""
     from ..music import beat_rms_db, track_music_beats
 
     y_arr = np.asarray(y)

@@ -1,23 +1,15 @@
 """The frame distance of eq. 1: point clouds compared after a floor-plane alignment.
 
-Following Kovar, Gleicher and Pighin (2002, "Motion graphs"), each beat frame ``f``
-is represented by the point cloud of all joint positions over a window of frames
-``f - h .. f + h`` (:func:`point_clouds`). Two clouds are compared after the rigid
-2-D transform (rotation about the vertical axis, translation on the floor) that best
-aligns them, which has a closed form: with both clouds centred on the floor plane,
-``D^2 = (S_i + S_j - 2 sqrt(a^2 + b^2) - 2 Y_ij) / M`` where ``S`` are the summed
-squared centred coordinates, ``a = sum(x_i x_j + z_i z_j)``,
-``b = sum(x_i z_j - z_i x_j)``, ``Y_ij = sum(y_i y_j)`` and ``M`` the number of
-points. The optimal rotation angle is ``atan2(-b, a)``.
-
-Numerical stability: the closed form is a difference of large sums, which cancels
-for nearly identical clouds (absolute error a few ulps of ``S_i + S_j``, worse far
-from the floor where the heights are large). Those entries are recomputed from direct
-point differences under the optimal rotation (:func:`aligned_distance_matrix`), and
-the row-wise :func:`aligned_pair_distance` always uses direct differences.
-
-Data contract: clouds ``(n, m, 3)`` [position unit]; ``up`` is the index of the
-vertical axis (1 = y, the BVH convention).
+After Kovar, Gleicher and Pighin (2002), each beat frame ``f`` is the point cloud of
+all joint positions over frames ``f - h .. f + h`` (:func:`point_clouds`) [position
+unit]. The rigid 2-D transform (rotation about the vertical axis ``up``, translation
+on the floor) that best aligns two clouds has a closed form: with both centred on the
+floor plane, ``D^2 = (S_i + S_j - 2 sqrt(a^2 + b^2) - 2 Y_ij) / M`` where ``S`` are the
+summed squared centred coordinates, ``a = sum(x_i x_j + z_i z_j)``,
+``b = sum(x_i z_j - z_i x_j)``, ``Y_ij = sum(y_i y_j)`` and ``M`` the number of points;
+the optimal angle is ``atan2(-b, a)``. The closed form cancels for nearly identical
+clouds, so those entries are recomputed from direct point differences under the
+optimal rotation (below :data:`CANCELLATION_RATIO`).
 
 Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb``; paper B eq. 1.
 """
@@ -40,10 +32,7 @@ __all__ = [
 
 
 def point_clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.ndarray:
-    """Point clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` around each frame.
-
-    Frames ``f - half .. f + half`` of ``positions`` (clipped at the clip ends).
-    """
+    """Clouds ``(len(frames), (2 half + 1) * n_joints, 3)`` of frames ``f - half .. f + half``."""
     n = positions.shape[0]
     idx = np.clip(frames[:, None] + np.arange(-half, half + 1)[None, :], 0, n - 1)
     c = positions[idx]  # (m, w, J, 3)
@@ -53,17 +42,13 @@ def point_clouds(positions: np.ndarray, frames: np.ndarray, half: int) -> np.nda
 def center_on_floor(c: np.ndarray, up: int) -> np.ndarray:
     """Clouds with their mean subtracted on the two floor axes (heights kept)."""
     c = c.copy()
-    for ax in range(3):
-        if ax != up:
-            c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
+    for ax in ground_axes(up):
+        c[:, :, ax] -= c[:, :, ax].mean(axis=1, keepdims=True)
     return c
 
 
 def ground_axes(up: int) -> tuple[int, int]:
-    """The two floor axes for vertical axis ``up``, in right-handed order.
-
-    ``(g0, up, g1)`` is a cyclic rotation of ``(x, y, z)``: y up gives ``(z, x)``.
-    """
+    """The two floor axes for vertical axis ``up``, right-handed: ``(g0, up, g1)`` is cyclic."""
     return {0: (1, 2), 1: (2, 0), 2: (0, 1)}[up]
 
 
@@ -107,24 +92,10 @@ def _direct_d2(a: np.ndarray, b: np.ndarray, theta: np.ndarray, up: int) -> np.n
 
 
 def aligned_distance_matrix(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
-    """RMS distance between point clouds after the best floor-plane rigid alignment.
+    """RMS distance ``(na, nb)`` between clouds after the best floor-plane rigid alignment.
 
-    The closed form (module docstring) is a difference of sums, which cancels when two
-    clouds are nearly identical: there the absolute error of ``D^2`` is a few ulps of
-    ``S_i + S_j``. Entries with ``D^2 < CANCELLATION_RATIO * (S_i + S_j)`` are therefore
-    recomputed from direct point differences under the optimal rotation (whose angle
-    is well conditioned), so identical clouds are at distance ~1e-8 of their size.
-
-    Parameters
-    ----------
-    a : np.ndarray [shape=(na, m, 3)] [position unit]
-    b : np.ndarray [shape=(nb, m, 3)]
-    up : int
-        Index of the vertical axis (1 = y, the BVH convention).
-
-    Returns
-    -------
-    d : np.ndarray [shape=(na, nb)] [position unit]
+    Entries with ``D^2 < CANCELLATION_RATIO * (S_i + S_j)`` come from direct differences,
+    so identical clouds are at distance ~1e-8 of their size.
     """
     a = center_on_floor(a, up)
     b = center_on_floor(b, up)
@@ -138,10 +109,7 @@ def aligned_distance_matrix(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.
 
 
 def aligned_pair_distance(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
-    """Row-wise version of :func:`aligned_distance_matrix` (``a[k]`` vs ``b[k]``).
-
-    Computed from direct differences under the optimal rotation (no cancellation).
-    """
+    """Row-wise :func:`aligned_distance_matrix` (``a[k]`` vs ``b[k]``), from direct differences."""
     a = center_on_floor(a, up)
     b = center_on_floor(b, up)
     m = a.shape[1]
@@ -163,5 +131,4 @@ def typical_speed(
             a, b = point_clouds(pos, ff, half), point_clouds(pos, ff + 1, half)
             d = aligned_pair_distance(a, b, up=up)
             vals.append(d * fps)
-    v = float(np.median(np.concatenate(vals))) if vals else 0.0
-    return v
+    return float(np.median(np.concatenate(vals))) if vals else 0.0

@@ -1,12 +1,9 @@
 """The objective of the motion-graph searches, their result and their input checks.
 
-See :mod:`beatsync.graph.search` for the objective ``E``; this module holds what the
-DP (:mod:`beatsync.graph.search`) and the baselines (:mod:`beatsync.graph.baselines`)
-share: :class:`SearchResult`, the validation of their inputs (once, at each public
-entry), the grid times and :func:`path_cost`.
-
-Data contract: music intensities and durations are 1-D arrays over the ``G`` grid
-intervals; durations in seconds; paths are node ids, boundaries grid indices.
+What the DP (:mod:`beatsync.graph.search`, where the objective ``E`` is defined) and
+the baselines (:mod:`beatsync.graph.baselines`) share; inputs are validated once, at
+each public entry. Music values are 1-D over the ``G`` grid intervals (durations [s]);
+paths are node ids, boundaries grid indices.
 """
 
 from __future__ import annotations
@@ -17,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..validation import check_finite
+from ..validation import check_finite, check_positive
 from .build import WeightedMotionGraph
 from .timescale import check_scale_bound
 
@@ -38,22 +35,11 @@ __all__ = [
 class SearchResult:
     """A path through the graph for ``G`` music grid intervals.
 
-    Attributes
-    ----------
-    path : np.ndarray [shape=(P,)] int
-        Interval node played during each motion interval.
-    boundaries : np.ndarray [shape=(P + 1,)] int
-        Grid boundary where each interval starts (and the last ends: ``G``).
-    transitions : np.ndarray [shape=(P,)] bool
-        True where interval ``i`` is entered through a transition edge (``i >= 1``).
-    scales : np.ndarray [shape=(P,)]
-        Time-scale factor of each interval (music / natural duration); NaN when the
-        music durations are unknown.
-    cost, intensity_cost, transition_cost, tempo_cost : float
-        The objective ``E`` and its parts (NaN for the random walk).
-    method : str
-    search_time : float [s]
-    info : dict
+    ``path`` ``(P,)``: the interval node of each motion interval; ``boundaries``
+    ``(P + 1,)``: the grid boundary where each starts (and the last ends, ``G``);
+    ``transitions`` ``(P,)``: entered through a transition edge; ``scales`` ``(P,)``:
+    time-scale factors (NaN without music durations); ``cost``, ``intensity_cost``,
+    ``transition_cost``, ``tempo_cost``: ``E`` and its parts (NaN for the random walk).
     """
 
     path: np.ndarray
@@ -104,12 +90,8 @@ def prepare_search(
     if not isinstance(graph, WeightedMotionGraph):
         raise ParameterError("graph must be a WeightedMotionGraph (see beatsync.graph.build_graph)")
     music_z = check_music(music_z, "music intensity")
-    v = float(lam)
-    if not np.isfinite(v) or v < 0:
-        raise ParameterError(f"lam={lam!r} (transition cost factor) must be finite and >= 0")
-    tw = float(tempo_weight)
-    if not np.isfinite(tw) or tw < 0:
-        raise ParameterError(f"tempo_weight={tempo_weight!r} must be finite and >= 0")
+    v = check_positive(lam, name="lam", unit="transition cost factor", allow_zero=True)
+    tw = check_positive(tempo_weight, name="tempo_weight", unit="cost", allow_zero=True)
     md = None
     if music_durations is not None:
         md = check_music(music_durations, "music_durations")
@@ -151,28 +133,12 @@ def path_cost(
     boundaries: Any = None,
     scale_bound: Any = None,
 ) -> tuple[float, float, float, float, np.ndarray]:
-    """Objective ``E`` of a given path (and its parts); refuses infeasible paths.
-
-    Parameters
-    ----------
-    boundaries : array_like of int, optional
-        Grid boundaries of the intervals (default one grid interval each).
-    scale_bound : (float, float), optional
-        Refuse intervals whose time-scale factor lies outside it.
-
-    Returns
-    -------
-    (total, intensity, transition, tempo, transitions)
-        ``transitions`` is the boolean array of :class:`SearchResult`.
-    """
+    """``(E, intensity, transition, tempo, transitions)`` of a path; refuses infeasible ones."""
     music_z, lam, tw, md, bound, _, _ = prepare_search(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, (1,), None
     )
     path = np.asarray(path, dtype=np.int64)
-    if boundaries is None:
-        bnd = np.arange(path.size + 1)
-    else:
-        bnd = np.asarray(boundaries, dtype=np.int64)
+    bnd = np.arange(path.size + 1) if boundaries is None else np.asarray(boundaries, dtype=np.int64)
     if bnd.shape != (path.size + 1,) or bnd[0] != 0 or bnd[-1] != music_z.size:
         raise ParameterError(
             f"path has {path.size} nodes and boundaries {bnd.size} for {music_z.size} music "
@@ -195,8 +161,7 @@ def path_cost_core(graph, path, bnd, music_z, lam, tw, md, bound):
     inten += float(cs2[-1])
     tempo = 0.0
     if md is not None:
-        t = grid_times(md, music_z.size)
-        scales = (t[bnd[1:]] - t[bnd[:-1]]) / graph.interval_duration()[path]
+        scales = interval_scales(graph, path, bnd, md, music_z.size)
         if bound is not None:
             bad = (scales < bound[0] * (1 - 1e-9)) | (scales > bound[1] * (1 + 1e-9))
             if bad.any():

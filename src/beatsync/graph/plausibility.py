@@ -1,21 +1,12 @@
-"""Physical plausibility of a composed dance against its library (paper B, issue of speed).
+"""Physical plausibility of a composed dance: its speeds against its library's.
 
-A composed dance whose intervals are squeezed into short music beats moves faster
-than any real motion of its library. Two speeds are compared with the library's:
-
-- **root speed** [position unit / s]: speed of the root joint (pelvis) in 3-D, frame
-  to frame;
-- **joint rotation speed** [deg / s]: angle of each joint's local rotation change
-  between successive frames (every joint with a rotation triple, the root included),
-  pooled over joints and frames. Position-only motions have no rotations: NaN.
-
-Each is summarised by its 50th, 95th and 99th percentiles. The reference of a library
-is the *largest* 99th percentile among its clips (the fastest real clip); a result
-whose 99th percentile exceeds it by more than :data:`TOLERANCE` (25 %) gets a
-:class:`~beatsync.errors.BeatsyncWarning`. The time-scale factors of the path's
-intervals (music / natural duration) are summarised beside them.
-
-Data contract: motions are :class:`beatsync.motion.Motion`; speeds per frame step.
+A dance whose intervals are squeezed into short music beats moves faster than any
+real motion of its library. Compared: the **root speed** [position unit / s] and the
+**joint rotation speed** [deg / s] (angle of each joint's local rotation change between
+frames, pooled over joints; NaN without rotations), each by its 50th, 95th and 99th
+percentiles. The reference is the *largest* clip 99th percentile of the library; a
+result above it by more than :data:`TOLERANCE` (25 %) gets a
+:class:`~beatsync.errors.BeatsyncWarning`.
 
 Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``.
 """
@@ -48,15 +39,7 @@ _CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
 
 
 def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
-    """Root speed per frame step and joint rotation speeds per frame step and joint.
-
-    Returns
-    -------
-    dict
-        ``root_speed`` [shape=(n - 1,)] [position unit / s];
-        ``rotation_speed`` [shape=(n - 1, n_rot_joints)] [deg / s] (empty columns for
-        position-only motions).
-    """
+    """Root speed [unit / s] ``(n - 1,)`` and joint rotation speeds [deg / s] ``(n - 1, J)``."""
     pos = np.asarray(motion.positions(), dtype=np.float64)
     root = np.linalg.norm(np.diff(pos[:, 0, :], axis=0), axis=1) * motion.fps
     triples = motion.rotation_triples() if getattr(motion, "skeleton", None) else []
@@ -103,26 +86,11 @@ def plausibility(
     scales: Any,
     bound: tuple[float, float] | None,
 ) -> tuple[dict[str, Any], list[str]]:
-    """Speeds of a result against its library, and the time-scale factors.
+    """Speeds of a result against its library (:func:`library_profile`), and the time-scales.
 
-    Parameters
-    ----------
-    motion : Motion
-        The composed dance.
-    library : dict
-        From :func:`library_profile`.
-    scales : np.ndarray
-        Time-scale factor of every interval of the path.
-    bound : (float, float) or None
-
-    Returns
-    -------
-    (report, warnings)
-        ``report`` holds the result's percentiles, the library reference, the ratios
-        ``root_speed_ratio`` and ``rotation_speed_ratio`` (result p99 / reference),
-        and ``scale_min``, ``scale_p5``, ``scale_p50``, ``scale_p95``, ``scale_max``,
-        ``scale_outside_bound`` (count); ``warnings`` the messages for ratios above
-        :data:`TOLERANCE`.
+    Returns the report (the result's percentiles, the library reference, the ratios
+    ``root_speed_ratio`` and ``rotation_speed_ratio``, ``scale_min`` ... ``scale_max`` and
+    ``scale_outside_bound``) and the warnings for ratios above :data:`TOLERANCE`.
     """
     prof = speed_profile(motion)
     ref = library["reference"]

@@ -3,44 +3,26 @@
 Objective (paper B, eqs. 3-6, as we read them)
 ----------------------------------------------
 The music is a *grid* of ``G`` intervals (its beats, or half beats, see
-:mod:`beatsync.graph.timescale`) with a z-scored intensity ``z_j`` each. A dance is
-a path of interval nodes ``u_0 .. u_{P-1}`` (:meth:`WeightedMotionGraph.successors`)
-with boundaries ``0 = b_0 < b_1 < ... < b_P = G``: interval ``u_i`` is time-warped
-onto grid intervals ``[b_i, b_{i+1})``, a whole number ``b_{i+1} - b_i`` of them
-taken from ``steps`` (``steps = (1,)``: one interval per beat, as in paper B). After
-playing ``u_i`` the dancer stands on the beat frame ``next_node[u_i]`` and either
-continues with that frame's own interval (cost 0) or takes a transition edge to a
-similar beat frame (cost ``lam * w2``, eq. 2). The cost is
+:mod:`beatsync.graph.timescale`) with a z-scored intensity ``z_j`` each. A dance is a
+path of interval nodes ``u_0 .. u_{P-1}`` (:meth:`WeightedMotionGraph.successors`)
+with boundaries ``0 = b_0 < b_1 < ... < b_P = G``: interval ``u_i`` is time-warped onto
+grid intervals ``[b_i, b_{i+1})``, ``b_{i+1} - b_i`` taken from ``steps`` (``(1,)``:
+one interval per beat, as in paper B). After ``u_i`` the dancer either continues with
+the next beat frame's own interval (cost 0) or takes a transition edge (cost
+``lam * w2``, eq. 2). The cost is
 
     E = sum_i sum_{j in [b_i, b_{i+1})} (z_motion(u_i) - z_j)^2 + lam * sum_{transitions} w2
         + tempo_weight * sum_i log(d_motion(u_i) / d_music(b_i, b_{i+1}))^2.
 
-The tempo term is 0 by default. A ``scale_bound = (lo, hi)`` makes every interval
-whose time-scale factor ``d_music / d_motion`` lies outside ``[lo, hi]`` infeasible
-(infinite cost), in all three searches alike; ``node_mask`` restricts them to part of
-the graph (the clips of the song's tempo group).
+The tempo term is 0 by default. In all three searches alike, ``scale_bound = (lo, hi)``
+makes an interval whose time-scale factor ``d_music / d_motion`` lies outside
+``[lo, hi]`` infeasible, and ``node_mask`` restricts them to part of the graph.
 
-- :func:`dp_search` (proposed): dynamic programming over the grid boundaries,
-  ``D_k(v) = min_{s in steps} c(v, k - s, k) + min_u (D_{k-s}(u) + lam w(u, v))``;
-  time ``O(G (N max_in + |steps| N))``, linear in the music; exact optimum of ``E``.
-- :func:`conventional_search` (baseline in the spirit of Shiratori et al. 2006): the
-  music is cut into segments of ``segment_beats`` grid intervals; for each segment in
-  turn, candidate motion sequences (graph paths continuing the previous segment) are
-  enumerated breadth-first, keeping only those whose rhythm matches the music above
-  ``rhythm_threshold`` at every beat (stage 1); the candidate with the best intensity
-  match per grid interval is chosen (stage 2). Each interval takes the feasible step
-  whose time-scale is nearest 1. The enumeration is exhaustive up to
-  ``max_candidates`` partial paths per depth (then the best by rhythm are kept), which
-  makes it a bounded greedy search; it avoids dead ends with the completion table of
-  :func:`beatsync.graph.timescale.completion_table` but is not given the DP.
-- :func:`random_walk` (control): uniform choice among the successors and steps that
-  can still complete the song.
+:func:`dp_search` (proposed) is exact and linear in the music:
+``D_k(v) = min_{s in steps} c(v, k - s, k) + min_u (D_{k-s}(u) + lam w(u, v))``. The
+baseline and the control are in :mod:`beatsync.graph.baselines`.
 
-Data contract: music intensities and durations are 1-D arrays over the ``G`` grid
-intervals (intensities already z-scored); durations in seconds. Paths are arrays of
-node ids, boundaries arrays of grid indices.
-
-Notebook: ``notebooks/paper_b_tab01_search_speed.ipynb`` (times),
+Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb`` (times),
 ``notebooks/paper_b_tab02_quality_proxies.ipynb`` (quality); paper B sections 3.3-3.4.
 """
 
@@ -59,7 +41,6 @@ from .timescale import no_path_error, span_feasible
 
 __all__ = [
     "METHODS",
-    "search",
     "SearchResult",
     "dp_search",
     "dp_core",
@@ -68,11 +49,8 @@ __all__ = [
     "path_cost",
 ]
 
-#: Search methods of :func:`search`.
+#: Search methods of :func:`beatsync.graph.compose.compose`.
 METHODS = ("dp", "conventional", "random")
-
-
-# --------------------------------------------------------------------------- DP
 
 
 def dp_search(
@@ -87,39 +65,13 @@ def dp_search(
     steps: Any = (1,),
     node_mask: Any = None,
 ) -> SearchResult:
-    """Globally optimal path by dynamic programming (paper B, eqs. 3-6).
+    """Globally optimal path by dynamic programming (paper B, eqs. 3-6, module docstring).
 
-    Parameters
-    ----------
-    graph : WeightedMotionGraph
-    music_z : np.ndarray [shape=(G,)]
-        Z-scored music intensity per grid interval.
-    lam : float >= 0
-        Factor on the transition weights.
-    start : {"any", "clip_start"}
-        Start nodes: every interval node (default: "all first beat frames"), or only
-        the first beat frame of each clip.
-    tempo_weight : float >= 0
-        Weight of the tempo term (0 as in the paper).
-    music_durations : np.ndarray [shape=(G,)] [s], optional
-        Needed for ``tempo_weight > 0`` and ``scale_bound``.
-    scale_bound : (float, float), optional
-        Bound on every interval's time-scale factor (music / natural duration).
-    steps : sequence of int >= 1
-        Grid intervals one motion interval may cover.
-    node_mask : np.ndarray [shape=(N,)] bool, optional
-        Nodes the path may use.
-
-    Returns
-    -------
-    SearchResult
-        ``search_time`` counts the DP only (the graph is built offline).
-
-    Raises
-    ------
-    ParameterError
-        Empty music; no path satisfies the bounds (the message names the library's
-        and the song's tempi and the bound to relax); a library with dead ends.
+    ``music_z`` ``(G,)``: z-scored music intensity per grid interval; ``start``: at any
+    interval node, or only at each clip's first beat frame (``"clip_start"``);
+    ``music_durations`` [s] ``(G,)``: needed for ``tempo_weight > 0`` and
+    ``scale_bound``; ``steps``: grid intervals one motion interval may cover;
+    ``node_mask`` ``(N,)``: nodes the path may use. ``search_time`` counts the DP only.
     """
     music_z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, steps, node_mask
@@ -152,7 +104,6 @@ def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", sub
     arg_arrive = np.zeros((g_n + 1, n), dtype=np.int32)
     arg_step = np.zeros((g_n + 1, n), dtype=np.int16)
     rows = np.arange(n)
-    d = np.full(n, np.inf)
     for k in range(1, g_n + 1):
         d = np.full(n, np.inf)
         for s in steps:
@@ -194,31 +145,3 @@ def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", sub
     return make_result(
         graph, path[::-1], bnd[::-1], music_z, lam, tw, md, bound, "dp", elapsed, {"start": start}
     )
-
-
-# --------------------------------------------------------------------------- dispatch
-
-
-def search(
-    graph: WeightedMotionGraph,
-    music_z: Any,
-    music_durations: Any,
-    *,
-    method: str = "dp",
-    lam: float = 1.0,
-    seed: int = 0,
-    **kwargs: Any,
-) -> SearchResult:
-    """Search a path with ``method``.
-
-    Dispatches to :func:`dp_search`, :func:`conventional_search` or :func:`random_walk`.
-    """
-    if method == "dp":
-        return dp_search(graph, music_z, lam=lam, music_durations=music_durations, **kwargs)
-    if method == "conventional":
-        return conventional_search(graph, music_z, music_durations, lam=lam, **kwargs)
-    if method == "random":
-        return random_walk(
-            graph, len(music_z), seed=seed, music_durations=music_durations, **kwargs
-        )
-    raise ParameterError(f"method={method!r} is not one of {METHODS}")

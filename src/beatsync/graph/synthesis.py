@@ -1,30 +1,17 @@
 """Synthesis of a composed dance from a graph path (paper B, section 3.5).
 
-Every chosen interval (from beat frame ``f_k`` to the next beat frame of its clip) is
-time-warped linearly onto its music beat interval ``[b_k, b_{k+1}]``, so each motion
-beat lands exactly on its music beat: source time
-``s(t) = f_k / fps + (t - b_k) / (b_{k+1} - b_k) * (f_{k+1} - f_k) / fps``.
-Output frames are sampled from the source clips with
-:func:`beatsync.rotations.sample_motion` (slerp on rotations).
-
-Runs of intervals that follow each other in one clip are played as they were
-captured. At a transition (from beat frame ``a`` of one clip to beat frame ``m`` of
-another, or of the same clip) the new run is placed with the rigid floor-plane
-transform (rotation about the vertical axis, translation on the floor) that puts its
-root at ``m`` where the previous run's root is at ``a``, with the same heading, so the
-dancer does not jump (Kovar et al. 2002). Over the first ``blend`` seconds (about
-1/3 s) after the transition the old run, continued past ``a`` at the new interval's
-rate, is blended into the new one with smooth-step weights
-(:func:`beatsync.rotations.blend_values`: slerp on rotations, linear on positions).
-At the beat itself the pose is the old run's beat frame, a beat frame.
-
-Before the first music beat the first interval's warp is extended backwards (the
-source clip's lead-in, held at its first frame), and after the last beat the last
-interval's warp continues until ``end_time``.
-
-Data contract: music beats in seconds, strictly increasing; the result is a
-:class:`beatsync.motion.Motion` with the library's skeleton at ``fps`` [Hz]; frame
-``j`` plays at ``j / fps`` seconds of the music.
+Every chosen interval (beat frame ``f_k`` to the next beat frame of its clip) is
+time-warped onto its music beat interval ``[b_k, b_{k+1}]``, so each motion beat lands
+exactly on its music beat:
+``s(t) = f_k / fps + (t - b_k) / (b_{k+1} - b_k) * (f_{k+1} - f_k) / fps``
+(or a monotone cubic through the same points), sampled with
+:func:`beatsync.rotations.sample_motion`. Runs of consecutive intervals of one clip
+play as captured; at a transition (beat frame ``a`` to ``m``) the new run is placed by
+the rigid floor-plane transform that puts its root at ``m`` where the old run's is at
+``a``, same heading (Kovar et al. 2002), and the old run, continued past ``a``, is
+blended into it over ``blend`` seconds with smooth-step weights
+(:func:`beatsync.rotations.blend_values`). The first and last intervals' warps extend
+to ``start_time`` and ``end_time``; frame ``j`` plays at ``j / fps`` s of the music.
 
 Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.
 """
@@ -51,25 +38,22 @@ from ..validation import check_fps, check_times, frames_to_time, time_to_frames
 from .build import WeightedMotionGraph
 from .distance import ground_axes
 
-__all__ = ["SynthesisResult", "synthesize", "synthesize_core", "beat_warp", "smoothstep"]
+__all__ = [
+    "SynthesisResult",
+    "synthesize",
+    "synthesize_core",
+    "check_blend_warp",
+    "beat_warp",
+]
 
 
 @dataclass(frozen=True, eq=False)
 class SynthesisResult:
     """A composed motion and where each output frame came from.
 
-    Attributes
-    ----------
-    motion : Motion
-    source_clip : np.ndarray [shape=(n_frames,)] int
-        Clip index of the run each output frame belongs to.
-    source_time : np.ndarray [shape=(n_frames,)] [s]
-        Time in that clip.
-    transition_times : np.ndarray [s]
-        Music beats at which a transition starts (blend from there for ``blend`` s).
-    beat_source_times : np.ndarray [shape=(K+1,)] [s]
-        Source time the warp assigns to every music beat (a beat frame time).
-    info : dict
+    ``source_clip`` and ``source_time`` [s]: the clip and time each output frame was
+    sampled from; ``transition_times`` [s]: music beats where a transition (and its
+    blend) starts; ``beat_source_times`` [s]: the source time of every music beat.
     """
 
     motion: Motion
@@ -80,29 +64,14 @@ class SynthesisResult:
     info: dict = field(default_factory=dict)
 
 
-def smoothstep(x: np.ndarray) -> np.ndarray:
-    """``3 x^2 - 2 x^3`` on ``[0, 1]`` (zero slope at both ends)."""
-    x = np.clip(np.asarray(x, dtype=np.float64), 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
-
-
 def beat_warp(
     music_beats: np.ndarray, src_start: np.ndarray, src_end: np.ndarray, times: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Piecewise-linear warp from music time to source time.
+    """Piecewise-linear warp from music time to source time: ``(k, s)`` per time.
 
-    Parameters
-    ----------
-    music_beats : np.ndarray [shape=(K+1,)] [s]
-    src_start, src_end : np.ndarray [shape=(K,)] [s]
-        Source times of the beat frames that start and end each interval.
-    times : np.ndarray [s]
-        Music times to map.
-
-    Returns
-    -------
-    (k, s) : interval index of each time (clipped to 0..K-1) and its source time [s].
-        ``s(b_k) = src_start[k]`` exactly; ``s(b_{k+1}) -> src_end[k]``.
+    ``src_start``, ``src_end`` [s] are the source times of the beat frames that start and
+    end each interval; ``k`` is the interval of each time (clipped to 0..K-1) and ``s``
+    its source time, with ``s(b_k) = src_start[k]`` exactly.
     """
     k_n = src_start.size
     k = np.clip(np.searchsorted(music_beats, times, side="right") - 1, 0, k_n - 1)
@@ -111,7 +80,7 @@ def beat_warp(
     return k, s
 
 
-def _root_layout(template: Motion, up: int) -> tuple[list[int], tuple[int, int, int], str]:
+def _root_layout(template: Motion) -> tuple[list[int], tuple[int, int, int], str]:
     skel = template.skeleton
     root = skel.joints[0].name
     pos_cols = []
@@ -151,27 +120,10 @@ def synthesize(
 ) -> SynthesisResult:
     """Concatenate, warp and blend the chosen intervals into one motion.
 
-    Parameters
-    ----------
-    graph : WeightedMotionGraph
-    path : array_like [shape=(K,)] int
-        Interval nodes (from a search) for the ``K = len(music_beats) - 1`` intervals.
-    music_beats : array_like [shape=(K+1,)] [s]
-    fps : float > 0 [Hz], optional
-        Output frame rate; default the library's.
-    blend : float >= 0 [s]
-        Transition blend length (capped at the interval's duration).
-    start_time, end_time : float [s]
-        Span of the output (default from 0 to the last music beat).
-    warp : {"pchip", "linear"}
-        Time warp inside a run of consecutive intervals: piecewise linear (the rate
-        jumps at every beat) or a monotone cubic (PCHIP) through the same beat
-        correspondences (continuous rate). Both put every motion beat exactly on its
-        music beat.
-
-    Returns
-    -------
-    SynthesisResult
+    ``path`` ``(K,)``: interval nodes for the ``K = len(music_beats) - 1`` intervals;
+    ``fps``: default the library's; ``blend`` [s]: capped at the interval's duration;
+    ``start_time``, ``end_time`` [s]: default 0 and the last beat; ``warp``: piecewise
+    linear (the rate jumps at every beat) or monotone cubic (continuous rate).
     """
     beats = check_times(music_beats, name="music beats")
     path = np.asarray(path, dtype=np.int64)
@@ -184,17 +136,22 @@ def synthesize(
         )
     if np.any(path < 0) or np.any(path >= graph.n_nodes) or not graph.is_interval[path].all():
         raise ParameterError("path contains nodes that do not start an interval")
-    template = graph.clips[0]
-    fps = check_fps(template.fps if fps is None else fps)
-    blend = float(blend)
-    if not np.isfinite(blend) or blend < 0 or blend > 5:
-        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
+    fps = check_fps(graph.clips[0].fps if fps is None else fps)
+    blend = check_blend_warp(blend, warp)
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > start_time >= 0:
         raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
+
+
+def check_blend_warp(blend: Any, warp: Any) -> float:
+    """The blend length [s] as a float in [0, 5], and ``warp`` one of "pchip", "linear"."""
+    blend = float(blend)
+    if not np.isfinite(blend) or blend < 0 or blend > 5:
+        raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
     if warp not in ("pchip", "linear"):
         raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
-    return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
+    return blend
 
 
 def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
@@ -202,7 +159,7 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     template = graph.clips[0]
     up = "xyz".index(graph.params.get("up_axis", "y"))
     g0, g1 = ground_axes(up)
-    pos_cols, rot_cols, order = _root_layout(template, up)
+    pos_cols, rot_cols, order = _root_layout(template)
     rot_cols = list(rot_cols)
 
     k_n = path.size
@@ -222,8 +179,6 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     run_of = run_id[k_of]
     if warp == "pchip":
         s_of = _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_of)
-    n_out = t.size
-    values = np.empty((n_out, template.n_channels))
 
     # rigid floor transforms per run: yaw angle and ground translation
     n_runs = int(run_id[-1]) + 1
@@ -235,28 +190,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         v = graph.clips[clip].values[frame]  # beat frames lie on frames: no sampling
         return v[pos_cols], euler_to_rotation(v[rot_cols][None, :], order)
 
-    def place(r: int, p: np.ndarray) -> np.ndarray:
-        rot = Rotation.from_rotvec(yaw[r] * _unit(up))
-        out = rot.apply(p)
-        out[..., g0] += shift[r, g0]
-        out[..., g1] += shift[r, g1]
-        return out
-
+    axis = np.eye(3)[up]  # the vertical axis
     for r in range(1, n_runs):
         k = run_first_k[r]
         # previous run ends on beat frame a (= next_node[path[k-1]]) of its clip
         a = graph.next_node[path[k - 1]]
-        ca = graph.node_clip[a]
-        pa, ra = raw_root(ca, graph.node_frame[a])
+        pa, ra = raw_root(graph.node_clip[a], graph.node_frame[a])
         pb, rb = raw_root(clip_of[k], graph.node_frame[path[k]])
-        ha = _heading(Rotation.from_rotvec(yaw[r - 1] * _unit(up)) * ra, up)[0]
-        hb = _heading(rb, up)[0]
-        yaw[r] = ha - hb
-        target = place(r - 1, pa)
-        moved = Rotation.from_rotvec(yaw[r] * _unit(up)).apply(pb)
-        shift[r] = 0.0
-        shift[r, g0] = target[g0] - moved[g0]
-        shift[r, g1] = target[g1] - moved[g1]
+        turn = Rotation.from_rotvec(yaw[r - 1] * axis)
+        yaw[r] = _heading(turn * ra, up)[0] - _heading(rb, up)[0]
+        target = turn.apply(pa)
+        target[[g0, g1]] += shift[r - 1, [g0, g1]]
+        moved = Rotation.from_rotvec(yaw[r] * axis).apply(pb)
+        shift[r, [g0, g1]] = target[[g0, g1]] - moved[[g0, g1]]
 
     def transformed(runs: np.ndarray, clips: np.ndarray, s: np.ndarray) -> np.ndarray:
         """Samples of the given clips at source times, placed by their runs' transforms."""
@@ -269,10 +215,9 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
             return v
         vm = v[moved]
         rm = runs[moved]
-        turn = Rotation.from_rotvec(yaw[rm][:, None] * _unit(up)[None, :])
+        turn = Rotation.from_rotvec(yaw[rm][:, None] * axis[None, :])
         p = turn.apply(vm[:, pos_cols])
-        p[:, g0] += shift[rm, g0]
-        p[:, g1] += shift[rm, g1]
+        p[:, [g0, g1]] += shift[rm][:, [g0, g1]]
         vm[:, pos_cols] = p
         rot = Rotation.from_quat(
             quat_multiply(turn.as_quat(), quat_from_euler(vm[:, rot_cols], order))
@@ -281,7 +226,7 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         v[moved] = vm
         return v
 
-    values[:] = transformed(run_of, clip_of[k_of], s_of)
+    values = transformed(run_of, clip_of[k_of], s_of)
 
     # blends after every transition (windows never overlap: one per music interval)
     trans_times = beats[:-1][trans]
@@ -299,7 +244,8 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         runs.append(np.full(sel.size, run_id[k] - 1))
         clips.append(np.full(sel.size, graph.node_clip[a]))
         s_old.append(node_t[a] + (t[sel] - beats[k]) * rate)
-        weights.append(smoothstep((t[sel] - beats[k]) / length))
+        x = np.clip((t[sel] - beats[k]) / length, 0.0, 1.0)
+        weights.append(x * x * (3.0 - 2.0 * x))  # smooth step: zero slope at both ends
     if idx:
         sel = np.concatenate(idx)
         old = transformed(np.concatenate(runs), np.concatenate(clips), np.concatenate(s_old))
@@ -346,9 +292,3 @@ def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
         inside = (run_id[k_of] == r) & (t >= x[0]) & (t <= x[-1])
         s[inside] = PchipInterpolator(x, y)(t[inside])
     return s
-
-
-def _unit(up: int) -> np.ndarray:
-    v = np.zeros(3)
-    v[up] = 1.0
-    return v

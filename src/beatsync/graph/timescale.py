@@ -1,34 +1,21 @@
 """Tempo-matched composition: clip tempi, tempo sub-groups, beat multiplicity, scale bound.
 
 Paper B builds its graphs per sub-group of motions that "share a range of tempos" and
-selects the graph "according to the music genre and music tempo", so that a motion
-beat interval is never squeezed into a music beat of a very different length. This
-module makes those choices explicit; the searches (:mod:`beatsync.graph.search`)
-enforce them.
+selects one "according to the music genre and music tempo", so that a motion beat
+interval is never squeezed into a music beat of a very different length; this module
+makes those choices explicit and the searches enforce them.
 
-- **Clip tempo**: beat induction from the clip's beat frames
-  (:func:`beatsync.motion_beats.motion_tempo`).
-- **Tempo sub-groups**: clips sorted by tempo are grouped greedily so that a group
-  spans at most ``hi / lo`` of the scale bound (a group is a range of tempos one
-  bound can serve). A group is *eligible* for a song when some beat multiplicity
-  brings its central tempo within the bound; if none is, the closest group is used
-  and the report says so.
-- **Beat multiplicity** ``m``: the number of music beats one motion-beat interval
-  covers. It is chosen from the tempo ratio ``rho = song BPM / library BPM`` (music
-  beats per motion beat at natural speed): the two rungs of the ladder
-  ``(1, 2, 3, 4)`` that bracket ``rho``, or the one rung within 5 % of it (a library
-  at 70 BPM covers 2 beats of 140 BPM music), or ``(1/2, 1)`` when the library is
-  more than ``1 / lo`` times faster than the music (a music beat holds 2 short
-  motion intervals: the search then runs on half beats). Each interval picks its
-  own multiplicity within that set, so irregular captured beats still fit.
-- **Time-scale factor** of an interval: its music duration divided by its natural
-  duration (``> 1``: played slower). Every interval of every search must lie within
-  ``scale_bound`` (default ``(0.8, 1.25)``): the interval and its multiplicity are
-  *feasible* only then.
-
-Data contract: music beats in seconds (1-D, increasing); tempi in BPM; the *grid* is
-the music beats, or the beats with their midpoints (half beats); ``steps`` count grid
-intervals per motion interval.
+- **Clip tempo**: :func:`beatsync.motion_beats.motion_tempo` of its beat frames.
+- **Tempo sub-groups**: clips sorted by tempo, grouped greedily to span at most
+  ``hi / lo`` of the scale bound; a group is *eligible* for a song when some
+  multiplicity brings its central tempo within the bound (else the closest one is
+  used, and the report says so).
+- **Beat multiplicity** ``m``: music beats per motion interval, from ``rho = song BPM /
+  library BPM``: the rungs of ``(1, 2, 3, 4)`` that bracket ``rho``, or the one within
+  5 % of it, or ``(1/2, 1)`` (the grid is then half beats) when the library is more
+  than ``1 / lo`` times faster than the music; each interval picks within that set.
+- **Time-scale factor**: music / natural duration of an interval (``> 1``: slower);
+  every interval must lie within ``scale_bound`` (default ``(0.8, 1.25)``).
 
 Notebook: ``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.1.
 """
@@ -42,7 +29,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion_beats import motion_tempo
-from ..validation import check_range
+from ..validation import check_interval
 
 __all__ = [
     "DEFAULT_SCALE_BOUND",
@@ -70,13 +57,7 @@ def check_scale_bound(bound: Any, *, name: str = "scale_bound") -> tuple[float, 
     """``None`` (unbounded) or ``(lo, hi)`` with ``0 < lo <= 1 <= hi``."""
     if bound is None:
         return None
-    try:
-        lo, hi = bound
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"{name}={bound!r} must be two numbers (lo, hi), e.g. (0.8, 1.25), or None"
-        ) from None
-    lo, hi = check_range(lo, hi, name=name, unit="time-scale factor")
+    lo, hi = check_interval(bound, name=name, unit="time-scale factor")
     if not lo <= 1.0 <= hi:
         raise ParameterError(
             f"{name}=({lo:g}, {hi:g}) must contain 1 (an interval played at its own speed); "
@@ -132,21 +113,10 @@ def choose_multiplicity(
 class TempoPlan:
     """Which clips a song may use, with which multiplicities, under which bound.
 
-    Attributes
-    ----------
-    song_bpm, library_bpm : float [BPM]
-        Median tempo of the song's beats, and of the eligible clips.
-    bound : (float, float) or None
-    multiplicity : tuple of float
-        Music beats per motion interval the search may use.
-    subdivision : int
-        1 (grid = music beats) or 2 (half beats).
-    steps : tuple of int
-        Grid intervals per motion interval (``multiplicity * subdivision``).
-    clip_table : list of dict
-        Per clip: ``clip``, ``tempo_bpm``, ``group``, ``eligible``, ``reason``.
-    node_mask : np.ndarray [shape=(N,)] bool
-        Nodes of eligible clips.
+    ``subdivision`` is 1 (grid = music beats) or 2 (half beats), ``steps`` the grid
+    intervals per motion interval (``multiplicity * subdivision``), ``clip_table`` one
+    dict per clip (``clip``, ``tempo_bpm``, ``group``, ``eligible``, ``reason``) and
+    ``node_mask`` the nodes of eligible clips.
     """
 
     song_bpm: float
@@ -177,17 +147,7 @@ def plan_tempo(
     multiplicity: Any = "auto",
     tempo_select: bool = True,
 ) -> TempoPlan:
-    """Choose the eligible clips and the multiplicities for a song (trusts its inputs).
-
-    Parameters
-    ----------
-    graph : WeightedMotionGraph
-    music_beats : np.ndarray [s] (validated, at least two)
-    scale_bound : (float, float) or None
-    multiplicity : "auto" or sequence of float in :data:`LADDER`
-    tempo_select : bool
-        False: every clip is eligible (the whole graph), the tempo is only reported.
-    """
+    """Eligible clips and multiplicities for a song (``tempo_select=False``: every clip)."""
     song_bpm = float(60.0 / np.median(np.diff(music_beats)))
     tempi = clip_tempi(graph)
     width = scale_bound[1] / scale_bound[0] if scale_bound is not None else np.inf
@@ -243,8 +203,6 @@ def plan_tempo(
     eligible = np.array([r["eligible"] for r in rows], dtype=bool)
     lib_bpm = float(np.median(tempi[eligible])) if eligible.any() else float("nan")
     if isinstance(multiplicity, str):
-        if multiplicity != "auto":
-            raise ParameterError(f"multiplicity={multiplicity!r} must be 'auto' or numbers")
         mult = choose_multiplicity(lib_bpm, song_bpm, scale_bound) if eligible.any() else (1.0,)
     else:
         mult = tuple(sorted({float(m) for m in multiplicity}))
@@ -264,23 +222,16 @@ def plan_tempo(
 
 def check_multiplicity(multiplicity: Any) -> Any:
     """``"auto"`` or a non-empty set of values from :data:`LADDER`."""
-    if isinstance(multiplicity, str):
-        if multiplicity != "auto":
-            raise ParameterError(
-                f"multiplicity={multiplicity!r} must be 'auto' or music beats per motion "
-                f"interval from {LADDER}"
-            )
+    if isinstance(multiplicity, str) and multiplicity == "auto":
         return "auto"
     try:
-        vals = [float(m) for m in multiplicity]
+        vals = [] if isinstance(multiplicity, str) else [float(m) for m in multiplicity]
     except (TypeError, ValueError):
-        raise ParameterError(
-            f"multiplicity={multiplicity!r} must be 'auto' or numbers from {LADDER}"
-        ) from None
+        vals = []
     if not vals or any(v not in LADDER for v in vals):
         raise ParameterError(
-            f"multiplicity={multiplicity!r}: every value must be one of {LADDER} "
-            "(music beats per motion-beat interval)"
+            f"multiplicity={multiplicity!r} must be 'auto' or music beats per motion "
+            f"interval from {LADDER}"
         )
     return tuple(sorted(set(vals)))
 
@@ -304,12 +255,7 @@ def span_feasible(
     bound: tuple[float, float] | None,
     node_mask: np.ndarray | None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Feasibility and scale of every node's interval over grid ``[start, start + step]``.
-
-    Returns
-    -------
-    (ok, scale) : bool and float arrays over nodes (NaN durations are infeasible).
-    """
+    """Feasibility and scale over nodes of every interval over grid ``[start, start + step]``."""
     span = grid_times[start + step] - grid_times[start]
     with np.errstate(invalid="ignore", divide="ignore"):
         scale = span / durations
@@ -330,13 +276,9 @@ def completion_table(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Which nodes can start at each grid boundary and still reach the last one.
 
-    Returns
-    -------
-    alive : np.ndarray [shape=(G + 1, N)] bool
-        ``alive[k, v]``: interval ``v`` started at boundary ``k`` can complete the song.
-    handoff : np.ndarray [shape=(G + 1, N)] bool
-        ``handoff[k, v]``: after an interval ending on ``v``'s end at boundary ``k`` the
-        song can be completed (``k = G``, or a successor of ``v`` alive at ``k``).
+    ``alive[k, v]``: interval ``v`` started at boundary ``k`` can complete the song;
+    ``handoff[k, v]``: after an interval ending on ``v``'s end at boundary ``k`` it can
+    (``k = G``, or a successor of ``v`` alive at ``k``). Both ``(G + 1, N)`` bool.
     """
     src, dst, _ = graph.successors()
     n = graph.n_nodes
@@ -365,7 +307,7 @@ def no_path_error(
     subdivision: int,
     node_mask: np.ndarray | None,
 ) -> ParameterError:
-    """The error raised when no path satisfies the bounds: names both tempi and the bound."""
+    """The error when no path satisfies the bounds: it names both tempi and the bound."""
     beat_s = float(np.median(np.diff(grid_times))) * subdivision
     song_bpm = 60.0 / beat_s
     tempi = clip_tempi(graph)

@@ -1,18 +1,8 @@
 """Channel choice for the segmentation: which joint angles, constant ones dropped, z-scored.
 
-Data contract
--------------
-- Input: channel names (``Motion.channels``: ``"rShin_Xrotation"``,
-  ``"CC_Base_L_Calf_Zrotation"``, ``"knee_L_angle"``) and values ``(n_frames,
-  n_channels)``, time first; rotation channels in degrees.
-- Output: a tuple of chosen names (:func:`select_channels`); a boolean mask of the
-  channels kept by the near-constant rule (:func:`nonconstant_channels`); unwrapped
-  rotations (:func:`unwrap_rotations`) and z-scored channels returned channel-first
-  ``(n_channels, n_frames)`` (:func:`standardise`), the layout of every function of
-  :mod:`.costs`, :mod:`.search`, :mod:`.period` and :mod:`.reference`.
-
-Only :func:`select_channels` validates its input (it is called at the public entry
-:func:`beatsync.segment.segment`); the array helpers trust theirs.
+Only :func:`select_channels` validates its input (it is called at the public entry);
+the array helpers trust theirs. :func:`standardise` returns channels first,
+``(n_channels, n_frames)``, the layout of the rest of the package.
 """
 
 from __future__ import annotations
@@ -78,34 +68,14 @@ def _is_default_channel(name: str) -> bool:
 def select_channels(
     names: Sequence[str], channels: str | Sequence[str] = "default"
 ) -> tuple[str, ...]:
-    """Choose the channels the segmentation uses.
+    """Choose the channels the segmentation uses: ``"default"``, ``"all"`` or exactly the names.
 
-    Parameters
-    ----------
-    names : sequence of str
-        All channel names, e.g. ``Motion.channels`` (``"rShin_Xrotation"``,
-        ``"CC_Base_L_Calf_Zrotation"``, ``"knee_L_angle"``).
-    channels : "default", "all" or sequence of str
-        ``"default"``: rotation channels of the main limb and spine joints (CMU:
-        abdomen chest neck rShldr rForeArm lShldr lForeArm rThigh rShin rFoot lThigh
-        lShin lFoot; iClone: ``CC_Base_Waist/Spine01/Spine02/*_Upperarm/*_Forearm/``
-        ``*_Thigh/*_Calf/*_Foot``; no twist bones, hands, toes, face, nor the root's
-        global orientation), plus every ``*_angle`` channel (marker-derived angles).
-        If nothing matches, all channels are used with a :class:`BeatsyncWarning`.
-        ``"all"``: every channel (constant ones are dropped later). A sequence: exactly
-        those names.
+    ``"default"``: rotation channels of the main limb and spine joints (CMU: abdomen chest
+    neck rShldr rForeArm rThigh rShin rFoot and their left twins; iClone: ``CC_Base_Waist``,
+    ``Spine01``, ``*_Upperarm``, ``*_Forearm``, ``*_Thigh``, ``*_Calf``, ``*_Foot``; never
+    twist bones, hands, toes, face or the root), and every ``*_angle`` channel; if none
+    matches, all channels with a :class:`BeatsyncWarning`.
 
-    Returns
-    -------
-    tuple of str
-
-    Raises
-    ------
-    ParameterError
-        Unknown channel names or an empty selection.
-
-    Examples
-    --------
     >>> select_channels(["hip_Xposition", "hip_Zrotation", "rShin_Xrotation", "rHand_Xrotation"])
     ('rShin_Xrotation',)
     """

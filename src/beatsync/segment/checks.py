@@ -1,9 +1,7 @@
 """Validation of the segmentation's arguments (called once, at the public entry).
 
-Data contract: each ``check_*`` takes what a user passed and returns it in the form
-the package uses (float, int, a ``(lo, hi)`` tuple of floats [s], a finite float64
-``(n_frames, n_channels)`` array), or raises :class:`~beatsync.errors.ParameterError`
-naming the value and the likely mistake.
+Each ``check_*`` returns what the user passed in the form the package uses, or raises
+:class:`~beatsync.errors.ParameterError` naming the value and the likely mistake.
 """
 
 from __future__ import annotations

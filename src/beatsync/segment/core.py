@@ -1,17 +1,8 @@
 """The public entry of the segmentation: :func:`segment`, :func:`segment_values`, the result.
 
-Data contract
--------------
-- Input: a :class:`~beatsync.motion.Motion` (:func:`segment`) or values ``(n_frames,
-  n_channels)`` at ``fps > 0`` [Hz] (:func:`segment_values`), time first; rotation
-  channels in degrees. Periods and ranges in seconds.
-- Output: :class:`Segmentation`, whose ``boundaries`` are ``n_periods + 1`` strictly
-  increasing times [s] within ``[0, (n_frames - 1) / fps]``. Frames are used only
-  inside the package; conversion goes through :func:`beatsync.validation.frames_to_time`.
-
-Every argument is validated here, once, cheapest first (numbers, then the values,
-then what the data allow: constant channels, clip length, whether the count fits);
-the modules below trust their inputs. User mistakes raise
+Every argument is validated here, once, cheapest first (numbers, then the values, then
+what the data allow: constant channels, clip length, whether the count fits); the
+modules below trust their inputs. User mistakes raise
 :class:`~beatsync.errors.ParameterError`.
 """
 
@@ -70,56 +61,24 @@ __all__ = [
 ]
 
 DEFAULT_PERIOD_RANGE = (0.25, 1.25)
-"""Shortest and longest period [s] searched by default when the count is estimated.
-
-The paper's range: dance steps and gait cycles. Longer cycles (dance figures: a
-waltz box of 6 beats lasts about 4 s) need a wider range, :data:`DANCE_PERIOD_RANGE`
-or :func:`period_range_from_beat` when the music is known. It is not the default
-because the periodicity test cannot yet tell a long figure from a non-periodic motion:
-with :data:`DANCE_PERIOD_RANGE`, the CMU 005_02 pirouette is accepted as periodic."""
+"""Periods [s] searched by default: the paper's (why not wider: ``docs/tuning.md``)."""
 
 DANCE_PERIOD_RANGE = (0.25, 6.25)
-"""Steps (0.25-1.25 s) and figures (1.25-6.25 s), searched shortest first (see
-:func:`~beatsync.segment.period.period_tiers`): covers a slow waltz box (6 beats at
-60 BPM, 6 s)."""
+"""Steps (0.25-1.25 s) and figures (1.25-6.25 s, a slow waltz box), shortest first."""
 
 MIN_CLIP_PERIODS = 3
-"""A clip shorter than this many of its estimated periods needs :data:`SHORT_CLIP_MAX_ENERGY`.
-
-Below three periods the optimum has a single pair of consecutive periods to compare,
-which a short clip of one movement can fake (a 1 s salsa excerpt, period ~1 s, was
-cut into two "periods" of 0.45 s whose halves were barely alike); from three on
-there are two pairs and the periodicity test can compare with longer periods."""
+"""A clip shorter than this many of its estimated periods needs :data:`SHORT_CLIP_MAX_ENERGY`."""
 
 SHORT_CLIP_MAX_ENERGY = 0.5
-"""Largest mean Pearson distance of a clip shorter than :data:`MIN_CLIP_PERIODS` periods.
-
-A clip that short is accepted only if its periods are clearly alike (mean r >= 0.5,
-halfway between uncorrelated and identical); otherwise it is refused as too short."""
+"""Largest mean Pearson distance of a clip shorter than :data:`MIN_CLIP_PERIODS` periods."""
 
 
 @dataclass(frozen=True)
 class Segmentation:
-    """Result of :func:`segment`.
-
-    Attributes
-    ----------
-    boundaries : np.ndarray [s]
-        ``n_periods + 1`` strictly increasing times: start of the first period ... end
-        of the last, within ``[0, (n_frames - 1) / fps]``.
-    n_periods : int
-    mean_period : float [s]
-    energy : float
-        E of the optimum (sum over consecutive period pairs and channels of 1 - r).
-    channels : tuple of str
-        Channels used (after selection and constant-channel exclusion).
-    fps : float [Hz]
-    period_method : str
-        ``"energy"``, ``"fft"`` or ``"given"``.
-    search_decimation : int >= 1
-        Time decimation factor of the search (1: exact search at full rate; above
-        :data:`SEARCH_MEMORY_BUDGET` the search runs at ``fps / f`` and the boundaries
-        are refined at full rate, see :func:`segment_values`).
+    """Result of :func:`segment`: ``boundaries`` [s] (``n_periods + 1``, increasing, within
+    ``[0, (n_frames - 1) / fps]``), ``energy`` E of the optimum, the ``channels`` used (after
+    selection and exclusion), ``period_method`` (``"energy"``, ``"fft"`` or ``"given"``) and
+    ``search_decimation`` (1: the exact search at full rate).
     """
 
     boundaries: np.ndarray
@@ -180,9 +139,6 @@ def _frame_band(n: int, fps: float, period_range: tuple[float, float]) -> tuple[
     return lo_f, hi_f
 
 
-# ---------------------------------------------------------------------- the entry
-
-
 #: What the periodicity test's refusal advises a caller of :func:`segment` to try; a
 #: caller without some of these settings says what it offers instead
 #: (:func:`beatsync.sync.core.motion_periods`).
@@ -192,8 +148,8 @@ NOT_PERIODIC_ADVICE = "Try other channels, another period_range, or a clip with 
 class PeriodicityRefused(NotPeriodicError):
     """The periodicity test refused the optimum (a longer tier may still be periodic).
 
-    Its message is the finding, the advice (:data:`NOT_PERIODIC_ADVICE`), a hint and
-    the tiers searched; :meth:`advised` gives it with the advice of another caller.
+    :meth:`advised` gives the message with another caller's advice in place of
+    :data:`NOT_PERIODIC_ADVICE`.
     """
 
     def __init__(self, finding: str, hint: str = "", searched: str = "") -> None:
@@ -215,12 +171,7 @@ def _segment(
     period_range: tuple[float, float],
     method: str,
 ) -> Segmentation:
-    """Segmentation of validated values (finite, 2-D, named); data checks and the search.
-
-    With the count estimated, the period range is searched tier by tier
-    (:func:`period_tiers`), shortest first; the first tier whose optimum passes the
-    periodicity test gives the result, so the period is the shortest repeating cycle.
-    """
+    """Segmentation of validated values; tiers of the period range searched shortest first."""
     n = vals.shape[0]
     if n_periods is not None:
         x, used = _motion_channels(vals, names)
@@ -243,8 +194,6 @@ def _segment(
                            period_range=tier, method=method)  # fmt: skip
         except PeriodicityRefused as exc:
             refusal = exc
-    if refusal is None:
-        raise RuntimeError("no tier of the period range was searched")
     searched = ""
     if len(bands) > 1:
         tried = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
@@ -350,50 +299,15 @@ def segment_values(
 ) -> Segmentation:
     """Globally optimal segmentation of a periodic multi-channel signal (paper A, sec. 3).
 
-    Parameters
-    ----------
-    values : np.ndarray [shape=(n_frames, n_channels)]
-        Joint angles (any unit; each channel is z-scored, which leaves r unchanged).
-        Angles must already be unwrapped (:func:`segment` does it for BVH rotations).
-    fps : float > 0 [Hz]
-    alpha : float in (0, 0.5)
-        Allowed relative deviation of every period from the nominal period (eq. 3).
-    n_periods : int >= 2, optional
-        Number of periods (e.g. from the music). Overrides ``period_method``; the result
-        then has exactly this many periods, each within the alpha band around
-        ``(n_frames - 1) / n_periods`` frames (or a ParameterError if they do not fit
-        or the forced segmentation is not periodic).
-    period_range : (float, float) [s]
-        Shortest and longest period for estimating the count (default
-        :data:`DEFAULT_PERIOD_RANGE`, the paper's 0.25-1.25 s). A range spanning more
-        than a factor 5 is searched in tiers, shortest first, and the first tier whose
-        optimum is periodic gives the result (the shortest repeating cycle):
-        :data:`DANCE_PERIOD_RANGE` (0.25-6.25 s) for dance figures, or
-        :func:`period_range_from_beat` when the music's beat is known.
-    period_method : {"energy", "fft", "given"}
-        How to get the count when ``n_periods`` is None (see
-        :func:`estimate_period_count`). ``"given"`` requires ``n_periods``.
-    channel_names : sequence of str, optional
-        Names of the columns (reported in :attr:`Segmentation.channels`).
-
-    Returns
-    -------
-    Segmentation
-
-    Raises
-    ------
-    ParameterError
-        NaN/inf values, ``fps <= 0``, alpha outside (0, 0.5), reversed period range, a
-        clip shorter than :data:`MIN_CLIP_PERIODS` (3) of the shortest period of the
-        range or of its own estimated period (with the count estimated), all channels
-        constant, ``n_periods`` too many for the frames, or a clip that is not
-        periodic (normalised energy above :data:`MAX_NORMALISED_ENERGY` or too little
-        periodicity contrast; with ``n_periods`` given, often a wrong count).
-    NotPeriodicError
-        (a ``ParameterError``) of those: a clip that is not periodic, and a clip too
-        short for the shortest period of the range or too short to tell with its own
-        period; its own motion beats can still sync it
-        (:func:`beatsync.sync.synchronize` with ``mode="beats"``).
+    ``values`` ``(n_frames, n_channels)``: joint angles, any unit (channels are z-scored,
+    which leaves r unchanged), already unwrapped (:func:`segment` does it for BVH
+    rotations); ``alpha``: allowed relative deviation of every period from the nominal
+    one (eq. 3); ``n_periods``: the count if known (overrides ``period_method``);
+    ``period_range`` [s]: shortest and longest period when the count is estimated
+    (``period_method``, see :func:`estimate_period_count`), in tiers of a factor 5,
+    shortest first. A clip that is not periodic, or too short to tell, raises
+    :class:`NotPeriodicError` (its own motion beats can still sync it:
+    :func:`beatsync.sync.synchronize`, ``mode="beats"``).
 
     Examples
     --------
@@ -434,36 +348,10 @@ def segment(
 ) -> Segmentation:
     """Split a periodic motion into its periods, globally optimally (paper A, sec. 3).
 
-    Parameters
-    ----------
-    motion : Motion
-        Joint angles (BVH rotations, degrees) or marker-derived ``*_angle`` channels
-        (:func:`beatsync.motion.marker_angles`).
-    alpha : float in (0, 0.5)
-        Allowed relative deviation of each period from the nominal period (eq. 3).
-    n_periods : int >= 2, optional
-        Period count if known (e.g. from the music); the result has exactly this many
-        periods (see :func:`segment_values`).
-    period_range : (float, float) [s]
-        Shortest and longest period when estimating the count (default
-        :data:`DEFAULT_PERIOD_RANGE`, 0.25-1.25 s; searched in tiers, shortest first, see
-        :func:`segment_values`).
-    period_method : {"energy", "fft", "given"}
-    channels : "default", "all" or list of str
-        See :func:`~beatsync.segment.select_channels`.
+    ``motion``: joint angles (BVH rotations [deg]) or marker-derived ``*_angle`` channels;
+    ``channels`` as in :func:`~beatsync.segment.select_channels`; the rest as in
+    :func:`segment_values`.
 
-    Returns
-    -------
-    Segmentation
-        ``boundaries`` [s] within ``[0, (n_frames-1)/fps]``; ``mean_period`` [s].
-
-    Raises
-    ------
-    ParameterError
-        See :func:`segment_values`.
-
-    Examples
-    --------
     >>> from beatsync.synth.motion import periodic_motion
     >>> s = periodic_motion(n_frames=300, n_periods=10, seed=1)
     >>> seg = segment(s.motion, n_periods=10)
@@ -486,8 +374,7 @@ def _segment_motion(
     method: str,
     channels: str | Sequence[str] = "default",
 ) -> Segmentation:
-    """:func:`segment` with its settings already checked (the motion's data is checked
-    here: the channels, their values and the frame count)."""
+    """:func:`segment` with its settings checked (the motion's data is checked here)."""
     names = select_channels(motion.channels, channels)
     idx = [motion.channel_index(nm) for nm in names]
     values = check_finite(motion.values[:, idx], name=f"motion {motion.name!r} values")
@@ -508,35 +395,10 @@ def estimate_period_count(
 ) -> int:
     """Number of whole periods ``p`` in a clip, by FFT peak or uniform-segmentation energy.
 
-    Parameters
-    ----------
-    values : np.ndarray [shape=(n_frames, n_channels)]
-        Channels to analyse (near-constant channels are ignored).
-    fps : float > 0 [Hz]
-    period_range : (float, float) [s]
-        Shortest and longest period considered (default :data:`DEFAULT_PERIOD_RANGE`),
-        all at once (no tiers: the count of the best uniform segmentation in the range).
-    method : {"energy", "fft"}
-        ``"fft"``: the peak of the channel-summed power spectrum (z-scored channels,
-        Hann window, 8x zero padding) within ``1/period_range``. ``"energy"``: the
-        period ``T`` minimising the energy of the uniform segmentation ``0, T, 2T, ...``
-        per pair of consecutive periods (``E(U) / (s - 1)``; the paper writes ``E/s``,
-        which favours fewer, longer periods on short clips), over a 0.25-frame grid
-        (at most 400 log-spaced candidates). If the minimum lies at the short end of
-        the range (where short windows of a slow signal correlate trivially), the
-        lowest interior local minimum is taken instead (if any). See
-        :func:`beatsync.segment.period.estimate_period`.
-
-    Returns
-    -------
-    int >= 2
-        ``floor((n_frames - 1) / (T * fps))``.
-
-    Raises
-    ------
-    ParameterError
-        Bad ``fps``/range/values/method, or a clip shorter than
-        :data:`MIN_CLIP_PERIODS` of the shortest periods.
+    The whole ``period_range`` [s] is searched at once (no tiers); ``method`` as in
+    :func:`beatsync.segment.period.estimate_period` (``"energy"``: the paper's ``E/s`` is
+    replaced by ``E(U) / (s - 1)``, which does not favour fewer, longer periods on short
+    clips). Returns ``floor((n_frames - 1) / (T * fps))``, at least 2.
     """
     fps = check_fps(fps)
     lo_s, hi_s = check_period_range(period_range)
@@ -553,32 +415,11 @@ def estimate_period_count(
 def period_range_from_beat(
     beat_period: float, *, beats: tuple[float, float] = (1.0, 8.0)
 ) -> tuple[float, float]:
-    """Period range [s] of a dance to music with this beat period: ``beats`` beats.
+    """Period range [s] of a dance to music of this beat period [s]: ``beats`` beats.
 
-    A dance cycle lasts a whole number of beats, from one step per beat to a figure
-    of a few bars (a waltz box: 6 beats; a salsa basic: 8). The range is searched
-    shortest first (:func:`~beatsync.segment.period.period_tiers`).
+    A dance cycle lasts a whole number of beats, from a step per beat to a figure of a
+    few bars (a waltz box: 6 beats; a salsa basic: 8).
 
-    Parameters
-    ----------
-    beat_period : float in [0.15, 3] [s]
-        The music's beat period (60 / BPM, within the package's 20-400 BPM), e.g. the
-        median inter-beat interval.
-    beats : (float, float)
-        Fewest and most beats per motion period (default 1 to 8).
-
-    Returns
-    -------
-    (float, float) [s]
-
-    Raises
-    ------
-    ParameterError
-        A beat period that is not a positive number of seconds (a BPM value, say), or
-        a reversed or non-positive ``beats`` range.
-
-    Examples
-    --------
     >>> period_range_from_beat(0.5)
     (0.5, 4.0)
     """

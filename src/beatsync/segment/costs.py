@@ -1,23 +1,12 @@
 """Edge costs of the segmentation: Pearson distances between consecutive periods (eqs. 1-2).
 
-Data contract
--------------
-- Input: standardised channels ``x`` ``(n_channels, n_frames)`` (see
-  :func:`.channels.standardise`); boundary frames (int); period lengths ``lo..hi``
-  [frames] (the alpha band, ``2 <= lo <= hi``).
-- Output: Pearson distances summed over channels, ``sum_c 1 - r_c``, of an earlier
-  period ``x[a..b]`` and the later one ``x[b..c]`` linearly resampled onto the earlier
-  one's ``b - a + 1`` samples (end points aligned). :func:`edge_costs` returns the
-  table ``cost[b, i0, i1]`` of every DAG edge (middle boundary ``b``, earlier length
-  ``lo + i0``, later length ``lo + i1``; ``inf`` where a period leaves the clip).
-
-Every sum in a Pearson correlation (sum of A, of A^2, of resampled B, of its square,
-and of A * B) is a fixed linear combination of lagged products ``X[s] X[s + l]`` in a
-window around the middle boundary, so each is one matrix product of windowed
-products with a constant kernel (:func:`edge_costs`). A period whose own variance is
-below :data:`FLAT_REL_VAR` of the channel's variance is treated as flat: its
-correlation is ~0 (cost ~1). The functions trust their inputs (they are called after
-the public entry :func:`beatsync.segment.segment_values` has validated them).
+The cost of an earlier period ``x[a..b]`` and the later ``x[b..c]`` is ``sum_c 1 - r_c``
+with the later period linearly resampled onto the earlier one's ``b - a + 1`` samples
+(end points aligned); ``x`` is standardised, channels first. Every sum in a Pearson
+correlation is a fixed linear combination of lagged products ``X[s] X[s + l]`` in a
+window around the middle boundary, so :func:`edge_costs` gets each as one matrix
+product of windowed products with a constant kernel. A period whose variance is below
+:data:`FLAT_REL_VAR` of its channel's is flat: correlation ~0, cost ~1.
 """
 
 from __future__ import annotations
@@ -47,9 +36,9 @@ CHUNK_ELEMENTS = 3e5
 def resample_weights(d0: int, d1: Any) -> tuple[np.ndarray, np.ndarray]:
     """Linear resampling of ``d1 + 1`` samples onto ``d0 + 1`` (end points aligned).
 
-    Output sample ``k`` (0..d0) is ``(1 - w_k) B[j_k] + w_k B[j_k + 1]`` with
-    ``j_k + w_k = k d1 / d0`` (exact integer arithmetic). ``d1`` may be an int
-    (returns shape ``(d0 + 1,)``) or an array of ints (shape ``d1.shape + (d0 + 1,)``).
+    Output sample ``k`` is ``(1 - w_k) B[j_k] + w_k B[j_k + 1]`` with ``j_k + w_k = k d1 / d0``
+    (exact integer arithmetic); ``d1`` an int or an array of ints (then shape
+    ``d1.shape + (d0 + 1,)``).
     """
     d1 = np.asarray(d1, dtype=np.int64)
     d1 = d1[..., None] if d1.ndim else d1
@@ -63,19 +52,7 @@ def resample_weights(d0: int, d1: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def pair_costs(x: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Pearson distance, summed over channels, for arbitrary boundary triples.
-
-    Parameters
-    ----------
-    x : np.ndarray [shape=(C, n)], standardised channels
-    a, b, c : np.ndarray [frames], int
-        Triples ``a < b < c``: earlier period ``x[a..b]``, later period ``x[b..c]``.
-
-    Returns
-    -------
-    np.ndarray [shape=(len(a),)]
-        ``sum_c 1 - r_c``.
-    """
+    """``sum_c 1 - r_c`` of periods ``x[a..b]``, ``x[b..c]`` for triples ``a < b < c`` [frames]."""
     a, b, c = (np.asarray(v, dtype=np.int64) for v in (a, b, c))
     out = np.empty(a.size)
     d0_all, d1_all = b - a, c - b
@@ -151,14 +128,11 @@ def _kernels(lo: int, hi: int) -> tuple[Any, ...]:
 
 
 def edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) -> np.ndarray:
-    """All DAG edge costs, vectorised: ``cost[b, i0, i1]`` (inf where invalid).
+    """All DAG edge costs ``cost[b, i0, i1]``: middle boundary ``b``, lengths ``lo + i0, lo + i1``.
 
-    ``b`` is the middle boundary [frames], the earlier period ``x[b-d0 .. b]`` has
-    ``d0 = lo + i0`` frames and the later ``x[b .. b+d1]`` has ``d1 = lo + i1``.
-    The sums of the later (resampled) period and the cross sums are matrix products
-    of windowed (lagged) products with the constant kernels of :func:`_kernels`,
-    in blocks of middle boundaries that fit in cache. ``dtype=np.float32`` halves the
-    memory traffic (edge costs then differ by ~1e-5 from float64).
+    Earlier period ``x[b-d0 .. b]``, later ``x[b .. b+d1]``; ``inf`` where a period leaves
+    the clip. Computed in blocks of middle boundaries that fit in cache;
+    ``dtype=np.float32`` halves the memory traffic (costs then differ by ~1e-5).
     """
     n_ch, n = x.shape
     band = hi - lo + 1

@@ -1,22 +1,7 @@
-"""Period estimation and the periodicity test of the segmentation.
+"""Period estimation and the periodicity test of the segmentation (frames, channels first).
 
-Data contract
--------------
-- Input: standardised channels ``x`` ``(n_channels, n_frames)`` (see
-  :func:`.channels.standardise`); periods and boundaries in frames (float periods
-  allowed, boundaries int).
-- Output: a nominal period [frames] (:func:`estimate_period`); mean Pearson distances
-  of uniform segmentations (:func:`uniform_energy`); the periodicity contrast of a
-  found segmentation (:func:`periodicity_contrast`).
-
-Seconds and validation belong to the public entry (:func:`beatsync.segment.segment_values`,
-:func:`beatsync.segment.estimate_period_count`): it turns the period range [s] into
-the frame band :func:`estimation_band` and checks that band before calling
-:func:`estimate_period`, which trusts it.
-
-The periodicity rule: a clip is refused as not periodic when the optimum's mean
-Pearson distance per channel and pair reaches :data:`MAX_NORMALISED_ENERGY`, or when
-its :func:`periodicity_contrast` is below :data:`MIN_PERIODICITY_CONTRAST`.
+The public entry turns the period range [s] into the frame band of
+:func:`estimation_band` and checks it; :func:`estimate_period` trusts it.
 """
 
 from __future__ import annotations
@@ -58,13 +43,10 @@ _MAX_COUNT_CANDIDATES = 400  # candidate periods of the "energy" method (then lo
 
 
 def period_tiers(lo: float, hi: float) -> list[tuple[float, float]]:
-    """Consecutive tiers ``(lo, 5 lo), (5 lo, 25 lo), ... , (.., hi)`` of a period range.
+    """Consecutive tiers ``(lo, 5 lo), (5 lo, 25 lo), ..., (.., hi)`` of a period range (any unit).
 
-    A range wider than :data:`TIER_FACTOR` is searched tier by tier, shortest first,
-    so that a motion periodic at a step (say 1 s) is not described by a multiple of it
-    (a 3 s figure, whose uniform segmentation is often as good or better); a motion
-    that repeats only over a longer figure (a 4 s waltz box) is found in a later tier.
-    Any unit; the paper's range (0.25, 1.25) is one tier.
+    Searched shortest first, so that a motion periodic at a step is not described by a
+    multiple of it, while one that repeats only over a longer figure is found later.
     """
     tiers = []
     a = float(lo)
@@ -78,11 +60,7 @@ def period_tiers(lo: float, hi: float) -> list[tuple[float, float]]:
 
 
 def estimation_band(n: int, lo_frames: float, hi_frames: float) -> tuple[float, float]:
-    """Candidate periods [frames] for a clip of ``n`` frames: two periods must fit.
-
-    ``lo_frames``/``hi_frames`` is the requested period range in frames; the band is
-    ``max(lo, 2) .. min(hi, (n - 1) / 2)`` (empty if the first exceeds the second).
-    """
+    """Candidate periods [frames], ``max(lo, 2) .. min(hi, (n - 1) / 2)``: two periods must fit."""
     return max(float(lo_frames), 2.0), min(float(hi_frames), (n - 1) / 2.0)
 
 
@@ -119,13 +97,11 @@ def uniform_energy(x: np.ndarray, periods: np.ndarray) -> np.ndarray:
 def estimate_period(x: np.ndarray, lo_f: float, hi_f: float, method: str) -> float:
     """Nominal period [frames] in ``lo_f..hi_f`` by FFT peak or uniform-segmentation energy.
 
-    ``lo_f..hi_f`` comes from :func:`estimation_band` (``2 <= lo_f <= hi_f``).
     ``"fft"``: the peak of the channel-summed power spectrum (Hann window, 8x zero
-    padding) within the band (the bin nearest to it if none lies inside). ``"energy"``:
-    the period ``T`` minimising :func:`uniform_energy` over a 0.25-frame grid (at most
-    400 log-spaced candidates); if the minimum lies at the short end of the band (where
-    short windows of a slow signal correlate trivially), the lowest interior local
-    minimum is taken instead (if any).
+    padding) within the band (else the nearest bin). ``"energy"``: the period minimising
+    :func:`uniform_energy` over a 0.25-frame grid (at most 400 log-spaced candidates); a
+    minimum at the short end of the band (where short windows of a slow signal correlate
+    trivially) gives way to the lowest interior local minimum, if any.
     """
     n = x.shape[1]
     if method == "fft":
@@ -163,12 +139,11 @@ def estimate_period(x: np.ndarray, lo_f: float, hi_f: float, method: str) -> flo
 def periodicity_contrast(x: np.ndarray, frames: np.ndarray) -> float:
     """How much better the found period is than wrong periods, for uniform segmentations.
 
-    ``min_f e(U_{f T}) - e(U_T)`` for ``f`` in (0.5, 0.75, 1.25, 1.5), where ``e`` is the
-    mean Pearson distance per channel and consecutive pair, ``T`` the optimum's mean
-    period and ``U_P`` the uniform segmentation with period ``P`` starting at the
-    optimum's first boundary (only those with at least two pairs count). Both sides are
-    unoptimised, so noise or a non-repeating motion scores about 0 (or below), while a
-    periodic motion scores clearly above. NaN if no off-period segmentation fits.
+    ``min_f e(U_{f T}) - e(U_T)`` for ``f`` in :data:`OFF_PERIOD_FACTORS`, with ``e`` the
+    mean Pearson distance per channel and pair, ``T`` the optimum's mean period and
+    ``U_P`` the uniform segmentation of period ``P`` from the optimum's first boundary.
+    Noise scores about 0 or below, a periodic motion clearly above; NaN if no
+    off-period segmentation fits.
     """
     n_found = frames.size - 1
     period = (frames[-1] - frames[0]) / n_found

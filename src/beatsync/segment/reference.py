@@ -1,16 +1,8 @@
 """The literal reference of eqs. 1-5: Python loops over DAG edges, channels and samples.
 
-Paper A (Panagiotakis et al.), section 3, written out with no vectorisation, as the
+Paper A (Panagiotakis et al.), section 3, written out without vectorisation: the
 reference the tests and ``benchmarks/bench_segment.py`` compare the fast path
-(:mod:`.costs`, :mod:`.search`) with: the same optimum, far slower (about a minute at
-the paper's scale).
-
-Data contract
--------------
-- Input: standardised channels ``x`` ``(n_channels, n_frames)`` (see
-  :func:`.channels.standardise`); the alpha band ``lo..hi`` [frames], ``2 <= lo <= hi``.
-- Output: boundary frames (int64, same free-end rules as :mod:`.search`: ``t_0 < lo``,
-  ``t_p >= n - lo``) and the energy ``E`` (eq. 2).
+(:mod:`.costs`, :mod:`.search`) with (same optimum and free-end rules, far slower).
 """
 
 from __future__ import annotations
@@ -49,26 +41,11 @@ def segment_literal(
 ) -> tuple[np.ndarray, float]:
     """Reference: direct, loop-by-loop implementation of eqs. 1-5 (no vectorisation).
 
-    Builds every edge of the DAG of boundary pairs with one Python loop per edge, per
-    channel and per sample (:func:`literal_edge_cost`: resampling with ``np.interp``
-    and the Pearson correlation written out), once; then relaxes the edges in
-    topological order with Python loops. Same optimum as the fast path; used by the
-    tests and by ``benchmarks/bench_segment.py`` as the baseline.
-
-    Parameters
-    ----------
-    x : np.ndarray [shape=(C, n)]
-        Standardised channels (see :func:`standardise`).
-    lo, hi : int [frames]
-        Alpha band of period lengths.
-    reward : float or None
-        Solve ``argmin E - reward (p - 1)`` (0: the plain ``argmin E``); ``None``: the
-        Dinkelbach iteration of :func:`min_mean_energy` (the objective of
-        :func:`segment`), reusing the edge costs.
-
-    Returns
-    -------
-    boundary frames, energy E
+    Every DAG edge is costed with :func:`literal_edge_cost` once, then relaxed in
+    topological order by :func:`literal_dp`. ``reward``: solve ``argmin E - reward (p - 1)``
+    (0: the plain ``argmin E``); ``None``: the Dinkelbach iteration of
+    :func:`min_mean_energy` (the objective of :func:`segment`). Returns the boundary
+    frames and the energy E.
     """
     n = x.shape[1]
     edges: dict[tuple[int, int, int], float] = {}

@@ -1,29 +1,10 @@
 """The globally optimal segmentation: DP over the forward DAG of boundary pairs (eqs. 3-5).
 
-Data contract
--------------
-- Input: standardised channels ``x`` ``(n_channels, n_frames)`` (see
-  :func:`.channels.standardise`) or the edge-cost table of :func:`.costs.edge_costs`;
-  the alpha band of period lengths ``lo..hi`` [frames] (:func:`period_band`,
-  ``2 <= lo <= hi``); optionally the period count.
-- Output: boundary frames ``t_0 < ... < t_p`` (int64) with every period
-  ``t_{i+1} - t_i`` in ``lo..hi``, the first in the lead-in (``t_0 < lo``) and the last
-  in the tail (``t_p >= n - lo``), and the energy ``E`` (eq. 2) of that optimum.
-
-The DAG's nodes are consecutive boundary pairs ``(t_{i-1}, t_i)``; a virtual end node
-is joined to every pair ending in the tail; the DP runs in frame order (no heap). With
-the count given, the DP carries the number of periods in its state
-(:func:`shortest_path_count`, ``argmin E``); with the count free, the optimum minimises
-the mean energy per consecutive pair (:func:`min_mean_energy`, a Dinkelbach iteration
-over :func:`shortest_path`). When the exact search would need more than
-:data:`SEARCH_MEMORY_BUDGET`, :func:`optimum` runs it on the signal decimated in time
-by the factor of :func:`search_decimation` and refines every boundary at full rate.
-
-These functions trust their inputs (the public entry
-:func:`beatsync.segment.segment_values` validates them and checks with
-:func:`search_decimation` that the search fits in memory; a count given as
-``(n - 1) / L`` periods always fits, :func:`count_fits`); a failure here is a broken
-invariant and raises ``RuntimeError``.
+The result is boundary frames ``t_0 < ... < t_p`` with every period in the band
+``lo..hi`` (:func:`period_band`), the first in the lead-in (``t_0 < lo``) and the last
+in the tail (``t_p >= n - lo``), and the energy ``E`` (eq. 2). These functions trust
+their inputs (the public entry checks with :func:`search_decimation` that the search
+fits in memory); a failure here is a broken invariant and raises ``RuntimeError``.
 """
 
 from __future__ import annotations
@@ -56,11 +37,7 @@ _MAX_REFINE_PASSES = 10  # full-rate refinement passes after a decimated search
 
 
 def period_band(nominal: float, alpha: float) -> tuple[int, int]:
-    """Whole-frame period lengths allowed around ``nominal`` [frames] (eq. 3).
-
-    The band ``[(1-alpha) L, (1+alpha) L]`` is rounded outward to whole frames, so a
-    period that is within alpha before rounding to frames is never excluded.
-    """
+    """Whole-frame period lengths around ``nominal`` [frames] (eq. 3), rounded outward."""
     return int(np.floor((1 - alpha) * nominal + 1e-9)), int(np.ceil((1 + alpha) * nominal - 1e-9))
 
 
@@ -69,12 +46,10 @@ def shortest_path(
 ) -> tuple[np.ndarray, float]:
     """DP over the forward DAG of boundary pairs, in frame order (eqs. 4-5).
 
-    ``V[b, i]`` is the least energy of a chain of periods ending at frame ``b`` whose
-    last period has ``lo + i`` frames. A chain may start at any frame ``t_0 < lo``
-    (the lead-in before the first full period is shorter than any period) and joins
-    the virtual end node from any frame ``t_p >= n - lo`` (likewise for the tail).
-    Frames are processed in blocks of ``lo`` (a block only depends on earlier
-    blocks), so the loop runs ``n / lo`` times.
+    ``V[b, i]`` is the least energy of a chain of periods ending at frame ``b`` whose last
+    period has ``lo + i`` frames; chains start at any ``t_0 < lo`` and end at any
+    ``t_p >= n - lo``. Frames go in blocks of ``lo`` (a block depends only on earlier
+    ones), so the loop runs ``n / lo`` times.
     """
     band = hi - lo + 1
     d = np.arange(lo, hi + 1)
@@ -127,12 +102,10 @@ def shortest_path(
 def min_mean_energy(solve: Any, max_iter: int = 30) -> tuple[np.ndarray, float]:
     """Dinkelbach iteration: the segmentation minimising ``E / (p - 1)``.
 
-    ``solve(reward)`` returns the frames and energy ``E`` of ``argmin E - reward (p-1)``.
-    Starting from ``reward = 0`` (plain ``argmin E``), the reward is set to the mean
-    energy per pair of the current solution until it no longer decreases (a few DP
-    passes). With a fixed period count this is the paper's ``argmin E``; with free
-    ends it stops the optimum from dropping a period at an end just to have one term
-    fewer.
+    ``solve(reward)`` returns the frames and energy ``E`` of ``argmin E - reward (p-1)``;
+    from ``reward = 0`` the reward is set to the current mean energy per pair until that
+    no longer decreases (with free ends, this keeps the optimum from dropping a period at
+    an end just to have one term fewer).
     """
     frames, energy = solve(0.0)
     ratio = energy / (frames.size - 2)
@@ -146,11 +119,7 @@ def min_mean_energy(solve: Any, max_iter: int = 30) -> tuple[np.ndarray, float]:
 
 
 def count_windows(n: int, lo: int, hi: int, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Feasible frames ``first[k] .. last[k]`` of boundary ``t_k`` (k = 0..count).
-
-    From the start (``t_0 < lo``, periods of ``lo..hi`` frames) and from the end
-    (``n - lo <= t_count <= n - 1``).
-    """
+    """Feasible frames ``first[k] .. last[k]`` of boundary ``t_k`` (k = 0..count), free ends."""
     k = np.arange(count + 1)
     first = np.maximum(k * lo, (n - lo) - (count - k) * hi)
     last = np.minimum(lo - 1 + k * hi, (n - 1) - (count - k) * lo)
@@ -158,11 +127,7 @@ def count_windows(n: int, lo: int, hi: int, count: int) -> tuple[np.ndarray, np.
 
 
 def count_fits(n: int, lo: int, hi: int, count: int) -> bool:
-    """Whether ``count`` periods of ``lo..hi`` frames fit ``n`` frames with the free ends.
-
-    The lead-in and the tail are each shorter than ``lo`` frames (see
-    :func:`count_windows`).
-    """
+    """Whether ``count`` periods of ``lo..hi`` frames fit ``n`` frames with the free ends."""
     first, last = count_windows(n, lo, hi, count)
     return bool(np.all(first <= last))
 
@@ -172,16 +137,8 @@ def shortest_path_count(
 ) -> tuple[np.ndarray, float]:
     """DP of :func:`shortest_path` constrained to exactly ``count`` periods (eqs. 4-5).
 
-    Layer ``k`` holds ``V_k[b, i]``, the least energy of a chain of ``k`` periods ending
-    at frame ``b`` whose last period has ``lo + i`` frames, for the frames ``b`` where
-    boundary ``t_k`` can lie (:func:`count_windows`; same free ends: ``t_0 < lo``,
-    ``t_p >= n - lo``). With the count fixed, ``argmin E`` is the paper's objective (no
-    Dinkelbach iteration needed).
-
-    Raises
-    ------
-    RuntimeError
-        ``count`` periods of ``lo..hi`` frames do not fit the clip (see :func:`count_fits`).
+    Layer ``k`` holds ``V_k[b, i]`` over the frames where boundary ``t_k`` can lie
+    (:func:`count_windows`); with the count fixed, ``argmin E`` is the paper's objective.
     """
     band = hi - lo + 1
     d = np.arange(lo, hi + 1)
@@ -266,7 +223,7 @@ def _refine(
     """Exact ``argmin E`` at full rate with each boundary within ``radius`` of ``guess``.
 
     A DP over the boundary index (states: pairs of candidate frames for consecutive
-    boundaries), keeping the count, the band ``lo..hi`` and the free-end rules.
+    boundaries) that keeps the count, the band and the free-end rules.
     """
     n = x.shape[1]
     p = guess.size - 1
@@ -309,12 +266,7 @@ def _refine(
 def search_decimation(
     n: int, lo: int, hi: int, n_ch: int, count: int | None, budget: float = SEARCH_MEMORY_BUDGET
 ) -> int | None:
-    """Smallest time decimation factor whose search fits ``budget`` bytes.
-
-    1 if the exact search at full rate fits; otherwise the smallest integer ``f >= 2``
-    for which the search on every ``f``-th frame (band :func:`coarse_band`) fits; None
-    if none does (the coarse band would drop below 2 frames).
-    """
+    """Smallest time decimation factor whose search fits ``budget`` bytes (None: none does)."""
     if search_bytes(n, lo, hi, n_ch, count) <= budget:
         return 1
     factor = 2
@@ -332,15 +284,10 @@ def optimum(
 ) -> tuple[np.ndarray, float]:
     """Optimal boundary frames and energy, searched at 1/``factor`` of the frame rate.
 
-    ``factor = 1``: the exact search at full rate (count given: :func:`shortest_path_count`;
-    free: :func:`min_mean_energy` over :func:`shortest_path`), on float32 edge costs.
-    ``factor > 1`` (from :func:`search_decimation`): the optimum is found on the signal
-    decimated in time (box filter of ``factor`` frames, every ``factor``-th frame, band
-    ``ceil(lo/f)..floor(hi/f)``), and every boundary is then refined at full rate within
-    ``+-factor`` frames (exact ``argmin E`` for the count found, float64 costs),
-    re-centring the window until the energy stops decreasing. This is a local
-    refinement: the result equals the full-rate optimum whenever that lies within the
-    window (on the synthetic tests: the same boundaries).
+    ``factor > 1``: the optimum of the decimated signal (box filter, every ``factor``-th
+    frame, band :func:`coarse_band`), then every boundary refined at full rate within
+    ``+-factor`` frames (float64 costs), re-centred until the energy stops decreasing: a
+    local refinement, equal to the full-rate optimum whenever that lies in the window.
     """
 
     def search(xx: np.ndarray, lo_: int, hi_: int) -> tuple[np.ndarray, float]:
