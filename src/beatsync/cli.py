@@ -52,7 +52,7 @@ __all__ = ["build_parser", "main", "UsageError"]
 
 
 class UsageError(Exception):
-    """An argparse error, raised instead of exiting so that ``main`` can report it."""
+    """An argparse error, raised instead of exiting so that ``main`` reports it."""
 
     def __init__(self, parser: argparse.ArgumentParser, message: str):
         super().__init__(message)
@@ -65,24 +65,9 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(self, message)
 
 
-def _load(name: str) -> object | None:
-    try:
-        return importlib.import_module(f".commands.{name}", __package__)
-    except ModuleNotFoundError as exc:
-        if exc.name == f"{__package__}.commands.{name}":
-            return None  # subcommand not part of this build
-        raise
-
-
 def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
-    """The program's parser.
-
-    Parameters
-    ----------
-    commands : iterable of str, optional
-        Subcommands to register fully (their modules are imported); the others are
-        listed with their one-line help only. Default: all of them.
-    """
+    """The program's parser; subcommands not in ``commands`` (default: all) are listed
+    with their one-line help only, without importing their modules."""
     full = set(COMMAND_MODULES if commands is None else commands)
     parser = _Parser(
         prog="beatsync",
@@ -97,10 +82,8 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
-        if name in full or name not in COMMAND_HELP:
-            module = _load(name)
-            if module is not None:
-                module.register(sub)  # type: ignore[attr-defined]
+        if name in full:
+            importlib.import_module(f".commands.{name}", __package__).register(sub)
         else:
             sub.add_parser(name, help=COMMAND_HELP[name], add_help=False)
     return parser

@@ -21,8 +21,7 @@ COMMAND_MODULES = (
     "data",
 )
 
-# One-line help of each subcommand, shown by ``beatsync --help`` (a module's own
-# ``register`` uses the same text; a subcommand missing here is imported to list it).
+# One-line help of each subcommand, shown by ``beatsync --help`` (and by its ``register``).
 COMMAND_HELP = {
     "segment": "find the period boundaries of a periodic motion (paper A, section 3)",
     "beats": "track the beats of a song and print their times in seconds",

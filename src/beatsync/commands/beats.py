@@ -41,19 +41,16 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--bpm",
         type=float,
-        default=None,
         help="known tempo [BPM]: skip tempo estimation, only find the phase",
     )
     add_tempo_range(p)
     p.add_argument(
         "--out",
-        default=None,
         metavar="FILE.beats",
         help="write the beat times [s] to this file, one per line",
     )
     p.add_argument(
         "--click",
-        default=None,
         metavar="OUT.wav",
         help="write the audio with a click on every beat (.wav or .flac)",
     )

@@ -54,7 +54,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "audio",
         nargs="?",
-        default=None,
         help="music file (.wav, .flac, .ogg, .mp3); may also follow --library",
     )
     p.add_argument(
@@ -69,7 +68,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--fps",
         type=float,
-        default=None,
         help="frame rate of the library clips [Hz]: overrides the BVH headers",
     )
     p.add_argument(
@@ -128,11 +126,10 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument(
         "--video",
-        default=None,
         metavar="OUT.mp4",
         help="also write a stick-figure video with the music as soundtrack",
     )
-    p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
+    p.add_argument("--report", metavar="FILE.json", help="write the report as JSON")
     p.add_argument(
         "--no-cache",
         action="store_true",
@@ -304,18 +301,10 @@ def run(args: argparse.Namespace) -> int:
     with outs:  # the dance, video and report are all written, or none of them
         io.write_bvh(outs.path(out), comp.motion)
         if video_path is not None:
-            from .. import render
-
-            staged = outs.path(video_path)
-            written = render.write_video(
-                comp.motion, staged, audio=(y, sr), beats=comp.music_beats, progress=fb.bars
+            video_path = outs.write_video(
+                video_path, comp.motion, audio=(y, sr), beats=comp.music_beats, progress=fb.bars
             )
-            if written != staged:  # no ffmpeg: a GIF and a WAV instead of the MP4
-                outs.forget(video_path)
-                video_path = outs.adopt(written, option="--video")
-                if staged.with_suffix(".wav").is_file():
-                    outs.adopt(staged.with_suffix(".wav"), option="--video")
-                result["video"] = str(video_path)
+            result["video"] = str(video_path)
         if chk["report"] is not None:
             io.write_json(outs.path(chk["report"]), result)
     g = graph.summary()

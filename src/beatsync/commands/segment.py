@@ -38,7 +38,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fps",
         type=float,
-        default=None,
         help="frame rate [Hz]; overrides a BVH header (CMU salsa files: 60), required for "
         ".csv/.npy",
     )
@@ -52,7 +51,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--periods",
         type=int,
-        default=None,
         help="number of periods if known (e.g. from the music); the result then has exactly "
         "N periods; default: estimate",
     )
@@ -60,7 +58,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--bpm",
         type=float,
-        default=None,
         help="tempo of the music the dance goes with [BPM]: search periods of 1 to 8 beats "
         "(steps to figures such as a 6-beat waltz box), shortest first; instead of "
         "--period-range",
@@ -77,9 +74,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=["default"],
         help="'default' (limb and spine rotations, or *_angle channels), 'all', or channel names",
     )
-    p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    p.add_argument("--variable", help="recording inside a .mat file (e.g. dance2)")
     add_position_options(p)
-    p.add_argument("--out", default=None, help="write the boundaries to this .csv file")
+    p.add_argument("--out", help="write the boundaries to this .csv file")
     add_output_flags(p)
     p.set_defaults(func=run)
 

@@ -75,19 +75,15 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--fps",
         type=float,
-        default=None,
         help="input frame rate [Hz]: overrides the BVH header; required for csv/npy",
     )
-    p.add_argument(
-        "--out-fps", type=float, default=None, help="output frame rate [Hz] (default: the input's)"
-    )
-    p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    p.add_argument("--out-fps", type=float, help="output frame rate [Hz] (default: the input's)")
+    p.add_argument("--variable", help="recording inside a .mat file (e.g. dance2)")
     add_position_options(p)
     add_music_beat_options(p)
     p.add_argument(
         "--beats-per-period",
         type=int,
-        default=None,
         metavar="N",
         help="music beats per motion period, or per median motion beat with --mode beats "
         "(default: periods round(motion period / beat), respecting the meters; motion "
@@ -124,7 +120,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--beats-per-bar",
         type=int,
-        default=None,
         metavar="N",
         help="the music's meter (3 for a waltz; default: estimated by the beat tracker); "
         "beats per period then respect it",
@@ -132,7 +127,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--dance-beats",
         type=int,
-        default=None,
         metavar="N",
         help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
         "a waltz box); with periods, beats per period are then a multiple of it (a warning "
@@ -143,7 +137,6 @@ def register(subparsers: Any) -> None:
         "--period-range",
         nargs=2,
         type=float,
-        default=None,
         metavar=("LO", "HI"),
         help="shortest and longest motion period searched [s] (default: with --mode periods "
         "one to eight beats of the song, so real dance cycles such as a 4 s waltz box are "
@@ -151,14 +144,13 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument(
         "--video",
-        default=None,
         metavar="OUT.mp4",
         help="also write a stick-figure video with the music as soundtrack",
     )
     p.add_argument(
         "--video-fps", type=float, default=30.0, help="frame rate of the video [Hz] (default 30)"
     )
-    p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
+    p.add_argument("--report", metavar="FILE.json", help="write the report as JSON")
     add_output_flags(p)
     p.set_defaults(func=run)
 
@@ -316,16 +308,15 @@ def _pipeline(
     written: dict[str, str] = {}
     if video is not None:
         t0 = time.perf_counter()
-        staged = outs.path(video)
-        duration = music_s if args.fill == "loop" else None
-        vid = _render_video(res.motion, staged, (y, sr), beats, args.video_fps, fb.bars, duration)
-        if vid == staged:
-            vid = video
-        else:  # no ffmpeg: a GIF and a WAV instead of the MP4
-            outs.forget(video)
-            vid = outs.adopt(vid, option="--video")
-            if staged.with_suffix(".wav").is_file():
-                outs.adopt(staged.with_suffix(".wav"), option="--video")
+        vid = outs.write_video(
+            video,
+            res.motion,
+            audio=(y, sr),
+            fps=args.video_fps,
+            beats=beats,
+            progress=fb.bars,
+            duration=music_s if args.fill == "loop" else None,
+        )
         written["video"] = str(vid)
         timings["video_s"] = time.perf_counter() - t0
 
@@ -354,22 +345,6 @@ def _pipeline(
         "timings": timings,
     }
     return result
-
-
-def _render_video(
-    motion: Any,
-    path: Path,
-    audio: Any,
-    beats: np.ndarray,
-    fps: float,
-    progress: bool,
-    duration: float | None,
-) -> Path:
-    from .. import render
-
-    return render.write_video(
-        motion, path, audio=audio, fps=fps, beats=beats, progress=progress, duration=duration
-    )
 
 
 def _text(result: dict[str, Any]) -> str:
@@ -413,18 +388,6 @@ def _text(result: dict[str, Any]) -> str:
     for k, v in result["outputs"].items():
         lines.append(f"wrote    {k}: {v}")
     return "\n".join(lines)
-
-
-def _placement_notes(r: dict[str, Any]) -> str:
-    """Where no whole number of beats fitted: merges and half-beat landings."""
-    out = ""
-    if r["n_merged_intervals"]:
-        out += f"; {r['n_merged_intervals']} merged with a neighbour"
-    if r["n_half_beat_landings"]:
-        out += f"; {r['n_half_beat_landings']} landing on a half beat"
-    if r.get("phrases_on_bars") is not None:
-        out += f"; {r['phrases_on_bars']:.0%} of the dance bars start on a bar line"
-    return out
 
 
 def _counts_text(used: dict[str, int]) -> str:
