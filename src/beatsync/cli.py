@@ -1,17 +1,11 @@
-"""The ``beatsync`` command-line program.
-
-``beatsync SUBCOMMAND --help`` describes each subcommand. Only the chosen
-subcommand's module is imported, so the program starts fast.
+"""The ``beatsync`` command-line program (only the chosen subcommand's module is imported).
 
 Every subcommand accepts ``--json`` (the result as a JSON object on stdout) and
-``--quiet`` (no progress bars or progress lines on stderr; warnings and errors are
-still printed). Progress bars appear only when stderr is a terminal.
+``--quiet`` (no progress on stderr; warnings and errors are still printed).
 
-Outputs are all-or-nothing: every output file of a command is checked before any
-work (an existing folder, a read-only file, an input file, a missing folder are
-refused), written beside it under a hidden temporary name (``.beatsync-tmp-*``) and
-renamed into place only when the whole command succeeded. An error, Ctrl-C or
-SIGTERM leaves every output path as it was.
+Outputs are all-or-nothing: every output file of a command is checked before any work,
+written beside it under a hidden temporary name (``.beatsync-tmp-*``) and renamed into
+place only when the whole command succeeded; an error or a signal leaves them as they were.
 
 Exit status
 -----------

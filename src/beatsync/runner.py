@@ -102,8 +102,8 @@ def check_params(
 def planned_outputs(
     todo: dict[str, Path], *, output_dir: str | Path | None = "results/notebooks", in_place: bool
 ) -> dict[str, Path]:
-    """Where :func:`run_notebooks` writes each notebook, and (key ``MANIFEST``, not
-    ``in_place``) its manifest."""
+    """Where :func:`run_notebooks` writes each notebook (and, not ``in_place``, the
+    manifest)."""
     if in_place:
         return dict(todo)
     out_dir = Path(output_dir or "results/notebooks")
@@ -114,11 +114,6 @@ def default_jobs(n_notebooks: int | None = None) -> int:
     """Notebooks run at once by default: the usable CPUs, at most 4 (and ``n_notebooks``)."""
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return max(1, min(cpus or 1, 4, n_notebooks or 4))
-
-
-def kernel_env() -> dict[str, str]:
-    """The environment of the notebook kernels: ours, one BLAS thread unless set."""
-    return {**{var: "1" for var in THREAD_VARIABLES}, **os.environ}
 
 
 def run_notebooks(
@@ -204,11 +199,9 @@ def _run_all(specs: dict[str, dict[str, Any]], jobs: int, progress: Any) -> dict
                 name = pending.pop(0)
                 log = tempfile.TemporaryFile()  # noqa: SIM115 (closed below)
                 command = [sys.executable, "-m", "beatsync.runner", name, json.dumps(specs[name])]
-                running[name] = (
-                    subprocess.Popen(command, stdout=log, stderr=log, env=kernel_env()),
-                    log,
-                    time.perf_counter(),
-                )
+                env = {**dict.fromkeys(THREAD_VARIABLES, "1"), **os.environ}  # one unless set
+                proc = subprocess.Popen(command, stdout=log, stderr=log, env=env)
+                running[name] = (proc, log, time.perf_counter())
                 say(f"running {name} ...")
             time.sleep(0.1)
             for name, (proc, log, start) in list(running.items()):

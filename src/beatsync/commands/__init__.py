@@ -1,12 +1,9 @@
 """Subcommands of the ``beatsync`` program, one module each.
 
-Each module defines ``register(subparsers)``, which adds its parser and sets
-``func=run``; ``run(args)`` checks the options and files (cheapest first, through
-:mod:`beatsync.commands._common`), calls the library, and prints a JSON-serialisable
-``dict`` or a human-readable text via :func:`beatsync.commands._common.emit`.
-
-The program imports only the module of the subcommand it runs: ``beatsync --help``
-lists the subcommands from :data:`COMMAND_HELP` without importing any of them.
+Each module's ``register(subparsers)`` adds its parser with ``func=run``; ``run(args)``
+checks the options and files (cheapest first), calls the library and prints a result
+via :func:`beatsync.commands._common.emit`. ``beatsync --help`` lists the subcommands
+from :data:`COMMAND_HELP` without importing any of them.
 """
 
 # Order shown in ``beatsync --help``.

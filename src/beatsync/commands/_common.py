@@ -449,7 +449,7 @@ class Feedback:
         """A bar for one step (its elapsed time moving even without calls); yields the
         ``progress(done, total=None)`` callable."""
         if not self.bars:
-            yield _no_progress
+            yield lambda done, total=None: None
             return
         from tqdm import tqdm
 
@@ -481,10 +481,6 @@ class Feedback:
             stop.set()
             ticker.join()
             bar.close()
-
-
-def _no_progress(done: float, total: float | None = None) -> None:
-    return None
 
 
 def feedback(args: argparse.Namespace) -> Feedback:

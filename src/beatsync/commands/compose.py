@@ -1,15 +1,7 @@
 """``beatsync compose``: compose a dance for a song from a motion library (paper B).
 
-Reads the library's BVH clips (one skeleton), builds their weighted motion graph (or
-loads it from the on-disk cache), finds the music's beats (tracker, optionally within a
-tempo range; a beats file; or a known BPM) and its level per beat interval, searches the
-best path by dynamic programming, synthesizes the dance (every motion beat on a music
-beat, blended transitions) and writes it as BVH, optionally a video with the music and a
-JSON report (path, number of transitions, graph-build and search times).
-
-Graph cache (on by default, :mod:`beatsync.graph.cache`): built graphs are stored in
-``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else in
-``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it.
+Built motion graphs are cached (:mod:`beatsync.graph.cache`) in ``$BEATSYNC_CACHE_DIR``,
+else ``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it.
 """
 
 from __future__ import annotations
@@ -162,7 +154,7 @@ def _library_files(entries: list[str]) -> list[Path]:
     return files
 
 
-def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
+def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Outputs]:
     entries = list(args.library or [])
     audio = args.audio
     if audio is None:
@@ -182,22 +174,15 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     if args.beats is not None and not Path(args.beats).is_file():
         raise ParameterError(f"beats file {args.beats!r} does not exist")
     files = _library_files(entries)
-    out = Path(args.output)
-    if out.suffix.lower() != ".bvh":
+    if Path(args.output).suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
     outs = Outputs(inputs=(audio, args.beats, *files))
     outs.add(args.output, option="-o/--output")
-    video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
-    report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
-    return {
-        "audio": audio,
-        "files": files,
-        "out": out,
-        "video": video,
-        "report": report,
-        "th": th,
-        "outs": outs,
-    }
+    if args.video:
+        outs.add(args.video, option="--video", suffixes=[".mp4"])
+    if args.report:
+        outs.add(args.report, option="--report", suffixes=[".json"])
+    return audio, files, th, outs
 
 
 def run(args: argparse.Namespace) -> int:
@@ -208,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
     if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
-    chk = _check_inputs(args)  # files after the options: cheapest first
+    audio, files, th, outs = _check_inputs(args)  # files after the options: cheapest first
     fb = feedback(args)
     from ..graph.timescale import check_multiplicity, check_scale_bound
 
@@ -216,13 +201,10 @@ def run(args: argparse.Namespace) -> int:
         None if args.no_scale_bound else check_scale_bound(args.scale_bound, name="--scale-bound")
     )
     mult = args.multiplicity
-    if mult != "auto":
-        mult = mult.split(",")
-    mult = check_multiplicity(mult)
-    files = chk["files"]
+    mult = check_multiplicity(mult if mult == "auto" else mult.split(","))
     t_read = time.perf_counter()
     with fb.noted() as read_notes:  # e.g. the MP3 decoder's
-        y, sr = io.read_audio(chk["audio"])
+        y, sr = io.read_audio(audio)
     beats = None
     if args.beats is not None:  # cheap checks first: the beats file before the clips
         try:
@@ -245,11 +227,7 @@ def run(args: argparse.Namespace) -> int:
         with fb.noted() as tracked, fb.step("tracking beats"):
             beats = track_music_beats(y, sr, **tempo_options(args))
         notes += tracked
-    params = {
-        "th": chk["th"],
-        "weight_rule": args.weight_rule,
-        "fps": args.fps,
-    }
+    params = {"th": th, "weight_rule": args.weight_rule, "fps": args.fps}
     t0 = time.perf_counter()
     with fb.step("building the motion graph"):
         graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
@@ -269,8 +247,9 @@ def run(args: argparse.Namespace) -> int:
             **kw,
         )
     notes += composed
-    out = chk["out"]
-    video_path = chk["video"]
+    out = Path(args.output)
+    video_path = Path(args.video) if args.video else None
+    report = Path(args.report) if args.report else None
     result = {
         "output": str(out),
         "video": str(video_path) if video_path else None,
@@ -297,7 +276,6 @@ def run(args: argparse.Namespace) -> int:
         "plausibility": comp.plausibility,
         "warnings": notes,
     }
-    outs = chk["outs"]
     with outs:  # the dance, video and report are all written, or none of them
         io.write_bvh(outs.path(out), comp.motion)
         if video_path is not None:
@@ -305,8 +283,8 @@ def run(args: argparse.Namespace) -> int:
                 video_path, comp.motion, audio=(y, sr), beats=comp.music_beats, progress=fb.bars
             )
             result["video"] = str(video_path)
-        if chk["report"] is not None:
-            io.write_json(outs.path(chk["report"]), result)
+        if report is not None:
+            io.write_json(outs.path(report), result)
     g = graph.summary()
     text = (
         f"wrote {out} ({comp.motion.n_frames} frames at {comp.motion.fps:g} fps, "
@@ -321,8 +299,8 @@ def run(args: argparse.Namespace) -> int:
     )
     if video_path:
         text += f"\nvideo: {video_path}"
-    if chk["report"] is not None:
-        text += f"\nreport: {chk['report']}"
+    if report is not None:
+        text += f"\nreport: {report}"
     return emit(result, text, args)
 
 

@@ -1,8 +1,4 @@
-"""``beatsync segment``: split a periodic motion into its periods (paper A, sec. 3).
-
-Prints the period boundaries [s], the period count and the mean period; ``--out``
-writes the boundaries as CSV (atomic; nothing is written on error).
-"""
+"""``beatsync segment``: split a periodic motion into its periods (paper A, sec. 3)."""
 
 from __future__ import annotations
 
@@ -110,17 +106,7 @@ def run(args: argparse.Namespace) -> int:
     converted = is_marker_motion(motion)
     positions = None if motion.position_info is None else motion.position_info.describe()
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
-    channels = args.channels
-    chan: str | list[str] = (
-        channels[0]
-        if len(channels) == 1
-        and channels[0]
-        in (
-            "default",
-            "all",
-        )
-        else list(channels)
-    )
+    chan = args.channels[0] if args.channels in (["default"], ["all"]) else args.channels
     with fb.step("segmenting periods"):
         seg = segment(
             motion,

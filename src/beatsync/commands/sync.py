@@ -1,16 +1,8 @@
 """``beatsync sync``: make a dance follow a song (paper A, section 5, and real dances).
 
-Reads a motion file (BVH; MoCap Toolbox ``.mat``; joint positions as Dance-with-Melody
-``.json``, ``.npy``/``.npz`` or C3D; CSV/NPY angle tables) and a song, finds the music's
-beats (:func:`beatsync.beats.track_beats` with its meter estimate, optionally within a
-tempo range, or a beats file / a known BPM) and calls :func:`beatsync.sync.synchronize`
-with ``boundaries=None``: it finds the motion's periods (``--mode periods``, paper A),
-or warps the dancer's own motion beats (``--mode beats``), or tries periods and falls
-back to beats with a warning (``--mode auto``, default), and with ``--fill loop``
-(default) repeats whole periods with blended joins until the dance reaches the song's
-last beat. Writes the motion (BVH with the input skeleton; joint positions in the
-input's layout; or CSV), optionally a video with the music that lasts as long as the
-song, and the report.
+Reads a motion and a song, finds the music's beats (or reads them) and calls
+:func:`beatsync.sync.synchronize` with ``boundaries=None`` in the ``--mode`` and ``--fill``
+chosen; writes the motion in its input's kind, optionally a video and the report.
 """
 
 from __future__ import annotations
