@@ -54,7 +54,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     from .. import io
     from ..errors import ParameterError
     from ..io import check_input_file
@@ -108,9 +107,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _text(table, out_dir: str) -> str:
-    """One line per pair, and its note or error on a line of its own (the table's
-    columns are in the summary CSV and ``--json``; as one table the notes made lines
-    of several hundred characters). Outputs are shown in ``out_dir`` as given."""
+    """A line per pair and its note or error on a line of its own (the columns are in the
+    summary CSV and ``--json``), outputs shown in ``out_dir`` as given."""
     from pathlib import Path
 
     lines = []

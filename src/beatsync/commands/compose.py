@@ -26,8 +26,6 @@ from ._common import (
 
 __all__ = ["register", "run"]
 
-_AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
-
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
@@ -155,18 +153,19 @@ def _library_files(entries: list[str]) -> list[Path]:
 
 
 def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Outputs]:
+    from ..graph.build import check_th
+    from ..io import AUDIO_SUFFIXES
+
     entries = list(args.library or [])
     audio = args.audio
     if audio is None:
         # argparse lets --library swallow the audio file that follows it
-        moved = [e for e in entries if Path(e).suffix.lower() in _AUDIO_SUFFIXES]
+        moved = [e for e in entries if Path(e).suffix.lower() in AUDIO_SUFFIXES]
         if len(moved) == 1:
             audio = moved[0]
             entries.remove(audio)
         else:
             raise ParameterError("give the music file (AUDIO), e.g. beatsync compose song.wav ...")
-    from ..graph.build import check_th
-
     th = check_th(args.th, name="--th")
     tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
     if not Path(audio).is_file():

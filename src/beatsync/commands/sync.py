@@ -31,7 +31,6 @@ from ._common import (
 
 __all__ = ["register", "run"]
 
-_MOTION_OUT = (".bvh", ".csv", ".json", ".npy", ".npz", ".c3d")
 #: shortest song the beat tracker is asked about [s]
 MIN_MUSIC_S = 1.0
 
@@ -148,6 +147,9 @@ def register(subparsers: Any) -> None:
 
 
 def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None, Path | None]:
+    from ..io import MOTION_OUTPUT_SUFFIXES, check_input_file
+    from ..validation import check_motion_fps
+
     if args.align_accents and args.phase_offset != 0.0:
         raise ParameterError(
             "--align-accents measures the phase offset itself; do not also give --phase-offset"
@@ -168,18 +170,15 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
             "LO HI with 0 < LO < HI [s]"
         )
     tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
-    out = Path(args.output)
-    if out.suffix.lower() not in _MOTION_OUT:
+    if Path(args.output).suffix.lower() not in MOTION_OUTPUT_SUFFIXES:
         raise ParameterError(
             f"output {args.output!r} must end in .bvh or .csv, or for joint positions .json, "
             ".npy, .npz or .c3d (the motion is written there)"
         )
     for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
-        if inp is not None and not Path(inp).is_file():
-            raise ParameterError(f"{what} file {inp!r} does not exist")
+        if inp is not None:
+            check_input_file(inp, what)
     if args.video:
-        from ..validation import check_motion_fps
-
         check_motion_fps(args.video_fps, name="--video-fps")  # before minutes of work
     outs = Outputs(inputs=(args.motion, args.audio, args.beats))
     out = outs.add(args.output, option="-o/--output")
