@@ -100,13 +100,13 @@ def test_grid_tempo_range_reaches_every_song(inputs, tmp_path):
 
 def test_grid_bad_arguments(inputs, tmp_path):
     _, clips, songs = inputs
-    with pytest.raises(ParameterError, match="does not exist"):
+    with pytest.raises(ParameterError, match="none.bvh"):
         sync_grid([tmp_path / "none.bvh"], songs, tmp_path)
-    with pytest.raises(ParameterError, match="output folder"):
+    with pytest.raises(ParameterError, match="missing"):
         sync_grid(clips, songs, tmp_path / "missing")
-    with pytest.raises(ParameterError, match="at least one"):
+    with pytest.raises(ParameterError, match="one clip"):
         sync_grid([], songs, tmp_path)
-    with pytest.raises(ParameterError, match="mode='bars' must be one of"):
+    with pytest.raises(ParameterError, match="mode='bars'"):
         sync_grid(clips, songs, tmp_path, mode="bars")
 
 
@@ -159,7 +159,7 @@ def test_batch_refuses_duplicate_song_names(inputs, tmp_path):
     for t in twins:  # the same file name in folders of the same name: nothing tells them apart
         t.parent.mkdir(parents=True)
         t.write_bytes(songs[0].read_bytes())
-    with pytest.raises(ParameterError, match=r"song names must differ.*\['take'\]"):
+    with pytest.raises(ParameterError, match=r"\['take'\]"):
         sync_grid(clips[:1], twins, tmp_path)
 
 
@@ -230,14 +230,14 @@ def _batch_args(inputs, out, *extra):
 @pytest.mark.parametrize(
     "extra, match",
     [
-        (["--workers", "-1"], "whole number of workers >= 1"),
-        (["--workers", "0"], "whole number of workers >= 1"),
-        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "give one or the other"),
-        (["--scheduler", "tcp://127.0.0.1:9"], "could not connect to the Dask scheduler"),
-        (["--scheduler", "nonsense"], "not a Dask scheduler address"),
+        (["--workers", "-1"], "--workers=-1"),
+        (["--workers", "0"], "--workers=0"),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "--workers 2"),
+        (["--scheduler", "tcp://127.0.0.1:9"], "127.0.0.1:9'"),
+        (["--scheduler", "nonsense"], "'nonsense'"),
         # the tempo options are checked before the cluster starts
-        (["--bpm", "100", "--max-bpm", "80"], "--max-bpm bounds the tempo.*one or the other"),
-        (["--min-bpm", "90", "--max-bpm", "60"], "--min-bpm 90 must be smaller"),
+        (["--bpm", "100", "--max-bpm", "80"], "--max-bpm.*--bpm"),
+        (["--min-bpm", "90", "--max-bpm", "60"], "--min-bpm 90"),
     ],
 )
 def test_batch_bad_cluster_options_fail_fast(inputs, tmp_path, monkeypatch, extra, match):
@@ -320,7 +320,7 @@ def test_batch_refuses_a_positions_output_that_is_an_input(inputs, tmp_path, cli
                 "--out-dir", str(tmp_path), "--fps", "25", "--mode", "beats"]  # fmt: skip
         assert main(argv) == 3
     else:
-        with pytest.raises(ParameterError, match="would overwrite an input"):
+        with pytest.raises(ParameterError, match="dancer__click100.json"):
             sync_grid(clips, songs[:1], tmp_path, processes=False, n_workers=1, fps=25.0)
     assert clips[1].read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(c.name for c in clips)
@@ -357,7 +357,7 @@ def test_batch_refuses_a_summary_named_like_a_pairs_output(inputs, tmp_path, cap
 def test_outputs_adopt_never_takes_another_options_file(tmp_path):
     from beatsync.commands._common import Outputs
 
-    with pytest.raises(ParameterError, match="both name"):
+    with pytest.raises(ParameterError, match="a.csv"):
         with Outputs(inputs=[]) as outs:
             folder = outs.add_folder(tmp_path, option="--out-dir")
             outs.add(folder / "a.csv", option="--summary")

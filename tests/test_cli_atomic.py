@@ -6,6 +6,7 @@ output path as it was and no temporary file or folder behind.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -88,6 +89,24 @@ def test_compose_video_failing_leaves_no_motion(inputs, tmp_path, capsys, monkey
     err = capsys.readouterr().err
     assert code == 3 and "ffmpeg failed" in err, err
     assert _listing(out) == []
+
+
+def test_without_ffmpeg_the_gif_and_wav_take_the_videos_place(inputs, tmp_path, monkeypatch):
+    from beatsync import render
+
+    def gif_and_wav(motion, path, **kwargs):  # what write_video writes without ffmpeg
+        path.with_suffix(".wav").write_bytes(b"RIFF")
+        path.with_suffix(".gif").write_bytes(b"GIF89a")
+        return path.with_suffix(".gif")
+
+    monkeypatch.setattr(render, "write_video", gif_and_wav)
+    out = tmp_path / "out"
+    out.mkdir()
+    argv = ["sync", str(inputs["clip"]), str(inputs["song"]), "-o", str(out / "d.bvh"),
+            "--report", str(out / "r.json"), "--video", str(out / "d.mp4"), "--quiet"]  # fmt: skip
+    assert main(argv) == 0
+    assert _listing(out) == ["d.bvh", "d.gif", "d.wav", "r.json"]
+    assert json.loads((out / "r.json").read_text())["outputs"]["video"] == str(out / "d.gif")
 
 
 @pytest.mark.slow

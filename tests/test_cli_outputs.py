@@ -314,7 +314,10 @@ def test_signal_during_multi_output_command_leaves_no_temporaries(study, sig, co
         lines.append(line)
         if line.startswith("running b"):
             break
-    time.sleep(3.0)  # b's kernel is sleeping; a's executed copy is staged
+    deadline = time.monotonic() + 60.0  # a's kernel starts slowly on a loaded machine
+    while not _listing(study["out"]) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(1.0)  # b's kernel is sleeping; a's copy is in flight
     assert _listing(study["out"]) != []  # something is in flight
     proc.send_signal(sig)
     rest = proc.communicate(timeout=60)[1]

@@ -203,13 +203,13 @@ BAD = [
     # a tempo range is checked before any work, named as the options, and conflicts with a
     # fixed tempo or given beats
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--bpm", "115", "--max-bpm", "80"],
-     "--max-bpm bounds the tempo.*--bpm.*one or the other"),
+     "--max-bpm.*--bpm"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
       "--min-bpm", "60", "--max-bpm", "80"], "--min-bpm and --max-bpm bound.*--beats"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--min-bpm", "300"],
-     "--min-bpm 300 must be smaller than --max-bpm 240 \\(the other bound is its default"),
+     "--min-bpm 300.*--max-bpm 240.*default"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--max-bpm", "1"],
-     "--max-bpm=1.0 is outside the plausible range"),
+     "--max-bpm=1.0"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--align-accents", "--phase-offset",
       "0.1"], "phase"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),
@@ -246,7 +246,7 @@ BAD = [
       "--video", "{o}/v.mp4", "--video-fps", "0"], "--video-fps=0"),
     # an absurd output or video frame rate: refused before the memory fills
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
-      "--out-fps", "100000"], "out_fps.*implausibly high"),
+      "--out-fps", "100000"], "out_fps=100000"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--first-beat", "500",
       "--beats", "{d}/song.beats"], "first_beat"),
 ]

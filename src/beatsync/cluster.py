@@ -17,10 +17,9 @@ from .validation import check_cluster_options, default_workers
 #: Seconds to wait for an existing scheduler (and its handshake) before giving up.
 CONNECT_TIMEOUT = 5.0
 
-#: Dask settings of a local cluster, for each key the user's configuration leaves at Dask's
-#: default: no profiler, and less often the periodic checks that feed a dashboard (on a few
-#: cores they compete with the work); a worker takes its next task when its thread is free.
-#: Measured against Dask's defaults by ``benchmarks/bench_cluster_config.py``.
+#: Dask settings of a local cluster where the user's configuration keeps Dask's default: no
+#: profiler, fewer periodic checks (on a few cores they compete with the work), a worker
+#: takes its next task when its thread is free (``benchmarks/bench_cluster_config.py``).
 LOCAL_CLUSTER_CONFIG: dict[str, Any] = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.tick.interval": "1s",
@@ -40,14 +39,9 @@ def dask_client(
     processes: bool = True,
     timeout: float | None = None,
 ) -> Iterator[Any]:
-    """A Dask client of a new local cluster (closed on the way out) or of ``scheduler``.
-
-    ``n_workers`` local workers (default: one per core), processes or threads of this
-    process; ``timeout`` [s] (default :data:`CONNECT_TIMEOUT`) to wait for ``scheduler``.
-    Raises :class:`~beatsync.errors.ParameterError` for options that
-    :func:`beatsync.validation.check_cluster_options` refuses, or a scheduler that does
-    not answer in time.
-    """
+    """A Dask client of a new local cluster of ``n_workers`` (default: one per core)
+    processes or threads, closed on the way out; or of ``scheduler`` if it answers within
+    ``timeout`` [s] (default :data:`CONNECT_TIMEOUT`)."""
     n = check_cluster_options(scheduler, n_workers)
     import dask
     from dask.distributed import Client, LocalCluster
@@ -85,10 +79,9 @@ def dask_client(
 def _connect(address: str, timeout: float) -> Any:
     """A client of the scheduler at ``address`` if it answers within ``timeout`` [s].
 
-    distributed's client reads the handshake with no time limit (a silent server holds it
-    forever), so a first connection has one, on a loop of its own thread (the caller's may
-    run one, as Jupyter's does). The client refuses a handshake batched with a busy
-    scheduler's broadcast (an AssertionError): it tries twice.
+    A first connection, with a time limit the client's handshake lacks, runs on a loop of
+    its own thread (the caller's may run one, as Jupyter's does). The client refuses a
+    handshake batched with a busy scheduler's broadcast (an AssertionError): it tries twice.
     """
     import asyncio
     from concurrent.futures import ThreadPoolExecutor

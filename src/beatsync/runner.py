@@ -1,20 +1,14 @@
-"""Run the study's notebooks with papermill from a parameter file.
+"""Run the study's notebooks with papermill from a parameter file (``beatsync reproduce``).
 
-A parameter file (``params/paper.yaml`` for the full study, ``params/ci.yaml`` for a
-quick run) maps each notebook name (file stem in ``notebooks/``) to its parameters::
-
-    paper_a_fig02_segmentation:
-      n_trials: 20
-      results_dir: ../results
-
-Unlike papermill, which only warns, the runner refuses a parameter that a notebook's
-``parameters`` cell does not declare, a missing notebook and an unlisted one. Each
-notebook runs with its own folder as working directory and one BLAS/OpenMP thread (unless
-the caller set one: a threaded BLAS sums in an order that depends on the thread count,
-and the artefacts must not depend on the machine). With ``jobs`` > 1 the notebooks run
-side by side, each in a process of its own (``python -m beatsync.runner``), the longest
-first (by the previous manifest); they write separate artefact folders. A manifest
-(``run_manifest.json``) records each notebook's parameter file, parameters and time.
+A parameter file (``params/paper.yaml``, or ``params/ci.yaml`` for a quick run) maps each
+notebook name (file stem in ``notebooks/``) to its parameters, e.g.
+``paper_a_fig02_segmentation: {n_trials: 20}``. Unlike papermill, which only warns, the
+runner refuses an undeclared parameter, a missing notebook and an unlisted one. Each
+notebook runs in its own folder with one BLAS/OpenMP thread unless the caller set one
+(a threaded BLAS sums in an order that depends on the thread count, and the artefacts
+must not depend on the machine), in a process of its own (``python -m beatsync.runner``),
+``jobs`` at a time, the longest first (by the previous manifest, ``run_manifest.json``,
+which records each notebook's parameter file, parameters and time).
 """
 
 from __future__ import annotations
@@ -74,12 +68,8 @@ def load_params(params_file: str | Path) -> dict[str, dict[str, Any]]:
 def check_params(
     params: dict[str, dict[str, Any]], notebooks_dir: str | Path, *, only: list[str] | None = None
 ) -> dict[str, Path]:
-    """Check the parameter mapping against the notebooks; return ``{name: path}`` to run.
-
-    Raises :class:`~beatsync.errors.ParameterError` for a listed notebook that does not
-    exist, a notebook not listed, an unknown ``only`` name, or a parameter a notebook
-    does not declare.
-    """
+    """Check the parameter mapping against the notebooks (each listed, present and
+    declaring its parameters); return ``{name: path}`` to run."""
     import papermill as pm
 
     present = {p.stem: p for p in sorted(Path(notebooks_dir).glob("*.ipynb"))}
@@ -112,8 +102,8 @@ def check_params(
 def planned_outputs(
     todo: dict[str, Path], *, output_dir: str | Path | None = "results/notebooks", in_place: bool
 ) -> dict[str, Path]:
-    """Where :func:`run_notebooks` writes each notebook, and (key ``MANIFEST``, not
-    ``in_place``) its manifest."""
+    """Where :func:`run_notebooks` writes each notebook (and, not ``in_place``, the
+    manifest)."""
     if in_place:
         return dict(todo)
     out_dir = Path(output_dir or "results/notebooks")
@@ -124,11 +114,6 @@ def default_jobs(n_notebooks: int | None = None) -> int:
     """Notebooks run at once by default: the usable CPUs, at most 4 (and ``n_notebooks``)."""
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return max(1, min(cpus or 1, 4, n_notebooks or 4))
-
-
-def kernel_env() -> dict[str, str]:
-    """The environment of the notebook kernels: ours, one BLAS thread unless set."""
-    return {**{var: "1" for var in THREAD_VARIABLES}, **os.environ}
 
 
 def run_notebooks(
@@ -142,15 +127,13 @@ def run_notebooks(
     progress: Callable[[str], None] | None = None,
     write_to: Callable[[Path], Path] | None = None,
 ) -> list[NotebookRun]:
-    """Execute the notebooks of ``params_file`` with papermill.
+    """Execute the notebooks of ``params_file`` with papermill into ``output_dir``
+    (created if missing, with the manifest), or ``in_place``.
 
-    ``output_dir`` receives the executed copies and the manifest (created if missing),
-    or ``in_place`` overwrites the notebooks themselves. ``jobs`` notebooks run at once.
-    ``progress`` is called with a line of text before and after each notebook.
-    ``write_to`` maps each destination of :func:`planned_outputs` to the file actually
-    written (a command writing all-or-nothing passes its staging paths). A notebook that
-    fails is kept, with its traceback cells, as ``<name>.failed.ipynb`` next to its
-    destination, and raises :class:`NotebookFailed` naming it.
+    ``progress`` gets a line of text before and after each notebook; ``write_to`` maps
+    each destination of :func:`planned_outputs` to the file actually written (a command's
+    staging paths). A notebook that fails is kept as ``<name>.failed.ipynb`` beside its
+    destination (for its traceback cells) and raises :class:`NotebookFailed`.
     """
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ParameterError(f"jobs={jobs!r}: run a whole number >= 1 of notebooks at once")
@@ -205,9 +188,8 @@ def _manifest(out_dir: Path | None) -> dict[str, dict[str, Any]]:
 
 
 def _run_all(specs: dict[str, dict[str, Any]], jobs: int, progress: Any) -> dict[str, float]:
-    """Run the notebooks of ``specs`` in order, ``jobs`` at a time, each in a worker
-    process (:func:`_worker_main`); their times [s]. A failure or an interruption stops
-    the others (they shut their kernels down and delete their running copies)."""
+    """Run the notebooks of ``specs`` in order, ``jobs`` at a time in worker processes
+    (:func:`_worker_main`); their times [s]. A failure or an interruption stops the others."""
     say = progress or (lambda line: None)
     seconds: dict[str, float] = {}
     pending, running = list(specs), {}
@@ -217,11 +199,9 @@ def _run_all(specs: dict[str, dict[str, Any]], jobs: int, progress: Any) -> dict
                 name = pending.pop(0)
                 log = tempfile.TemporaryFile()  # noqa: SIM115 (closed below)
                 command = [sys.executable, "-m", "beatsync.runner", name, json.dumps(specs[name])]
-                running[name] = (
-                    subprocess.Popen(command, stdout=log, stderr=log, env=kernel_env()),
-                    log,
-                    time.perf_counter(),
-                )
+                env = {**dict.fromkeys(THREAD_VARIABLES, "1"), **os.environ}  # one unless set
+                proc = subprocess.Popen(command, stdout=log, stderr=log, env=env)
+                running[name] = (proc, log, time.perf_counter())
                 say(f"running {name} ...")
             time.sleep(0.1)
             for name, (proc, log, start) in list(running.items()):
@@ -260,9 +240,8 @@ def _running_copy(dest: Path) -> Path:
 def _execute(name: str, notebook: str, parameters: dict, dest: str, write_to: str) -> None:
     """Run one notebook into ``write_to`` (a failed run kept as ``<dest>.failed.ipynb``).
 
-    The kernel talks to papermill over Unix sockets in a private folder: over TCP every
-    kernel warns that it runs without encryption, and any local process could reach it.
-    (TCP on Windows, and where the temporary folder's path is too long for a socket.)
+    The kernel talks over Unix sockets in a private folder (over TCP any local process
+    could reach it); TCP on Windows and where that path is too long for a socket.
     """
     import nbformat
     import papermill as pm
@@ -305,9 +284,8 @@ def _execute(name: str, notebook: str, parameters: dict, dest: str, write_to: st
 
 
 def _worker_main(argv: list[str]) -> int:
-    """``python -m beatsync.runner NAME SPEC_JSON``: run one notebook (a worker). SIGTERM
-    and SIGHUP become KeyboardInterrupt, so papermill shuts the kernel down; a failure's
-    message goes to stderr."""
+    """``python -m beatsync.runner NAME SPEC_JSON``: run one notebook (a worker); SIGTERM
+    and SIGHUP become KeyboardInterrupt, so that papermill shuts the kernel down."""
 
     def stop(signum: int, frame: Any) -> None:
         raise KeyboardInterrupt

@@ -1,27 +1,12 @@
-"""A study over many motion clips x songs, run on Dask.
+"""A study over many motion clips x songs, run on Dask (``beatsync batch``).
 
-Syncing every clip to every song is embarrassingly parallel. The work is a Dask
-task graph: each song's beats are tracked once, each clip is read and segmented
-once, and every (clip, song) pair is synchronised from those results. By default a
-local cluster (one process per core) runs it; give ``scheduler`` (an address such as
-``"tcp://10.0.0.5:8786"``) to use an existing cluster. A pair that fails on bad
-input (a clip that is not periodic, a song without beats) records the error message
-in its row instead of stopping the study. Every pair is synchronised as ``beatsync
-sync`` does with its defaults: ``mode`` is that of :func:`beatsync.sync.synchronize`
-(``"auto"`` by default: periods when the clip is periodic, else its motion beats, what
-real dancers need; or paper A's periods, or the dancer's own motion beats), the dance
-is looped to the song's last beat (``fill="loop"``) and the song's meter estimated by
-the beat tracker is respected; the clip is segmented once either way.
-
-Items are named by their file name without suffix; when file names repeat (a dataset
-of one folder per take, ``DANCE_C_4/skeletons.json``, ``DANCE_R_3/skeletons.json``),
-by the folder that holds them (:func:`item_names`).
-
-Data contract: every time is in seconds; every output file is written atomically
-under ``out_dir`` as ``<clip>__<song>`` in the clip's own kind of file
-(:func:`output_suffix`: ``.bvh`` with a skeleton, joint positions back in their
-input's layout, ``.json``, ``.npy``, ``.npz`` or ``.c3d``, else a ``.csv`` table);
-inputs are never written.
+Each song's beats are tracked once, each clip is read and segmented once, and every
+(clip, song) pair is synchronised from those results as ``beatsync sync`` does with its
+defaults (:func:`beatsync.sync.synchronize`; ``mode="auto"``, looped to the song's last
+beat, the song's estimated meter respected). A pair that fails records its error in its
+row instead of stopping the study. Outputs are ``<clip>__<song>`` under ``out_dir`` in
+the clip's own kind of file (:func:`output_suffix`), items named by their file name
+without suffix, or by their folder where file names repeat (:func:`item_names`).
 """
 
 from __future__ import annotations
@@ -44,14 +29,8 @@ __all__ = [
 
 
 def item_names(paths: Sequence[str | os.PathLike[str]], what: str) -> list[str]:
-    """Names of clips or songs in outputs (``<clip>__<song>``): the file name without
-    suffix, or the folder's name for files whose names repeat (one folder per take).
-
-    Raises
-    ------
-    ParameterError
-        Two items still share a name.
-    """
+    """Names of clips or songs in outputs: the file name without suffix, or the folder's
+    name for files whose names repeat (one folder per take); refused if two still match."""
     stems = [Path(p).stem for p in paths]
     names = [
         Path(p).resolve().parent.name if stems.count(st) > 1 else st
@@ -67,13 +46,9 @@ def item_names(paths: Sequence[str | os.PathLike[str]], what: str) -> list[str]:
 
 
 def output_suffix(motion: Any) -> str:
-    """The suffix a synchronised clip is written with, as ``beatsync sync`` would keep it.
-
-    ``.bvh`` for motion with a skeleton; joint positions in their input's layout
-    (Dance-with-Melody ``.json``, ``.npy``, ``.npz``, ``.c3d``; units and vertical axis
-    as read, see :func:`beatsync.io.write_motion`); anything else (an angle table,
-    MoCap Toolbox markers, positions made in memory) as a ``.csv`` table.
-    """
+    """The suffix a synchronised clip is written with, as ``beatsync sync`` would keep it:
+    ``.bvh`` with a skeleton, joint positions in their input's layout (``.json``, ``.npy``,
+    ``.npz``, ``.c3d``), anything else as a ``.csv`` table."""
     from .io.positions import POSITION_SUFFIXES  # the layouts written back as read
 
     if motion.skeleton is not None:
@@ -84,8 +59,8 @@ def output_suffix(motion: Any) -> str:
 
 
 def output_suffixes(clip: str | os.PathLike[str]) -> tuple[str, ...]:
-    """Every suffix the pairs of the clip file ``clip`` may be written with (the
-    overwrite checks run before the clip is read)."""
+    """Every suffix the pairs of the clip file ``clip`` may be written with (checked
+    before the clip is read)."""
     from .io.positions import POSITION_SUFFIXES
 
     own = Path(clip).suffix.lower()
@@ -108,7 +83,6 @@ def prepare_song(
     track = track_beats(y, sr, bpm=bpm, **{k: v for k, v in told.items() if v is not None})
     bar = int(getattr(track, "beats_per_bar", 0) or 0)
     return {
-        "song": Path(path).stem,
         "beats": track.beats,
         "tempo_bpm": track.tempo,
         "beats_per_bar": bar if bar > 0 else None,
@@ -124,20 +98,14 @@ def prepare_clip(
     alpha: float = 0.1,
     mode: str = "auto",
 ) -> dict[str, Any]:
-    """Read a motion clip and find its periods (a task of the graph).
-
-    ``mode="beats"``: no segmentation (the pairs use the motion beats);
-    ``mode="auto"``: a clip that segmentation refuses as not periodic
-    (:class:`~beatsync.errors.NotPeriodicError`) gets no boundaries and the reason in
-    ``note``; ``mode="periods"``: that refusal is the clip's error. Any other error
-    (bad ``alpha`` or ``period_range``, no motion) is the clip's error in both.
-    """
+    """Read a motion clip and find its periods (a task of the graph): none with
+    ``mode="beats"``; a clip that is not periodic gets the reason in ``note`` with
+    ``"auto"``, and that is its error with ``"periods"`` (as any other error in both)."""
     from . import io
     from .sync.core import motion_periods
 
     motion = io.read_motion(path, fps=fps, variable=variable)
     clip = {
-        "clip": Path(path).stem,
         "motion": motion,
         "boundaries": None,
         "mean_period_s": float("nan"),
@@ -183,11 +151,8 @@ def sync_pair(
             res = synchronize(clip["motion"], None, song["beats"], mode="beats", **kw)
         else:
             res = synchronize(clip["motion"], clip["boundaries"], song["beats"], **kw)
-    except ParameterError as exc:
-        row.update(status="error", error=str(exc))
-        return row
     except Exception as exc:  # one broken pair must not stop a study of thousands
-        row.update(status="error", error=f"{type(exc).__name__}: {exc}")
+        row.update(status="error", error=_error_text(exc))
         return row
     out = Path(out_dir) / f"{clip_name}__{song_name}{output_suffix(res.motion)}"
     io.write_motion(out, res.motion)
@@ -209,16 +174,19 @@ def sync_pair(
     return row
 
 
+def _error_text(exc: Exception) -> str:
+    """A task's error as its rows record it: bad input by its message, else with its type."""
+    return str(exc) if isinstance(exc, ParameterError) else f"{type(exc).__name__}: {exc}"
+
+
 def _guard(func: Any) -> Any:
     """Wrap a task so its error is returned (and recorded by the pairs), not raised."""
 
     def wrapped(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
-        except ParameterError as exc:
-            return exc
-        except Exception as exc:  # recorded per pair, like bad input
-            return RuntimeError(f"{type(exc).__name__}: {exc}")
+        except Exception as exc:
+            return RuntimeError(_error_text(exc))
 
     wrapped.__name__ = func.__name__
     return wrapped
@@ -242,61 +210,26 @@ def sync_grid(
     mode: str = "auto",
     progress: Callable[..., None] | None = None,
 ) -> Any:
-    """Synchronise every clip with every song on Dask; return a table of reports.
+    """Synchronise every clip with every song on Dask; return a table, a row per pair.
 
-    Parameters
-    ----------
-    clips, songs : sequence of path
-        Motion files (any of :func:`beatsync.io.read_motion`: BVH, MoCap Toolbox ``.mat``,
-        CSV/NPY angle tables, joint positions in ``.json``, ``.npy``, ``.npz`` or
-        ``.c3d``; ``fps`` where the file has none) and audio files.
-    out_dir : path
-        Existing folder for the synchronised clips (``<clip>__<song>`` with the suffix
-        of :func:`output_suffix`: BVH, joint positions in the input's layout, or CSV).
-    scheduler : str, optional
-        Address of an existing Dask scheduler; default: a local cluster. The workers
-        read the inputs and write the outputs themselves, so every path must be valid
-        on every worker (a shared file system). See :func:`beatsync.cluster.dask_client`
-        (an unreachable scheduler is refused after a few seconds).
-    n_workers : int >= 1, optional
-        Workers of the local cluster (default: one per core).
-    processes : bool
-        Local cluster with worker processes (default) or threads.
-    fps : float, optional [Hz]
-        Frame-rate override for every clip (e.g. 60 for the CMU salsa files).
-    variable : str, optional
-        The recording inside a ``.mat`` file, or the array inside an ``.npz``, of every
-        clip (e.g. ``"dance2"``).
-    bpm : float, optional [BPM]
-        Known tempo of every song.
-    min_bpm, max_bpm : float, optional [BPM]
-        Tempo range searched in every song (default: :func:`beatsync.beats.track_beats`'s).
-    mode : {"auto", "periods", "beats"}
-        What lands on the beats (``beatsync sync``'s default ``"auto"``): periods when
-        the clip is periodic and motion beats otherwise, paper A's periods (a clip that
-        is not periodic fails), or the clip's own motion beats (see
-        :func:`beatsync.sync.synchronize`).
-    progress : callable ``progress(done, total=None)``, optional
-        Called as pairs finish (e.g. a command's progress bar).
+    ``clips`` are motion files of :func:`beatsync.io.read_motion` (``fps`` and
+    ``variable`` apply to each), ``songs`` audio files, ``out_dir`` an existing folder.
+    ``scheduler`` is the address of an existing Dask scheduler (its workers read and
+    write the paths themselves: a shared file system), else ``n_workers`` local workers,
+    processes or threads (:func:`beatsync.cluster.dask_client`). ``bpm``, ``min_bpm``
+    and ``max_bpm`` [BPM] fix or bound every song's tempo; ``period_range`` [s],
+    ``alpha`` and ``mode`` are those of :func:`beatsync.sync.synchronize`.
+    ``progress(done, total=None)`` is called as pairs finish.
 
-    Returns
-    -------
-    pandas.DataFrame
-        One row per (clip, song): status, output path, the mode used (and why, for a
-        clip that ``"auto"`` found not periodic), tempo, frames, beats per period,
-        maximum boundary residual [ms], or the error message.
-
-    Raises
-    ------
-    ParameterError
-        No clip or song, a missing input, a missing output folder, two inputs of the
-        same name, an output that would overwrite an input, a worker count below 1,
-        ``n_workers`` with ``scheduler``, an unreachable scheduler, a bad ``fps``,
-        ``alpha`` or ``period_range`` (checked once, before any work).
+    A row holds the status, output path, the mode used (and why, for a clip that
+    ``"auto"`` found not periodic), tempo, frames, beats per period and largest boundary
+    residual [ms], or the error. Bad shared settings and inputs are refused with a
+    ``ParameterError`` before any work.
     """
     import pandas as pd
 
     from .cluster import dask_client
+    from .io import check_input_file
     from .segment.checks import check_alpha, check_period_range
     from .sync import MODES
     from .validation import check_cluster_options, check_motion_fps
@@ -315,8 +248,7 @@ def sync_grid(
     if not clips or not songs:
         raise ParameterError("sync_grid needs at least one clip and one song")
     for p in clips + songs:
-        if not Path(p).is_file():
-            raise ParameterError(f"input file {p!r} does not exist")
+        check_input_file(p, "input")
     out = Path(out_dir)
     if not out.is_dir():
         raise ParameterError(f"output folder {str(out)!r} does not exist; create it first")

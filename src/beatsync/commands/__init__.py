@@ -1,12 +1,9 @@
 """Subcommands of the ``beatsync`` program, one module each.
 
-Each module defines ``register(subparsers)``, which adds its parser and sets
-``func=run``; ``run(args)`` checks the options and files (cheapest first, through
-:mod:`beatsync.commands._common`), calls the library, and prints a JSON-serialisable
-``dict`` or a human-readable text via :func:`beatsync.commands._common.emit`.
-
-The program imports only the module of the subcommand it runs: ``beatsync --help``
-lists the subcommands from :data:`COMMAND_HELP` without importing any of them.
+Each module's ``register(subparsers)`` adds its parser with ``func=run``; ``run(args)``
+checks the options and files (cheapest first), calls the library and prints a result
+via :func:`beatsync.commands._common.emit`. ``beatsync --help`` lists the subcommands
+from :data:`COMMAND_HELP` without importing any of them.
 """
 
 # Order shown in ``beatsync --help``.
@@ -21,8 +18,7 @@ COMMAND_MODULES = (
     "data",
 )
 
-# One-line help of each subcommand, shown by ``beatsync --help`` (a module's own
-# ``register`` uses the same text; a subcommand missing here is imported to list it).
+# One-line help of each subcommand, shown by ``beatsync --help`` (and by its ``register``).
 COMMAND_HELP = {
     "segment": "find the period boundaries of a periodic motion (paper A, section 3)",
     "beats": "track the beats of a song and print their times in seconds",

@@ -1,17 +1,10 @@
 """What every subcommand shares: options, output checks, feedback, errors.
 
-Outputs are all-or-nothing per command (:class:`Outputs`): each output is checked
-before any work, written beside its destination under a hidden temporary name
-(``.beatsync-tmp-<token>-<name>``) and renamed into place only when the whole command
-succeeded; an error, Ctrl-C (SIGINT), SIGTERM or SIGHUP removes the temporaries and
-leaves every destination as it was.
-
-Feedback goes to stderr (:class:`Feedback`): a tqdm bar per step a user waits for,
-only when stderr is a terminal, silenced by ``--quiet``; library code receives it as
-an optional ``progress(done, total)`` callable and never imports tqdm.
-
-This module imports nothing heavy at import time (no numpy), so that ``beatsync
---help`` and the start of every subcommand stay fast.
+Outputs are all-or-nothing per command (:class:`Outputs`, see :mod:`beatsync.cli`).
+Feedback goes to stderr (:class:`Feedback`): a tqdm bar per step a user waits for, only
+when stderr is a terminal, silenced by ``--quiet``; library code receives it as an
+optional ``progress(done, total)`` callable and never imports tqdm. No numpy is
+imported here, so that ``beatsync --help`` and every subcommand start fast.
 """
 
 from __future__ import annotations
@@ -33,7 +26,6 @@ from ..errors import ParameterError
 
 EXIT_OK = 0
 EXIT_FAILED_ITEMS = 1  # ran, but no item done (batch, evaluate) or a checksum failed (data)
-EXIT_USAGE = 2  # argparse: unknown option, missing argument, wrong type
 EXIT_BAD_INPUT = 3  # ParameterError: a value, file or option combination is unusable
 EXIT_OS_ERROR = 4  # the system refused: disk full, permission denied while writing
 EXIT_INTERNAL = 70  # a bug in beatsync (EX_SOFTWARE): the traceback is printed
@@ -41,8 +33,7 @@ EXIT_INTERNAL = 70  # a bug in beatsync (EX_SOFTWARE): the traceback is printed
 
 STAGING_PREFIX = ".beatsync-tmp-"
 
-ProgressCallback = Callable[..., None]
-"""``progress(done, total=None)``: ``done`` of ``total`` units of a step are finished."""
+ProgressCallback = Callable[..., None]  # progress(done, total=None)
 
 _SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 # The signals received while a command runs. The exception a signal raises can be lost
@@ -96,22 +87,15 @@ def add_period_range(parser: argparse.ArgumentParser) -> None:
 
 
 def add_position_options(parser: argparse.ArgumentParser) -> None:
-    """``--up``, ``--units``, ``--max-gap`` for commands that read joint-position motion.
-
-    Pass them on with ``io.read_motion(path, fps=args.fps, variable=args.variable,
-    **position_options(args))``; ``--fps`` stays each command's own option (required
-    for .json and .npy joint positions; a C3D file's own rate may not be contradicted).
-    """
+    """``--up``, ``--units``, ``--max-gap`` for ``io.read_motion`` (:func:`position_options`)."""
     parser.add_argument(
         "--up",
         choices=("y", "z"),
-        default=None,
         help="vertical axis of joint positions (.json/.npy/.npz/.c3d); default detected",
     )
     parser.add_argument(
         "--units",
         choices=("m", "cm", "mm"),
-        default=None,
         help="length unit of joint positions; default detected from the body's size",
     )
     parser.add_argument(
@@ -130,18 +114,15 @@ def position_options(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def add_music_beat_options(parser: argparse.ArgumentParser) -> None:
-    """``--beats FILE`` (known beat times: no tracking), ``--bpm`` (known tempo) and the
-    tempo range searched (:func:`add_tempo_range`)."""
+    """``--beats FILE``, ``--bpm`` and the tempo range searched (:func:`add_tempo_range`)."""
     parser.add_argument(
         "--beats",
-        default=None,
         metavar="FILE",
         help="music beat times [s], one per line (first column): skip beat tracking",
     )
     parser.add_argument(
         "--bpm",
         type=float,
-        default=None,
         help="known tempo of the music [BPM]: the tracker only finds the phase",
     )
     add_tempo_range(parser)
@@ -152,28 +133,19 @@ def add_tempo_range(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--min-bpm",
         type=float,
-        default=None,
         help="slowest tempo the beat tracker considers [BPM] (default 40); with --max-bpm, "
         "a range that keeps the tracker off a metrical level you know is wrong",
     )
     parser.add_argument(
         "--max-bpm",
         type=float,
-        default=None,
         help="fastest tempo the beat tracker considers [BPM] (default 240)",
     )
 
 
 def tempo_options(args: argparse.Namespace) -> dict[str, float]:
-    """The beat tracker's tempo keywords (``bpm``, ``min_bpm``, ``max_bpm``) from the
-    options, checked before any work and named as options in the errors.
-
-    Raises
-    ------
-    ParameterError
-        ``--beats`` with ``--bpm``, a range given with either (the tempo is then not
-        searched), a tempo outside 20-400 BPM, or ``--min-bpm`` not below ``--max-bpm``.
-    """
+    """The beat tracker's tempo keywords (``bpm``, ``min_bpm``, ``max_bpm``), checked
+    before any work (``--beats`` or ``--bpm`` with each other or with a range refused)."""
     from ..beats.tracker import DEFAULT_MAX_BPM, DEFAULT_MIN_BPM  # noqa: PLC0415 (numpy)
     from ..validation import check_bpm  # noqa: PLC0415
 
@@ -241,12 +213,8 @@ def check_output(
 ) -> Path:
     """Refuse an output path that cannot be written whole; return it as a ``Path``.
 
-    Refused: an empty name, a name ending in a path separator (``Path`` would drop it
-    and write a file), a wrong suffix (if ``suffixes`` are given), the suffix of an
-    audio, video or binary motion file for a text output (``text`` says what the file
-    holds, e.g. ``"beat times"``), an existing folder, a file that is not a regular
-    file, a read-only file, one of ``inputs`` (also through links), a missing or
-    unwritable folder. Nothing is touched on disk.
+    ``text`` says what a text output holds (e.g. ``"beat times"``): an audio, video or
+    motion file's suffix is then refused as a mistaken option. Nothing is touched on disk.
     """
     from ..io import AUDIO_SUFFIXES, SOUNDFILE_SUFFIXES, check_output_folder
 
@@ -314,22 +282,12 @@ def _signals_held() -> Iterator[None]:
 class Outputs:
     """Every output file of one command: checked up front, written all-or-nothing.
 
-    Use it as a context manager around the command's work::
-
-        with Outputs(inputs=[args.audio]) as outs:
-            out = outs.add(args.out, option="--out", suffixes=[".beats"])
-            click = outs.add(args.click, option="--click", suffixes=[".wav", ".flac"])
-            ...  # the expensive work
-            io.write_beats(outs.path(out), beats)
-            io.write_audio(outs.path(click), mix, sr)
-        # here both files are in place, or (on any error or signal) neither was touched
-
-    :meth:`add` checks a path at once (:func:`check_output`; no two outputs may name
-    one file). :meth:`path` gives the file to write instead: beside the destination,
-    hidden, with the same suffix (writers choose their format by it), named with this
-    command's token. On success each is renamed over its destination (keeping an old
-    file's mode) with signals held; on an exception every file and folder whose name
-    carries the token is removed from the output folders.
+    Use it as a context manager around the command's work: :meth:`add` checks a path at
+    once (:func:`check_output`; no two outputs may name one file); :meth:`path` gives
+    the file to write instead (beside the destination, hidden, same suffix). On success
+    each is renamed over its destination (keeping an old file's mode) with signals held;
+    on an exception every file and folder whose name carries this command's token is
+    removed from the output folders and the destinations stay as they were.
     """
 
     def __init__(self, inputs: Iterable[str | os.PathLike[str] | None] = ()):
@@ -397,31 +355,43 @@ class Outputs:
         self._staged[p.resolve()] = s
         return p
 
-    def forget(self, final: str | os.PathLike[str]) -> None:
-        """Withdraw a declared output (a writer chose other files: :meth:`adopt` them)."""
-        key = Path(final).resolve()
-        self._staged.pop(key, None)
-        self._declared.pop(key, None)
+    def write_video(self, video: Path, motion: Any, **kwargs: Any) -> Path:
+        """Render ``motion`` for the declared ``--video`` (:func:`beatsync.render.write_video`);
+        without ffmpeg the GIF and WAV written instead are adopted in its place."""
+        from .. import render
 
-    def commit(self) -> list[Path]:
-        """Rename every written temporary into place; return the destinations."""
-        with _signals_held():
-            if _RECEIVED:  # a signal whose exception was swallowed
-                raise Interrupted(_RECEIVED[0])
-            done = []
-            for key, tmp in self._staged.items():
-                dest = self._declared[key][0]
-                with contextlib.suppress(FileNotFoundError):
-                    os.chmod(tmp, dest.stat().st_mode & 0o777)  # keep an old file's mode
-                os.replace(tmp, dest)
-                done.append(dest)
-            self._remove_temporaries()
-        return done
+        staged = self.path(video)
+        written = render.write_video(motion, staged, **kwargs)
+        if written == staged:
+            return video
+        self._staged.pop(video.resolve())
+        self._declared.pop(video.resolve())
+        if staged.with_suffix(".wav").is_file():
+            self.adopt(staged.with_suffix(".wav"), option="--video")
+        return self.adopt(written, option="--video")
 
-    def rollback(self) -> None:
-        """Remove every temporary of this command; destinations stay untouched."""
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        """Rename every written temporary into place, or (on an error) none."""
         with _signals_held():
-            self._remove_temporaries()
+            try:
+                if exc is None:
+                    if _RECEIVED:  # a signal whose exception was swallowed
+                        raise Interrupted(_RECEIVED[0])
+                    for key, tmp in self._staged.items():
+                        dest = self._declared[key][0]
+                        with contextlib.suppress(FileNotFoundError):
+                            os.chmod(tmp, dest.stat().st_mode & 0o777)  # an old file's mode
+                        os.replace(tmp, dest)
+            except BaseException as failed:
+                exc = failed
+                raise
+            finally:
+                self._remove_temporaries()
+                if exc is not None and self._declared:
+                    exc.outcome = "; no output was written"  # said in the report
 
     def _remove_temporaries(self) -> None:
         import shutil
@@ -433,34 +403,13 @@ class Outputs:
                 else:
                     p.unlink(missing_ok=True)
 
-    def __enter__(self) -> Outputs:
-        return self
-
-    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
-        if exc is None:
-            try:
-                self.commit()
-                return
-            except BaseException as failed:
-                self._roll_back(failed)
-                raise
-        self._roll_back(exc)
-
-    def _roll_back(self, exc: BaseException) -> None:
-        self.rollback()
-        if self._declared:
-            exc.nothing_written = True  # type: ignore[attr-defined]  # said in the report
-
 
 # -------------------------------------------------------------------- feedback
 
 
 class Feedback:
-    """Progress and information on stderr for one command.
-
-    Bars (tqdm) appear only when the stream is a terminal and not ``quiet``;
-    :meth:`info` lines appear unless ``quiet``; :meth:`warn` lines always.
-    """
+    """Progress on stderr: bars only on a terminal and not ``quiet``; :meth:`info` lines
+    unless ``quiet``; :meth:`warn` lines always."""
 
     def __init__(self, command: str = "", *, quiet: bool = False, stream: TextIO | None = None):
         self.command = command
@@ -481,12 +430,8 @@ class Feedback:
 
     @contextlib.contextmanager
     def noted(self) -> Iterator[list[str]]:
-        """The :class:`~beatsync.errors.BeatsyncWarning` messages issued in the block.
-
-        Filled when the block ends (:func:`~beatsync.errors.collect_warnings`), and each
-        said with :meth:`warn` then; other packages' warnings inside the block are
-        dropped.
-        """
+        """The :class:`~beatsync.errors.BeatsyncWarning` messages issued in the block, filled
+        and each said with :meth:`warn` when it ends; other packages' warnings are dropped."""
         import warnings
 
         from ..errors import collect_warnings
@@ -501,12 +446,10 @@ class Feedback:
 
     @contextlib.contextmanager
     def step(self, desc: str, total: float | None = None) -> Iterator[ProgressCallback]:
-        """A bar for one step; yields the ``progress(done, total=None)`` callable.
-
-        The elapsed time keeps moving even if the step never calls ``progress``.
-        """
+        """A bar for one step (its elapsed time moving even without calls); yields the
+        ``progress(done, total=None)`` callable."""
         if not self.bars:
-            yield _no_progress
+            yield lambda done, total=None: None
             return
         from tqdm import tqdm
 
@@ -538,10 +481,6 @@ class Feedback:
             stop.set()
             ticker.join()
             bar.close()
-
-
-def _no_progress(done: float, total: float | None = None) -> None:
-    return None
 
 
 def feedback(args: argparse.Namespace) -> Feedback:
@@ -591,23 +530,14 @@ def interrupted_by() -> int | None:
 def error_report(
     exc: BaseException, command: str | None, *, as_json: bool, stream: TextIO | None = None
 ) -> int:
-    """Print ``exc`` for the user (text or a JSON object on stderr); return the exit code.
-
-    =================  ===============  ============================================
-    exception          ``kind``         exit code
-    =================  ===============  ============================================
-    ParameterError     ``bad-input``    3
-    OSError            ``os-error``     4
-    KeyboardInterrupt  ``interrupted``  128 + signal (130 SIGINT, 143 SIGTERM)
-    anything else      ``internal``     70, with the traceback
-    =================  ===============  ============================================
-
-    An error that follows a signal whose exception was lost is reported as the signal.
-    """
+    """Print ``exc`` for the user (text or a JSON object on stderr); return the exit code
+    (the kinds and codes of :mod:`beatsync.cli`). An error that follows a signal whose
+    exception was lost is reported as the signal; an interruption or a system error is
+    followed by its ``outcome`` attribute, if set (what was or was not written)."""
     stream = sys.stderr if stream is None else stream
     with _signals_held():  # a second signal must not cut the report short
         tb = None
-        nothing = "; no output was written" if getattr(exc, "nothing_written", False) else ""
+        outcome = getattr(exc, "outcome", "")
         if _RECEIVED and not isinstance(exc, KeyboardInterrupt):
             exc = Interrupted(_RECEIVED[0])  # the error that followed a lost interruption
         if isinstance(exc, ParameterError):
@@ -615,11 +545,11 @@ def error_report(
         elif isinstance(exc, KeyboardInterrupt):
             signum = getattr(exc, "signum", signal.SIGINT)
             kind, code = "interrupted", 128 + int(signum)
-            msg = f"interrupted by {signal.Signals(signum).name}{nothing}"
+            msg = f"interrupted by {signal.Signals(signum).name}{outcome}"
         elif isinstance(exc, OSError):
             kind, code = "os-error", EXIT_OS_ERROR
             where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
-            msg = f"{exc.strerror or exc}{where}{nothing}"
+            msg = f"{exc.strerror or exc}{where}{outcome}"
         else:
             import traceback
 
@@ -630,12 +560,7 @@ def error_report(
             )
             tb = "".join(traceback.format_exception(exc))
         if as_json:
-            obj: dict[str, Any] = {
-                "error": msg,
-                "kind": kind,
-                "command": command,
-                "exit_code": code,
-            }
+            obj = {"error": msg, "kind": kind, "command": command, "exit_code": code}
             if tb is not None:
                 obj["traceback"] = tb
             print(json.dumps(obj), file=stream, flush=True)

@@ -37,29 +37,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--songs", nargs="+", required=True, help="audio files")
     p.add_argument("--out-dir", required=True, help="existing output folder")
-    p.add_argument(
-        "--fps", type=float, default=None, help="frame-rate override for every clip [Hz]"
-    )
+    p.add_argument("--fps", type=float, help="frame-rate override for every clip [Hz]")
     p.add_argument(
         "--variable",
-        default=None,
         help="recording inside a .mat file, or array inside an .npz (e.g. dance2), of every clip",
     )
-    p.add_argument("--bpm", type=float, default=None, help="known tempo of every song [BPM]")
+    p.add_argument("--bpm", type=float, help="known tempo of every song [BPM]")
     add_tempo_range(p)
     add_period_range(p)
     add_mode(p, default="auto")
-    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
-    p.add_argument(
-        "--workers", type=int, default=None, help="local cluster workers (default: cores)"
-    )
-    p.add_argument("--summary", default=None, help="summary CSV (default OUT_DIR/summary.csv)")
+    p.add_argument("--scheduler", help="address of an existing Dask scheduler")
+    p.add_argument("--workers", type=int, help="local cluster workers (default: cores)")
+    p.add_argument("--summary", help="summary CSV (default OUT_DIR/summary.csv)")
     add_output_flags(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-
     from .. import io
     from ..errors import ParameterError
     from ..io import check_input_file
@@ -113,9 +107,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _text(table, out_dir: str) -> str:
-    """One line per pair, and its note or error on a line of its own (the table's
-    columns are in the summary CSV and ``--json``; as one table the notes made lines
-    of several hundred characters). Outputs are shown in ``out_dir`` as given."""
+    """A line per pair and its note or error on a line of its own (the columns are in the
+    summary CSV and ``--json``), outputs shown in ``out_dir`` as given."""
     from pathlib import Path
 
     lines = []

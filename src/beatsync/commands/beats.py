@@ -1,12 +1,5 @@
-"""``beatsync beats``: track the beats of a piece of music (paper A, section 4).
-
-Reads an audio file, runs :func:`beatsync.beats.track_beats` and prints the beat
-times in seconds, one per line (or a JSON object with ``--json``, which also gives
-the tempo curve and the meter estimate, ``beats_per_bar``). ``--out`` writes
-them to a file (one per line, :func:`beatsync.io.write_beats`); ``--click`` renders
-the beats as clicks over the audio (:func:`beatsync.beats.mix_clicks`). All writes are atomic,
-happen only after tracking succeeded, and never overwrite the input.
-"""
+"""``beatsync beats``: track the beats of a piece of music (paper A, section 4); with
+``--json`` also the tempo curve and the meter estimate (``beats_per_bar``)."""
 
 from __future__ import annotations
 
@@ -41,19 +34,16 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--bpm",
         type=float,
-        default=None,
         help="known tempo [BPM]: skip tempo estimation, only find the phase",
     )
     add_tempo_range(p)
     p.add_argument(
         "--out",
-        default=None,
         metavar="FILE.beats",
         help="write the beat times [s] to this file, one per line",
     )
     p.add_argument(
         "--click",
-        default=None,
         metavar="OUT.wav",
         help="write the audio with a click on every beat (.wav or .flac)",
     )
@@ -70,14 +60,11 @@ def run(args: Any) -> int:
     tempo = tempo_options(args)
     fb = feedback(args)
     with Outputs(inputs=[args.audio]) as outs:  # both files are written, or neither
-        out = (
-            outs.add(args.out, option="--out", text="beat times") if args.out is not None else None
-        )
-        click = (
-            outs.add(args.click, option="--click", suffixes=(".wav", ".flac"))
-            if args.click is not None
-            else None
-        )
+        out = click = None
+        if args.out is not None:
+            out = outs.add(args.out, option="--out", text="beat times")
+        if args.click is not None:
+            click = outs.add(args.click, option="--click", suffixes=(".wav", ".flac"))
         with fb.noted() as notes:  # the decoder's and the tracker's
             with fb.step("reading audio"):
                 y, sr = io.read_audio(args.audio)
@@ -86,8 +73,7 @@ def run(args: Any) -> int:
         if track.beats.size == 0:
             raise ParameterError(
                 f"no beats found in {args.audio!r} (no onsets: no attack in any band, e.g. near "
-                "silence?); "
-                "nothing written"
+                "silence?); nothing written"
             )
         written = []
         if out is not None:

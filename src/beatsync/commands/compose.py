@@ -1,15 +1,7 @@
 """``beatsync compose``: compose a dance for a song from a motion library (paper B).
 
-Reads the library's BVH clips (one skeleton), builds their weighted motion graph (or
-loads it from the on-disk cache), finds the music's beats (tracker, optionally within a
-tempo range; a beats file; or a known BPM) and its level per beat interval, searches the
-best path by dynamic programming, synthesizes the dance (every motion beat on a music
-beat, blended transitions) and writes it as BVH, optionally a video with the music and a
-JSON report (path, number of transitions, graph-build and search times).
-
-Graph cache (on by default, :mod:`beatsync.graph.cache`): built graphs are stored in
-``$BEATSYNC_CACHE_DIR`` if that environment variable is set, else in
-``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it.
+Built motion graphs are cached (:mod:`beatsync.graph.cache`) in ``$BEATSYNC_CACHE_DIR``,
+else ``~/.cache/beatsync``; ``--no-cache`` neither reads nor writes it.
 """
 
 from __future__ import annotations
@@ -34,8 +26,6 @@ from ._common import (
 
 __all__ = ["register", "run"]
 
-_AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".mp3", ".aif", ".aiff", ".m4a")
-
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
@@ -54,7 +44,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "audio",
         nargs="?",
-        default=None,
         help="music file (.wav, .flac, .ogg, .mp3); may also follow --library",
     )
     p.add_argument(
@@ -69,7 +58,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--fps",
         type=float,
-        default=None,
         help="frame rate of the library clips [Hz]: overrides the BVH headers",
     )
     p.add_argument(
@@ -128,11 +116,10 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument(
         "--video",
-        default=None,
         metavar="OUT.mp4",
         help="also write a stick-figure video with the music as soundtrack",
     )
-    p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
+    p.add_argument("--report", metavar="FILE.json", help="write the report as JSON")
     p.add_argument(
         "--no-cache",
         action="store_true",
@@ -165,19 +152,20 @@ def _library_files(entries: list[str]) -> list[Path]:
     return files
 
 
-def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
+def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Outputs]:
+    from ..graph.build import check_th
+    from ..io import AUDIO_SUFFIXES
+
     entries = list(args.library or [])
     audio = args.audio
     if audio is None:
         # argparse lets --library swallow the audio file that follows it
-        moved = [e for e in entries if Path(e).suffix.lower() in _AUDIO_SUFFIXES]
+        moved = [e for e in entries if Path(e).suffix.lower() in AUDIO_SUFFIXES]
         if len(moved) == 1:
             audio = moved[0]
             entries.remove(audio)
         else:
             raise ParameterError("give the music file (AUDIO), e.g. beatsync compose song.wav ...")
-    from ..graph.build import check_th
-
     th = check_th(args.th, name="--th")
     tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
     if not Path(audio).is_file():
@@ -185,22 +173,15 @@ def _check_inputs(args: argparse.Namespace) -> dict[str, Any]:
     if args.beats is not None and not Path(args.beats).is_file():
         raise ParameterError(f"beats file {args.beats!r} does not exist")
     files = _library_files(entries)
-    out = Path(args.output)
-    if out.suffix.lower() != ".bvh":
+    if Path(args.output).suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
     outs = Outputs(inputs=(audio, args.beats, *files))
     outs.add(args.output, option="-o/--output")
-    video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
-    report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
-    return {
-        "audio": audio,
-        "files": files,
-        "out": out,
-        "video": video,
-        "report": report,
-        "th": th,
-        "outs": outs,
-    }
+    if args.video:
+        outs.add(args.video, option="--video", suffixes=[".mp4"])
+    if args.report:
+        outs.add(args.report, option="--report", suffixes=[".json"])
+    return audio, files, th, outs
 
 
 def run(args: argparse.Namespace) -> int:
@@ -211,7 +192,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
     if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
-    chk = _check_inputs(args)  # files after the options: cheapest first
+    audio, files, th, outs = _check_inputs(args)  # files after the options: cheapest first
     fb = feedback(args)
     from ..graph.timescale import check_multiplicity, check_scale_bound
 
@@ -219,13 +200,10 @@ def run(args: argparse.Namespace) -> int:
         None if args.no_scale_bound else check_scale_bound(args.scale_bound, name="--scale-bound")
     )
     mult = args.multiplicity
-    if mult != "auto":
-        mult = mult.split(",")
-    mult = check_multiplicity(mult)
-    files = chk["files"]
+    mult = check_multiplicity(mult if mult == "auto" else mult.split(","))
     t_read = time.perf_counter()
     with fb.noted() as read_notes:  # e.g. the MP3 decoder's
-        y, sr = io.read_audio(chk["audio"])
+        y, sr = io.read_audio(audio)
     beats = None
     if args.beats is not None:  # cheap checks first: the beats file before the clips
         try:
@@ -248,11 +226,7 @@ def run(args: argparse.Namespace) -> int:
         with fb.noted() as tracked, fb.step("tracking beats"):
             beats = track_music_beats(y, sr, **tempo_options(args))
         notes += tracked
-    params = {
-        "th": chk["th"],
-        "weight_rule": args.weight_rule,
-        "fps": args.fps,
-    }
+    params = {"th": th, "weight_rule": args.weight_rule, "fps": args.fps}
     t0 = time.perf_counter()
     with fb.step("building the motion graph"):
         graph, cached, cache_path = load_or_build(files, clips, params, use_cache=not args.no_cache)
@@ -272,8 +246,9 @@ def run(args: argparse.Namespace) -> int:
             **kw,
         )
     notes += composed
-    out = chk["out"]
-    video_path = chk["video"]
+    out = Path(args.output)
+    video_path = Path(args.video) if args.video else None
+    report = Path(args.report) if args.report else None
     result = {
         "output": str(out),
         "video": str(video_path) if video_path else None,
@@ -300,24 +275,15 @@ def run(args: argparse.Namespace) -> int:
         "plausibility": comp.plausibility,
         "warnings": notes,
     }
-    outs = chk["outs"]
     with outs:  # the dance, video and report are all written, or none of them
         io.write_bvh(outs.path(out), comp.motion)
         if video_path is not None:
-            from .. import render
-
-            staged = outs.path(video_path)
-            written = render.write_video(
-                comp.motion, staged, audio=(y, sr), beats=comp.music_beats, progress=fb.bars
+            video_path = outs.write_video(
+                video_path, comp.motion, audio=(y, sr), beats=comp.music_beats, progress=fb.bars
             )
-            if written != staged:  # no ffmpeg: a GIF and a WAV instead of the MP4
-                outs.forget(video_path)
-                video_path = outs.adopt(written, option="--video")
-                if staged.with_suffix(".wav").is_file():
-                    outs.adopt(staged.with_suffix(".wav"), option="--video")
-                result["video"] = str(video_path)
-        if chk["report"] is not None:
-            io.write_json(outs.path(chk["report"]), result)
+            result["video"] = str(video_path)
+        if report is not None:
+            io.write_json(outs.path(report), result)
     g = graph.summary()
     text = (
         f"wrote {out} ({comp.motion.n_frames} frames at {comp.motion.fps:g} fps, "
@@ -332,8 +298,8 @@ def run(args: argparse.Namespace) -> int:
     )
     if video_path:
         text += f"\nvideo: {video_path}"
-    if chk["report"] is not None:
-        text += f"\nreport: {chk['report']}"
+    if report is not None:
+        text += f"\nreport: {report}"
     return emit(result, text, args)
 
 

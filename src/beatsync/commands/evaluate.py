@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
-from ._common import add_output_flags, emit
+from . import COMMAND_HELP
+from ._common import EXIT_FAILED_ITEMS, add_output_flags, emit
 
 #: Unmatched audio files named in the text output before "... and N more".
 SHOWN = 10
-
-EXIT_FAILED_ITEMS = 1  # as beatsync.commands._common (not imported: --help stays light)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -19,7 +17,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     p = subparsers.add_parser(
         "evaluate",
-        help="score beat trackers against annotations over a dataset (on Dask)",
+        help=COMMAND_HELP["evaluate"],
         description="Score a method over a dataset of files. WHAT is what is scored.",
         epilog="`beatsync evaluate WHAT --help` lists the options of WHAT (each accepts "
         "--json for machine-readable output).",
@@ -60,7 +58,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     b.add_argument(
         "--min-bpm",
         type=float,
-        default=None,
         help="slowest tempo the tracker searches on every track [BPM] (default 40); "
         "essentia's trackers take whole BPM from 40 to 180, at least 20 below --max-bpm. "
         "With a bound other than the default, librosa searches a flat tempo prior inside "
@@ -71,14 +68,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     b.add_argument(
         "--max-bpm",
         type=float,
-        default=None,
         help="fastest tempo the tracker searches [BPM] (default 240 for psf and librosa, "
         "208 for essentia's, which take whole BPM from 60 to 250)",
     )
-    b.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
-    b.add_argument(
-        "--workers", type=int, default=None, help="local cluster workers (default: cores)"
-    )
+    b.add_argument("--scheduler", help="address of an existing Dask scheduler")
+    b.add_argument("--workers", type=int, help="local cluster workers (default: cores)")
     b.add_argument(
         "--force",
         action="store_true",
@@ -166,8 +160,15 @@ def run_beats(args: argparse.Namespace) -> int:
                 n_workers=workers,
                 progress=progress,
             )
-    except KeyboardInterrupt as exc:
-        return _interrupted(exc, out / "tracks.jsonl", args)
+    except KeyboardInterrupt as exc:  # the finished tracks stay recorded: say so
+        log = out / "tracks.jsonl"
+        exc.outcome = (  # type: ignore[attr-defined]  # said by the error report
+            f"; the finished tracks are recorded in {str(log)!r}: run the same command "
+            "again to score the others"
+            if log.is_file()
+            else " before any track finished: nothing was recorded"
+        )
+        raise
     t = run.tracks
     failed = t[t["status"] != "ok"]
     warned = t["warning"].fillna("").astype(str) if "warning" in t else pd.Series("", t.index)
@@ -230,30 +231,3 @@ def _some(paths: list) -> str:
     names = [str(p) for p in paths]
     more = f" ... and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
     return ", ".join(names[:SHOWN]) + more
-
-
-def _interrupted(exc: KeyboardInterrupt, log: object, args: argparse.Namespace) -> int:
-    """Ctrl-C or SIGTERM: the finished tracks stay recorded; say so and how to go on."""
-    import json
-    import signal
-
-    signum = int(getattr(exc, "signum", signal.SIGINT))
-    from pathlib import Path
-
-    if Path(str(log)).is_file():
-        msg = (
-            f"interrupted by {signal.Signals(signum).name}; the finished tracks are recorded "
-            f"in {str(log)!r}: run the same command again to score the others"
-        )
-    else:
-        msg = (
-            f"interrupted by {signal.Signals(signum).name} before any track finished: "
-            "nothing was recorded"
-        )
-    if args.json:
-        obj = {"error": msg, "kind": "interrupted", "command": "evaluate",
-               "exit_code": 128 + signum}  # fmt: skip
-        print(json.dumps(obj), file=sys.stderr, flush=True)
-    else:
-        print(f"beatsync evaluate: error: {msg}", file=sys.stderr, flush=True)
-    return 128 + signum

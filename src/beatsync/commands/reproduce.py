@@ -1,9 +1,7 @@
-"""``beatsync reproduce``: run the study's notebooks with papermill.
+"""``beatsync reproduce``: run the study's notebooks with papermill (:mod:`beatsync.runner`).
 
-The executed notebooks (and ``run_manifest.json``) are written all-or-nothing: they
-replace the previous ones only when every notebook ran. A notebook that fails is
-kept as ``<name>.failed.ipynb`` next to its destination, for its traceback cells.
-The artefacts the notebooks write themselves (``results/<notebook>/``) are theirs.
+A notebook that fails is kept as ``<name>.failed.ipynb`` beside its destination; the
+artefacts the notebooks write themselves (``results/<notebook>/``) are theirs.
 """
 
 from __future__ import annotations

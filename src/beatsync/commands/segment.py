@@ -1,8 +1,4 @@
-"""``beatsync segment``: split a periodic motion into its periods (paper A, sec. 3).
-
-Prints the period boundaries [s], the period count and the mean period; ``--out``
-writes the boundaries as CSV (atomic; nothing is written on error).
-"""
+"""``beatsync segment``: split a periodic motion into its periods (paper A, sec. 3)."""
 
 from __future__ import annotations
 
@@ -38,7 +34,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fps",
         type=float,
-        default=None,
         help="frame rate [Hz]; overrides a BVH header (CMU salsa files: 60), required for "
         ".csv/.npy",
     )
@@ -52,7 +47,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--periods",
         type=int,
-        default=None,
         help="number of periods if known (e.g. from the music); the result then has exactly "
         "N periods; default: estimate",
     )
@@ -60,7 +54,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--bpm",
         type=float,
-        default=None,
         help="tempo of the music the dance goes with [BPM]: search periods of 1 to 8 beats "
         "(steps to figures such as a 6-beat waltz box), shortest first; instead of "
         "--period-range",
@@ -77,9 +70,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=["default"],
         help="'default' (limb and spine rotations, or *_angle channels), 'all', or channel names",
     )
-    p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    p.add_argument("--variable", help="recording inside a .mat file (e.g. dance2)")
     add_position_options(p)
-    p.add_argument("--out", default=None, help="write the boundaries to this .csv file")
+    p.add_argument("--out", help="write the boundaries to this .csv file")
     add_output_flags(p)
     p.set_defaults(func=run)
 
@@ -113,17 +106,7 @@ def run(args: argparse.Namespace) -> int:
     converted = is_marker_motion(motion)
     positions = None if motion.position_info is None else motion.position_info.describe()
     motion = segmentation_view(motion)  # markers -> joint angles, as in batch and sync
-    channels = args.channels
-    chan: str | list[str] = (
-        channels[0]
-        if len(channels) == 1
-        and channels[0]
-        in (
-            "default",
-            "all",
-        )
-        else list(channels)
-    )
+    chan = args.channels[0] if args.channels in (["default"], ["all"]) else args.channels
     with fb.step("segmenting periods"):
         seg = segment(
             motion,

@@ -1,16 +1,8 @@
 """``beatsync sync``: make a dance follow a song (paper A, section 5, and real dances).
 
-Reads a motion file (BVH; MoCap Toolbox ``.mat``; joint positions as Dance-with-Melody
-``.json``, ``.npy``/``.npz`` or C3D; CSV/NPY angle tables) and a song, finds the music's
-beats (:func:`beatsync.beats.track_beats` with its meter estimate, optionally within a
-tempo range, or a beats file / a known BPM) and calls :func:`beatsync.sync.synchronize`
-with ``boundaries=None``: it finds the motion's periods (``--mode periods``, paper A),
-or warps the dancer's own motion beats (``--mode beats``), or tries periods and falls
-back to beats with a warning (``--mode auto``, default), and with ``--fill loop``
-(default) repeats whole periods with blended joins until the dance reaches the song's
-last beat. Writes the motion (BVH with the input skeleton; joint positions in the
-input's layout; or CSV), optionally a video with the music that lasts as long as the
-song, and the report.
+Reads a motion and a song, finds the music's beats (or reads them) and calls
+:func:`beatsync.sync.synchronize` with ``boundaries=None`` in the ``--mode`` and ``--fill``
+chosen; writes the motion in its input's kind, optionally a video and the report.
 """
 
 from __future__ import annotations
@@ -39,7 +31,6 @@ from ._common import (
 
 __all__ = ["register", "run"]
 
-_MOTION_OUT = (".bvh", ".csv", ".json", ".npy", ".npz", ".c3d")
 #: shortest song the beat tracker is asked about [s]
 MIN_MUSIC_S = 1.0
 
@@ -75,19 +66,15 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--fps",
         type=float,
-        default=None,
         help="input frame rate [Hz]: overrides the BVH header; required for csv/npy",
     )
-    p.add_argument(
-        "--out-fps", type=float, default=None, help="output frame rate [Hz] (default: the input's)"
-    )
-    p.add_argument("--variable", default=None, help="recording inside a .mat file (e.g. dance2)")
+    p.add_argument("--out-fps", type=float, help="output frame rate [Hz] (default: the input's)")
+    p.add_argument("--variable", help="recording inside a .mat file (e.g. dance2)")
     add_position_options(p)
     add_music_beat_options(p)
     p.add_argument(
         "--beats-per-period",
         type=int,
-        default=None,
         metavar="N",
         help="music beats per motion period, or per median motion beat with --mode beats "
         "(default: periods round(motion period / beat), respecting the meters; motion "
@@ -124,7 +111,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--beats-per-bar",
         type=int,
-        default=None,
         metavar="N",
         help="the music's meter (3 for a waltz; default: estimated by the beat tracker); "
         "beats per period then respect it",
@@ -132,7 +118,6 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--dance-beats",
         type=int,
-        default=None,
         metavar="N",
         help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
         "a waltz box); with periods, beats per period are then a multiple of it (a warning "
@@ -143,7 +128,6 @@ def register(subparsers: Any) -> None:
         "--period-range",
         nargs=2,
         type=float,
-        default=None,
         metavar=("LO", "HI"),
         help="shortest and longest motion period searched [s] (default: with --mode periods "
         "one to eight beats of the song, so real dance cycles such as a 4 s waltz box are "
@@ -151,19 +135,21 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument(
         "--video",
-        default=None,
         metavar="OUT.mp4",
         help="also write a stick-figure video with the music as soundtrack",
     )
     p.add_argument(
         "--video-fps", type=float, default=30.0, help="frame rate of the video [Hz] (default 30)"
     )
-    p.add_argument("--report", default=None, metavar="FILE.json", help="write the report as JSON")
+    p.add_argument("--report", metavar="FILE.json", help="write the report as JSON")
     add_output_flags(p)
     p.set_defaults(func=run)
 
 
 def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None, Path | None]:
+    from ..io import MOTION_OUTPUT_SUFFIXES, check_input_file
+    from ..validation import check_motion_fps
+
     if args.align_accents and args.phase_offset != 0.0:
         raise ParameterError(
             "--align-accents measures the phase offset itself; do not also give --phase-offset"
@@ -184,18 +170,15 @@ def _check_inputs(args: argparse.Namespace) -> tuple[Outputs, Path, Path | None,
             "LO HI with 0 < LO < HI [s]"
         )
     tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
-    out = Path(args.output)
-    if out.suffix.lower() not in _MOTION_OUT:
+    if Path(args.output).suffix.lower() not in MOTION_OUTPUT_SUFFIXES:
         raise ParameterError(
             f"output {args.output!r} must end in .bvh or .csv, or for joint positions .json, "
             ".npy, .npz or .c3d (the motion is written there)"
         )
     for inp, what in ((args.motion, "motion"), (args.audio, "audio"), (args.beats, "beats")):
-        if inp is not None and not Path(inp).is_file():
-            raise ParameterError(f"{what} file {inp!r} does not exist")
+        if inp is not None:
+            check_input_file(inp, what)
     if args.video:
-        from ..validation import check_motion_fps
-
         check_motion_fps(args.video_fps, name="--video-fps")  # before minutes of work
     outs = Outputs(inputs=(args.motion, args.audio, args.beats))
     out = outs.add(args.output, option="-o/--output")
@@ -316,16 +299,15 @@ def _pipeline(
     written: dict[str, str] = {}
     if video is not None:
         t0 = time.perf_counter()
-        staged = outs.path(video)
-        duration = music_s if args.fill == "loop" else None
-        vid = _render_video(res.motion, staged, (y, sr), beats, args.video_fps, fb.bars, duration)
-        if vid == staged:
-            vid = video
-        else:  # no ffmpeg: a GIF and a WAV instead of the MP4
-            outs.forget(video)
-            vid = outs.adopt(vid, option="--video")
-            if staged.with_suffix(".wav").is_file():
-                outs.adopt(staged.with_suffix(".wav"), option="--video")
+        vid = outs.write_video(
+            video,
+            res.motion,
+            audio=(y, sr),
+            fps=args.video_fps,
+            beats=beats,
+            progress=fb.bars,
+            duration=music_s if args.fill == "loop" else None,
+        )
         written["video"] = str(vid)
         timings["video_s"] = time.perf_counter() - t0
 
@@ -354,22 +336,6 @@ def _pipeline(
         "timings": timings,
     }
     return result
-
-
-def _render_video(
-    motion: Any,
-    path: Path,
-    audio: Any,
-    beats: np.ndarray,
-    fps: float,
-    progress: bool,
-    duration: float | None,
-) -> Path:
-    from .. import render
-
-    return render.write_video(
-        motion, path, audio=audio, fps=fps, beats=beats, progress=progress, duration=duration
-    )
 
 
 def _text(result: dict[str, Any]) -> str:
@@ -413,18 +379,6 @@ def _text(result: dict[str, Any]) -> str:
     for k, v in result["outputs"].items():
         lines.append(f"wrote    {k}: {v}")
     return "\n".join(lines)
-
-
-def _placement_notes(r: dict[str, Any]) -> str:
-    """Where no whole number of beats fitted: merges and half-beat landings."""
-    out = ""
-    if r["n_merged_intervals"]:
-        out += f"; {r['n_merged_intervals']} merged with a neighbour"
-    if r["n_half_beat_landings"]:
-        out += f"; {r['n_half_beat_landings']} landing on a half beat"
-    if r.get("phrases_on_bars") is not None:
-        out += f"; {r['phrases_on_bars']:.0%} of the dance bars start on a bar line"
-    return out
 
 
 def _counts_text(used: dict[str, int]) -> str:
