@@ -327,3 +327,13 @@ def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, c
     assert sum(r["beats_per_motion_beat_used"].values()) == r["periods_used"]
     assert r["joins"] and all(j["peak_joint_speed"] > 0 for j in r["joins"])
     assert "beats    per motion beat used: " in stdout and "% of the output within" in stdout
+
+
+def test_sync_reports_the_dance_phrase_it_steers_onto_bar_lines(inputs, tmp_path, capsys):
+    d, _, _ = inputs  # the real waltz dancer: a phrase of 3 motion beats, given
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(tmp_path / "o.json"),
+            "--fps", "25", "--beats", str(d / "song.beats"), "--mode", "beats",
+            "--beats-per-bar", "3", "--dance-beats", "3"]  # fmt: skip
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    assert "dance    phrases of 3 motion beats (given) start on bar lines" in stdout

@@ -122,7 +122,8 @@ def register(subparsers: Any) -> None:
         help="the dance's meter: beats of one period of the dance (3 for a waltz step, 6 for "
         "a waltz box); with periods, beats per period are then a multiple of it (a warning "
         "says so when the song's meter does not fit); with motion beats, every N motion "
-        "beats start on a bar line of the song where the speed allows",
+        "beats start on a bar line of the song where the speed allows (default: the "
+        "dance's own phrase, estimated from its period when it is clear)",
     )
     p.add_argument(
         "--period-range",
@@ -370,6 +371,14 @@ def _text(result: dict[str, Any]) -> str:
             else ""
         )
         + (f"; {r['n_half_beat_landings']} on a half beat" if r["n_half_beat_landings"] else ""),
+        *(
+            [
+                f"dance    phrases of {r['dance_beats_per_period']} motion beats "
+                f"({r['dance_meter_rule']}) start on bar lines where the speed allows"
+            ]
+            if r.get("dance_meter_rule") and r["mode"] == "beats"
+            else []
+        ),
         *_speed_lines(r),
         f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
         f"({r['output_duration_s']:.2f} s)",
