@@ -1,28 +1,17 @@
 """Stick-figure drawings and videos of motion, with music beats marked.
 
-- :func:`plot_frames`: a strip of skeleton poses at chosen times, side by side, the
-  poses that fall on a music beat drawn in colour (paper A, Figure 3).
-- :func:`plot_beat_timeline`: mean joint speed over time with music beats, kinematic
-  beats and period boundaries.
-- :func:`write_video`: an MP4 of the dancer seen in perspective by a camera that
-  follows them over a floor, the beats marked, with the music as soundtrack: Pillow
-  draws each frame and pipes it to ffmpeg (the binary bundled with ``imageio-ffmpeg``,
-  or one on ``PATH``). Without ffmpeg it writes an animated GIF and the music as a
-  WAV next to it, and says so with a :class:`~beatsync.errors.BeatsyncWarning`.
+Figures (:func:`plot_frames`: paper A's Figure 3; :func:`plot_beat_timeline`) use an
+orthographic view. :func:`write_video` films the dancer in perspective with a camera
+that follows them over a floor: Pillow draws each frame and pipes it to ffmpeg
+(``imageio-ffmpeg``'s, or one on ``PATH``); without ffmpeg it writes an animated GIF
+and the music as a WAV beside it, and says so with a
+:class:`~beatsync.errors.BeatsyncWarning`.
 
-Data contract
--------------
-- Poses come from forward kinematics (:meth:`beatsync.motion.Motion.positions`) for
-  skeletal motion, or from ``<marker>_x/_y/_z`` channels for marker tables
-  (:func:`beatsync.motion_beats.motion_positions`); figures use an orthographic
-  view, videos a perspective one.
-  BVH skeletons are y-up, marker data (MoCap Toolbox) z-up; ``up=`` overrides.
-- Times and beats are seconds in the motion's timeline (frame ``k`` at ``k / fps``).
-- Audio is mono float ``y`` with its sample rate ``sr`` [Hz], starting at the motion's
-  time 0.
-- Every file is written atomically (temporary file in the same folder, then renamed).
-
-Notebook: ``notebooks/paper_a_fig03_animation_frames.ipynb`` (paper A, Figure 3).
+Data contract: poses come from forward kinematics for skeletal motion, or from
+``<marker>_x/_y/_z`` channels (:func:`beatsync.motion_beats.motion_positions`); BVH
+skeletons are y-up, marker data z-up (``up=`` overrides). Times and beats are seconds
+in the motion's timeline (frame ``k`` at ``k / fps``); audio is mono ``y`` at ``sr``
+[Hz] from the motion's time 0. Every file is written atomically.
 """
 
 from __future__ import annotations
