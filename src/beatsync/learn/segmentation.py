@@ -1,9 +1,5 @@
-"""Exercises of tutorial 01 (periodic motion segmentation, paper A, sec. 3).
-
-Notebook: ``notebooks/tutorials/01_segmentation.ipynb``. Each judge computes the
-expected answer with :mod:`beatsync.segment` on the CMU salsa take 60_01 (the
-tutorial's data, read here so that the check does not depend on the notebook).
-"""
+"""Exercises of ``notebooks/tutorials/01_segmentation.ipynb`` (paper A, sec. 3), judged
+with :mod:`beatsync.segment` on the CMU salsa take 60_01."""
 
 from __future__ import annotations
 

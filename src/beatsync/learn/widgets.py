@@ -26,6 +26,7 @@ import html
 import io
 import itertools
 import json
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -53,24 +54,9 @@ class State:
 def explore(
     update: Callable[..., Any], *, max_states: int = MAX_STATES, **sliders: Sequence[Any]
 ) -> Explorer:
-    """A slider per keyword over ``update(**values)``; the first value of each list is shown first.
-
-    Parameters
-    ----------
-    update : callable
-        ``update(**values) -> Figure | (Figure, extra)``, called with one value per slider.
-    max_states : int > 0
-        The most combinations (the product of the lists' lengths) to precompute for
-        the static page; more raise, since each is a PNG in the executed notebook.
-    **sliders : list
-        Slider name -> its values (hashable: numbers, strings, tuples), in slider order.
-
-    Raises
-    ------
-    ParameterError
-        No slider, a slider with no values or an unhashable value, or more
-        combinations than ``max_states``.
-    """
+    """A slider per keyword (name -> its hashable values) over ``update(**values)``; the
+    first value of each list is shown first. At most ``max_states`` combinations: each
+    is a PNG in the executed notebook."""
     if not callable(update):
         raise ParameterError(f"update={update!r} is not callable: pass the function itself")
     if not sliders:
@@ -89,9 +75,7 @@ def explore(
                 f"slider {name}={sliders[name]!r} has an unhashable value: use tuples, not lists"
             ) from None
         values[name] = vals
-    n = 1
-    for vals in values.values():
-        n *= len(vals)
+    n = math.prod(len(vals) for vals in values.values())
     if n > max_states:
         sizes = " x ".join(f"{len(v)} {k}" for k, v in values.items())
         raise ParameterError(
