@@ -5,16 +5,12 @@ validated beat times); methods are named as in
 :data:`beatsync.other_trackers.TRACKERS` (``psf`` is ours). Every time is in seconds,
 every tempo in BPM.
 
-- :func:`find_tracks` pairs every audio file with the annotation of the same stem
-  (``.beats``: one time [s] per line, an optional second column such as the beat in
-  the bar is ignored); :func:`read_annotation` refuses values that are not seconds.
-- :func:`evaluate_track` reads, tracks and scores one file into a row; a track that
-  fails (unreadable, silent, too short) is a row with its error, never an exception.
-- :func:`evaluate_dataset` (``beatsync evaluate beats``) runs the tracks on Dask
-  (:func:`beatsync.cluster.dask_client`) in groups, appends each row to
-  ``OUT/tracks.jsonl`` as soon as its group finishes (a crash or Ctrl-C loses at most
-  the groups in flight; a rerun skips the tracks already scored), then writes
-  ``OUT/tracks.csv`` and ``OUT/summary.csv`` (:func:`summarize_dataset`) atomically.
+:func:`find_tracks` pairs every audio file with the annotation of the same stem
+(``.beats``: one time [s] per line, an optional second column such as the beat in the
+bar is ignored). :func:`evaluate_dataset` (``beatsync evaluate beats``) runs the
+tracks on Dask in groups, appends each row to ``OUT/tracks.jsonl`` as soon as its
+group finishes (a crash or Ctrl-C loses at most the groups in flight; a rerun skips
+the tracks already scored), then writes ``OUT/tracks.csv`` and ``OUT/summary.csv``.
 
 pandas is imported by the table functions only: a worker imports this module to run
 :func:`evaluate_tracks` and needs none of it.
