@@ -558,10 +558,12 @@ def write_video(
         from tqdm import tqdm
 
         frames_iter = tqdm(frames_iter, desc="video", unit="frame", leave=False)
-    length = len(t) / fps
-
+    frames = (stage.draw(k, float(t[k]), bool(on[k]), ruler[k]) for k in frames_iter)
+    if y_sr is not None:  # the music cut to the video's length
+        y, sr = y_sr
+        y_sr = (y[: int(np.ceil(len(t) / fps * sr))], sr)
     if exe is None:
-        return _write_gif_fallback(dest, stage, t, on, ruler, fps, y_sr, length, frames_iter)
+        return _write_gif(dest, frames, fps, y_sr)
 
     with tempfile.TemporaryDirectory(dir=parent, prefix=".beatsync-video-") as tmp:
         tmp_video = Path(tmp) / ("out" + (dest.suffix or ".mp4"))
@@ -573,10 +575,7 @@ def write_video(
         if y_sr is not None:
             from .io import write_audio
 
-            y, sr = y_sr
-            n = min(y.size, int(np.ceil(length * sr)))
-            wav = write_audio(Path(tmp) / "audio.wav", y[:n], sr)
-            cmd += ["-i", str(wav)]
+            cmd += ["-i", str(write_audio(Path(tmp) / "audio.wav", *y_sr))]
         cmd += ["-c:v", "libx264", "-preset", preset, "-crf", "23"]
         if y_sr is not None:
             cmd += ["-c:a", "aac", "-b:a", "128k"]
@@ -591,9 +590,8 @@ def write_video(
         pending: deque[Future[int]] = deque()
         with ThreadPoolExecutor(1) as writer:
             try:
-                for k in frames_iter:
-                    frame = _yuv420(stage.draw(k, float(t[k]), bool(on[k]), ruler[k]))
-                    pending.append(writer.submit(proc.stdin.write, frame))
+                for im in frames:
+                    pending.append(writer.submit(proc.stdin.write, _yuv420(im)))
                     if len(pending) > 4:
                         pending.popleft().result()
                 while pending:
@@ -663,22 +661,12 @@ def _reporting(frames: range, progress: Callable[[int, int], None]) -> Iterator[
         progress(done, total)
 
 
-def _write_gif_fallback(
-    dest: Path,
-    stage: _Stage,
-    t: np.ndarray,
-    on: np.ndarray,
-    ruler: list[np.ndarray],
-    fps: float,
-    y_sr: tuple[np.ndarray, int] | None,
-    duration: float,
-    frames_iter: Any,
-) -> Path:
+def _write_gif(dest: Path, frames: Iterator[Any], fps: float, audio: Any) -> Path:
+    """Without ffmpeg: the frames as an animated GIF, the ``audio`` as a WAV beside it."""
     from .io import atomic_write, write_audio
 
-    gif = dest.with_suffix(".gif")
-    wav = dest.with_suffix(".wav")
-    images = [stage.draw(k, float(t[k]), bool(on[k]), ruler[k]) for k in frames_iter]
+    gif, wav = dest.with_suffix(".gif"), dest.with_suffix(".wav")
+    images = list(frames)
     with atomic_write(gif, "wb") as fh:
         images[0].save(
             fh,
@@ -689,9 +677,8 @@ def _write_gif_fallback(
             loop=0,
         )
     msg = f"no ffmpeg found: wrote the animation as {str(gif)!r} without sound"
-    if y_sr is not None:
-        y, sr = y_sr
-        write_audio(wav, y[: min(y.size, int(np.ceil(duration * sr)))], sr)
+    if audio is not None:
+        write_audio(wav, *audio)
         msg += f" and the music as {str(wav)!r}; play them together"
     msg += " (install ffmpeg or `pip install imageio-ffmpeg` for an MP4 with sound)"
     warn(msg, stacklevel=3)
