@@ -502,14 +502,9 @@ def evaluate_dataset(
                 f"{_range_text(other_range[0])}, not {_range_text(bpm_range)}; use --force "
                 "to re-run them or another --out"
             )
-        for t in tracks:
-            row = previous.get(t.key)
-            if row is None or row.get("status") != "ok":
-                continue
-            if _same_inputs(row, t, refs[t.key]):
-                done.add(t.key)
-            else:
-                changed += 1
+        ok = [t for t in tracks if previous.get(t.key, {}).get("status") == "ok"]
+        done = {t.key for t in ok if _same_inputs(previous[t.key], t, refs[t.key])}
+        changed = len(ok) - len(done)
     todo = [t for t in tracks if t.key not in done]
     if method == "librosa" and tempo:
         _check_librosa_rates(todo, tempo)

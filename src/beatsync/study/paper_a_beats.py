@@ -179,10 +179,8 @@ def check_targets(scores: pd.DataFrame) -> pd.DataFrame:
             sel = sc.query(query)
             if sel.empty:
                 continue
-            if metric == "octave":
-                value = float((sel["octave"] == "correct").mean())
-            else:
-                value = float(sel[metric].mean())
+            at_level = sel["octave"] == "correct"
+            value = float(at_level.mean() if metric == "octave" else sel[metric].mean())
             rows.append(
                 {
                     "target": desc,

@@ -130,19 +130,15 @@ def _z(level: np.ndarray) -> np.ndarray:
 
 
 def _song_grid(graph: WeightedMotionGraph, beats: np.ndarray, level: np.ndarray, bound: Any):
-    """What compose searches for a song: the tempo plan, z per grid interval, durations."""
+    """What compose searches for a song: the tempo plan, z per grid interval, the grid
+    intervals' durations [s] and the search's options."""
     from ..graph.timescale import music_grid, plan_tempo
 
     mult = "auto" if bound is not None else (1.0,)
     plan = plan_tempo(graph, beats, scale_bound=bound, multiplicity=mult)
     grid, glevel = music_grid(beats, level, plan.subdivision)
-    search_kw = {
-        "music_durations": np.diff(grid),
-        "scale_bound": plan.bound,
-        "steps": plan.steps,
-        "node_mask": plan.node_mask,
-    }
-    return plan, _z(glevel), search_kw
+    kw = {"scale_bound": plan.bound, "steps": plan.steps, "node_mask": plan.node_mask}
+    return plan, _z(glevel), np.diff(grid), kw
 
 
 def speed_table(
@@ -175,8 +171,7 @@ def speed_table(
         g.successor_lists()
         for dur in durations:
             beats, level = song(float(dur), bpm=bpm, seed=seed)
-            plan, z, kw = _song_grid(g, beats, level, scale_bound)
-            md = kw.pop("music_durations")
+            plan, z, md, kw = _song_grid(g, beats, level, scale_bound)
             t_dp, t_cv = [], []
             for i in range(int(repeats)):
                 runs = [
