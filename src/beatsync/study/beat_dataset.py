@@ -1,9 +1,7 @@
 """Beat trackers run and scored against the annotations of a dataset, on Dask.
 
-Every score is :func:`beatsync.evaluate.beats.evaluate` (``mir_eval.beat.evaluate`` on
-validated beat times); methods are named as in
-:data:`beatsync.other_trackers.TRACKERS` (``psf`` is ours). Every time is in seconds,
-every tempo in BPM.
+Scores are :func:`beatsync.evaluate.beats.evaluate`'s, methods those of
+:data:`beatsync.other_trackers.TRACKERS`; times are in seconds, tempi in BPM.
 
 :func:`find_tracks` pairs every audio file with the annotation of the same stem
 (``.beats``: one time [s] per line, an optional second column such as the beat in the

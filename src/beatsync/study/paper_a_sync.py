@@ -180,20 +180,11 @@ def make_songs(
     truth = {bpm: beat_times(bpm, duration=song_seconds, start=0.4) for bpm in song_bpms[:2]}
     a, b = song_bpms[0], song_bpms[1]
     audio = {
-        f"A: drums {a:g} BPM": (
-            drum_pattern(truth[a], sr=sr, duration=song_seconds),
-            sr,
-            truth[a],
-            a,
-            "synthetic drum pattern",
-        ),
-        f"B: clicks {b:g} BPM": (
-            click_track(truth[b], sr=sr, duration=song_seconds),
-            sr,
-            truth[b],
-            b,
-            "synthetic click track",
-        ),
+        name: (synth(truth[bpm], sr=sr, duration=song_seconds), sr, truth[bpm], bpm, data)
+        for name, synth, bpm, data in (
+            (f"A: drums {a:g} BPM", drum_pattern, a, "synthetic drum pattern"),
+            (f"B: clicks {b:g} BPM", click_track, b, "synthetic click track"),
+        )
     }
     if use_808:
         y, rate = datasets.load_click_808()
@@ -203,11 +194,6 @@ def make_songs(
         track = track_beats(y, rate)
         beats = track.beats if (beat_source == "track" or true is None) else true
         songs[name] = {"beats": beats, "bpm": bpm, "data": data}
-        err = (
-            round(1000 * float(nearest_distance(track.beats, true).max()), 1)
-            if true is not None
-            else "n/a"
-        )
         rows.append(
             {
                 "song": name,
@@ -215,10 +201,15 @@ def make_songs(
                 "BPM": bpm,
                 "beats used": len(beats),
                 "tracked tempo [BPM]": round(float(track.tempo), 2),
-                "max |tracked - true| [ms]": err,
+                "max |tracked - true| [ms]": _max_error_ms(track.beats, true),
             }
         )
     return songs, pd.DataFrame(rows)
+
+
+def _max_error_ms(tracked: np.ndarray, true: np.ndarray | None) -> float | str:
+    """The largest distance of a tracked beat from the true beats [ms], "n/a" without."""
+    return "n/a" if true is None else round(1000 * float(nearest_distance(tracked, true).max()), 1)
 
 
 def drum_song(
@@ -226,7 +217,6 @@ def drum_song(
 ) -> tuple[np.ndarray, int, np.ndarray, dict[str, Any]]:
     """Figure 3's song, a synthetic drum pattern: ``(y, sr, beats, summary)``, the beats
     [s] tracked by :func:`beatsync.beats.track_beats` and summarised against the truth."""
-
     from ..beats import track_beats
     from ..synth.audio import beat_times, drum_pattern
 
@@ -236,9 +226,7 @@ def drum_song(
     summary = {
         "beats": len(track.beats),
         "tempo [BPM]": round(float(track.tempo), 2),
-        "max |tracked - true| [ms]": round(
-            1000 * float(nearest_distance(track.beats, true).max()), 1
-        ),
+        "max |tracked - true| [ms]": _max_error_ms(track.beats, true),
     }
     return y, sr, track.beats, summary
 

@@ -1,12 +1,9 @@
 """Paper B's study: libraries, timing and quality tables, figures (the notebooks' calls).
 
-The libraries stand in for paper B's Break dance and Indian dance captures (not
-available): CMU salsa takes, CMU walking clips of one skeleton, or synthetic dances.
-Table 1 (:func:`speed_table`, :func:`ratio_table`) times the proposed DP and the
-conventional multi-stage search on synthetic drum songs, graph build excluded;
+The libraries (:data:`LIBRARIES`) stand in for paper B's captures, not available.
+Table 1 (:func:`speed_table`) times the proposed DP and the conventional search;
 Table 2 (:func:`quality_table`) scores compositions with the proxies of
-:mod:`beatsync.evaluate.composition` and the plausibility checks of
-:mod:`beatsync.graph.plausibility`.
+:mod:`beatsync.evaluate.composition` and :mod:`beatsync.graph.plausibility`.
 
 Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 ``notebooks/paper_b_tab02_quality_proxies.ipynb``.
@@ -236,12 +233,9 @@ def ratio_table(speed: Any) -> Any:
 def threshold_table(
     graph: WeightedMotionGraph, *, ths: Sequence[float] = (1.0, 2.0, 3.0, 5.0, 10.0)
 ) -> Any:
-    """Transition edges for each TH under two ``rd`` normalisations.
-
-    ``rd_unit = 0.1 s`` is our default (module :mod:`beatsync.graph.build`);
-    ``rd_unit = 1 / fps`` measures the pose jump in frame-to-frame distances (TH
-    ``x`` in frames is ``x / (0.1 fps)`` in our unit). ``graph`` must have been built
-    with a TH at least ``max(ths)`` (in our unit; :func:`library_graphs`).
+    """Transition edges for each TH with ``rd`` per 0.1 s of typical movement (our
+    default, :mod:`beatsync.graph.build`) and per frame-to-frame distance (TH ``x`` in
+    frames is ``x / (0.1 fps)`` in ours); ``graph`` built with a TH of at least ``max(ths)``.
     """
     import pandas as pd
 
@@ -311,12 +305,10 @@ def quality_table(
 ) -> Any:
     """Quality proxies and physical plausibility per method, one row per (method, song).
 
-    Methods: keys of :data:`QUALITY_METHODS`; the tempo-matched ones use the
-    defaults of :func:`~beatsync.graph.compose.compose` (tempo group, multiplicity,
-    time-scale bound 0.8-1.25), the unbounded ones paper B as written (every interval
-    warped onto one beat). Plausibility columns come from the composition's report
-    (:mod:`beatsync.graph.plausibility`); ``scale_outside`` counts the intervals
-    outside the default bound (for every method alike).
+    ``methods``: keys of :data:`QUALITY_METHODS`; the tempo-matched ones compose with
+    :func:`~beatsync.graph.compose.compose`'s defaults, the unbounded ones as paper B
+    (every interval warped onto one beat). ``scale_outside`` counts the intervals
+    outside the default time-scale bound, for every method alike.
     """
     import pandas as pd
 
