@@ -335,10 +335,12 @@ class _Stage:
         self.clock_at = (title_box[2] + 12, 6)
         self._plan()
 
-    def _screen(self, p: np.ndarray, eye: np.ndarray | None = None) -> np.ndarray:
+    def _screen(self, p: np.ndarray) -> np.ndarray:
         """(x, y, depth) in pixels of points ``p`` [shape=(n_frames, k, 3)]."""
-        eye = self.eye if eye is None else eye
-        c = (p - eye[:, None, :]) @ self.basis.T
+        return self._pixels((p - self.eye[:, None, :]) @ self.basis.T)
+
+    def _pixels(self, c: np.ndarray) -> np.ndarray:
+        """(x, y, depth) in pixels of camera coordinates ``c`` [shape=(..., 3)]."""
         z = np.maximum(c[..., 2], 1e-6)
         x = self.centre[0] + self.f * c[..., 0] / z
         y = self.centre[1] - self.f * c[..., 1] / z
@@ -367,11 +369,7 @@ class _Stage:
         span = cam[..., 1, :] - cam[..., 0, :]
         a = cam[..., 0, :] + np.where(d0 < near, s0, 0)[..., None] * span
         b = cam[..., 1, :] - np.where(d1 < near, s1, 0)[..., None] * span
-        seg = np.empty(cam.shape[:2] + (4,))
-        for k, q in enumerate((a, b)):
-            z = np.maximum(q[..., 2], 1e-6)
-            seg[..., 2 * k] = self.centre[0] + self.f * q[..., 0] / z
-            seg[..., 2 * k + 1] = self.centre[1] - self.f * q[..., 1] / z
+        seg = np.concatenate([self._pixels(a)[..., :2], self._pixels(b)[..., :2]], axis=-1)
         w, h = 2 * self.centre
         behind = (d0 < near) & (d1 < near)
         outside = ((seg[..., 0] < 0) & (seg[..., 2] < 0)) | ((seg[..., 0] > w) & (seg[..., 2] > w))
