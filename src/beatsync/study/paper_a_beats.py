@@ -252,7 +252,6 @@ def frontend_sweep(
     mean F, CMLt and AMLt, and for sets of at most :data:`SWEEP_ITEMS_LISTED` items the
     F of each (a mean of three recordings can move with one of them).
     """
-
     keys = list(grid)
     rows = []
     for combo in itertools.product(*(grid[k] for k in keys)):
