@@ -324,11 +324,8 @@ GROUP_TRACKS = 8
 
 
 class TrackLog:
-    """The append-only JSON-lines record of a dataset run (``OUT/tracks.jsonl``).
-
-    Each :meth:`append` writes its rows' lines at once and flushes them to disk, so a
-    crash loses at most the lines being written; :meth:`rows` skips a torn line.
-    """
+    """The append-only JSON-lines record of a dataset run (``OUT/tracks.jsonl``): a
+    crash loses at most the lines being appended, and :meth:`rows` skips a torn line."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
@@ -509,9 +506,8 @@ def evaluate_dataset(
     created = not out.exists()
     try:
         with contextlib.ExitStack() as stack:
-            # the tracks silence other packages' warnings with warnings.catch_warnings,
-            # whose filters are process-wide: tracks on the threads of this process
-            # (processes=False) could leave them changed; restored when the run ends
+            # the tracks' warnings.catch_warnings filters are process-wide: tracks on this
+            # process's threads (processes=False) could leave them changed; restored here
             stack.enter_context(warnings.catch_warnings())
             if todo:  # connect first: an unreachable scheduler changes nothing on disk
                 client = stack.enter_context(
@@ -618,13 +614,10 @@ def _prepare_workers(client, method: str) -> None:
 
 
 def _groups(todo: Sequence[Track], n_threads: int) -> list[list[Track]]:
-    """The tracks in order, in groups of decreasing size: one task each.
-
-    A Dask task costs about as much as tracking a short excerpt, so a task takes
-    several tracks: the remaining tracks over the worker threads, at most
-    :data:`GROUP_TRACKS` (guided self-scheduling, Polychronopoulos & Kuck 1987), so the
-    last groups hold one track and the workers finish together.
-    """
+    """The tracks in order, in groups of decreasing size, one task each (a Dask task
+    costs about as much as tracking a short excerpt): the remaining tracks over the
+    worker threads, at most :data:`GROUP_TRACKS` (guided self-scheduling), so that the
+    workers finish together."""
     groups, i = [], 0
     while i < len(todo):
         size = min(GROUP_TRACKS, -(-(len(todo) - i) // max(1, n_threads)))
@@ -658,9 +651,8 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
         )  # fmt: skip
 
     def submit(groups: list[list[Track]]) -> None:
-        # in one call, so that the scheduler sees the run's tasks as one group and queues
-        # them (worker-saturation) instead of handing the first ones out at once, in this
-        # order; one key prefix for the run, as Dask groups tasks by it
+        # in one call and with one key prefix, so that the scheduler sees the run's tasks
+        # as one group and queues them in this order (worker-saturation)
         futs = client.map(
             evaluate_tracks,
             [[(str(t.audio), refs[t.key], t.key, t.group) for t in group] for group in groups],
