@@ -11,6 +11,7 @@ Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from typing import Any
 
@@ -319,35 +320,31 @@ def quality_table(
     lo, hi = DEFAULT_SCALE_BOUND
     rows = []
     _COMPOSED.clear()
-    for bpm in bpms:
-        for dur in durations:
-            for seed in seeds:
-                beats, level = song(float(dur), bpm=float(bpm), seed=int(seed))
-                for m in methods:
-                    label, method, kw = QUALITY_METHODS[m]
-                    g = g_rd if m.startswith("dp_rd") else graph
-                    with silenced():
-                        comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
-                    if m == "dp":  # kept for example_composition (no second search)
-                        _COMPOSED[(id(graph), float(bpm), float(dur), int(seed))] = comp
-                    q = composition_proxies(comp, sigma=sigma)
-                    p = comp.plausibility
-                    s = comp.search.scales
-                    rows.append(
-                        {
-                            "method": label,
-                            "bpm": float(bpm),
-                            "music_s": float(dur),
-                            "seed": int(seed),
-                            **q,
-                            **{k: p[k] for k in _PLAUSIBILITY_COLUMNS},
-                            "scale_outside": int(np.sum((s < lo - 1e-9) | (s > hi + 1e-9))),
-                            "two_beat_share": float(np.mean(np.diff(comp.search.boundaries) > 1))
-                            if comp.tempo.subdivision == 1
-                            else 0.0,
-                            "speed_warning": bool(comp.warnings),
-                        }
-                    )
+    for bpm, dur, seed in itertools.product(bpms, durations, seeds):
+        beats, level = song(float(dur), bpm=float(bpm), seed=int(seed))
+        for m in methods:
+            label, method, kw = QUALITY_METHODS[m]
+            g = g_rd if m.startswith("dp_rd") else graph
+            with silenced():
+                comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
+            if m == "dp":  # kept for example_composition (no second search)
+                _COMPOSED[(id(graph), float(bpm), float(dur), int(seed))] = comp
+            s = comp.search.scales
+            rows.append(
+                {
+                    "method": label,
+                    "bpm": float(bpm),
+                    "music_s": float(dur),
+                    "seed": int(seed),
+                    **composition_proxies(comp, sigma=sigma),
+                    **{k: comp.plausibility[k] for k in _PLAUSIBILITY_COLUMNS},
+                    "scale_outside": int(np.sum((s < lo - 1e-9) | (s > hi + 1e-9))),
+                    "two_beat_share": float(np.mean(np.diff(comp.search.boundaries) > 1))
+                    if comp.tempo.subdivision == 1
+                    else 0.0,
+                    "speed_warning": bool(comp.warnings),
+                }
+            )
     return pd.DataFrame(rows)
 
 
