@@ -65,10 +65,8 @@ def judge_pearson_distance(pearson_distance: Any) -> str | None:
                 "period onto the earlier one's samples (end points aligned) instead."
             )
         grid = np.linspace(0, first.size - 1, later.size)
-        if (
-            abs(got - (1 - np.corrcoef(np.interp(grid, np.arange(first.size), first), later)[0, 1]))
-            < 1e-4
-        ):
+        resampled = np.interp(grid, np.arange(first.size), first)
+        if abs(got - (1 - np.corrcoef(resampled, later)[0, 1])) < 1e-4:
             return f"for the {where} you resampled the earlier period: resample the later one."
         return f"for the {where} your distance is {got:.4f}, off by {got - want:+.4f}."
     return None
