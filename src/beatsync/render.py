@@ -60,17 +60,12 @@ def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
     position-only motion, none for a table whose bones are unknown (drawn as dots)."""
     from .motion_beats import motion_positions
 
-    pos = motion_positions(motion)
     skel = getattr(motion, "skeleton", None)
-    if skel is None:
-        if getattr(motion, "is_positional", False):
-            bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
-            return pos, bones
-        return pos, np.zeros((0, 2), dtype=np.int64)
-    bones = np.array(
-        [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0], dtype=np.int64
-    ).reshape(-1, 2)
-    return pos, bones
+    if skel is not None:
+        bones = [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0]
+    else:
+        bones = motion.bones if getattr(motion, "is_positional", False) else []
+    return motion_positions(motion), np.asarray(bones, dtype=np.int64).reshape(-1, 2)
 
 
 def _up_axis(motion: Any, up: str | None) -> int:
