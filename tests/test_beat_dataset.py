@@ -1,6 +1,7 @@
 """Dataset pieces of beat evaluation: pairing, annotations, the log, preparing workers."""
 
 import json
+import re
 
 import numpy as np
 import pandas as pd
@@ -80,14 +81,14 @@ def test_ambiguous_stem_is_unmatched(tmp_path):
         (b / sub).mkdir(parents=True)
         (b / sub / "song.beats").write_text("0.5\n")
     (b / "other.beats").write_text("0.5\n")
-    with pytest.raises(ParameterError, match="none of the 1 audio files"):
+    with pytest.raises(ParameterError, match="song.beats"):
         find_tracks(a, b)
 
 
 def test_annotation_folder_is_a_file(tmp_path):
     _touch_audio(tmp_path / "a" / "x.wav")
     (tmp_path / "n").write_text("x")
-    with pytest.raises(ParameterError, match="annotation folder .* is a file"):
+    with pytest.raises(ParameterError, match=re.escape(str(tmp_path / "n"))):
         find_tracks(tmp_path / "a", tmp_path / "n")
 
 
@@ -102,11 +103,11 @@ def test_read_annotation_one_or_two_columns(tmp_path):
 @pytest.mark.parametrize(
     "text, match",
     [
-        ("500\n1000\n1500\n2000\n", "looks like milliseconds"),
-        ("43\n86\n129\n172\n", "looks like frame indices"),
-        ("0.5\nabc\n", "line 2: .*'abc' is not a number"),
-        ("1.0\n0.5\n", "strictly increasing"),
-        ("# nothing\n", "empty"),
+        ("500\n1000\n1500\n2000\n", "2000 .* milliseconds"),
+        ("43\n86\n129\n172\n", "172 .* frame indices"),
+        ("0.5\nabc\n", "line 2: 'abc'"),
+        ("1.0\n0.5\n", r"#1 \(0\.5 s\)"),
+        ("# nothing\n", "a.beats is empty"),
     ],
 )
 def test_read_annotation_refuses(tmp_path, text, match):

@@ -80,10 +80,10 @@ def test_extras_are_shown_under_each_state():
     ("sliders", "match"),
     [
         ({}, "no slider"),
-        ({"alpha": 0.3}, "alpha=0.3 is one value"),
-        ({"alpha": []}, r"alpha=\[\] has no values"),
-        ({"band": [[0, 200]]}, "unhashable"),
-        ({"a": range(5), "b": range(5)}, "25 combinations"),
+        ({"alpha": 0.3}, "alpha=0.3"),
+        ({"alpha": []}, r"alpha=\[\]"),
+        ({"band": [[0, 200]]}, r"band=\[\[0, 200\]\]"),
+        ({"a": range(5), "b": range(5)}, "max_states=24"),
     ],
 )
 def test_bad_sliders_raise(sliders, match):
@@ -92,7 +92,7 @@ def test_bad_sliders_raise(sliders, match):
 
 
 def test_update_must_return_a_figure():
-    with pytest.raises(ParameterError, match="returned int"):
+    with pytest.raises(ParameterError, match="int"):
         explore(lambda a: 3, a=[1]).render(a=1)
 
 

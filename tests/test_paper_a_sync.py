@@ -39,7 +39,7 @@ def test_crop_by_seconds():
     m = _bounce(seconds=3.0)
     assert study.crop(m, 1.0).n_frames == 60
     assert study.crop(m, 10.0).n_frames == m.n_frames
-    with pytest.raises(ParameterError, match="seconds"):
+    with pytest.raises(ParameterError, match="seconds=-1"):
         study.crop(m, -1.0)
 
 

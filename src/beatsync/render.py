@@ -1,28 +1,17 @@
 """Stick-figure drawings and videos of motion, with music beats marked.
 
-- :func:`plot_frames`: a strip of skeleton poses at chosen times, side by side, the
-  poses that fall on a music beat drawn in colour (paper A, Figure 3).
-- :func:`plot_beat_timeline`: mean joint speed over time with music beats, kinematic
-  beats and period boundaries.
-- :func:`write_video`: an MP4 of the dancer seen in perspective by a camera that
-  follows them over a floor, the beats marked, with the music as soundtrack: Pillow
-  draws each frame and pipes it to ffmpeg (the binary bundled with ``imageio-ffmpeg``,
-  or one on ``PATH``). Without ffmpeg it writes an animated GIF and the music as a
-  WAV next to it, and says so with a :class:`~beatsync.errors.BeatsyncWarning`.
+Figures (:func:`plot_frames`: paper A's Figure 3; :func:`plot_beat_timeline`) use an
+orthographic view. :func:`write_video` films the dancer in perspective with a camera
+that follows them over a floor: Pillow draws each frame and pipes it to ffmpeg
+(``imageio-ffmpeg``'s, or one on ``PATH``); without ffmpeg it writes an animated GIF
+and the music as a WAV beside it, and says so with a
+:class:`~beatsync.errors.BeatsyncWarning`.
 
-Data contract
--------------
-- Poses come from forward kinematics (:meth:`beatsync.motion.Motion.positions`) for
-  skeletal motion, or from ``<marker>_x/_y/_z`` channels for marker tables
-  (:func:`beatsync.motion_beats.motion_positions`); figures use an orthographic
-  view, videos a perspective one.
-  BVH skeletons are y-up, marker data (MoCap Toolbox) z-up; ``up=`` overrides.
-- Times and beats are seconds in the motion's timeline (frame ``k`` at ``k / fps``).
-- Audio is mono float ``y`` with its sample rate ``sr`` [Hz], starting at the motion's
-  time 0.
-- Every file is written atomically (temporary file in the same folder, then renamed).
-
-Notebook: ``notebooks/paper_a_fig03_animation_frames.ipynb`` (paper A, Figure 3).
+Data contract: poses come from forward kinematics for skeletal motion, or from
+``<marker>_x/_y/_z`` channels (:func:`beatsync.motion_beats.motion_positions`); BVH
+skeletons are y-up, marker data z-up (``up=`` overrides). Times and beats are seconds
+in the motion's timeline (frame ``k`` at ``k / fps``); audio is mono ``y`` at ``sr``
+[Hz] from the motion's time 0. Every file is written atomically.
 """
 
 from __future__ import annotations
@@ -41,6 +30,7 @@ import numpy as np
 
 from .errors import ParameterError, warn
 from .validation import (
+    check_audio,
     check_fps,
     check_motion_fps,
     check_positive,
@@ -65,29 +55,17 @@ _POSE_COLOR = "#333333"
 
 
 def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Joint positions and the bones to draw between them.
-
-    Returns
-    -------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)] [position unit]
-    bones : np.ndarray [shape=(n_bones, 2)], int
-        Pairs of joint indices: (child, parent) for a skeleton; the motion's bones
-        (given, or inferred from steady joint distances) for position-only motion;
-        empty for a table whose bones are unknown (drawn as dots).
-    """
+    """Joint positions [shape=(n_frames, n_joints, 3)] and the bones to draw between them:
+    pairs of joint indices, (child, parent) for a skeleton, the motion's bones for
+    position-only motion, none for a table whose bones are unknown (drawn as dots)."""
     from .motion_beats import motion_positions
 
-    pos = motion_positions(motion)
     skel = getattr(motion, "skeleton", None)
-    if skel is None:
-        if getattr(motion, "is_positional", False):
-            bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
-            return pos, bones
-        return pos, np.zeros((0, 2), dtype=np.int64)
-    bones = np.array(
-        [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0], dtype=np.int64
-    ).reshape(-1, 2)
-    return pos, bones
+    if skel is not None:
+        bones = [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0]
+    else:
+        bones = motion.bones if getattr(motion, "is_positional", False) else []
+    return motion_positions(motion), np.asarray(bones, dtype=np.int64).reshape(-1, 2)
 
 
 def _up_axis(motion: Any, up: str | None) -> int:
@@ -99,23 +77,10 @@ def _up_axis(motion: Any, up: str | None) -> int:
 
 
 def project(positions: Any, *, up: int = 1, azimuth: float = 0.0) -> np.ndarray:
-    """Orthographic projection of 3-D positions on a vertical image plane.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(..., 3)]
-    up : int
-        Index of the vertical axis (1 for y-up BVH, 2 for z-up markers).
-    azimuth : float [deg]
-        Rotation of the camera about the vertical axis (0: look along the depth axis
-        that follows ``up`` cyclically, i.e. the image's horizontal axis is the axis
-        before ``up``).
-
-    Returns
-    -------
-    xy : np.ndarray [shape=(..., 2)]
-        Horizontal and vertical image coordinates.
-    """
+    """Orthographic projection of positions [shape=(..., 3)] on a vertical image plane
+    [shape=(..., 2)]: ``up`` is the vertical axis (1 for y-up BVH, 2 for z-up markers),
+    ``azimuth`` [deg] the camera's rotation about it (0: the image's horizontal axis is
+    the axis before ``up``)."""
     p = np.asarray(positions, dtype=np.float64)
     h1, h2 = (up + 1) % 3, (up + 2) % 3  # y-up: z, x ; z-up: x, y
     a = np.deg2rad(azimuth)
@@ -127,31 +92,15 @@ def project(positions: Any, *, up: int = 1, azimuth: float = 0.0) -> np.ndarray:
 def _near_beat(times: np.ndarray, beats: np.ndarray | None, tol: float) -> np.ndarray:
     if beats is None or len(beats) == 0:
         return np.zeros(times.shape, dtype=bool)
-    idx = np.clip(np.searchsorted(beats, times), 1, len(beats) - 1) if len(beats) > 1 else None
-    if idx is None:
-        return np.abs(times - beats[0]) <= tol
-    d = np.minimum(np.abs(times - beats[idx - 1]), np.abs(times - beats[idx]))
-    return d <= tol
+    return np.abs(times[:, None] - beats[None, :]).min(axis=1) <= tol
 
 
 def beat_strip_times(
     beats: Any, *, start: float = 0.0, n_beats: int = 4, per_beat: int = 2
 ) -> np.ndarray:
-    """Times for a strip of poses: ``per_beat`` evenly spaced poses in each of
-    ``n_beats`` beat intervals, starting on the first beat at or after ``start``.
-
-    Parameters
-    ----------
-    beats : np.ndarray [s]
-    start : float [s]
-    n_beats : int >= 1
-    per_beat : int >= 1
-
-    Returns
-    -------
-    times : np.ndarray [shape=(n_beats * per_beat + 1,)] [s]
-        The first and every ``per_beat``-th time is a beat; ends on a beat.
-    """
+    """Times [s] for a strip of poses: ``per_beat`` evenly spaced poses in each of
+    ``n_beats`` beat intervals from the first beat at or after ``start`` [s], and the
+    beat that ends them."""
     b = check_times(beats, name="beats", allow_empty=False)
     if int(n_beats) < 1 or int(per_beat) < 1:
         raise ParameterError(f"n_beats={n_beats!r} and per_beat={per_beat!r} must be >= 1")
@@ -178,32 +127,13 @@ def plot_frames(
     spacing: float | None = None,
     tol: float | None = None,
 ) -> Any:
-    """Draw skeleton poses at chosen times side by side; poses on a beat in colour.
+    """Draw skeleton poses at ``times`` [s] side by side; poses within ``tol`` [s] of a
+    beat in colour, labelled; returns the Figure.
 
-    Parameters
-    ----------
-    motion : Motion
-    times : np.ndarray [shape=(k,)] [s], optional
-        Times to draw (snapped to the nearest frame); default ``n_frames`` times evenly
-        spread over the motion.
-    beats : np.ndarray [s], optional
-        Music beats (in the motion's timeline). Poses within ``tol`` of a beat are
-        drawn in red and labelled.
-    n_frames : int
-        Number of poses when ``times`` is not given.
-    ax : matplotlib Axes, optional
-    up : {"x", "y", "z"}, optional
-        Vertical axis; default ``y`` for skeletons, ``z`` for markers.
-    azimuth : float [deg]
-        Camera rotation about the vertical axis.
-    spacing : float, optional [position unit]
-        Horizontal distance between poses; default 1.3 times the widest pose.
-    tol : float, optional [s]
-        Beat tolerance; default half a frame.
-
-    Returns
-    -------
-    fig : matplotlib Figure
+    ``times`` are snapped to frames (default: ``n_frames`` spread over the motion);
+    ``up`` is the vertical axis (default ``y`` for skeletons, ``z`` for markers);
+    ``azimuth`` [deg] turns the camera about it; ``spacing`` [position unit] defaults to
+    1.3 times the widest pose, ``tol`` to half a frame.
     """
     import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
@@ -263,25 +193,10 @@ def plot_beat_timeline(
     ax: Any = None,
     smooth: float = 0.05,
 ) -> Any:
-    """Mean joint speed over time, with music beats, motion beats and period boundaries.
+    """Mean joint speed over time (Gaussian-smoothed over ``smooth`` [s]) with music
+    ``beats`` (red lines), kinematic ``motion_beats`` (dots) and period ``boundaries``
+    (dashed), all [s]; returns the Figure."""
 
-    Parameters
-    ----------
-    motion : Motion
-    beats : np.ndarray [s], optional
-        Music beats (vertical red lines).
-    motion_beats : np.ndarray [s], optional
-        Kinematic beats (dots on the curve).
-    boundaries : np.ndarray [s], optional
-        Period boundaries (dashed grey lines).
-    ax : matplotlib Axes, optional
-    smooth : float >= 0 [s]
-        Gaussian smoothing of the speed curve.
-
-    Returns
-    -------
-    fig : matplotlib Figure
-    """
     import matplotlib.pyplot as plt
 
     from .motion_beats import speed_curve
@@ -342,19 +257,16 @@ def find_ffmpeg() -> str | None:
 
 
 class _Stage:
-    """Draws the dancer in perspective, one frame at a time, into a Pillow image (in
-    H.264's YCbCr for ffmpeg, or RGB for the GIF fallback).
+    """Draws the dancer in perspective into a Pillow image per frame (H.264's YCbCr for
+    ffmpeg, RGB for the GIF fallback).
 
-    The camera looks at the dancer from ``azimuth`` degrees about the vertical axis
-    and ``elevation`` degrees above the floor, and follows the dancer: it aims at the
-    joints' horizontal centroid smoothed over a second, so steps move the figure over a
-    floor grid that stays put in the world. The dancer's height (the 95th percentile
-    of the per-frame vertical extent) sets the distance, so the figure fills about
-    two thirds of the frame whatever the units. Bones are drawn far to near, with
-    their shadows on the floor; on a beat the figure turns red, a dot lights, and the
-    beat ruler at the bottom (beats within two seconds of now, scrolling past a
-    playhead) shows where the beats fall. Pillow draws every frame, from geometry
-    planned for all frames at once (:meth:`_plan`); speed: ``benchmarks/bench_render.py``.
+    The camera looks from ``azimuth`` [deg] about the vertical axis and ``elevation``
+    [deg] above the floor at the joints' horizontal centroid smoothed over a second, so
+    steps move the figure over a floor grid fixed in the world; the dancer's height sets
+    the distance (the figure fills about two thirds of the frame whatever the units).
+    Bones are drawn far to near over their shadows; on a beat the figure turns red and a
+    dot lights; a ruler at the bottom scrolls the beats within 2 s past a playhead. The
+    geometry of all frames is planned at once (:meth:`_plan`).
     """
 
     def __init__(
@@ -418,10 +330,12 @@ class _Stage:
         self.clock_at = (title_box[2] + 12, 6)
         self._plan()
 
-    def _screen(self, p: np.ndarray, eye: np.ndarray | None = None) -> np.ndarray:
+    def _screen(self, p: np.ndarray) -> np.ndarray:
         """(x, y, depth) in pixels of points ``p`` [shape=(n_frames, k, 3)]."""
-        eye = self.eye if eye is None else eye
-        c = (p - eye[:, None, :]) @ self.basis.T
+        return self._pixels((p - self.eye[:, None, :]) @ self.basis.T)
+
+    def _pixels(self, c: np.ndarray) -> np.ndarray:
+        """(x, y, depth) in pixels of camera coordinates ``c`` [shape=(..., 3)]."""
         z = np.maximum(c[..., 2], 1e-6)
         x = self.centre[0] + self.f * c[..., 0] / z
         y = self.centre[1] - self.f * c[..., 1] / z
@@ -450,11 +364,7 @@ class _Stage:
         span = cam[..., 1, :] - cam[..., 0, :]
         a = cam[..., 0, :] + np.where(d0 < near, s0, 0)[..., None] * span
         b = cam[..., 1, :] - np.where(d1 < near, s1, 0)[..., None] * span
-        seg = np.empty(cam.shape[:2] + (4,))
-        for k, q in enumerate((a, b)):
-            z = np.maximum(q[..., 2], 1e-6)
-            seg[..., 2 * k] = self.centre[0] + self.f * q[..., 0] / z
-            seg[..., 2 * k + 1] = self.centre[1] - self.f * q[..., 1] / z
+        seg = np.concatenate([self._pixels(a)[..., :2], self._pixels(b)[..., :2]], axis=-1)
         w, h = 2 * self.centre
         behind = (d0 < near) & (d1 < near)
         outside = ((seg[..., 0] < 0) & (seg[..., 2] < 0)) | ((seg[..., 0] > w) & (seg[..., 2] > w))
@@ -584,61 +494,20 @@ def write_video(
     duration: float | None = None,
     preset: str = "ultrafast",
 ) -> Path:
-    """Write a video of ``motion`` seen in perspective, with the music as soundtrack.
+    """Write a video of ``motion`` seen in perspective (:class:`_Stage`), with the music.
 
-    The camera follows the dancer over a floor grid; beats are marked (see
-    :class:`_Stage`).
+    ``audio`` is ``(y, sr)`` from motion time 0, cut to the video's length. ``fps`` [Hz]
+    defaults to the motion's (frames are picked, not interpolated). From each of
+    ``beats`` [s] the figure is red for 0.1 s. ``size`` [px] is rounded to even numbers.
+    ``azimuth`` [deg] 0 is :func:`plot_frames`' side view; ``elevation`` [deg, 0-80] the
+    camera's angle down on the dancer. ``ffmpeg``: a binary, ``None`` to find one
+    (:func:`find_ffmpeg`), ``False`` for the GIF + WAV fallback. ``progress``: True for a
+    tqdm bar, or ``progress(done, total)`` after each frame. ``duration`` [s] longer than
+    the motion holds the last pose. ``preset``: x264's speed/size trade-off
+    (``"veryfast"`` files are about three times smaller than ``"ultrafast"`` ones).
 
-    Parameters
-    ----------
-    motion : Motion
-        Skeletal motion (or marker positions); frame ``k`` at ``k / motion.fps`` [s].
-    path : path-like
-        Output ``.mp4``. Never overwritten in place: written to a temporary file in the
-        same folder, then renamed.
-    audio : (np.ndarray, int), optional
-        ``(y, sr)``: mono samples starting at motion time 0, sample rate [Hz]. Cut to
-        the video's length.
-    fps : float > 0, optional [Hz]
-        Video frame rate; default the motion's (frames are picked, not interpolated).
-    beats : np.ndarray [s], optional
-        Music beats: the figure turns red and a dot lights for 0.1 s from each beat,
-        and a ruler at the bottom shows the beats scrolling past.
-    size : (int, int) [px]
-        Width and height (rounded to even numbers for H.264).
-    up : {"x", "y", "z"}, optional
-        Vertical axis; default ``y`` for skeletons, ``z`` for markers.
-    azimuth : float [deg]
-        Camera position about the vertical axis (0: the side view of
-        :func:`plot_frames`).
-    elevation : float [deg], in [0, 80]
-        Camera height: the angle at which it looks down on the dancer.
-    title : str, optional
-        Text in the corner; default the motion's name.
-    ffmpeg : str or bool, optional
-        Path of an ffmpeg binary; ``None`` finds one (:func:`find_ffmpeg`); ``False``
-        forces the GIF + WAV fallback.
-    progress : bool or callable
-        True: a tqdm progress bar on stderr; a callable: ``progress(done, total)``
-        after each frame drawn.
-    duration : float > 0, optional [s]
-        Length of the video; default the motion's. Longer: the last pose is held
-        (e.g. to the end of the song, whose last beat the dance reaches).
-    preset : str
-        x264's speed/size trade-off: ``"ultrafast"`` writes a song-long video many
-        times faster than real time; ``"veryfast"`` makes files about three times
-        smaller (for videos embedded in a notebook or a page).
-
-    Returns
-    -------
-    path : Path
-        The video written: ``path`` itself, or ``path`` with suffix ``.gif`` in the
-        fallback (the audio is then written next to it as ``.wav``).
-
-    Raises
-    ------
-    ParameterError
-        Bad frame rate or size, unwritable folder, malformed audio, ffmpeg failure.
+    Returns ``path``, or ``path`` with suffix ``.gif`` in the fallback (the music then
+    beside it as ``.wav``).
     """
     from .io import check_output_folder
 
@@ -656,13 +525,10 @@ def write_video(
         try:
             y, sr = audio
         except (TypeError, ValueError):
-            raise ParameterError("audio must be a pair (y, sr)") from None
-        y = np.asarray(y, dtype=np.float32)
-        if y.ndim != 1 or y.size == 0:
-            raise ParameterError(f"audio samples must be a non-empty mono 1-D array, got {y.shape}")
-        if not sr or int(sr) <= 0:
-            raise ParameterError(f"audio sample rate {sr!r} must be > 0 [Hz]")
-        y_sr = (y, int(sr))
+            raise ParameterError(f"audio={type(audio).__name__} is not a pair (y, sr)") from None
+
+        y, sr = check_audio(y, sr, name="audio")
+        y_sr = (np.asarray(y, dtype=np.float32), int(sr))
 
     if not 0.0 <= float(elevation) <= 80.0:
         raise ParameterError(f"elevation={elevation!r} must be in [0, 80] degrees")
@@ -685,10 +551,12 @@ def write_video(
         from tqdm import tqdm
 
         frames_iter = tqdm(frames_iter, desc="video", unit="frame", leave=False)
-    length = len(t) / fps
-
+    frames = (stage.draw(k, float(t[k]), bool(on[k]), ruler[k]) for k in frames_iter)
+    if y_sr is not None:  # the music cut to the video's length
+        y, sr = y_sr
+        y_sr = (y[: int(np.ceil(len(t) / fps * sr))], sr)
     if exe is None:
-        return _write_gif_fallback(dest, stage, t, on, ruler, fps, y_sr, length, frames_iter)
+        return _write_gif(dest, frames, fps, y_sr)
 
     with tempfile.TemporaryDirectory(dir=parent, prefix=".beatsync-video-") as tmp:
         tmp_video = Path(tmp) / ("out" + (dest.suffix or ".mp4"))
@@ -700,10 +568,7 @@ def write_video(
         if y_sr is not None:
             from .io import write_audio
 
-            y, sr = y_sr
-            n = min(y.size, int(np.ceil(length * sr)))
-            wav = write_audio(Path(tmp) / "audio.wav", y[:n], sr)
-            cmd += ["-i", str(wav)]
+            cmd += ["-i", str(write_audio(Path(tmp) / "audio.wav", *y_sr))]
         cmd += ["-c:v", "libx264", "-preset", preset, "-crf", "23"]
         if y_sr is not None:
             cmd += ["-c:a", "aac", "-b:a", "128k"]
@@ -718,9 +583,8 @@ def write_video(
         pending: deque[Future[int]] = deque()
         with ThreadPoolExecutor(1) as writer:
             try:
-                for k in frames_iter:
-                    frame = _yuv420(stage.draw(k, float(t[k]), bool(on[k]), ruler[k]))
-                    pending.append(writer.submit(proc.stdin.write, frame))
+                for im in frames:
+                    pending.append(writer.submit(proc.stdin.write, _yuv420(im)))
                     if len(pending) > 4:
                         pending.popleft().result()
                 while pending:
@@ -790,24 +654,12 @@ def _reporting(frames: range, progress: Callable[[int, int], None]) -> Iterator[
         progress(done, total)
 
 
-def _write_gif_fallback(
-    dest: Path,
-    stage: _Stage,
-    t: np.ndarray,
-    on: np.ndarray,
-    ruler: list[np.ndarray],
-    fps: float,
-    y_sr: tuple[np.ndarray, int] | None,
-    duration: float,
-    frames_iter: Any,
-) -> Path:
-
+def _write_gif(dest: Path, frames: Iterator[Any], fps: float, audio: Any) -> Path:
+    """Without ffmpeg: the frames as an animated GIF, the ``audio`` as a WAV beside it."""
     from .io import atomic_write, write_audio
 
-    gif = dest.with_suffix(".gif")
-    wav = dest.with_suffix(".wav")
-    w, h = stage.size
-    images = [stage.draw(k, float(t[k]), bool(on[k]), ruler[k]) for k in frames_iter]
+    gif, wav = dest.with_suffix(".gif"), dest.with_suffix(".wav")
+    images = list(frames)
     with atomic_write(gif, "wb") as fh:
         images[0].save(
             fh,
@@ -818,9 +670,8 @@ def _write_gif_fallback(
             loop=0,
         )
     msg = f"no ffmpeg found: wrote the animation as {str(gif)!r} without sound"
-    if y_sr is not None:
-        y, sr = y_sr
-        write_audio(wav, y[: min(y.size, int(np.ceil(duration * sr)))], sr)
+    if audio is not None:
+        write_audio(wav, *audio)
         msg += f" and the music as {str(wav)!r}; play them together"
     msg += " (install ffmpeg or `pip install imageio-ffmpeg` for an MP4 with sound)"
     warn(msg, stacklevel=3)

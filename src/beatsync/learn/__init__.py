@@ -1,14 +1,10 @@
 """Exercises that check themselves, for the tutorials in ``notebooks/tutorials/``.
 
-A tutorial's exercise cell holds a skeleton (a function or value for the student to
-write); the cell after it calls :func:`check` with the exercise's name and the
-student's answer. The check computes the expected answer with the package itself and
-says right, or not yet with a hint that names the mismatch (a shape, a unit, an
-index), never the solution.
-
-Each tutorial's exercises are registered with :func:`exercise` in a module of this
-package named for its block (``segmentation``, ``beats``, ...); :func:`check` imports
-them on first use.
+A tutorial's exercise cell holds a skeleton for the student to fill in; the next cell
+calls :func:`check` with the exercise's name and the answer. Each judge, registered
+with :func:`exercise` in this package's module of its tutorial block, computes the
+expected answer with the package itself and returns a hint that names the mismatch
+(a shape, a unit, an index), never the solution.
 """
 
 from __future__ import annotations
@@ -49,11 +45,8 @@ class Verdict:
 
 
 def exercise(name: str) -> Callable[[Callable[[Any], str | None]], Callable[[Any], str | None]]:
-    """Register ``judge(answer) -> None | hint`` as the check of exercise ``name``.
-
-    The judge returns ``None`` when the answer is right, else a hint naming what does
-    not match. It may raise; an exception from the student's code becomes the hint.
-    """
+    """Register ``judge(answer) -> None | hint`` as the check of exercise ``name``: None
+    when the answer is right; an exception from the student's code becomes the hint."""
 
     def register(judge: Callable[[Any], str | None]) -> Callable[[Any], str | None]:
         _REGISTRY[name] = judge
@@ -69,13 +62,7 @@ def exercises() -> list[str]:
 
 
 def check(name: str, answer: Any) -> Verdict:
-    """Judge ``answer`` to exercise ``name``; display the returned :class:`Verdict`.
-
-    Raises
-    ------
-    KeyError
-        ``name`` is not an exercise (the message lists the known ones).
-    """
+    """Judge ``answer`` to exercise ``name``; display the returned :class:`Verdict`."""
     _load()
     if name not in _REGISTRY:
         raise KeyError(f"no exercise named {name!r}; known: {', '.join(sorted(_REGISTRY))}")

@@ -1,10 +1,5 @@
-"""Exercises of tutorial 02 (beat tracking, paper A, sec. 4).
-
-Notebook: ``notebooks/tutorials/02_beat_tracking.ipynb``. Each judge computes the
-expected answer with :mod:`beatsync.evaluate.beats` (mir_eval) on the human beat
-annotations of Hainsworth 001 (the tutorial's data, read here so that the check does
-not depend on the notebook).
-"""
+"""Exercises of ``notebooks/tutorials/02_beat_tracking.ipynb`` (paper A, sec. 4), judged
+with :mod:`beatsync.evaluate.beats` on the annotations of Hainsworth 001."""
 
 from __future__ import annotations
 

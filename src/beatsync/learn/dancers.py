@@ -1,11 +1,5 @@
-"""Exercises of tutorial 5, real dancers and the two beat-alignment scores.
-
-Each judge computes the expected answer with :mod:`beatsync.evaluate.alignment` on
-inputs of its own (the kinematic beats of a bundled Dance-with-Melody dancer and the
-beats of a steady pulse) and returns a hint naming the mismatch, never the solution.
-
-Notebook: ``notebooks/tutorials/05_real_dancers.ipynb``.
-"""
+"""Exercises of ``notebooks/tutorials/05_real_dancers.ipynb`` (the two beat-alignment
+scores), judged with :mod:`beatsync.evaluate.alignment` on a bundled dancer's beats."""
 
 from __future__ import annotations
 

@@ -1,12 +1,5 @@
-"""Exercises of tutorial 4, motion graphs and DP composition (paper B).
-
-Each judge computes the expected answer with the package (:mod:`beatsync.graph`,
-:mod:`beatsync.motion_beats`, :mod:`beatsync.music`) on inputs of its own (a CMU
-salsa clip, a synthetic drum song) and returns a hint naming the mismatch, never the
-solution.
-
-Notebook: ``notebooks/tutorials/04_motion_graphs.ipynb``.
-"""
+"""Exercises of ``notebooks/tutorials/04_motion_graphs.ipynb`` (paper B), judged on a
+CMU salsa clip and a synthetic drum song."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""Exercises of tutorial 3, beat-synchronous resampling (paper A, section 5).
-
-Each judge computes the expected answer with :mod:`beatsync.sync` on inputs of its
-own (a synthetic periodic motion with known boundaries, a steady beat with a tempo
-change) and returns a hint naming the mismatch, never the solution.
-
-Notebook: ``notebooks/tutorials/03_resampling.ipynb``.
-"""
+"""Exercises of ``notebooks/tutorials/03_resampling.ipynb`` (paper A, section 5), judged
+with :mod:`beatsync.sync` on a synthetic periodic motion and a slowing beat."""
 
 from __future__ import annotations
 
@@ -28,12 +22,9 @@ def compare_arrays(
     rtol: float = 1e-6,
     atol: float = 0.0,
 ) -> str | None:
-    """None if ``got`` equals ``expected`` (to ``rtol``, ``atol``), else a hint naming the mismatch.
-
-    The hint says the shape, the first element that differs and by how much (a
-    constant offset, a factor, a sign), never the expected values. Shared by the
-    judges of tutorials 3-5.
-    """
+    """None if ``got`` equals ``expected`` (to ``rtol``, ``atol``), else a hint naming the
+    mismatch (shape, first element that differs, an offset, factor or sign), never the
+    expected values."""
     if got is None:
         return f"{what} returned None: fill in the skeleton."
     try:
@@ -62,24 +53,22 @@ def compare_arrays(
 
 
 @functools.cache
-def _case() -> tuple[np.ndarray, np.ndarray]:
-    """Period boundaries (0.9-1.1 s periods) and beats that slow from 120 to 100 BPM."""
+def _case() -> tuple[Any, np.ndarray]:
+    """A periodic motion (0.9-1.1 s periods) and beats that slow from 120 to 100 BPM."""
     from ..synth.motion import periodic_motion
 
     syn = periodic_motion(n_frames=301, fps=30.0, n_periods=10, seed=3, snr_db=None)
     gaps = np.linspace(0.5, 0.6, 40)
-    beats = 0.25 + np.concatenate([[0.0], np.cumsum(gaps)])
-    return syn.boundaries, beats
+    return syn, 0.25 + np.concatenate([[0.0], np.cumsum(gaps)])
 
 
 @exercise("resampling.landing_beats")
 def _landing_beats(answer: Any) -> str | None:
     """``landing_beats(beats, n_periods, m, first_beat)``: the beat of every boundary."""
     from ..sync import synchronize
-    from ..synth.motion import periodic_motion
 
-    syn = periodic_motion(n_frames=301, fps=30.0, n_periods=10, seed=3, snr_db=None)
-    beats = _case()[1].copy()  # the student's code may change its arguments
+    syn, beats = _case()
+    beats = beats.copy()  # the student's code may change its arguments
     n_periods = syn.boundaries.size - 1
     for m, first in ((2, 0), (3, 1)):
         res = synchronize(syn.motion, syn.boundaries, beats, beats_per_period=m, first_beat=first)
@@ -103,7 +92,7 @@ def _period_rates(answer: Any) -> str | None:
     """``period_rates(boundaries, targets)``: r_i of every period (paper A, sec. 5)."""
     from ..sync import time_warp
 
-    boundaries, beats = (a.copy() for a in _case())
+    boundaries, beats = (a.copy() for a in (_case()[0].boundaries, _case()[1]))
     targets = beats[: 2 * boundaries.size : 2][: boundaries.size]
     expected = time_warp(boundaries, targets).period_rates
     got = answer(boundaries, targets)

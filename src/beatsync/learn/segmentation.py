@@ -1,9 +1,5 @@
-"""Exercises of tutorial 01 (periodic motion segmentation, paper A, sec. 3).
-
-Notebook: ``notebooks/tutorials/01_segmentation.ipynb``. Each judge computes the
-expected answer with :mod:`beatsync.segment` on the CMU salsa take 60_01 (the
-tutorial's data, read here so that the check does not depend on the notebook).
-"""
+"""Exercises of ``notebooks/tutorials/01_segmentation.ipynb`` (paper A, sec. 3), judged
+with :mod:`beatsync.segment` on the CMU salsa take 60_01."""
 
 from __future__ import annotations
 
@@ -69,10 +65,8 @@ def judge_pearson_distance(pearson_distance: Any) -> str | None:
                 "period onto the earlier one's samples (end points aligned) instead."
             )
         grid = np.linspace(0, first.size - 1, later.size)
-        if (
-            abs(got - (1 - np.corrcoef(np.interp(grid, np.arange(first.size), first), later)[0, 1]))
-            < 1e-4
-        ):
+        resampled = np.interp(grid, np.arange(first.size), first)
+        if abs(got - (1 - np.corrcoef(resampled, later)[0, 1])) < 1e-4:
             return f"for the {where} you resampled the earlier period: resample the later one."
         return f"for the {where} your distance is {got:.4f}, off by {got - want:+.4f}."
     return None

@@ -1,21 +1,16 @@
 """Live sliders for the tutorials that keep working on a static page.
 
-``explore(update, alpha=[0.1, 0.3, 1.0], ...)`` returns an :class:`Explorer`. Shown
-in a kernel (JupyterLab, Notebook) it is an ipywidgets view: one ``SelectionSlider``
-per parameter, and ``update(**values)`` re-run as a slider moves. The same display
-also carries ``text/html``: every combination of the slider values rendered when the
-cell runs, as PNG images (and any audio) swapped by a plain ``<input type=range>`` and
+``explore(update, alpha=[0.1, 0.3, 1.0], ...)`` returns an :class:`Explorer`. In a
+kernel it is an ipywidgets view: a ``SelectionSlider`` per parameter, ``update(**values)``
+re-run as one moves. The same display carries ``text/html``: every combination rendered
+when the cell runs, as PNG images (and any audio) swapped by ``<input type=range>`` and
 a few lines of inline JavaScript, so a page built from the executed notebook keeps a
-working slider with no kernel, no CDN and no request leaving the page. The page names
-the values it holds ("precomputed for: alpha = 0.1, 0.3, 1.0").
+working slider with no kernel and no request leaving the page.
 
 ``update`` returns a matplotlib Figure, or ``(figure, extra)`` where ``extra`` (or each
-item of a list of extras) has ``_repr_html_`` (``IPython.display.Audio``, ``HTML``) and
-is shown below the figure. Each combination is computed once: the live view and the
-static page share one cache of rendered states (PNG bytes and the extras' HTML), so a
-slider moved back to a value seen before, or to any precomputed value, costs nothing.
-Whatever does not depend on the sliders belongs outside ``update`` (computed once in
-the tutorial); a cold update should take well under a second.
+of a list) has ``_repr_html_`` (``IPython.display.Audio``, ``HTML``), shown below it.
+Both views share one cache of rendered states, so each combination is computed once.
+Whatever does not depend on the sliders belongs outside ``update``.
 """
 
 from __future__ import annotations
@@ -26,6 +21,7 @@ import html
 import io
 import itertools
 import json
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -53,24 +49,9 @@ class State:
 def explore(
     update: Callable[..., Any], *, max_states: int = MAX_STATES, **sliders: Sequence[Any]
 ) -> Explorer:
-    """A slider per keyword over ``update(**values)``; the first value of each list is shown first.
-
-    Parameters
-    ----------
-    update : callable
-        ``update(**values) -> Figure | (Figure, extra)``, called with one value per slider.
-    max_states : int > 0
-        The most combinations (the product of the lists' lengths) to precompute for
-        the static page; more raise, since each is a PNG in the executed notebook.
-    **sliders : list
-        Slider name -> its values (hashable: numbers, strings, tuples), in slider order.
-
-    Raises
-    ------
-    ParameterError
-        No slider, a slider with no values or an unhashable value, or more
-        combinations than ``max_states``.
-    """
+    """A slider per keyword (name -> its hashable values) over ``update(**values)``; the
+    first value of each list is shown first. At most ``max_states`` combinations: each
+    is a PNG in the executed notebook."""
     if not callable(update):
         raise ParameterError(f"update={update!r} is not callable: pass the function itself")
     if not sliders:
@@ -89,9 +70,7 @@ def explore(
                 f"slider {name}={sliders[name]!r} has an unhashable value: use tuples, not lists"
             ) from None
         values[name] = vals
-    n = 1
-    for vals in values.values():
-        n *= len(vals)
+    n = math.prod(len(vals) for vals in values.values())
     if n > max_states:
         sizes = " x ".join(f"{len(v)} {k}" for k, v in values.items())
         raise ParameterError(
@@ -137,17 +116,14 @@ class Explorer:
         combos = self.combinations()
         states = [self.render(**c) for c in combos]
         uid = "bsx-" + hashlib.sha1(b"".join(s.png for s in states)).hexdigest()[:12]
-        first = self.initial
-        inputs = []
-        for name, vals in self.sliders.items():
-            labels = json.dumps([_label(v) for v in vals])
-            i0 = vals.index(first[name])
-            inputs.append(
-                f'<label style="display:block">{html.escape(name)} '
-                f'<input type="range" min="0" max="{len(vals) - 1}" step="1" value="{i0}" '
-                f"data-labels='{html.escape(labels)}'/> "
-                f"<span>{html.escape(_label(vals[i0]))}</span></label>"
-            )
+        first = self.initial  # each slider at its first value
+        inputs = [
+            f'<label style="display:block">{html.escape(name)} '
+            f'<input type="range" min="0" max="{len(vals) - 1}" step="1" value="0" '
+            f"data-labels='{html.escape(json.dumps([_label(v) for v in vals]))}'/> "
+            f"<span>{html.escape(_label(vals[0]))}</span></label>"
+            for name, vals in self.sliders.items()
+        ]
         divs = []
         for combo, state in zip(combos, states, strict=True):
             key = "-".join(str(self.sliders[k].index(v)) for k, v in combo.items())

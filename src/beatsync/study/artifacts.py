@@ -48,29 +48,10 @@ def write_artifacts(
     figures: dict[str, Any] | None = None,
     data: dict[str, Any] | None = None,
 ) -> list[Path]:
-    """Write a notebook's artefacts under ``results_dir/notebook/``.
-
-    Parameters
-    ----------
-    results_dir : path
-        The study's results folder (``../results`` or ``../results/ci``: relative ones
-        are found from the repository's ``notebooks/`` folder, :func:`results_folder`).
-    notebook : str
-        The notebook's name (file stem); the artefacts' folder.
-    params : dict
-        The notebook's parameters, written to ``params.json`` with the version.
-    tables : dict of str -> pandas.DataFrame, optional
-        Written as ``<name>.csv`` (no index, floats at :data:`CSV_FLOAT_FORMAT`).
-    figures : dict of str -> matplotlib Figure, optional
-        Written as ``<name>.png``.
-    data : dict of str -> JSON-able object, optional
-        Further results written as ``<name>.json``.
-
-    Returns
-    -------
-    list of Path
-        Every file written.
-    """
+    """Write a notebook's artefacts under ``results_dir/notebook/`` (a relative
+    ``results_dir`` is taken from the repository's ``notebooks/``, :func:`results_folder`):
+    ``tables`` as ``<name>.csv`` (no index), ``figures`` as ``<name>.png``, ``data`` as
+    ``<name>.json``, and ``params.json``; returns every file written."""
     out = results_folder(results_dir) / notebook
     out.mkdir(parents=True, exist_ok=True)
     written = []

@@ -1,20 +1,14 @@
 """Beat trackers run and scored against the annotations of a dataset, on Dask.
 
-Every score is :func:`beatsync.evaluate.beats.evaluate` (``mir_eval.beat.evaluate`` on
-validated beat times); methods are named as in
-:data:`beatsync.other_trackers.TRACKERS` (``psf`` is ours). Every time is in seconds,
-every tempo in BPM.
+Scores are :func:`beatsync.evaluate.beats.evaluate`'s, methods those of
+:data:`beatsync.other_trackers.TRACKERS`; times are in seconds, tempi in BPM.
 
-- :func:`find_tracks` pairs every audio file with the annotation of the same stem
-  (``.beats``: one time [s] per line, an optional second column such as the beat in
-  the bar is ignored); :func:`read_annotation` refuses values that are not seconds.
-- :func:`evaluate_track` reads, tracks and scores one file into a row; a track that
-  fails (unreadable, silent, too short) is a row with its error, never an exception.
-- :func:`evaluate_dataset` (``beatsync evaluate beats``) runs the tracks on Dask
-  (:func:`beatsync.cluster.dask_client`) in groups, appends each row to
-  ``OUT/tracks.jsonl`` as soon as its group finishes (a crash or Ctrl-C loses at most
-  the groups in flight; a rerun skips the tracks already scored), then writes
-  ``OUT/tracks.csv`` and ``OUT/summary.csv`` (:func:`summarize_dataset`) atomically.
+:func:`find_tracks` pairs every audio file with the annotation of the same stem
+(``.beats``: one time [s] per line, an optional second column such as the beat in the
+bar is ignored). :func:`evaluate_dataset` (``beatsync evaluate beats``) runs the
+tracks on Dask in groups, appends each row to ``OUT/tracks.jsonl`` as soon as its
+group finishes (a crash or Ctrl-C loses at most the groups in flight; a rerun skips
+the tracks already scored), then writes ``OUT/tracks.csv`` and ``OUT/summary.csv``.
 
 pandas is imported by the table functions only: a worker imports this module to run
 :func:`evaluate_tracks` and needs none of it.
@@ -75,16 +69,8 @@ ANNOTATION_SUFFIX = ".beats"
 
 @dataclass(frozen=True)
 class Track:
-    """One audio file and its annotation.
-
-    Attributes
-    ----------
-    key : str
-        The audio file's path relative to the audio folder, without suffix (POSIX).
-    group : str
-        Its folder relative to the audio folder (``"."`` at the top).
-    audio, annotation : Path
-    """
+    """One audio file and its annotation: ``key`` is the audio file's path relative to
+    the audio folder without suffix (POSIX), ``group`` its folder (``"."`` at the top)."""
 
     key: str
     group: str
@@ -96,19 +82,12 @@ class Track:
 class TrackList:
     """Output of :func:`find_tracks`: the pairs, and the audio files left without one.
 
-    Attributes
-    ----------
-    tracks : list of Track
-    unmatched : list of Path
-        Audio files with no annotation of their name.
-    shared : dict of Path -> list of Path
-        Annotations found by name only (a flat folder) that more than one audio file
-        would use (``a/x.wav`` and ``b/x.wav`` for ``x.beats``), or that another audio
-        file has at its own relative path: the audio files that found them by name are
-        skipped, as an annotation fits one recording at most.
-    duplicates : list of Path
-        Audio files skipped because a file of the same path and name with another
-        suffix was taken (``x.wav`` beside ``x.flac``: the first in sorted order).
+    ``unmatched``: audio files with no annotation of their name. ``shared``: annotations
+    found by name only that several audio files would use (``a/x.wav`` and ``b/x.wav``
+    for ``x.beats``), or that another audio file has at its own relative path, with the
+    audio files skipped for it (an annotation fits one recording). ``duplicates``: audio
+    files skipped beside one of the same name with another suffix (``x.wav`` beside
+    ``x.flac``: the first in sorted order is taken).
     """
 
     tracks: list[Track]
@@ -129,19 +108,10 @@ def _folder(path: str | os.PathLike[str], what: str) -> Path:
 def find_tracks(
     audio_dir: str | os.PathLike[str], annotation_dir: str | os.PathLike[str]
 ) -> TrackList:
-    """Pair every audio file under ``audio_dir`` with the ``.beats`` file of its stem.
-
-    The annotation at the same relative path is preferred (``a/x.wav`` ->
-    ``a/x.beats``); otherwise the only ``x.beats`` anywhere under ``annotation_dir``
-    (flat annotation folders, as in most datasets). Audio files are those with a
-    suffix in :data:`beatsync.io.AUDIO_SUFFIXES`, searched recursively.
-
-    Raises
-    ------
-    ParameterError
-        A folder that is missing or a file; no audio file; no annotation file; no
-        audio file with an annotation of its own (see :class:`TrackList`).
-    """
+    """Pair every audio file under ``audio_dir`` (:data:`beatsync.io.AUDIO_SUFFIXES`,
+    recursively) with the ``.beats`` file at the same relative path (``a/x.wav`` ->
+    ``a/x.beats``), else with the only one of its stem under ``annotation_dir`` (flat
+    annotation folders, as in most datasets)."""
     a_dir = _folder(audio_dir, "audio")
     b_dir = _folder(annotation_dir, "annotation")
     audio = sorted(
@@ -197,15 +167,8 @@ def find_tracks(
 
 
 def read_annotation(path: str | os.PathLike[str]) -> np.ndarray:
-    """Beat times [s] of an annotation file, refused if they are not seconds.
-
-    Raises
-    ------
-    ParameterError
-        Unreadable, empty, unsorted, non-numeric (:func:`beatsync.io.read_beats`),
-        values that look like frame indices or milliseconds (the message says which),
-        or times closer than a beat at 400 BPM (minutes, or onsets).
-    """
+    """Beat times [s] of an annotation file (:func:`beatsync.io.read_beats`), refused if
+    they look like frame indices, milliseconds, minutes or onsets instead."""
     times = io.read_beats(path)
     detail = not_seconds_detail(times)
     if detail is not None:
@@ -237,37 +200,18 @@ def evaluate_track(
     min_bpm: float | None = None,
     max_bpm: float | None = None,
 ) -> dict[str, Any]:
-    """Track one audio file and score it; a failure becomes the row's ``error``.
+    """Track one audio file and score it against ``reference`` [s]: the row of one track.
 
-    The work of a Dask task of :func:`evaluate_dataset` (:func:`evaluate_tracks`); it
-    never raises for a bad track (unreadable, silent, too short), so that one track
-    cannot stop a run.
-
-    Parameters
-    ----------
-    audio : str
-        Audio file path (valid on the worker).
-    reference : np.ndarray [s]
-        Annotated beats (:func:`read_annotation`).
-    method : str
-        A name of :data:`beatsync.other_trackers.TRACKERS`.
-    min_beat_time : float >= 0 [s]
-    name, group : str
-        The track's :attr:`Track.key` (recorded as ``key``) and :attr:`Track.group`.
-    min_bpm, max_bpm : float, optional [BPM]
-        The tempo range searched (:func:`beatsync.other_trackers.check_tempo_range`);
-        ``None``: the method's default. Recorded as checked (a bound equal to the
-        default as ``None``); a range the method refuses is the row's ``error``.
-
-    Returns
-    -------
-    dict
-        ``key, group, audio, audio_bytes`` (its size, None if unreadable),
-        ``reference_digest``, ``method, min_beat_time, min_bpm, max_bpm, status``
-        (``"ok"`` or ``"error"``), ``error``, ``warning`` (the tracker's or scorer's
-        warnings), ``n_ref, n_est, tempo_ref, tempo_est, octave``, every metric of
-        :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking
-        time), ``audio_seconds`` and ``beats`` (the estimated times).
+    A Dask task of :func:`evaluate_dataset`: a bad track (unreadable, silent, too short,
+    a tempo range the method refuses) is a row with its ``error``, never an exception,
+    so that one track cannot stop a run. ``name`` and ``group`` are the track's
+    :attr:`Track.key` and :attr:`Track.group`; ``min_bpm``, ``max_bpm`` [BPM] the tempo
+    range (:func:`beatsync.other_trackers.check_tempo_range`, recorded as checked).
+    The row: ``key, group, audio, audio_bytes, reference_digest, method, min_beat_time,
+    min_bpm, max_bpm, status`` (``"ok"`` or ``"error"``), ``error``, ``warning``,
+    ``n_ref, n_est, tempo_ref, tempo_est, octave``, every metric of
+    :data:`~beatsync.evaluate.beats.METRICS`, ``seconds`` (reading and tracking),
+    ``audio_seconds`` and ``beats`` (the estimated times).
     """
     row = _failed_row(
         audio, reference, "", method=method, min_beat_time=min_beat_time, name=name,
@@ -380,11 +324,8 @@ GROUP_TRACKS = 8
 
 
 class TrackLog:
-    """The append-only JSON-lines record of a dataset run (``OUT/tracks.jsonl``).
-
-    Each :meth:`append` writes its rows' lines at once and flushes them to disk, so a
-    crash loses at most the lines being written; :meth:`rows` skips a torn line.
-    """
+    """The append-only JSON-lines record of a dataset run (``OUT/tracks.jsonl``): a
+    crash loses at most the lines being appended, and :meth:`rows` skips a torn line."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
@@ -422,17 +363,10 @@ def _setting(rows: pd.DataFrame, key: str) -> float:
 
 
 def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
-    """Means per method and folder (and over all folders) of a dataset run's rows.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns ``method, group`` (``"all"`` for every folder together), the settings
-        the scored rows were scored with (``min_beat_time``, ``min_bpm``, ``max_bpm``:
-        empty for the default range, or if the rows differ; those of the failed rows if
-        none scored), ``tracks``, ``failed``, the mean of every metric over the scored
-        tracks, ``octave errors`` and ``other tempo`` (counts).
-    """
+    """Means per method and folder (``group`` ``"all"``: every folder together) of a
+    dataset run's rows: the settings the scored rows share (empty for the default range
+    or if they differ; the failed rows' if none scored), ``tracks``, ``failed``, each
+    metric's mean over the scored tracks, ``octave errors`` and ``other tempo``."""
     import pandas as pd
 
     table = pd.DataFrame(list(rows))
@@ -467,22 +401,11 @@ def summarize_dataset(rows: Sequence[dict[str, Any]]) -> pd.DataFrame:
 
 @dataclass(frozen=True)
 class DatasetRun:
-    """Output of :func:`evaluate_dataset`.
-
-    Attributes
-    ----------
-    tracks : pandas.DataFrame
-        The latest row of every track of this method (without the beat lists).
-    summary : pandas.DataFrame
-        :func:`summarize_dataset` of every method recorded in the output folder.
-    scored, skipped : int
-        Tracks run now, and tracks already recorded by an earlier run.
-    files : dict of str -> Path
-        ``log`` (``tracks.jsonl``), ``tracks`` (CSV) and ``summary`` (CSV).
-    changed : int
-        Tracks run now although scored before: their audio file (path or size) or
-        annotation changed since.
-    """
+    """Output of :func:`evaluate_dataset`: this method's latest row of every track
+    (without the beats), the :func:`summarize_dataset` of every method in the folder,
+    the tracks ``scored`` now and ``skipped`` (recorded before), the ``files`` (``log``,
+    ``tracks``, ``summary``), and the tracks run again because their audio file or
+    annotation ``changed``."""
 
     tracks: pd.DataFrame
     summary: pd.DataFrame
@@ -526,43 +449,18 @@ def evaluate_dataset(
 ) -> DatasetRun:
     """Track and score every track on Dask; record each row as soon as its group finishes.
 
-    Parameters
-    ----------
-    tracks : sequence of Track
-        From :func:`find_tracks`.
-    out_dir : path
-        Results folder (created if missing; its parent must exist): ``tracks.jsonl``
-        (one row per finished track, appended), ``tracks.csv``, ``summary.csv``.
-    method : str
-        A name of :data:`beatsync.other_trackers.TRACKERS`.
-    min_beat_time : float >= 0 [s]
-        Beats before this time are not scored (mir_eval/MIREX use 5 s; 0 scores all).
-    min_bpm, max_bpm : float, optional [BPM]
-        The tempo range the method searches on every track; a bound not given keeps the
-        method's default (:func:`beatsync.other_trackers.check_tempo_range`). Recorded
-        in each row.
-    force : bool
-        Re-run these tracks although recorded for ``method`` (default: skip those
-        scored). The new rows are appended; once the run completes, the record keeps
-        the latest row of every track, and drops rows of this method for tracks outside
-        this run that were scored with other settings. Tracks recorded with an error,
-        and tracks whose audio file (path or size) or annotation changed since they were
-        scored, are always re-run.
-    scheduler, n_workers, processes
-        See :func:`beatsync.cluster.dask_client`. Workers of an existing cluster must
-        see the audio files at the same paths.
-    progress : callable ``progress(done, total=None)``, optional
-        Called as groups of tracks finish, with the number of tracks done.
-
-    Raises
-    ------
-    ParameterError
-        An unknown or unavailable method; an annotation that is not beat times in
-        seconds; an output folder that is a file; results in ``out_dir`` scored with
-        another ``min_beat_time`` or tempo range (without ``force``; failed rows do not
-        count, they are re-run); a tempo range the method does not accept (for librosa,
-        one holding none of its tempi at a track's sample rate); a bad worker count or
-        an unreachable scheduler (:func:`~beatsync.cluster.dask_client`).
+    ``out_dir`` is created if missing (its parent must exist). ``min_beat_time`` [s]:
+    beats before it are not scored (mir_eval/MIREX use 5 s). ``min_bpm``, ``max_bpm``
+    [BPM]: the tempo range searched on every track (a bound not given keeps the
+    method's default). Tracks already scored for ``method`` are skipped, unless
+    ``force``; tracks recorded with an error, or whose audio file (path or size) or
+    annotation changed, are always re-run. With ``force`` the new rows are appended;
+    once the run completes the record keeps the latest row of every track and drops
+    this method's rows of tracks outside the run that were scored with other settings.
+    Without ``force``, scored results of other settings in ``out_dir`` are refused.
+    ``scheduler``, ``n_workers``, ``processes``: :func:`beatsync.cluster.dask_client`
+    (an existing cluster's workers must see the audio at the same paths).
+    ``progress(done, total=None)`` is called as groups of tracks finish.
     """
     from ..cluster import dask_client
     from ..validation import check_cluster_options, check_positive
@@ -599,23 +497,17 @@ def evaluate_dataset(
                 f"{_range_text(other_range[0])}, not {_range_text(bpm_range)}; use --force "
                 "to re-run them or another --out"
             )
-        for t in tracks:
-            row = previous.get(t.key)
-            if row is None or row.get("status") != "ok":
-                continue
-            if _same_inputs(row, t, refs[t.key]):
-                done.add(t.key)
-            else:
-                changed += 1
+        ok = [t for t in tracks if previous.get(t.key, {}).get("status") == "ok"]
+        done = {t.key for t in ok if _same_inputs(previous[t.key], t, refs[t.key])}
+        changed = len(ok) - len(done)
     todo = [t for t in tracks if t.key not in done]
     if method == "librosa" and tempo:
         _check_librosa_rates(todo, tempo)
     created = not out.exists()
     try:
         with contextlib.ExitStack() as stack:
-            # the tracks silence other packages' warnings with warnings.catch_warnings,
-            # whose filters are process-wide: tracks on the threads of this process
-            # (processes=False) could leave them changed; restored when the run ends
+            # the tracks' warnings.catch_warnings filters are process-wide: tracks on this
+            # process's threads (processes=False) could leave them changed; restored here
             stack.enter_context(warnings.catch_warnings())
             if todo:  # connect first: an unreachable scheduler changes nothing on disk
                 client = stack.enter_context(
@@ -652,8 +544,7 @@ def evaluate_dataset(
 
 
 def _same_inputs(row: dict[str, Any], track: Track, reference: np.ndarray) -> bool:
-    """Was ``row`` scored on this track's audio file and annotation? Rows written before
-    the digest and size were recorded are taken as they are."""
+    """Was ``row`` scored on this track's audio file (path and size) and annotation?"""
     stored = row.get("audio")
     if stored is not None and os.path.realpath(stored) != os.path.realpath(track.audio):
         return False  # (the same file given through another path is the same file)
@@ -687,13 +578,9 @@ def _range_text(bounds: tuple[float | None, float | None]) -> str:
 
 
 def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> None:
-    """Refuse, before any work, a tempo range librosa cannot search at a track's rate.
-
-    librosa's tempi are lags of an onset autocorrelation, so which exist depends on the
-    sample rate (:func:`beatsync.beats.tracker.librosa_tempo_prior`). A file the client
-    cannot open (e.g. a path valid only on the workers) or with an implausible rate is
-    left to its task, which records why it fails.
-    """
+    """Refuse, before any work, a tempo range librosa cannot search at a track's rate
+    (its tempi are lags of an onset autocorrelation: which exist depends on the rate).
+    A file the client cannot open is left to its task, which records why it fails."""
     import soundfile as sf
 
     from ..beats.tracker import librosa_tempo_prior
@@ -717,10 +604,8 @@ def _check_librosa_rates(tracks: Sequence[Track], tempo: dict[str, float]) -> No
 
 
 def _prepare_workers(client, method: str) -> None:
-    """:func:`beatsync.other_trackers.prepare` on each worker in turn, never two at once:
-    a fresh install's workers would otherwise compile librosa's numba cache together,
-    which can crash them. A worker that fails here records the error with its first
-    track."""
+    """:func:`beatsync.other_trackers.prepare` on each worker in turn: workers compiling
+    librosa's numba cache together can crash (a failure shows in the first track)."""
     if method != "librosa":
         return
     for address in client.nthreads():  # every worker
@@ -729,15 +614,10 @@ def _prepare_workers(client, method: str) -> None:
 
 
 def _groups(todo: Sequence[Track], n_threads: int) -> list[list[Track]]:
-    """The tracks in order, in groups of decreasing size: one task each.
-
-    Dask spends a few milliseconds on every task, comparable to tracking a short
-    excerpt, so each task takes several tracks (Dask's best practices: fewer, larger
-    tasks). Each group holds the remaining tracks over the worker threads, at most
-    :data:`GROUP_TRACKS` (guided self-scheduling, Polychronopoulos & Kuck 1987), so the
-    last groups hold one track and the workers finish together. A group's rows are
-    recorded when it finishes: a crash or Ctrl-C loses at most the groups in flight.
-    """
+    """The tracks in order, in groups of decreasing size, one task each (a Dask task
+    costs about as much as tracking a short excerpt): the remaining tracks over the
+    worker threads, at most :data:`GROUP_TRACKS` (guided self-scheduling), so that the
+    workers finish together."""
     groups, i = [], 0
     while i < len(todo):
         size = min(GROUP_TRACKS, -(-(len(todo) - i) // max(1, n_threads)))
@@ -747,9 +627,9 @@ def _groups(todo: Sequence[Track], n_threads: int) -> list[list[Track]]:
 
 
 def _longest_first(todo: Sequence[Track]) -> list[Track]:
-    """The tracks by audio file size, largest first (ties in their order): the longest
-    go out in the first, largest groups and the shortest last, so the workers finish
-    together (longest processing time first; a file's size stands for its length)."""
+    """The tracks by audio file size (for length), largest first: longest processing
+    time first, so that the workers finish together."""
+
     return sorted(todo, key=lambda t: -(_audio_bytes(t.audio) or 0))
 
 
@@ -771,9 +651,8 @@ def _run(client, todo, refs, log, *, method, mbt, tempo, progress) -> None:
         )  # fmt: skip
 
     def submit(groups: list[list[Track]]) -> None:
-        # in one call, so that the scheduler sees the run's tasks as one group and queues
-        # them (worker-saturation) instead of handing the first ones out at once, in this
-        # order; one key prefix for the run, as Dask groups tasks by it
+        # in one call and with one key prefix, so that the scheduler sees the run's tasks
+        # as one group and queues them in this order (worker-saturation)
         futs = client.map(
             evaluate_tracks,
             [[(str(t.audio), refs[t.key], t.key, t.group) for t in group] for group in groups],

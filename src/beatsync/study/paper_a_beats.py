@@ -1,19 +1,13 @@
 """Paper A, section 4: the beat-tracking study (our tracker beside other trackers).
 
-One function per step of ``notebooks/paper_a_sec4_beat_tracking.ipynb``: build the
-items (the synthetic set with exact beats, and every real recording with human
-annotations in ``data/``), track and score them with every method, summarise per
-group, check the targets, plot the tempo curves of the tempo-change items, sweep
-the phase-slope front end on the development recordings and the synthetic set, and
-sweep the weight of the drum-pattern cue (:mod:`beatsync.beats.drums`).
-
-Methods (:mod:`beatsync.other_trackers`): ``psf`` (ours), ``librosa`` and, when the
-optional ``essentia`` package is installed, essentia's ``BeatTrackerDegara`` and
-``BeatTrackerMultiFeature`` (:func:`available_methods` says which ran), scored with
-:func:`beatsync.evaluate.beats.evaluate` (``mir_eval.beat.evaluate``). Synthetic
-items use the notebook's ``min_beat_time``; the two long real recordings use
-mir_eval's default 5 s (their annotations' convention), the 2.8 s madmom sample 0 s.
-Two or three recordings are a sanity check, not a benchmark.
+One function per step of ``notebooks/paper_a_sec4_beat_tracking.ipynb``: the items
+(the synthetic set with exact beats, and the real recordings with human annotations
+in ``data/``) tracked by every method of :mod:`beatsync.other_trackers` that runs here
+and scored with :func:`beatsync.evaluate.beats.evaluate`, the targets, the tempo
+curves, and the sweeps of the front end and of the drum-pattern cue. Synthetic items
+use the notebook's ``min_beat_time``; the two long real recordings mir_eval's 5 s
+(their annotations' convention), the 2.8 s madmom sample 0 s. Two or three
+recordings are a sanity check, not a benchmark.
 """
 
 from __future__ import annotations
@@ -54,7 +48,7 @@ SHORT_NAMES = {
     "Correct Metric Level Total": "CMLt",
     "Any Metric Level Total": "AMLt",
 }
-_METRICS = tuple(SHORT_NAMES)
+
 
 #: Targets of the tracker: (description, item selection, metric, threshold).
 TARGETS = (
@@ -73,11 +67,7 @@ _REAL_MIN_BEAT_TIME = {"hainsworth_001": 5.0, "ballroom_waltz": 5.0, "madmom_sam
 
 
 def available_methods() -> list[str]:
-    """Trackers that can run here, ours first (:func:`beatsync.other_trackers.available`).
-
-    Always ``psf`` and ``librosa``; essentia's two trackers when the optional
-    ``essentia`` package is installed.
-    """
+    """Trackers that can run here, ours first (essentia's only when it is installed)."""
     return [name for name, ok in other_trackers.available().items() if ok]
 
 
@@ -108,11 +98,8 @@ def synthetic_items(**kwargs: Any) -> list[BeatTestItem]:
 
 
 def real_items() -> list[BeatTestItem]:
-    """Every bundled real recording with human beat annotations, as test items.
-
-    Hainsworth 001 and the Ballroom waltz (``datasets.load_real_dev``) and the madmom
-    sample; group ``"real"``, ``bpm`` the median annotated tempo.
-    """
+    """Every bundled real recording with human beat annotations, as test items of group
+    ``"real"`` whose ``bpm`` is the median annotated tempo."""
     out = []
     for name in datasets.REAL_DEV_ITEMS:
         y, sr, ref = datasets.load_real_dev(name)
@@ -138,14 +125,9 @@ def score_items(
     min_beat_time: float = 0.0,
     **track_kwargs: Any,
 ) -> pd.DataFrame:
-    """Track and score every item with every method; one row per item and method.
-
-    Each real recording is scored from its own ``min_beat_time``, with the study's short
-    metric names. Columns: item, group, method, tempo_ref, tempo_est, octave
-    (:func:`~beatsync.evaluate.beats.tempo_octave`), F, CMLt, AMLt, seconds (tracking
-    time, not for display). ``track_kwargs`` go to the ``psf`` tracker (front-end
-    parameters).
-    """
+    """Track and score every item with every method; one row per item and method, with
+    the study's short metric names and ``seconds`` (tracking time, not for display).
+    ``track_kwargs`` go to the ``psf`` tracker (front-end parameters)."""
     methods = available_methods() if methods is None else list(methods)
     for m in methods:
         other_trackers.get(m)
@@ -197,10 +179,8 @@ def check_targets(scores: pd.DataFrame) -> pd.DataFrame:
             sel = sc.query(query)
             if sel.empty:
                 continue
-            if metric == "octave":
-                value = float((sel["octave"] == "correct").mean())
-            else:
-                value = float(sel[metric].mean())
+            at_level = sel["octave"] == "correct"
+            value = float(at_level.mean() if metric == "octave" else sel[metric].mean())
             rows.append(
                 {
                     "target": desc,
@@ -265,23 +245,12 @@ def frontend_sweep(
     *,
     min_beat_time: float = 0.0,
 ) -> pd.DataFrame:
-    """Score the ``psf`` tracker for every front-end combination on each item set.
+    """Score the ``psf`` tracker for every combination of the front-end ``grid``
+    (parameter -> values; ``hop_s > win_s / 2`` skipped) on each non-empty item set.
 
-    Parameters
-    ----------
-    item_sets : dict of name -> items
-        E.g. ``{"real": real_items(), "synthetic": ...}``; an empty set is left out.
-    grid : dict
-        Front-end parameter (``win_s``, ``hop_s``, ``band_edges_hz``, ...) -> values;
-        combinations with ``hop_s > win_s / 2`` are skipped.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per combination and item set: the parameters, whether they are the
-        defaults, mean F, CMLt and AMLt, and for sets of at most
-        :data:`SWEEP_ITEMS_LISTED` items the F of each item (``"F per item"``: a mean
-        of three recordings can move with one of them).
+    One row per combination and set: the parameters, whether they are the defaults,
+    mean F, CMLt and AMLt, and for sets of at most :data:`SWEEP_ITEMS_LISTED` items the
+    F of each (a mean of three recordings can move with one of them).
     """
     keys = list(grid)
     rows = []

@@ -1,17 +1,10 @@
 """Paper A, Figure 2: the segmentation study (clips, period table, figure, error table).
 
-Runs the pipelines of ``notebooks/paper_a_fig02_segmentation.ipynb`` so that the
-notebook makes one call per step: the clips that stand in for the paper's Cretan
-dances (:func:`load_clips`), their segmentation with the default and the knee
-channels (:func:`period_table`), the figure (:func:`figure`), the refusal of a
-non-periodic clip (:func:`nonperiodic_refusal`), and the boundary error against
-synthetic ground truth with two baselines (:func:`synthetic_error_table`,
-:func:`error_pivot`). Artefacts are written with
-:func:`beatsync.study.artifacts.write_artifacts`.
-
-Data contract: real clips are cropped by seconds (:func:`crop_seconds`); periods and
-boundaries in tables are seconds unless a column says ``frames``; boundary errors are
-in frames (of the synthetic clip's rate).
+One call per step of ``notebooks/paper_a_fig02_segmentation.ipynb``: the clips that
+stand in for the paper's Cretan dances, their segmentation with the default and the
+knee channels, the refusal of a non-periodic clip, and the boundary error against
+synthetic ground truth beside two baselines. Periods and boundaries are in seconds
+unless a column says ``frames``; boundary errors are in frames of the synthetic clip.
 """
 
 from __future__ import annotations
@@ -32,10 +25,10 @@ from ..segment.checks import check_period_range, check_values
 from ..segment.period import estimate_period, estimation_band, uniform_frames
 from ..synth.motion import SyntheticMotion, periodic_motion
 from ..validation import check_finite, check_fps, frames_to_time, time_to_frames
+from .paper_a_sync import crop
 
 __all__ = [
     "SegmentationClips",
-    "crop_seconds",
     "load_clips",
     "clip_table",
     "period_table",
@@ -51,21 +44,9 @@ __all__ = [
 
 @dataclass(frozen=True)
 class SegmentationClips:
-    """The three clips of Figure 2 and the channels drawn for each.
-
-    Attributes
-    ----------
-    toolbox : Motion
-        MoCap Toolbox recording as marker-derived joint angles.
-    salsa : Motion
-        CMU salsa take (BVH rotations).
-    synth : SyntheticMotion
-        Synthetic clip with its true boundaries.
-    knees : dict of str -> list of str
-        Left and right knee channels of each clip (by clip name).
-    reference : dict of str -> str
-        The period documented for each clip (by clip name).
-    """
+    """The three clips of Figure 2 (MoCap Toolbox markers as joint angles, a CMU salsa
+    take, a synthetic clip with its true boundaries), and by clip name its left and
+    right knee channels and its documented period."""
 
     toolbox: Motion
     salsa: Motion
@@ -77,12 +58,6 @@ class SegmentationClips:
     def motions(self) -> tuple[Motion, Motion, Motion]:
         """The clips in the order of the table and the figure."""
         return self.toolbox, self.salsa, self.synth.motion
-
-
-def crop_seconds(motion: Motion, seconds: float) -> Motion:
-    """The first ``seconds`` [s] of ``motion`` (all of it if shorter)."""
-    stop = int(time_to_frames(seconds, fps=motion.fps))
-    return motion.slice_frames(0, min(motion.n_frames, stop))
 
 
 def load_clips(
@@ -101,9 +76,9 @@ def load_clips(
 
     The MoCap Toolbox markers become joint angles (:func:`beatsync.motion.segmentation_view`).
     """
-    salsa = crop_seconds(datasets.load_salsa(salsa_take), max_clip_seconds)
+    salsa = crop(datasets.load_salsa(salsa_take), max_clip_seconds)
     toolbox = segmentation_view(datasets.load_mocap_toolbox(toolbox_recording))
-    toolbox = crop_seconds(toolbox, max_clip_seconds)
+    toolbox = crop(toolbox, max_clip_seconds)
     synth = periodic_motion(
         n_frames=synth_n_frames,
         n_channels=synth_channels,
@@ -137,15 +112,8 @@ def period_table(
     period_range: Sequence[float],
     period_method: str,
 ) -> tuple[dict[tuple[str, str], Segmentation], Any]:
-    """Segment every clip with the default channels and with the two knees.
-
-    Returns
-    -------
-    segs : dict (clip name, "default" or "knees") -> Segmentation
-    table : pandas.DataFrame
-        clip, channels (with their count), periods, mean period [s], normalised
-        energy, and the documented reference period.
-    """
+    """Segment every clip with the default channels and with the two knees: the
+    segmentations by ``(clip name, "default" or "knees")``, and a table of them."""
     import pandas as pd
 
     segs, rows = {}, []
@@ -212,23 +180,8 @@ def plot_segmentation(
     truth: Any = None,
     ax: Any = None,
 ) -> Any:
-    """Plot joint angles with the found period boundaries (paper A, Figure 2 style).
-
-    Parameters
-    ----------
-    motion : Motion
-    seg : Segmentation
-    channels : sequence of str
-        Channels to draw, e.g. left and right knee.
-    title : str
-    truth : array_like [s], optional
-        Ground-truth boundaries, drawn dashed.
-    ax : matplotlib Axes, optional
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
+    """Plot joint angles (e.g. the knees) with the found period boundaries, and the
+    ``truth`` [s] if given (dashed), in the style of paper A's Figure 2."""
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -260,16 +213,8 @@ def uniform_baseline(
     period_range: Sequence[float] = (0.25, 1.25),
     method: str = "fft",
 ) -> np.ndarray:
-    """Baseline: one period estimate, uniform boundaries ``0, T, 2T, ...`` [frames].
-
-    Parameters
-    ----------
-    values : np.ndarray [shape=(n_frames, n_channels)]
-    fps : float > 0 [Hz]
-    period_range : (float, float) [s]
-    method : {"fft", "energy"}
-        Period estimate (see :func:`beatsync.segment.estimate_period_count`).
-    """
+    """Baseline: one period estimate (``method`` "fft" or "energy"), uniform boundaries
+    ``0, T, 2T, ...`` [frames]."""
     fps = check_fps(fps)
     vals = check_values(values)
     lo_s, hi_s = check_period_range(period_range)
@@ -282,19 +227,8 @@ def uniform_baseline(
 
 
 def minima_baseline(signal: Any, *, fps: float, period: float) -> np.ndarray:
-    """Baseline: local minima of one joint angle as period boundaries [frames].
-
-    Minima at least ``0.7 * period`` apart (``scipy.signal.find_peaks`` on the negated,
-    lightly smoothed signal).
-
-    Parameters
-    ----------
-    signal : np.ndarray [shape=(n_frames,)]
-        One angle, e.g. a knee.
-    fps : float > 0 [Hz]
-    period : float > 0 [s]
-        Expected period (e.g. from :func:`uniform_baseline`'s estimate).
-    """
+    """Baseline: local minima of one joint angle as period boundaries [frames], at
+    least 0.7 of the expected ``period`` [s] apart (on the lightly smoothed signal)."""
     from scipy.ndimage import uniform_filter1d
     from scipy.signal import find_peaks
 
@@ -319,20 +253,15 @@ def synthetic_error_table(
     variation: float = 0.05,
     period_range: Sequence[float] = (0.25, 1.25),
 ) -> Any:
-    """Boundary error vs ground truth over noise levels and alpha (notebook fig02).
+    """Boundary error [frames] vs ground truth, one row per SNR, alpha and method.
 
-    For every SNR, alpha and seed: a :func:`beatsync.synth.motion.periodic_motion`
-    signal, segmented (a) by :func:`segment` with the period count estimated
-    (``"energy"``), (b) with the count given, and baselines (c) FFT period + uniform
-    boundaries and (d) local minima of channel 0 (offset-corrected, see
-    :func:`~beatsync.evaluate.segmentation.boundary_errors`). Errors in frames,
-    averaged over seeds (``max``: max). ``period_range`` [s] bounds every period estimate.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per (SNR, alpha, method).
+    For every SNR, alpha and seed, a :func:`beatsync.synth.motion.periodic_motion`
+    signal is segmented (a) by :func:`segment` with the period count estimated, (b)
+    with the count given, and by the baselines (c) FFT period + uniform boundaries and
+    (d) local minima of channel 0 (offset-corrected); errors are averaged over seeds
+    (``max``: the largest).
     """
+
     import pandas as pd
 
     rows = []

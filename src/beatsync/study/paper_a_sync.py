@@ -1,21 +1,12 @@
 """Paper A, section 5 (beat-synchronous resampling): the study behind Table 1 and Figure 3.
 
-The notebooks call these functions, one per step; everything that runs the pipeline
-(segmentation, beat tracking, :func:`beatsync.sync.synchronize`, kinematic beats)
-for the paper's tables lives here, the scores themselves in
-:mod:`beatsync.evaluate.alignment` (metrics on arrays).
-
-- Inputs: :func:`crop`, :func:`load_clips` (CMU salsa BVH, MoCap Toolbox markers,
-  synthetic clips sized like the paper's), :func:`clip_table`, :func:`make_songs`
-  (two synthetic songs of different tempo and the real 808 loop, beats tracked),
-  :func:`drum_song`, :func:`segment_clip`.
-- Table 1: :func:`evaluate_sync` (one clip on one song: frames, residuals, both
-  alignment scores before/after synchronisation, the random-offset control, and the
-  dancer's accents put on the beat), :func:`sync_table` (every clip on every song),
-  :func:`frame_count_view`, :func:`alignment_view`, :func:`alignment_summary`.
-- Figure 3: :func:`residual_table`, :func:`figure3`, :func:`animation_video`.
-- Real dancers re-synchronised to other songs: :mod:`.paper_a_dancers`.
-- Artefacts: :func:`beatsync.study.artifacts.write_artifacts`.
+The notebooks call these functions, one per step; the scores themselves are
+:mod:`beatsync.evaluate.alignment`'s. Inputs: :func:`load_clips` (CMU salsa BVH, MoCap
+Toolbox markers, synthetic clips sized like the paper's), :func:`make_songs`,
+:func:`drum_song`. Table 1: :func:`evaluate_sync` (one clip on one song),
+:func:`sync_table` (every clip on every song) and its views. Figure 3:
+:func:`residual_table`, :func:`figure3`, :func:`animation_video`. Real dancers
+re-synchronised to other songs: :mod:`.paper_a_dancers`.
 
 Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb``,
 ``notebooks/paper_a_fig03_animation_frames.ipynb``.
@@ -85,18 +76,7 @@ _TABLE_SCORES = [
 
 
 def crop(motion: Motion, seconds: float) -> Motion:
-    """The first ``seconds`` of a motion (all of it if shorter).
-
-    Parameters
-    ----------
-    motion : Motion
-    seconds : float > 0 [s]
-
-    Returns
-    -------
-    Motion
-        ``min(n_frames, round(seconds * fps))`` frames.
-    """
+    """The first ``seconds`` [s] of a motion (all of it if shorter)."""
     seconds = check_positive(seconds, name="seconds", unit="s")
     n = min(motion.n_frames, int(time_to_frames(seconds, fps=motion.fps)))
     return motion.slice_frames(0, max(n, 1))
@@ -112,30 +92,15 @@ def load_clips(
     max_clip_seconds: float = 40.0,
     seed: int = 0,
 ) -> dict[str, dict[str, Any]]:
-    """The motion clips of Table 1 (stand-ins for paper A's, which are not available).
+    """The motion clips of Table 1 (stand-ins for paper A's, which are not available):
+    ``name -> {"motion", "segment_input" (or absent), "data"}``, as :func:`sync_table`
+    takes them.
 
-    Parameters
-    ----------
-    salsa_clips : list of str
-        CMU salsa takes (60 fps BVH), e.g. ``["60_01", "61_01"]``.
-    toolbox_clips : list of str
-        MoCap Toolbox demo dances (60 Hz markers): gaps filled, segmented on joint
-        angles derived from the markers (:func:`beatsync.motion.marker_angles`).
-    synthetic_frames : list of int
-        Lengths [frames] of synthetic 29-angle clips (the paper's clip sizes).
-    synthetic_fps : float [Hz]
-    synthetic_period : float [s]
-        Nominal period of the synthetic clips (about one per this many seconds).
-    max_clip_seconds : float [s]
-        Real clips are cropped to this length.
-    seed : int
-        Seed of the first synthetic clip (the next ones count up).
-
-    Returns
-    -------
-    dict
-        ``name -> {"motion", "segment_input" (or absent), "data"}``, as
-        :func:`sync_table` takes it.
+    MoCap Toolbox markers have their gaps filled and are segmented on the joint angles
+    derived from them (:func:`beatsync.motion.marker_angles`); real clips are cropped
+    to ``max_clip_seconds``. Synthetic 29-angle clips of ``synthetic_frames`` frames
+    (the paper's sizes) have a period of about ``synthetic_period`` [s], and seeds
+    counting up from ``seed``.
     """
     from .. import datasets
     from ..motion import fill_gaps, marker_angles
@@ -192,26 +157,15 @@ def make_songs(
     beat_source: str = "track",
     sr: int = 22050,
 ) -> tuple[dict[str, dict[str, Any]], Any]:
-    """The songs of Table 1 and their beats (stand-ins for paper A's songs).
+    """The songs of Table 1 (stand-ins for paper A's): ``(songs, table)``.
 
     Song A is a synthetic drum pattern at ``song_bpms[0]``, song B a click track at
     ``song_bpms[1]`` (beats from 0.4 s), song C the real 808 kick loop (BeatNet test
     data, 120 BPM, 10 s) if ``use_808``. Beats are tracked by
-    :func:`beatsync.beats.track_beats` (paper A, section 4) or, with
-    ``beat_source="truth"``, taken from the synthetic songs' ground truth.
-
-    Returns
-    -------
-    songs : dict
-        ``name -> {"beats", "bpm", "data"}``, as :func:`sync_table` takes it.
-    table : pandas.DataFrame
-        Per song: data, BPM, beats used, tracked tempo, largest distance of a tracked
-        beat from the true beats [ms] (``"n/a"`` without ground truth).
-
-    Raises
-    ------
-    ParameterError
-        Fewer than two tempi, or an unknown ``beat_source``.
+    :func:`beatsync.beats.track_beats` or, with ``beat_source="truth"``, the synthetic
+    songs' ground truth. ``songs``: ``name -> {"beats", "bpm", "data"}``, as
+    :func:`sync_table` takes them; ``table``: one row per song, with the tracked tempo
+    and the largest distance of a tracked beat from the true ones [ms].
     """
     import pandas as pd
 
@@ -226,20 +180,11 @@ def make_songs(
     truth = {bpm: beat_times(bpm, duration=song_seconds, start=0.4) for bpm in song_bpms[:2]}
     a, b = song_bpms[0], song_bpms[1]
     audio = {
-        f"A: drums {a:g} BPM": (
-            drum_pattern(truth[a], sr=sr, duration=song_seconds),
-            sr,
-            truth[a],
-            a,
-            "synthetic drum pattern",
-        ),
-        f"B: clicks {b:g} BPM": (
-            click_track(truth[b], sr=sr, duration=song_seconds),
-            sr,
-            truth[b],
-            b,
-            "synthetic click track",
-        ),
+        name: (synth(truth[bpm], sr=sr, duration=song_seconds), sr, truth[bpm], bpm, data)
+        for name, synth, bpm, data in (
+            (f"A: drums {a:g} BPM", drum_pattern, a, "synthetic drum pattern"),
+            (f"B: clicks {b:g} BPM", click_track, b, "synthetic click track"),
+        )
     }
     if use_808:
         y, rate = datasets.load_click_808()
@@ -249,11 +194,6 @@ def make_songs(
         track = track_beats(y, rate)
         beats = track.beats if (beat_source == "track" or true is None) else true
         songs[name] = {"beats": beats, "bpm": bpm, "data": data}
-        err = (
-            round(1000 * float(nearest_distance(track.beats, true).max()), 1)
-            if true is not None
-            else "n/a"
-        )
         rows.append(
             {
                 "song": name,
@@ -261,26 +201,22 @@ def make_songs(
                 "BPM": bpm,
                 "beats used": len(beats),
                 "tracked tempo [BPM]": round(float(track.tempo), 2),
-                "max |tracked - true| [ms]": err,
+                "max |tracked - true| [ms]": _max_error_ms(track.beats, true),
             }
         )
     return songs, pd.DataFrame(rows)
 
 
+def _max_error_ms(tracked: np.ndarray, true: np.ndarray | None) -> float | str:
+    """The largest distance of a tracked beat from the true beats [ms], "n/a" without."""
+    return "n/a" if true is None else round(1000 * float(nearest_distance(tracked, true).max()), 1)
+
+
 def drum_song(
     bpm: float, *, song_seconds: float = 8.0, sr: int = 22050, start: float = 0.3
 ) -> tuple[np.ndarray, int, np.ndarray, dict[str, Any]]:
-    """A synthetic drum pattern and its tracked beats (Figure 3's song).
-
-    Returns
-    -------
-    y : np.ndarray [shape=(n,)]
-    sr : int [Hz]
-    beats : np.ndarray [s]
-        Tracked by :func:`beatsync.beats.track_beats`.
-    summary : dict
-        ``beats``, ``tempo [BPM]`` (tracked), ``max |tracked - true| [ms]``.
-    """
+    """Figure 3's song, a synthetic drum pattern: ``(y, sr, beats, summary)``, the beats
+    [s] tracked by :func:`beatsync.beats.track_beats` and summarised against the truth."""
     from ..beats import track_beats
     from ..synth.audio import beat_times, drum_pattern
 
@@ -290,9 +226,7 @@ def drum_song(
     summary = {
         "beats": len(track.beats),
         "tempo [BPM]": round(float(track.tempo), 2),
-        "max |tracked - true| [ms]": round(
-            1000 * float(nearest_distance(track.beats, true).max()), 1
-        ),
+        "max |tracked - true| [ms]": _max_error_ms(track.beats, true),
     }
     return y, sr, track.beats, summary
 
@@ -324,72 +258,35 @@ def evaluate_sync(
     motion: Motion,
     beats: Any,
     *,
-    boundaries: Any = None,
-    segment_input: Motion | None = None,
-    period_range: tuple[float, float] = (0.25, 1.25),
+    boundaries: Any,
     sigma: float = DEFAULT_SIGMA,
     n_control: int = 100,
     seed: int = 0,
-    **sync_kwargs: Any,
 ) -> dict[str, Any]:
-    """Synchronise a motion to music beats and score it: one row of Table 1.
+    """Synchronise a motion's periods (``boundaries`` [s]) to music ``beats`` [s] and
+    score it: one row of Table 1.
 
-    Runs :func:`beatsync.segment.segment` (unless ``boundaries`` are given) and
-    :func:`beatsync.sync.synchronize`, then scores the kinematic beats against the
-    music beats with both published alignment scores and the phase consistency
-    *before* (the original clip played from music time 0) and *after*
-    synchronisation, the random-offset control of the synchronised motion
-    (:func:`beatsync.evaluate.alignment.offset_control`), and ``aligned_*``: the
-    motion synchronised with ``land="accents"`` so that the dancer's accents, not
-    the segmentation's boundaries, land on the beats. Motions without positions
-    (plain joint-angle tables) get NaN alignment scores.
-
-    Parameters
-    ----------
-    motion : Motion
-    beats : np.ndarray [s]
-        Music beats.
-    boundaries : np.ndarray [s], optional
-        Period boundaries; default from ``segment(segment_input or motion)``.
-    segment_input : Motion, optional
-        What to segment if different from ``motion`` (e.g. ``marker_angles(markers)``).
-    period_range : (float, float) [s]
-        Passed to ``segment``.
-    sigma : float > 0 [s]
-        Gaussian width of the alignment scores.
-    n_control, seed : int
-        Random-offset control trials and seed.
-    **sync_kwargs
-        Passed to :func:`~beatsync.sync.synchronize` (``beats_per_period``, ``out_fps``...).
-
-    Returns
-    -------
-    dict
-        ``input_frames``, ``input_fps``, ``output_frames``, ``periods_available``,
-        ``periods_used``, ``beats_per_period``, ``mean_period_s``, ``beat_period_s``,
-        ``speed_min``, ``speed_max``, ``max_residual_ms``, ``max_residual_frames``;
-        ``before_/after_/aligned_/control_`` + ``motion``/``music`` scores,
-        ``before_/after_phase``, ``phase_offset_s``; and ``result`` (the
-        :class:`~beatsync.sync.SyncResult`).
+    The kinematic beats are scored against the music beats with both published
+    alignment scores (Gaussian width ``sigma`` [s]) and the phase consistency *before*
+    (the clip played from music time 0) and *after* :func:`beatsync.sync.synchronize`;
+    ``control_*`` is the random-offset control of the synchronised motion (``n_control``
+    trials, :func:`beatsync.evaluate.alignment.offset_control`), ``aligned_*`` the motion
+    synchronised with ``land="accents"``, so that the dancer's accents, not the
+    boundaries, land on the beats. Motions without positions (joint-angle tables) score
+    NaN. The row also holds the report's frame counts and residuals, and ``result``
+    (the :class:`~beatsync.sync.SyncResult`).
     """
     from ..sync import synchronize
     from ..validation import check_times
 
     yb = check_times(beats, name="beats")
-    n_periods = None
-    if boundaries is None:
-        from ..segment import segment
-
-        seg = segment(motion if segment_input is None else segment_input, period_range=period_range)
-        boundaries = seg.boundaries
-        n_periods = int(seg.n_periods)
-    res = synchronize(motion, boundaries, yb, **sync_kwargs)
+    res = synchronize(motion, boundaries, yb)
     rep = res.report
     row: dict[str, Any] = {
         "input_frames": rep["input_frames"],
         "input_fps": rep["input_fps"],
         "output_frames": rep["output_frames"],
-        "periods_available": rep["periods_available"] if n_periods is None else n_periods,
+        "periods_available": rep["periods_available"],
         "periods_used": rep["periods_used"],
         "beats_per_period": rep["beats_per_period"],
         "mean_period_s": rep["mean_motion_period_s"],
@@ -399,59 +296,37 @@ def evaluate_sync(
         "max_residual_ms": rep["max_abs_residual_ms"],
         "max_residual_frames": rep["max_abs_residual_frames"],
     }
-    keys = (
-        "before_motion",
-        "before_music",
-        "before_phase",
-        "after_motion",
-        "after_music",
-        "after_phase",
-        "control_motion",
-        "control_music",
-        "phase_offset_s",
-        "aligned_motion",
-        "aligned_music",
-    )
     try:
-        mb_before = kinematic_beats(motion)
-        mb_after = kinematic_beats(res.motion)
+        mb_before, mb_after = kinematic_beats(motion), kinematic_beats(res.motion)
     except ParameterError:  # no positions: a plain joint-angle table
-        row.update({k: float("nan") for k in keys})
-        row["result"] = res
-        return row
-    before = alignment_scores(
-        mb_before, yb, sigma=sigma, span=(0.0, min(float(motion.duration), yb[-1]))
-    )
-    after = alignment_scores(
-        mb_after, yb, sigma=sigma, span=(0.0, min(float(res.motion.duration), yb[-1]))
-    )
+        nan_scores = dict.fromkeys([*_TABLE_SCORES, "phase_offset_s"], float("nan"))
+        return {**row, **nan_scores, "result": res}
+
+    def scores(motion_beats: np.ndarray, m: Motion) -> dict[str, float]:
+        span = (0.0, min(float(m.duration), yb[-1]))  # the music beats within the motion
+        return alignment_scores(motion_beats, yb, sigma=sigma, span=span)
+
+    before, after = scores(mb_before, motion), scores(mb_after, res.motion)
     ctrl = offset_control(
         mb_after, yb[yb <= float(res.motion.duration)], sigma=sigma, n_trials=n_control, seed=seed
     )
-    res_al = synchronize(motion, boundaries, yb, land="accents", **sync_kwargs)
-    aligned = alignment_scores(
-        kinematic_beats(res_al.motion),
-        yb,
-        sigma=sigma,
-        span=(0.0, min(float(res_al.motion.duration), yb[-1])),
-    )
-    row.update(
-        {
-            "before_motion": before["alignment_motion"],
-            "before_music": before["alignment_music"],
-            "before_phase": beat_phase_consistency(mb_before, yb),
-            "after_motion": after["alignment_motion"],
-            "after_music": after["alignment_music"],
-            "after_phase": beat_phase_consistency(mb_after, yb),
-            "control_motion": ctrl["alignment_motion_mean"],
-            "control_music": ctrl["alignment_music_mean"],
-            "phase_offset_s": res_al.report["phase_offset_s"],
-            "aligned_motion": aligned["alignment_motion"],
-            "aligned_music": aligned["alignment_music"],
-        }
-    )
-    row["result"] = res
-    return row
+    res_al = synchronize(motion, boundaries, yb, land="accents")
+    aligned = scores(kinematic_beats(res_al.motion), res_al.motion)
+    return {
+        **row,
+        "before_motion": before["alignment_motion"],
+        "before_music": before["alignment_music"],
+        "before_phase": beat_phase_consistency(mb_before, yb),
+        "after_motion": after["alignment_motion"],
+        "after_music": after["alignment_music"],
+        "after_phase": beat_phase_consistency(mb_after, yb),
+        "control_motion": ctrl["alignment_motion_mean"],
+        "control_music": ctrl["alignment_music_mean"],
+        "phase_offset_s": res_al.report["phase_offset_s"],
+        "aligned_motion": aligned["alignment_motion"],
+        "aligned_music": aligned["alignment_music"],
+        "result": res,
+    }
 
 
 def sync_table(
@@ -464,31 +339,14 @@ def sync_table(
     seed: int = 0,
     paper_frames: dict[tuple[str, str], Any] | None = None,
 ) -> Any:
-    """Synchronise every clip to every song; one row per pair (paper A, Table 1).
+    """Synchronise every clip to every song (:func:`evaluate_sync`); one row per pair
+    (paper A, Table 1).
 
-    Parameters
-    ----------
-    clips : dict
-        ``name -> {"motion": Motion, "segment_input": Motion or None, "data": str}``
-        (:func:`load_clips`); each clip is segmented once.
-    songs : dict
-        ``name -> {"beats": np.ndarray [s], "bpm": float, "data": str}`` (:func:`make_songs`).
-    period_range : (float, float) [s]
-    sigma : float [s]
-    n_control, seed : int
-        Random-offset control (see :func:`beatsync.evaluate.alignment.offset_control`).
-    paper_frames : dict, optional
-        ``(clip, song) -> the paper's number of output frames``; missing pairs are
-        reported as ``"n/a"`` (not available), never invented.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns: clip, clip data, fps, input frames, song, song data, BPM, periods,
-        periods used, beats/period, output frames, paper output frames, max residual
-        [frames], alignment before/after/control/aligned (``_motion`` and ``_music``),
-        phase consistency before/after, phase offset [s], and ``note`` (why a clip has
-        no result, e.g. segmentation refused it as not periodic).
+    ``clips`` as :func:`load_clips` gives them (each segmented once, its
+    ``segment_input`` if any, within ``period_range`` [s]), ``songs`` as
+    :func:`make_songs`. ``paper_frames``: ``(clip, song) ->`` the paper's number of output
+    frames; missing pairs show ``"n/a"``, never an invented number. A clip that has no
+    result (e.g. segmentation refused it as not periodic) says why in ``note``.
     """
     import pandas as pd
 
@@ -501,22 +359,21 @@ def sync_table(
         try:
             seg = segment(clip.get("segment_input") or motion, period_range=period_range)
         except ParameterError as exc:  # e.g. refused as not periodic: say so in the table
-            for sname, song in songs.items():
-                rows.append(
-                    {
-                        "clip": cname,
-                        "clip data": clip.get("data", ""),
-                        "fps": float(motion.fps),
-                        "input frames": int(motion.n_frames),
-                        "song": sname,
-                        "song data": song.get("data", ""),
-                        "BPM": song.get("bpm", float("nan")),
-                        "paper output frames": paper_frames.get((cname, sname), "n/a"),
-                        "note": f"segmentation refused: {str(exc)[:60]}...",
-                    }
-                )
-            continue
+            seg, note = None, f"segmentation refused: {str(exc)[:60]}..."
         for sname, song in songs.items():
+            row = {
+                "clip": cname,
+                "clip data": clip.get("data", ""),
+                "fps": float(motion.fps),
+                "input frames": int(motion.n_frames),
+                "song": sname,
+                "song data": song.get("data", ""),
+                "BPM": song.get("bpm", float("nan")),
+            }
+            paper = paper_frames.get((cname, sname), "n/a")
+            if seg is None:
+                rows.append({**row, "paper output frames": paper, "note": note})
+                continue
             r = evaluate_sync(
                 motion,
                 song["beats"],
@@ -527,18 +384,12 @@ def sync_table(
             )
             rows.append(
                 {
-                    "clip": cname,
-                    "clip data": clip.get("data", ""),
-                    "fps": r["input_fps"],
-                    "input frames": r["input_frames"],
-                    "song": sname,
-                    "song data": song.get("data", ""),
-                    "BPM": song.get("bpm", float("nan")),
+                    **row,
                     "periods": int(seg.n_periods),
                     "periods used": r["periods_used"],
                     "beats/period": r["beats_per_period"],
                     "output frames": r["output_frames"],
-                    "paper output frames": paper_frames.get((cname, sname), "n/a"),
+                    "paper output frames": paper,
                     "max residual [frames]": r["max_residual_frames"],
                     **{k: r[k] for k in _TABLE_SCORES[:8]},
                     "phase offset [s]": r["phase_offset_s"],
@@ -568,20 +419,8 @@ def alignment_summary(table: Any) -> Any:
 
 
 def residual_table(result: Any, decimals: int | None = None) -> tuple[dict[str, Any], Any]:
-    """Every boundary of a :class:`~beatsync.sync.SyncResult`, its beat and residuals.
-
-    Parameters
-    ----------
-    decimals : int, optional
-        Round the table for display (a value that rounds to zero shows as 0, not -0).
-
-    Returns
-    -------
-    counts : dict
-        ``input_frames``, ``output_frames``, ``periods_used``, ``beats_per_period``.
-    table : pandas.DataFrame
-        boundary [s], beat [s], residual warp [ms], residual nearest frame [ms].
-    """
+    """A :class:`~beatsync.sync.SyncResult`'s frame counts, and a table of every boundary,
+    its beat and residuals, rounded to ``decimals`` if given (-0 shown as 0)."""
     import pandas as pd
 
     rep = result.report
@@ -611,16 +450,9 @@ def figure3(
     azimuth: float = 90.0,
     xlim: float | None = None,
 ) -> Any:
-    """Figure 3: poses of the synchronised animation over a few beats, and a timeline.
-
-    Top: skeleton poses over ``strip_beats`` beats from ``strip_start`` [s],
-    ``poses_per_beat`` per beat (poses on a beat in red). Bottom: mean joint speed of
-    the synchronised motion with the music beats, the warped period boundaries
-    (dashed) and the kinematic beats (dots), up to ``xlim`` [s].
-
-    Returns
-    -------
-    matplotlib Figure
+    """Figure 3: poses of the synchronised animation over ``strip_beats`` beats from
+    ``strip_start`` [s] (poses on a beat in red), and below them the mean joint speed
+    with the music beats, the warped boundaries and the kinematic beats up to ``xlim`` [s].
     """
     import matplotlib.pyplot as plt
 
@@ -659,17 +491,9 @@ def animation_video(
     azimuth: float = 90.0,
     title: str | None = None,
 ) -> Path:
-    """The first ``seconds`` of the synchronised dance as a video with the song.
+    """The first ``seconds`` of the synchronised dance as a video with the song, in a
+    folder created if missing (:func:`beatsync.render.write_video`); the file written."""
 
-    The folder of ``path`` is created if missing.
-    Written by :func:`beatsync.render.write_video` (an MP4 with the ffmpeg bundled
-    with ``imageio-ffmpeg``; without ffmpeg a GIF plus a WAV, and a warning).
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
     from .. import render
 
     Path(path).parent.mkdir(parents=True, exist_ok=True)

@@ -1,29 +1,9 @@
 """Paper B's study: libraries, timing and quality tables, figures (the notebooks' calls).
 
-The notebooks only call these functions.
-
-- :func:`load_library` returns the motion libraries that stand in for paper B's
-  (their Break dance and Indian dance captures are not available): the four CMU
-  salsa takes, the CMU walking clips of one skeleton, or synthetic dances
-  (:mod:`beatsync.synth.library`).
-- :func:`speed_table` times the DP (proposed) and the multi-stage search
-  (conventional) on synthetic drum songs of the given lengths
-  (:func:`beatsync.synth.audio.drum_song`), side by side in the same run, graph build
-  excluded, and :func:`ratio_table` derives the speedups and the time ratios when
-  the music doubles, with paper B's reported values beside ours.
-- :func:`threshold_table` counts transition edges for several TH under two
-  normalisations of ``rd`` (per frame-to-frame distance, and per 0.1 s of typical
-  movement, our default).
-- :func:`library_graphs` builds each library's graph once per run (the largest TH
-  needed; smaller TH by filtering).
-- :func:`eligibility_table` says which clips a song of each tempo uses and why;
-  :func:`plausibility_targets` checks root and joint rotation speeds and time-scale
-  factors against the library (:mod:`beatsync.graph.plausibility`).
-- :func:`quality_table` scores compositions with the proxies of
-  :mod:`beatsync.evaluate.composition` (:func:`composition_proxies` computes the
-  arrays they need: kinematic beats, positions, intensities).
-- :func:`write_artifacts` writes tables (CSV), figures (PNG) and the parameters with
-  the package version (JSON) under ``results/<notebook>/``.
+The libraries (:data:`LIBRARIES`) stand in for paper B's captures, not available.
+Table 1 (:func:`speed_table`) times the proposed DP and the conventional search;
+Table 2 (:func:`quality_table`) scores compositions with the proxies of
+:mod:`beatsync.evaluate.composition` and :mod:`beatsync.graph.plausibility`.
 
 Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 ``notebooks/paper_b_tab02_quality_proxies.ipynb``.
@@ -31,6 +11,7 @@ Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from typing import Any
 
@@ -94,17 +75,8 @@ PAPER_B_TABLE1 = {
 def load_library(
     name: str, *, duration: float = 30.0, n_clips: int = 4, seed: int = 0
 ) -> tuple[list[Any], list[np.ndarray] | None]:
-    """Clips (and exact beats for synthetic ones, else None) of a study library.
-
-    Parameters
-    ----------
-    name : {"salsa", "synthetic", "walk"}
-    duration : float [s]
-        Length of each synthetic clip.
-    n_clips : int
-        Number of synthetic clips.
-    seed : int
-    """
+    """Clips of a study library (:data:`LIBRARIES`), and exact beats for the synthetic
+    one (``n_clips`` of ``duration`` [s] each), else None."""
     from .. import datasets
 
     if name == "salsa":
@@ -127,16 +99,9 @@ def library_graphs(
     duration: float = 30.0,
     seed: int = 0,
 ) -> tuple[dict[str, WeightedMotionGraph], dict[str, WeightedMotionGraph]]:
-    """The graph of each study library at TH, and the graph at ``th_max`` it comes from.
-
-    Each library's distances are computed once, with the largest threshold the
-    notebook needs (``th_max``, default ``th``); the TH graph keeps the transitions
-    below ``th`` (:meth:`WeightedMotionGraph.with_threshold`).
-
-    Returns
-    -------
-    (graphs, full) : dicts of library name -> graph at ``th`` / at ``th_max``.
-    """
+    """The graph of each study library at ``th``, and the graph at ``th_max`` (the
+    largest TH the notebook needs, default ``th``) it is filtered from: each library's
+    distances are computed once."""
     top = max(th, th_max) if th_max is not None else th
     graphs, full = {}, {}
     for name in names:
@@ -163,19 +128,15 @@ def _z(level: np.ndarray) -> np.ndarray:
 
 
 def _song_grid(graph: WeightedMotionGraph, beats: np.ndarray, level: np.ndarray, bound: Any):
-    """What compose searches for a song: the tempo plan, z per grid interval, durations."""
+    """What compose searches for a song: the tempo plan, z per grid interval, the grid
+    intervals' durations [s] and the search's options."""
     from ..graph.timescale import music_grid, plan_tempo
 
     mult = "auto" if bound is not None else (1.0,)
     plan = plan_tempo(graph, beats, scale_bound=bound, multiplicity=mult)
     grid, glevel = music_grid(beats, level, plan.subdivision)
-    search_kw = {
-        "music_durations": np.diff(grid),
-        "scale_bound": plan.bound,
-        "steps": plan.steps,
-        "node_mask": plan.node_mask,
-    }
-    return plan, _z(glevel), search_kw
+    kw = {"scale_bound": plan.bound, "steps": plan.steps, "node_mask": plan.node_mask}
+    return plan, _z(glevel), np.diff(grid), kw
 
 
 def speed_table(
@@ -191,28 +152,14 @@ def speed_table(
     scale_bound: Any = DEFAULT_SCALE_BOUND,
     conventional_repeats: int = 2,
 ) -> Any:
-    """Search times of the DP (best of ``repeats``) and the conventional method [s].
+    """Search times [s] of the DP (best of ``repeats``, each the mean of ``dp_inner``
+    runs: one takes about a millisecond) and the conventional search (best of
+    ``conventional_repeats``: it takes seconds); one row per library and music length.
 
-    The conventional search takes seconds, so the best of ``conventional_repeats``
-    (at most ``repeats``) runs times it well enough; the DP takes milliseconds and
-    gets every repeat.
-
-    Both searches run as :func:`beatsync.graph.compose.compose` runs them: on the
-    song's grid, with the tempo plan's clips, multiplicities and ``scale_bound``
-    (``None``: unbounded, one beat per interval, paper B as written). Each DP timing
-    sample is the mean of ``dp_inner`` consecutive runs (one DP takes about a
-    millisecond, too short to time alone on a shared machine).
-
-    Times are the searches' own clocks (:attr:`SearchResult.search_time`): the graph
-    build and its successor/predecessor tables (built once per graph, offline) are
-    excluded, as in paper B.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per (library, music length): ``library``, ``stands_in_for``,
-        ``music_s``, ``n_beats``, ``nodes``, ``transitions``, ``multiplicity``,
-        ``dp_s``, ``conventional_s``, ``speedup``, ``dp_cost``, ``conventional_cost``.
+    Both search as :func:`beatsync.graph.compose.compose` does: on the song's grid, with
+    the tempo plan and ``scale_bound`` (``None``: paper B as written). The times are the
+    searches' own clocks: the graph and its search tables (offline) are excluded, as in
+    paper B.
     """
     import pandas as pd
 
@@ -222,8 +169,7 @@ def speed_table(
         g.successor_lists()
         for dur in durations:
             beats, level = song(float(dur), bpm=bpm, seed=seed)
-            plan, z, kw = _song_grid(g, beats, level, scale_bound)
-            md = kw.pop("music_durations")
+            plan, z, md, kw = _song_grid(g, beats, level, scale_bound)
             t_dp, t_cv = [], []
             for i in range(int(repeats)):
                 runs = [
@@ -288,12 +234,9 @@ def ratio_table(speed: Any) -> Any:
 def threshold_table(
     graph: WeightedMotionGraph, *, ths: Sequence[float] = (1.0, 2.0, 3.0, 5.0, 10.0)
 ) -> Any:
-    """Transition edges for each TH under two ``rd`` normalisations.
-
-    ``rd_unit = 0.1 s`` is our default (module :mod:`beatsync.graph.build`);
-    ``rd_unit = 1 / fps`` measures the pose jump in frame-to-frame distances (TH
-    ``x`` in frames is ``x / (0.1 fps)`` in our unit). ``graph`` must have been built
-    with a TH at least ``max(ths)`` (in our unit; :func:`library_graphs`).
+    """Transition edges for each TH with ``rd`` per 0.1 s of typical movement (our
+    default, :mod:`beatsync.graph.build`) and per frame-to-frame distance (TH ``x`` in
+    frames is ``x / (0.1 fps)`` in ours); ``graph`` built with a TH of at least ``max(ths)``.
     """
     import pandas as pd
 
@@ -363,12 +306,10 @@ def quality_table(
 ) -> Any:
     """Quality proxies and physical plausibility per method, one row per (method, song).
 
-    Methods: keys of :data:`QUALITY_METHODS`; the tempo-matched ones use the
-    defaults of :func:`~beatsync.graph.compose.compose` (tempo group, multiplicity,
-    time-scale bound 0.8-1.25), the unbounded ones paper B as written (every interval
-    warped onto one beat). Plausibility columns come from the composition's report
-    (:mod:`beatsync.graph.plausibility`); ``scale_outside`` counts the intervals
-    outside the default bound (for every method alike).
+    ``methods``: keys of :data:`QUALITY_METHODS`; the tempo-matched ones compose with
+    :func:`~beatsync.graph.compose.compose`'s defaults, the unbounded ones as paper B
+    (every interval warped onto one beat). ``scale_outside`` counts the intervals
+    outside the default time-scale bound, for every method alike.
     """
     import pandas as pd
 
@@ -379,35 +320,31 @@ def quality_table(
     lo, hi = DEFAULT_SCALE_BOUND
     rows = []
     _COMPOSED.clear()
-    for bpm in bpms:
-        for dur in durations:
-            for seed in seeds:
-                beats, level = song(float(dur), bpm=float(bpm), seed=int(seed))
-                for m in methods:
-                    label, method, kw = QUALITY_METHODS[m]
-                    g = g_rd if m.startswith("dp_rd") else graph
-                    with silenced():
-                        comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
-                    if m == "dp":  # kept for example_composition (no second search)
-                        _COMPOSED[(id(graph), float(bpm), float(dur), int(seed))] = comp
-                    q = composition_proxies(comp, sigma=sigma)
-                    p = comp.plausibility
-                    s = comp.search.scales
-                    rows.append(
-                        {
-                            "method": label,
-                            "bpm": float(bpm),
-                            "music_s": float(dur),
-                            "seed": int(seed),
-                            **q,
-                            **{k: p[k] for k in _PLAUSIBILITY_COLUMNS},
-                            "scale_outside": int(np.sum((s < lo - 1e-9) | (s > hi + 1e-9))),
-                            "two_beat_share": float(np.mean(np.diff(comp.search.boundaries) > 1))
-                            if comp.tempo.subdivision == 1
-                            else 0.0,
-                            "speed_warning": bool(comp.warnings),
-                        }
-                    )
+    for bpm, dur, seed in itertools.product(bpms, durations, seeds):
+        beats, level = song(float(dur), bpm=float(bpm), seed=int(seed))
+        for m in methods:
+            label, method, kw = QUALITY_METHODS[m]
+            g = g_rd if m.startswith("dp_rd") else graph
+            with silenced():
+                comp = compose(g, beats, level, method=method, seed=int(seed), **kw)
+            if m == "dp":  # kept for example_composition (no second search)
+                _COMPOSED[(id(graph), float(bpm), float(dur), int(seed))] = comp
+            s = comp.search.scales
+            rows.append(
+                {
+                    "method": label,
+                    "bpm": float(bpm),
+                    "music_s": float(dur),
+                    "seed": int(seed),
+                    **composition_proxies(comp, sigma=sigma),
+                    **{k: comp.plausibility[k] for k in _PLAUSIBILITY_COLUMNS},
+                    "scale_outside": int(np.sum((s < lo - 1e-9) | (s > hi + 1e-9))),
+                    "two_beat_share": float(np.mean(np.diff(comp.search.boundaries) > 1))
+                    if comp.tempo.subdivision == 1
+                    else 0.0,
+                    "speed_warning": bool(comp.warnings),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -506,19 +443,10 @@ def example_composition(
 def composition_proxies(
     comp: Any, *, sigma: float = 0.05, blend: float = 1.0 / 3.0, beat_smooth: float = 0.1
 ) -> dict[str, float]:
-    """Quality proxies of a :class:`~beatsync.graph.compose.Composition`.
+    """:func:`beatsync.evaluate.composition.quality_proxies` of a composition, and its
+    ``n_transitions``: kinematic beats (smoothed over ``beat_smooth`` [s]; on noise-free
+    motion only 0 keeps beats that land exactly), positions and intensities computed."""
 
-    Runs the stages the proxies need on the composed motion (kinematic beats with
-    ``beat_smooth`` [s] smoothing, joint positions, intensity per music beat interval)
-    and scores them with :func:`beatsync.evaluate.composition.quality_proxies`. On
-    noise-free motion the default smoothing can move a speed minimum by a frame or
-    two, so motion whose beats land exactly scores alignment 1 only with 0.
-
-    Returns
-    -------
-    dict
-        The proxies plus ``n_transitions``.
-    """
     from ..evaluate.composition import foot_joints, quality_proxies
     from ..motion_beats import beat_interval_intensity, kinematic_beats, motion_positions
     from ..validation import frames_to_time
