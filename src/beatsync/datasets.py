@@ -253,6 +253,8 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
         audio_offset=float(excerpt["audio_offset_s"]),
         excerpt=excerpt,
     )
+
+
 def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
     """A real development recording and its human beat annotations [s].
 

@@ -2,25 +2,18 @@
 
 Data contract
 -------------
-- ``Motion.values`` is ``(n_frames, n_channels)`` float64, time first, sampled at
-  ``fps > 0`` [Hz]. Frame ``i`` is at time ``i / fps`` [s].
-- Channels are named ``"<joint>_<dof>"`` (``"rShin_Xrotation"``, ``"hip_Xposition"``)
-  for skeletal data, ``"<marker>_x"`` for marker positions, ``"<name>_angle"`` for
-  derived joint angles. Rotation channels are degrees, as in BVH; positions are in
-  the file's units (the bundled CMU salsa files are in metres, marker data is
-  converted to metres on reading).
-- A :class:`Skeleton` (from BVH) gives forward kinematics; marker data and plain
-  tables have ``skeleton=None``.
-- A *position-only* motion (``skeleton=None``, channels ``"<joint>_x/_y/_z"`` in
-  joint order; :attr:`Motion.is_positional`) holds world joint positions directly:
-  :meth:`Motion.positions` reshapes them (no forward kinematics) and
-  :attr:`Motion.bones` gives joint-index pairs, given or inferred from constant joint
-  distances (:func:`infer_bones`). Canonical frame of joint positions read by
-  :mod:`beatsync.io.positions`: **metres, z up** (right-handed), the frame of the
-  MoCap Toolbox and most C3D files, and the one ``render`` assumes for skeleton-less
-  motion; files in centimetres or y up are converted on reading and back on writing.
-  :attr:`Motion.position_info` (a :class:`PositionInfo`) keeps what is needed to
-  write the motion back in its input's layout.
+- ``Motion.values`` is ``(n_frames, n_channels)`` float64 at ``fps > 0`` [Hz]; frame
+  ``i`` is at ``i / fps`` [s].
+- Channels are ``"<joint>_<dof>"`` (``"rShin_Xrotation"``) for BVH, ``"<marker>_x"``
+  for positions, ``"<name>_angle"`` for joint angles. Rotations are degrees;
+  positions in the file's units (markers and joint positions: metres).
+- A :class:`Skeleton` (from BVH) gives forward kinematics; other motion has
+  ``skeleton=None``.
+- A *position-only* motion (:attr:`Motion.is_positional`: no skeleton, channels
+  ``"<joint>_x/_y/_z"``) holds world joint positions in the canonical frame,
+  **metres, z up** (right-handed; files in cm or y up are converted on reading and
+  back on writing); :attr:`Motion.bones` are given or inferred (:func:`infer_bones`),
+  and :attr:`Motion.position_info` keeps the input's layout for writing it back.
 """
 
 from __future__ import annotations
@@ -67,19 +60,8 @@ _POS_DOFS = ("Xposition", "Yposition", "Zposition")
 
 @dataclass(frozen=True, eq=False)
 class Joint:
-    """One joint (or end site) of a BVH hierarchy.
-
-    Attributes
-    ----------
-    name : str
-    parent : int
-        Index of the parent joint in :attr:`Skeleton.joints`; -1 for the root.
-    offset : np.ndarray [shape=(3,)]
-        Offset from the parent, in the file's length units.
-    channels : tuple of str
-        BVH channel names in file order (``()`` for end sites).
-    is_end_site : bool
-    """
+    """One joint (or end site) of a BVH hierarchy: ``parent`` index (-1: root), ``offset``
+    from it [file units], BVH channel names in file order."""
 
     name: str
     parent: int
@@ -135,25 +117,10 @@ class Skeleton:
 class PositionInfo:
     """What a position-only motion needs beyond its values: bones and its file's layout.
 
-    Parameters
-    ----------
-    bones : np.ndarray [shape=(n_bones, 2)], int, optional
-        Joint-index pairs; ``None``: inferred from the data (:func:`infer_bones`).
-    layout : str
-        Layout of the file it came from: ``"json"`` (Dance-with-Melody ``skeletons`` +
-        ``center``), ``"npy"``, ``"npz"``, ``"c3d"``, or ``"array"`` (made in memory).
-    units : {"m", "cm", "mm"}
-        Length unit of that file (the motion itself is in metres).
-    up : {"y", "z"}
-        Vertical axis of that file (the motion itself is z up).
-    units_source, up_source : {"given", "detected", "file"}
-        Whether the unit / axis was given by the caller, detected from the body's
-        size and shape, or read from the file's own parameters.
-    center : np.ndarray [shape=(n_frames, 3)] [m], optional
-        The JSON layout's per-frame root track, in the canonical frame; joint
-        positions of the motion are absolute (file ``skeletons`` + ``center``).
-    key : str, optional
-        Array name in an ``.npz`` file.
+    ``bones`` ``None``: inferred. ``layout``: ``"json"``, ``"npy"``, ``"npz"``, ``"c3d"``
+    or ``"array"`` (made in memory); ``units``/``up`` of that file, each ``"given"``,
+    ``"detected"`` or read from the ``"file"``; ``center`` [m]: the JSON layout's root
+    track; ``key``: the array's name in an ``.npz``.
     """
 
     bones: np.ndarray | None = None
@@ -176,19 +143,7 @@ class PositionInfo:
 
 @dataclass(frozen=True, eq=False)
 class Motion:
-    """Multi-channel motion sampled at a constant frame rate.
-
-    Parameters
-    ----------
-    values : np.ndarray [shape=(n_frames, n_channels)]
-        Rotations in degrees; positions in the file's units.
-    fps : float > 0 [Hz]
-    channels : tuple of str [len = n_channels]
-    skeleton : Skeleton or None
-    name : str
-    position_info : PositionInfo or None
-        Bones and file layout of a position-only motion (see :attr:`is_positional`).
-    """
+    """Multi-channel motion sampled at a constant frame rate (see the module's contract)."""
 
     values: np.ndarray
     fps: float
@@ -233,31 +188,22 @@ class Motion:
     # -- position-only motion ---------------------------------------------
     @property
     def is_positional(self) -> bool:
-        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples.
-
-        MoCap Toolbox markers and joint positions read by :mod:`beatsync.io.positions`
-        are position-only; BVH motion and angle tables are not.
-        """
+        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples."""
         if "positional" not in self._cache:
             ch = self.channels
-            ok = self.skeleton is None and len(ch) >= 3 and len(ch) % 3 == 0
-            if ok:
-                for i in range(0, len(ch), 3):
-                    stems = {c.rpartition("_")[0] for c in ch[i : i + 3]}
-                    axes = tuple(c.rpartition("_")[2] for c in ch[i : i + 3])
-                    if len(stems) != 1 or axes != ("x", "y", "z") or "" in stems:
-                        ok = False
-                        break
-            self._cache["positional"] = ok
+            stems = [c.rpartition("_")[0] for c in ch[::3]]
+            self._cache["positional"] = (
+                self.skeleton is None
+                and len(ch) % 3 == 0
+                and "" not in stems
+                and len(ch) >= 3
+                and ch == tuple(f"{s}_{a}" for s in stems for a in "xyz")
+            )
         return self._cache["positional"]
 
     @property
     def bones(self) -> np.ndarray:
-        """Joint-index pairs ``(n_bones, 2)`` into axis 1 of :meth:`positions`.
-
-        BVH: ``(joint, parent)`` from the skeleton. Position-only motion: the given
-        bones, else inferred from constant joint distances (:func:`infer_bones`).
-        """
+        """Joint-index pairs ``(n_bones, 2)``: BVH ``(joint, parent)``, else given or inferred."""
         if self.skeleton is not None:
             return np.array(
                 [(i, j.parent) for i, j in enumerate(self.skeleton.joints) if j.parent >= 0],
@@ -350,29 +296,22 @@ class Motion:
 
     # -- rotations and kinematics -----------------------------------------
     def rotation_triples(self) -> list[tuple[str, tuple[int, int, int], str]]:
-        """Each joint with three rotation channels: ``(joint, channel indices, order)``.
+        """``(joint, channel indices, order)`` of each joint with three rotation channels.
 
-        ``order`` is the intrinsic Euler order as listed in the file, e.g. ``"ZXY"``
-        for ``Zrotation Xrotation Yrotation`` (R = Rz @ Rx @ Ry).
+        ``order`` is the intrinsic Euler order of the file: ``"ZXY"`` is R = Rz @ Rx @ Ry.
         """
         if "triples" in self._cache:
             return self._cache["triples"]
-        out: list[tuple[str, tuple[int, int, int], str]] = []
-        by_joint: dict[str, list[tuple[int, str]]] = {}
-        order_seen: list[str] = []
+        by_joint: dict[str, list[tuple[int, str]]] = {}  # in order of first appearance
         for i, ch in enumerate(self.channels):
             joint, _, dof = ch.rpartition("_")
             if dof in _ROT_DOFS:
-                if joint not in by_joint:
-                    by_joint[joint] = []
-                    order_seen.append(joint)
-                by_joint[joint].append((i, dof[0]))
-        for joint in order_seen:
-            items = by_joint[joint]
-            if len(items) == 3:
-                idx = tuple(i for i, _ in items)
-                order = "".join(a for _, a in items)
-                out.append((joint, idx, order))  # type: ignore[arg-type]
+                by_joint.setdefault(joint, []).append((i, dof[0]))
+        out = [
+            (joint, tuple(i for i, _ in items), "".join(a for _, a in items))
+            for joint, items in by_joint.items()
+            if len(items) == 3
+        ]
         self._cache["triples"] = out
         return out
 
@@ -386,27 +325,16 @@ class Motion:
         ]
 
     def positions(self) -> np.ndarray:
-        """World positions of every joint and end site by forward kinematics.
+        """World positions ``(n_frames, n_joints, 3)`` [file units] along :attr:`joint_names`.
 
-        Position-only motion: the values reshaped (a view), no kinematics.
-
-        Returns
-        -------
-        positions : np.ndarray [shape=(n_frames, n_joints, 3)]
-            In the file's length units (position-only motion: metres, z up); axis 1
-            follows :attr:`joint_names`.
+        Forward kinematics for BVH; position-only motion: the values reshaped (a view).
         """
         if "positions" in self._cache:
             return self._cache["positions"]
-        if self.skeleton is None and self.is_positional:
-            pos = self.values.reshape(self.n_frames, -1, 3)
+        if self.skeleton is None:  # joint_names refuses a plain table
+            pos = self.values.reshape(self.n_frames, len(self.joint_names), 3)
             self._cache["positions"] = pos
             return pos
-        if self.skeleton is None:
-            raise ParameterError(
-                f"motion {self.name!r} has no skeleton (marker data or a plain table); "
-                "joint positions need a BVH file"
-            )
         n = self.n_frames
         joints = self.skeleton.joints
         pos = np.zeros((n, len(joints), 3))
@@ -444,10 +372,8 @@ class Motion:
 def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
     """Refuse offsets or translations so large that forward kinematics would overflow.
 
-    A joint's world position is at most the sum, along its chain, of the offsets and
-    translations (rotations keep lengths; each summed as ``|x| + |y| + |z|``, which
-    bounds the length); that sum, times 2 sqrt(3) so that every coordinate of a
-    position and of a difference of two stays finite, must be a finite float.
+    A world position is at most the chain's sum of ``|x| + |y| + |z|`` of offsets and
+    translations (rotations keep lengths); times 2 sqrt(3) it must stay finite.
     """
     joints = skeleton.joints
     with np.errstate(over="ignore"):  # an overflow is inf: refused below
@@ -476,15 +402,7 @@ def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
 
 
 def fill_gaps(motion: Motion) -> Motion:
-    """Fill NaN gaps in every channel by linear interpolation (edges held constant).
-
-    Marker data often has short dropouts (e.g. MoCap Toolbox ``walk1``).
-
-    Raises
-    ------
-    ParameterError
-        If a channel has no finite value at all.
-    """
+    """Fill NaN gaps in every channel by linear interpolation (edges held constant)."""
     values = motion.values.copy()
     t = np.arange(motion.n_frames)
     for c in range(values.shape[1]):
@@ -497,12 +415,8 @@ def fill_gaps(motion: Motion) -> Motion:
 
 
 def _marker(motion: Motion, names: tuple[str, ...]) -> np.ndarray:
-    cols = []
-    for n in names:
-        cols.append(
-            np.stack([motion.values[:, motion.channel_index(f"{n}_{a}")] for a in "xyz"], axis=1)
-        )
-    return np.mean(cols, axis=0)
+    idx = [[motion.channel_index(f"{n}_{a}") for a in "xyz"] for n in names]
+    return motion.values[:, idx].mean(axis=1)
 
 
 def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -551,23 +465,10 @@ _MCT_ANGLES = {
 
 
 def marker_angles(motion: Motion) -> Motion:
-    """Joint angles [deg] from MoCap Toolbox markers (the 28-marker demo set).
+    """Joint angles [deg] (:data:`_MCT_ANGLES`) from the MoCap Toolbox 28-marker set.
 
-    Each angle is the interior angle at a joint between its two segments
-    (180 deg = straight), e.g. the knee angle between hip centre -> knee and
-    ankle -> knee. NaN gaps in markers are filled linearly first.
-
-    Parameters
-    ----------
-    motion : Motion
-        Marker positions with channels ``"<marker>_x/_y/_z"`` (see
-        :func:`beatsync.io.read_mocap_mat`).
-
-    Returns
-    -------
-    Motion
-        Channels ``knee_L_angle``, ``knee_R_angle``, ``hip_*``, ``ankle_*``,
-        ``elbow_*``, ``shoulder_*``, ``neck_angle`` at the same frame rate.
+    Each is the interior angle at a joint between its two segments (180 deg =
+    straight). NaN gaps in markers are filled linearly first.
     """
     motion = fill_gaps(motion)
     try:
@@ -585,19 +486,11 @@ def marker_angles(motion: Motion) -> Motion:
 
 
 def bone_angles(motion: Motion) -> Motion:
-    """Angles [deg] between every two bones that meet at a joint, as a motion.
+    """Interior angles [deg] between every two bones that meet at a joint, as a motion.
 
-    For a position-only motion without a known marker set: each joint with two or
-    more bones (:attr:`Motion.bones`) gives the interior angle between each pair of
-    them (180 deg = straight), e.g. hip-knee-ankle. Such angles do not change when
-    the dancer travels or turns, nor with body size or units, so they suit paper A's
-    segmentation (which works on joint angles) where root-relative positions would
-    follow every turn of a ballroom dance. NaN gaps are filled linearly first.
-
-    Returns
-    -------
-    Motion
-        Channels ``"<a>-<joint>-<b>_angle"`` at the same frame rate, no skeleton.
+    Channels ``"<a>-<joint>-<b>_angle"``. Unchanged by travel, turns, body size and
+    units, so they suit paper A's segmentation of position-only motion without a
+    known marker set. NaN gaps are filled linearly first.
     """
     motion = fill_gaps(motion)
     pos = motion.positions()
@@ -640,10 +533,8 @@ def is_marker_motion(motion: Motion) -> bool:
 def segmentation_view(motion: Motion) -> Motion:
     """The joint-angle motion that segmentation works on (paper A works on joint angles).
 
-    BVH motion and angle tables are returned as they are; MoCap Toolbox markers are
-    turned into joint angles with :func:`marker_angles`; other position-only motion
-    (e.g. keypoints without marker names) into the angles between its bones with
-    :func:`bone_angles` (travel- and turn-invariant, see there).
+    BVH and angle tables as they are; markers through :func:`marker_angles`, other
+    position-only motion through :func:`bone_angles`.
     """
     if not is_marker_motion(motion):
         return motion

@@ -114,9 +114,7 @@ def _jsonable(obj: Any, digits: int | None) -> Any:
     return obj
 
 
-def write_json(
-    path: str | os.PathLike[str], obj: Any, *, float_digits: int | None = None
-) -> Path:
+def write_json(path: str | os.PathLike[str], obj: Any, *, float_digits: int | None = None) -> Path:
     """Write ``obj`` as indented JSON (numpy values converted) (atomic).
 
     Parameters
@@ -147,9 +145,7 @@ def write_json(
     return Path(path)
 
 
-def write_csv(
-    path: str | os.PathLike[str], frame: Any, *, float_format: str | None = None
-) -> Path:
+def write_csv(path: str | os.PathLike[str], frame: Any, *, float_format: str | None = None) -> Path:
     """Write a pandas DataFrame as CSV without its index (atomic).
 
     ``float_format`` (a printf format such as ``"%.6g"``) fixes the precision of floats.

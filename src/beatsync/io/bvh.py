@@ -1,11 +1,9 @@
 """BVH motion files: read (with a frame-rate override) and write (exact round trip).
 
-The reader is one pass over the file's lines in linear time: the hierarchy is parsed
-token by token (so a joint may be named ``MOTION``), and the MOTION block is streamed
-into a preallocated float64 array in chunks, so memory stays near the size of the
-values (an 86 MB file no longer needs a gigabyte). Every malformed header, hierarchy
-line or frame line is refused with its line number. The writer is iterative, so any
-hierarchy the reader accepts (however deep) can be written back.
+The reader is one linear pass: the hierarchy token by token (a joint may be named
+``MOTION``), the frames streamed in chunks into a preallocated array (memory near the
+values' size). Every malformed line is refused with its number. The writer is
+iterative, so any hierarchy the reader accepts (however deep) can be written back.
 """
 
 from __future__ import annotations
@@ -35,9 +33,8 @@ _CHUNK_ROWS = 4096  # frame lines converted to floats at once
 
 
 class _Lines:
-    """Numbered text lines of a binary file: UTF-8 (an optional byte-order mark
-    skipped), ``\\n``, ``\\r\\n`` or ``\\r`` line ends, decoded one line at a time so a
-    decoding error is reported with its line number."""
+    """Numbered UTF-8 lines of a binary file (BOM skipped; ``\\n``, ``\\r\\n`` or ``\\r``
+    ends), decoded one at a time so a decoding error names its line."""
 
     def __init__(self, fh, path: Path) -> None:
         self._it = self._numbered(fh)
@@ -173,11 +170,7 @@ class _HierarchyParser:
                         f"OFFSET of {self.label(top)} is not finite ({' '.join(toks)}); a bone "
                         "length must be a number"
                     )
-                if self.pending:
-                    raise self.err(
-                        f"OFFSET is followed by {self.pending[-1][:40]!r} on its line (an "
-                        "OFFSET has three values)"
-                    )
+                self.line_ends("OFFSET", "an OFFSET has three values")
                 top.offset = off
             elif up == "CHANNELS":
                 assert top is not None
@@ -200,11 +193,7 @@ class _HierarchyParser:
                 if len(set(chans)) != len(chans):
                     dup = next(c for c in chans if chans.count(c) > 1)
                     raise self.err(f"channel {dup} listed twice in {self.label(top)}")
-                if self.pending:
-                    raise self.err(
-                        f"CHANNELS {count} is followed by {self.pending[-1][:40]!r} on its line "
-                        "(wrong channel count?)"
-                    )
+                self.line_ends(f"CHANNELS {count}", "wrong channel count?")
                 top.channels = chans
             elif tok == "}":
                 assert top is not None
@@ -229,6 +218,10 @@ class _HierarchyParser:
             )
         )
 
+    def line_ends(self, what: str, hint: str) -> None:
+        if self.pending:
+            raise self.err(f"{what} is followed by {self.pending[-1][:40]!r} on its line ({hint})")
+
     def expect_brace(self, what: str) -> None:
         brace = self.next_token(f"'{{' after {what}")
         if brace != "{":
@@ -245,8 +238,7 @@ _NUMBER_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 
 
 def _is_plain_number(tok: str) -> bool:
-    """A decimal number in ASCII (no underscores, no Unicode digits); also nan/inf,
-    refused later by the finite check with a clearer message."""
+    """An ASCII decimal number (no ``_``, no Unicode digits), or nan/inf (refused later)."""
     return _NUMBER_RE.fullmatch(tok) is not None or tok.lower().lstrip("+-") in (
         "nan",
         "inf",
@@ -270,29 +262,7 @@ def _header_value(lines: _Lines, pattern: re.Pattern[str], what: str, path: Path
 
 
 def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motion:
-    """Read a BVH file.
-
-    Parameters
-    ----------
-    path : path-like
-        A UTF-8 text file (a byte-order mark is allowed).
-    fps : float > 0 [Hz], optional
-        Override the frame rate declared by ``Frame Time`` (the CMU salsa BVH files
-        declare 120 fps but are 60 fps).
-
-    Returns
-    -------
-    Motion
-        Channels ``"<joint>_<dof>"`` in file order, rotations in degrees.
-
-    Raises
-    ------
-    ParameterError
-        With the line number: a missing, truncated or malformed file; a joint without
-        OFFSET or CHANNELS, a non-finite offset, duplicate joint or channel names;
-        frame lines with the wrong number of values or non-numeric values; a frame
-        count that does not match; NaN/inf values; a bad frame time.
-    """
+    """Read a BVH file; ``fps`` [Hz] overrides ``Frame Time`` (CMU salsa says 120, is 60)."""
     p = check_input_file(path, "BVH")
     try:
         with open(p, "rb") as fh:
@@ -347,15 +317,11 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
 
 
 def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.ndarray:
-    """Stream the frame lines into a preallocated ``(n_declared, n_ch)`` array.
+    """Stream the frame lines, in chunks read by numpy, into an ``(n_declared, n_ch)`` array.
 
-    Lines are gathered in chunks; each chunk is parsed by numpy's C text reader, and
-    only a chunk it refuses (or reads to another shape) is split line by line in
-    Python to name the first bad line.
+    A frame line takes at least ``2 * n_ch`` bytes, so a huge declared count in a small
+    file allocates no more than the file could fill.
     """
-    # A frame line holds n_ch numbers: at least 2 * n_ch - 1 characters and a newline,
-    # so the file's size bounds the number of frames it can hold: a huge declared count
-    # in a small file allocates no more than the file could fill.
     capacity = min(n_declared, path.stat().st_size // (2 * n_ch) + 1)
     values = np.empty((capacity, n_ch), dtype=np.float64)
     chunk: list[str] = []
@@ -380,12 +346,7 @@ def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.nd
             row += 1
             continue
         if not line.isascii() or "_" in line:  # Python and numpy read "1_0" and Unicode digits
-            bad = next((t for t in line.split() if not _is_plain_number(t)), None)
-            if bad is not None:
-                raise ParameterError(
-                    f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
-                    "frame line"
-                )
+            _refuse_non_numeric(line.split(), lineno, path)
         chunk.append(line)
         chunk_lines.append(lineno)
         row += 1
@@ -421,14 +382,17 @@ def _parse_chunk(
                 f"BVH {str(path)!r}, line {lineno}: frame line {first_row + k + 1} has "
                 f"{len(toks)} values but the hierarchy defines {n_ch} channels"
             )
-        bad = next((t for t in toks if not _is_plain_number(t)), None)
-        if bad is not None:
-            raise ParameterError(
-                f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
-                "frame line"
-            )
+        _refuse_non_numeric(toks, lineno, path)
         rows.append(toks)
     return np.array(rows, dtype=np.float64)
+
+
+def _refuse_non_numeric(toks: list[str], lineno: int, path: Path) -> None:
+    bad = next((t for t in toks if not _is_plain_number(t)), None)
+    if bad is not None:
+        raise ParameterError(
+            f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a frame line"
+        )
 
 
 def _fmt(x: float) -> str:
@@ -436,17 +400,7 @@ def _fmt(x: float) -> str:
 
 
 def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write ``motion`` as BVH with its skeleton; atomic.
-
-    Values are written with the shortest decimal that round-trips exactly, so
-    ``read_bvh(write_bvh(p, m))`` gives identical values and frame rate. The
-    hierarchy is written without recursion, so any depth the reader accepts works.
-
-    Raises
-    ------
-    ParameterError
-        No skeleton (marker data or a plain table), or NaN/inf values or offsets.
-    """
+    """Write ``motion`` as BVH (atomic), each value as its shortest exact decimal."""
     if motion.skeleton is None:
         raise ParameterError(
             f"motion {motion.name!r} has no skeleton (marker data or a plain table) and "

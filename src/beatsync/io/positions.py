@@ -1,28 +1,24 @@
 """Joint-position motion files: Dance-with-Melody JSON, ``.npy``/``.npz`` arrays, C3D.
 
-Every reader returns a position-only :class:`~beatsync.motion.Motion` in the canonical
-frame (metres, z up; see :mod:`beatsync.motion`) with a
-:class:`~beatsync.motion.PositionInfo` that records the file's layout, units and
-vertical axis, so that the writers here put the motion back in that layout.
+Readers return a position-only :class:`~beatsync.motion.Motion` in the canonical frame
+(metres, z up) with a :class:`~beatsync.motion.PositionInfo` recording the file's
+layout, units and vertical axis, which the writers here restore.
 
 Layouts
 -------
 - ``.json`` (Dance-with-Melody): ``{"length": N, "center": [N][3], "skeletons":
-  [N][J][3]}``; ``skeletons`` are joint positions relative to ``center``, the
-  per-frame root position (the four bundled dancers: 23 joints, centimetres, y up,
-  25 fps, which the file does not store). The motion holds absolute positions
-  (``skeletons + center``).
-- ``.npy``: one array ``(n_frames, n_joints, 3)`` (e.g. AIST++ ``keypoints3d``).
-- ``.npz``: such an array under a key (named, or found: ``keypoints3d`` or the only
-  3-D array with 3 columns); a scalar ``fps`` in the archive is used as the rate.
-- ``.c3d``: marker points through the ``c3d`` package; the file's own rate, labels
-  and unit (``POINT:UNITS``); points flagged invalid (negative residual) are gaps.
+  [N][J][3]}``, joints relative to the per-frame root ``center`` (no rate stored; the
+  bundled dancers are 25 fps, cm, y up). The motion holds ``skeletons + center``.
+- ``.npy``: one ``(n_frames, n_joints, 3)`` array (e.g. AIST++ ``keypoints3d``).
+- ``.npz``: such an array under a key (named, ``keypoints3d`` or the only one); a
+  scalar ``fps`` in the archive is the rate.
+- ``.c3d``: marker points, with the file's rate, labels and ``POINT:UNITS``; points
+  with a negative residual are gaps.
 
-Units (``"m"``, ``"cm"``, ``"mm"``) and vertical axis (``"y"``, ``"z"``) are given
-or detected: the vertical axis is the one of y and z along which the body extends
-most (median over frames), the unit the one that makes that extent a human size
-(0.25-3 m). Short NaN gaps are filled (:func:`beatsync.motion.fill_joint_gaps`),
-long ones refused with the joint named.
+Units (``"m"``, ``"cm"``, ``"mm"``) and vertical axis (``"y"``, ``"z"``) are given or
+detected: up is whichever of y and z the body extends along most (median over
+frames), the unit the one that makes that extent 0.25-3 m. Gaps up to ``max_gap`` [s]
+are filled (:func:`beatsync.joints.fill_joint_gaps`), longer ones refused.
 """
 
 from __future__ import annotations
@@ -45,6 +41,7 @@ from ..motion import (
 )
 from ..validation import check_fps, check_positive
 from ._files import atomic_write, check_input_file
+from .tables import read_npz
 
 __all__ = [
     "read_positions_json",
@@ -68,9 +65,6 @@ _HEIGHT_M = (0.25, 3.0)
 _KEYPOINT_KEYS = ("keypoints3d", "keypoints3d_optim", "positions", "joints")
 
 
-# --------------------------------------------------------------------------- frames
-
-
 def _check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str | None:
     if value is None:
         return None
@@ -90,11 +84,7 @@ def _extents(pos: np.ndarray) -> np.ndarray:
 
 
 def detect_up(positions: Any) -> str:
-    """The vertical axis (``"y"`` or ``"z"``) of joint positions ``(n_frames, n_joints, 3)``.
-
-    The body of a standing or dancing person extends further along the vertical
-    than along the depth axis; an ambiguous case (extents within 15 %) is refused.
-    """
+    """The vertical axis (``"y"`` or ``"z"``): the longer body extent, by more than 15 %."""
     ext = _extents(np.asarray(positions, dtype=np.float64))
     ey, ez = float(ext[1]), float(ext[2])
     if ey > 1.15 * ez:
@@ -108,10 +98,7 @@ def detect_up(positions: Any) -> str:
 
 
 def detect_units(positions: Any, up: str) -> str:
-    """The length unit (``"m"``, ``"cm"``, ``"mm"``) that makes the body a human size.
-
-    The body's vertical extent (median over frames) must be 0.25-3 m in one unit.
-    """
+    """The length unit (``"m"``, ``"cm"``, ``"mm"``) that makes the body 0.25-3 m tall."""
     h = float(_extents(np.asarray(positions, dtype=np.float64))["xyz".index(up)])
     for unit, scale in UNIT_METRES.items():
         if _HEIGHT_M[0] <= h * scale <= _HEIGHT_M[1]:
@@ -151,9 +138,6 @@ def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, 
             f"(detected: {detect_units(pos, up) if h > 0 else '?'})"
         )
     return units, units_det, up, up_det
-
-
-# --------------------------------------------------------------------------- building
 
 
 def _names(n_joints: int, names: Any = None) -> tuple[str, ...]:
@@ -229,9 +213,6 @@ def _need_fps(fps: Any, source: str, hint: str = "") -> float:
     return check_fps(fps)
 
 
-# --------------------------------------------------------------------------- JSON
-
-
 def read_positions_json(
     path: str | os.PathLike[str],
     *,
@@ -241,26 +222,10 @@ def read_positions_json(
     bones: Any = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read the Dance-with-Melody JSON layout (``skeletons`` [N][J][3] + ``center`` [N][3]).
+    """Read the Dance-with-Melody JSON layout; ``fps`` [Hz] is required (the file has none).
 
-    Parameters
-    ----------
-    fps : float > 0 [Hz]
-        Required (the layout stores no rate; the Dance-with-Melody dataset is 25 fps).
-    up : {"y", "z"}, optional
-        Vertical axis of the file; default detected.
-    units : {"m", "cm", "mm"}, optional
-        Length unit of the file; default detected.
-    bones : array_like [shape=(n_bones, 2)], optional
-        Joint-index pairs; default inferred from the data.
-    max_gap : float >= 0 [s]
-        Longest run of missing (``null``/NaN) values filled per joint.
-
-    Returns
-    -------
-    Motion
-        Absolute joint positions (``skeletons + center``) in metres, z up, joints
-        ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
+    ``up``, ``units``: detected unless given; ``bones``: inferred unless given; joints
+    are named ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
     """
     p = check_input_file(path, "JSON motion")
     up = _check_choice(up, "up", ("y", "z"))
@@ -346,10 +311,8 @@ def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
 def write_positions_json(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write a position-only motion in the Dance-with-Melody JSON layout (atomic).
 
-    Positions go back to the units and vertical axis of ``motion.position_info``
-    (metres, z up without it). ``center`` is the motion's root track where it still
-    has one per frame (a motion read from such a file), else the per-frame mean of
-    the joints; ``skeletons`` are the positions relative to it.
+    In the units and axis of ``position_info``; ``center`` is the motion's root track
+    if it has one per frame, else the joints' per-frame mean.
     """
     info = _positional_info(motion, ".json")
     pos = motion.positions()
@@ -375,14 +338,8 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
     return info if info is not None else PositionInfo()
 
 
-# --------------------------------------------------------------------------- arrays
-
-
 def is_position_array(path: str | os.PathLike[str]) -> bool:
-    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only).
-
-    Other shapes are left to the table reader, which explains what it needs.
-    """
+    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only)."""
     p = check_input_file(path, ".npy")
     try:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
@@ -407,18 +364,8 @@ def read_positions_array(
 ) -> Motion:
     """Read joint positions ``(n_frames, n_joints, 3)`` from ``.npy`` or ``.npz``.
 
-    Parameters
-    ----------
-    fps : float > 0 [Hz], optional
-        Required unless an ``.npz`` holds a scalar ``fps``; a given rate that
-        contradicts the archive's is refused.
-    key : str, optional
-        Array name in an ``.npz``; default ``keypoints3d`` (AIST++) or the only
-        ``(n, J, 3)`` array.
-    up, units, bones, max_gap
-        As for :func:`read_positions_json`.
-    joint_names : sequence of str, optional
-        Default ``j0``, ``j1``, ...
+    ``fps`` [Hz] is required unless an ``.npz`` stores one (then it must agree); ``key``
+    names the ``.npz`` array; the rest as for :func:`read_positions_json`.
     """
     p = check_input_file(path, "array")
     up = _check_choice(up, "up", ("y", "z"))
@@ -426,11 +373,7 @@ def read_positions_array(
     suffix = p.suffix.lower()
     file_fps = None
     if suffix == ".npz":
-        try:
-            with np.load(p, allow_pickle=False) as data:
-                arrays = {k: data[k] for k in data.files}
-        except Exception as exc:
-            raise ParameterError(f"cannot read {str(p)!r} as an .npz archive: {exc}") from None
+        arrays = read_npz(p)
         cands = [k for k, v in arrays.items() if v.ndim == 3 and v.shape[-1] == 3]
         if key is None:
             pref = [k for k in _KEYPOINT_KEYS if k in cands]
@@ -483,12 +426,8 @@ def _file_rate(fps: Any, file_fps: float, p: Path) -> float:
 
 
 def write_positions_array(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write a position-only motion as ``(n_frames, n_joints, 3)`` (atomic).
-
-    ``.npy``: the array alone; ``.npz``: the array under the motion's key (default
-    ``keypoints3d``) and the scalar ``fps``. Units and vertical axis of
-    ``motion.position_info`` (metres, z up without it).
-    """
+    """Write a position-only motion as ``(n_frames, n_joints, 3)`` (atomic), in its file's
+    units and axis; ``.npz`` adds the scalar ``fps`` (array key default ``keypoints3d``)."""
     dest = Path(path)
     info = _positional_info(motion, dest.suffix.lower())
     arr = from_canonical(motion.positions(), units=info.units, up=info.up)
@@ -498,9 +437,6 @@ def write_positions_array(path: str | os.PathLike[str], motion: Motion) -> Path:
         else:
             np.save(fh, arr)
     return dest
-
-
-# --------------------------------------------------------------------------- C3D
 
 
 def read_c3d(
@@ -514,10 +450,8 @@ def read_c3d(
 ) -> Motion:
     """Read the marker points of a C3D file (its own rate, labels and unit).
 
-    Points with a negative residual (the C3D flag for 'not seen') are gaps, filled
-    up to ``max_gap`` seconds. ``fps`` may be given only if it equals the file's
-    rate. ``units`` defaults to the file's ``POINT:UNITS``; ``up`` to the file's
-    ``POINT:Y_SCREEN`` (``+Y``/``+Z``) or is detected.
+    ``fps`` must equal the file's rate if given; ``units`` defaults to ``POINT:UNITS``,
+    ``up`` to ``POINT:Y_SCREEN`` (``+Y``/``+Z``), else both are detected.
     """
     import c3d
 
@@ -572,8 +506,6 @@ def read_c3d(
         joint_names=labels if len(labels) == n_points else None,
     )
     info = motion.position_info
-    if info is None:  # pragma: no cover - _build always sets it
-        raise RuntimeError("position reader lost its PositionInfo")
     info = replace(
         info,
         units_source="file" if units is None and file_unit else info.units_source,
@@ -593,11 +525,8 @@ def _param_str(reader: Any, name: str) -> str:
 
 
 def write_c3d(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write a position-only motion as C3D points (float, the motion's rate) (atomic).
-
-    Units and vertical axis of ``motion.position_info`` (millimetres, z up without
-    one: the usual C3D convention); joint names become point labels.
-    """
+    """Write a position-only motion as C3D float points (atomic), in its file's units and
+    axis (without one: mm, z up, the usual C3D convention)."""
     import c3d
 
     info = _positional_info(motion, ".c3d")

@@ -14,20 +14,10 @@ from ._files import atomic_write, check_input_file, write_csv
 
 
 def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) -> Motion:
-    """Read marker data from a MoCap Toolbox ``.mat`` file (MATLAB v5 struct).
+    """Read markers of a MoCap Toolbox ``.mat`` struct (``variable``, e.g. ``"dance2"``).
 
-    Parameters
-    ----------
-    path : path-like
-    variable : str
-        Name of the struct, e.g. ``"dance2"``; may be omitted if the file has only one.
-
-    Returns
-    -------
-    Motion
-        Marker positions in metres (the toolbox stores mm), channels
-        ``"<marker>_x"``, ``"_y"``, ``"_z"`` (z up), ``fps`` from the struct's
-        ``freq``, no skeleton. NaN gaps are kept (see :func:`beatsync.motion.fill_gaps`).
+    Positions in metres (the toolbox stores mm), z up, rate from ``freq``; NaN gaps kept.
+    ``variable`` may be left out if the file holds one recording.
     """
     import scipy.io
 
@@ -87,15 +77,8 @@ def _scalar(value: object) -> object:
 def read_table(
     path: str | os.PathLike[str], *, fps: float | None, channels: list[str] | None = None
 ) -> Motion:
-    """Read a plain joint-angle table: ``.csv`` with a header row, or ``.npy`` ``(n, c)``.
-
-    Parameters
-    ----------
-    fps : float > 0 [Hz]
-        Required: tables carry no frame rate.
-    channels : list of str, optional
-        Names for ``.npy`` columns (default ``"ch0"``, ``"ch1"``, ...).
-    """
+    """Read a joint-angle table at ``fps`` [Hz]: ``.csv`` with a header row, or ``.npy``
+    ``(n, c)`` (columns ``channels``, default ``"ch0"``, ``"ch1"``, ...)."""
     p = check_input_file(path, "table")
     if fps is None:
         raise ParameterError(
@@ -107,8 +90,7 @@ def read_table(
         names = tuple(channels) if channels else tuple(f"ch{i}" for i in range(values.shape[1]))
         if len(names) != values.shape[1]:
             raise ParameterError(
-                f"{len(names)} channel names given for the {values.shape[1]} columns of "
-                f"{str(p)!r}"
+                f"{len(names)} channel names given for the {values.shape[1]} columns of {str(p)!r}"
             )
     else:
         import pandas as pd
@@ -140,15 +122,7 @@ def read_table(
 
 
 def check_npy_header(path: str | os.PathLike[str]) -> tuple[tuple[int, ...], np.dtype]:
-    """Return the shape and dtype of a ``.npy`` file from its header, nothing else read.
-
-    Raises
-    ------
-    ParameterError
-        Not a ``.npy`` file (an ``.npz`` archive renamed is named as such), a broken
-        header, or a dtype that is not integers or floats (strings, bytes, records,
-        complex numbers, dates, Python objects).
-    """
+    """Shape and dtype of a ``.npy`` file from its header alone; refuses non-numeric dtypes."""
     p = check_input_file(path, ".npy")
     with open(p, "rb") as fh:
         magic = fh.read(6)
@@ -212,8 +186,7 @@ def write_table(path: str | os.PathLike[str], motion: Motion) -> Path:
 
 
 def _check_csv_rows(p: Path) -> None:
-    """Refuse a CSV row with more or fewer fields than the header, naming its line
-    (pandas would fill a short row with NaN, which reads as a gap in the motion)."""
+    """Refuse a row with another number of fields than the header (pandas fills NaN)."""
     import csv
 
     try:
