@@ -1,22 +1,20 @@
-"""Bundled real data (the repository's ``data/`` folder), verified by SHA-256.
+"""Bundled real data (``<repo>/data``, or ``$BEATSYNC_DATA``), verified by SHA-256.
 
-Every file was copied byte for byte from a public source; ``data/README.md`` gives
-origins, licences and the checksums repeated in :data:`CHECKSUMS`. Loading a file
-through this module verifies its checksum once per process, so a corrupted or
-edited file is refused rather than silently used.
-
-The data folder is found next to the source tree (``<repo>/data``) or from the
-environment variable ``BEATSYNC_DATA``.
+Every file is a byte-for-byte copy from a public source (``data/README.md``: origins,
+licences, checksums). Each file's checksum is verified once per process, so a
+corrupted or edited file is refused rather than silently used.
 """
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from . import io
 from .errors import ParameterError
 from .motion import Motion
 
@@ -106,22 +104,14 @@ def data_dir() -> Path:
 
 
 def path(relpath: str, *, verify: bool = True) -> Path:
-    """Path of a bundled data file (relative to ``data/``), checksum-verified.
-
-    Raises
-    ------
-    ParameterError
-        Unknown file, missing file, or checksum mismatch.
-    """
+    """Path of a bundled data file (relative to ``data/``), checksum-verified."""
     if relpath not in CHECKSUMS:
         raise ParameterError(f"{relpath!r} is not a bundled data file; known: {sorted(CHECKSUMS)}")
     p = data_dir() / relpath
     if not p.is_file():
         raise ParameterError(f"bundled data file {str(p)!r} is missing")
     if verify and relpath not in _verified:
-        from .io import sha256_file
-
-        digest = sha256_file(p)
+        digest = io.sha256_file(p)
         if digest != CHECKSUMS[relpath]:
             raise ParameterError(
                 f"bundled data file {str(p)!r} fails its SHA-256 check ({digest[:12]}... != "
@@ -147,8 +137,6 @@ def verify_all() -> dict[str, bool]:
 
 def load_salsa(take: str = "60_01") -> Motion:
     """A CMU salsa clip (``"60_01"``, ``"61_01"``, ``"60_04"``, ``"61_04"``) at 60 fps."""
-    from . import io
-
     if take not in SALSA_CLIPS:
         raise ParameterError(f"unknown salsa take {take!r}; choose from {SALSA_CLIPS}")
     m = io.read_bvh(path(f"motion/cmu_salsa/{take}_scaled.bvh"), fps=CMU_FPS)
@@ -158,8 +146,6 @@ def load_salsa(take: str = "60_01") -> Motion:
 def load_walk(clip: str = "007_01") -> Motion:
     """A CMU subject 7 walk (``"007_01"``, ``"007_02"``, ``"007_12"``) or the 5 pirouette
     (``"005_02"``, not periodic) at 60 fps."""
-    from . import io
-
     if clip not in WALK_CLIPS:
         raise ParameterError(f"unknown clip {clip!r}; choose from {WALK_CLIPS}")
     m = io.read_bvh(path(f"motion/cmu_walk_modern/{clip}.bvh"), fps=CMU_FPS)
@@ -168,8 +154,6 @@ def load_walk(clip: str = "007_01") -> Motion:
 
 def load_mocap_toolbox(variable: str = "dance2") -> Motion:
     """MoCap Toolbox demo markers (``"dance1"``, ``"dance2"``, ``"walk1"``, ``"walk2"``), 60 Hz, metres."""
-    from . import io
-
     if variable not in ("dance1", "dance2", "walk1", "walk2"):
         raise ParameterError(f"unknown MoCap Toolbox recording {variable!r}")
     return io.read_mocap_mat(path("motion/mocaptoolbox/mcdemodata.mat"), variable)
@@ -177,8 +161,6 @@ def load_mocap_toolbox(variable: str = "dance2") -> Motion:
 
 def load_madmom_sample() -> tuple[np.ndarray, int, np.ndarray]:
     """The madmom test recording (2.8 s, 44.1 kHz) and its 4 hand-annotated beats [s]."""
-    from . import io
-
     y, sr = io.read_audio(path("audio/madmom/sample.wav"))
     beats = io.read_beats(path("audio/madmom/sample.beats"))
     return y, sr, beats
@@ -186,8 +168,6 @@ def load_madmom_sample() -> tuple[np.ndarray, int, np.ndarray]:
 
 def load_click_808() -> tuple[np.ndarray, int]:
     """The BeatNet 808 kick loop (10 s, 120 BPM; tempo only, no beat list)."""
-    from . import io
-
     return io.read_audio(path("audio/click_808_120bpm/808kick120bpm.mp3"))
 
 
@@ -200,22 +180,9 @@ _DANCE_STYLE = {"C": "cha-cha", "R": "rumba", "W": "waltz"}
 class DancePair:
     """A real dancer with the song they danced to (a bundled 24 s excerpt).
 
-    Attributes
-    ----------
-    name : str
-        ``"DANCE_C_4"``, ...
-    style : str
-        ``"cha-cha"``, ``"rumba"`` or ``"waltz"``.
-    motion : Motion
-        Joint positions, 23 joints, 25 fps, metres, z up (file: cm, y up).
-    y : np.ndarray [shape=(n,)]
-        The matching part of the song, mono.
-    sr : int [Hz]
-    audio_offset : float [s]
-        Time in ``y`` of motion frame 0 (the excerpt's audio starts this much earlier;
-        the dataset's own alignment of dance and song is approximate).
-    excerpt : dict
-        What was cut: original ``config``, first frame, song time of frame 0.
+    ``motion``: 23 joints, 25 fps, metres, z up; ``y``: the song's matching part, mono;
+    ``audio_offset`` [s]: time in ``y`` of motion frame 0 (the dataset's own alignment
+    is approximate); ``excerpt``: what was cut (``config``, first frame, song time).
     """
 
     name: str
@@ -232,10 +199,6 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
 
     Frame ``i`` of the motion plays at time ``audio_offset + i / fps`` of ``y``.
     """
-    import json
-
-    from . import io
-
     if name not in DANCE_PAIRS:
         raise ParameterError(f"unknown Dance-with-Melody pair {name!r}; choose from {DANCE_PAIRS}")
     folder = f"motion/dance_with_melody/{name}"
@@ -256,14 +219,8 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
 
 
 def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
-    """A real development recording and its human beat annotations [s].
-
-    ``"hainsworth_001"`` (Hainsworth dataset excerpt 001, 56.5 s, about 100 BPM, 4/4) or
-    ``"ballroom_waltz"`` (Ballroom dataset, Waltz, Media-105901, 31.8 s, about 84 BPM,
-    3/4); both 44.1 kHz. Returns ``(y, sr, beats)``.
-    """
-    from . import io
-
+    """``(y, sr, beats [s])`` of a real recording with human beat annotations: Hainsworth
+    excerpt 001 (4/4, about 100 BPM) or ``"ballroom_waltz"`` (Media-105901, 3/4, 84 BPM)."""
     if name not in REAL_DEV_ITEMS:
         raise ParameterError(
             f"unknown development recording {name!r}; choose from {sorted(REAL_DEV_ITEMS)}"

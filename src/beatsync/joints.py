@@ -1,14 +1,5 @@
-"""Joint positions as arrays: bones, bone lengths, gap filling.
-
-Functions on ``(n_frames, n_joints, 3)`` arrays used by position-only
-:class:`beatsync.motion.Motion` and by the readers of :mod:`beatsync.io.positions`.
-
-Data contract
--------------
-- Positions are ``(n_frames, n_joints, 3)`` float64, time first, in one length unit.
-- Bones are joint-index pairs ``(n_bones, 2)`` (``(joint, parent)`` when inferred).
-- Frame rates ``fps > 0`` [Hz]; gap lengths in seconds.
-"""
+"""Joint positions ``(n_frames, n_joints, 3)`` (one length unit) as arrays: bones
+(joint-index pairs ``(n_bones, 2)``), bone lengths, gap filling."""
 
 from __future__ import annotations
 
@@ -64,27 +55,12 @@ def _distance_stats(pos: np.ndarray, max_frames: int) -> tuple[np.ndarray, np.nd
 
 
 def infer_bones(positions: Any, *, max_frames: int = 2000) -> np.ndarray:
-    """Bones of a position-only motion from joint distances that stay short and constant.
+    """``(joint, parent)`` bones from joint distances that stay short and constant.
 
-    A bone joins two joints whose distance is both short and steady; the bones are
-    the minimum spanning tree of the joint-to-joint cost ``mean + 2 std`` of the
-    distance over frames, oriented from the most central joint (the joint with the
-    smallest mean distance to the others) outwards. On the four Dance-with-Melody
-    dancers (23 joints, noisy markerless data) this finds the limbs, spine and hips;
-    where the knees stay close together it may join the knees instead of one thigh
-    (checked on all four against the anatomy, not tuned to one). Give the bones
-    explicitly (``bones=`` of the readers) when they are known.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)], finite, n_joints >= 2
-    max_frames : int
-        At most this many evenly spaced frames are used.
-
-    Returns
-    -------
-    bones : np.ndarray [shape=(n_joints - 1, 2)], int
-        ``(joint, parent)`` pairs.
+    The minimum spanning tree of the cost ``mean + 2 std`` of each joint-to-joint
+    distance (over at most ``max_frames`` evenly spaced frames), rooted at the most
+    central joint. Where knees stay close it may join them instead of a thigh: give
+    ``bones=`` to the readers when they are known.
     """
     from scipy.sparse.csgraph import breadth_first_order, minimum_spanning_tree
 
@@ -121,26 +97,8 @@ def fill_joint_gaps(
     max_gap: float = 0.25,
     joint_names: list[str] | tuple[str, ...] | None = None,
 ) -> np.ndarray:
-    """Fill short gaps (NaN) of each joint by linear interpolation; refuse long ones.
-
-    A joint is missing in a frame if any of its coordinates is NaN or infinite.
-    Gaps at the start or end are held at the nearest valid frame.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)]
-    fps : float > 0 [Hz]
-    max_gap : float >= 0 [s]
-        Longest gap filled; a longer one raises.
-    joint_names : sequence of str, optional
-        Used in the error message.
-
-    Raises
-    ------
-    ParameterError
-        A gap longer than ``max_gap`` (the joint and the frames named), or a joint
-        that is never seen.
-    """
+    """Fill gaps (a NaN/inf coordinate) up to ``max_gap`` [s] per joint linearly, refuse
+    longer ones; gaps at the ends hold the nearest valid frame."""
     pos = np.array(positions, dtype=np.float64)
     rate = check_fps(fps)
     missing = ~np.all(np.isfinite(pos), axis=2)
