@@ -402,9 +402,13 @@ def _fmt(x: float) -> str:
 def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write ``motion`` as BVH (atomic), each value as its shortest exact decimal."""
     if motion.skeleton is None:
+        what, alt = ("a table without a skeleton", "write .csv (write_table)")
+        if motion.is_positional:
+            what = "joint positions without joint rotations"
+            alt = "write .json, .npy or .c3d (positions, in the input's layout) or .csv"
         raise ParameterError(
-            f"motion {motion.name!r} has no skeleton (marker data or a plain table) and "
-            "cannot be written as BVH; write it as CSV (write_table) instead"
+            f"cannot write {str(path)!r} as BVH: motion {motion.name!r} is {what}, and BVH "
+            f"stores rotations of a skeleton; {alt}"
         )
     check_finite(motion.values, name="motion values")
     joints = motion.skeleton.joints

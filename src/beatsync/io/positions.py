@@ -26,7 +26,6 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -65,14 +64,15 @@ _HEIGHT_M = (0.25, 3.0)
 _KEYPOINT_KEYS = ("keypoints3d", "keypoints3d_optim", "positions", "joints")
 
 
-def _check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str | None:
-    if value is None:
-        return None
-    if value not in choices:
-        raise ParameterError(
-            f"{name}={value!r} must be one of {', '.join(repr(c) for c in choices)}"
-        )
-    return str(value)
+def _options(up: Any, units: Any, bones: Any, max_gap: Any) -> dict[str, Any]:
+    """The readers' common options, checked (``up``/``units`` ``None``: detect)."""
+    for name, value, choices in (("up", up, ("y", "z")), ("units", units, tuple(UNIT_METRES))):
+        if value is not None and value not in choices:
+            raise ParameterError(
+                f"{name}={value!r} must be one of {', '.join(repr(c) for c in choices)}"
+            )
+    max_gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
+    return {"up": up, "units": units, "bones": bones, "max_gap": max_gap}
 
 
 def _extents(pos: np.ndarray) -> np.ndarray:
@@ -126,10 +126,8 @@ def from_canonical(positions: Any, *, units: str, up: str) -> np.ndarray:
     return p / UNIT_METRES[units]
 
 
-def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, bool, str, bool]:
-    up_det = up is None
+def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, str]:
     up = detect_up(pos) if up is None else up
-    units_det = units is None
     units = detect_units(pos, up) if units is None else units
     h = float(_extents(pos)["xyz".index(up)]) * UNIT_METRES[units]
     if not 0.05 <= h <= 10.0:
@@ -137,7 +135,7 @@ def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, 
             f"with units={units!r} the body is {h:.3g} m tall: the unit looks wrong "
             f"(detected: {detect_units(pos, up) if h > 0 else '?'})"
         )
-    return units, units_det, up, up_det
+    return units, up
 
 
 def _names(n_joints: int, names: Any = None) -> tuple[str, ...]:
@@ -156,20 +154,24 @@ def _names(n_joints: int, names: Any = None) -> tuple[str, ...]:
 
 def _build(
     pos: np.ndarray,
-    *,
     fps: float,
     name: str,
     source: str,
     layout: str,
+    *,
     units: str | None,
     up: str | None,
     bones: Any,
     max_gap: float,
+    file_frame: tuple[str | None, str | None] = (None, None),
     joint_names: Any = None,
     center: np.ndarray | None = None,
     key: str | None = None,
 ) -> Motion:
-    """Validate file positions ``(n, J, 3)``, fill gaps, convert, and make the Motion."""
+    """Check file positions ``(n, J, 3)``, fill gaps, convert, and make the Motion.
+
+    ``file_frame``: the units and vertical axis the file states, used unless given.
+    """
     if pos.ndim != 3 or pos.shape[2] != 3:
         raise ParameterError(
             f"{source} holds an array of shape {pos.shape}; joint positions must be "
@@ -184,21 +186,22 @@ def _build(
     if n < 2:
         raise ParameterError(f"{source} has {n} frame(s); need at least 2")
     names = _names(n_j, joint_names)
-    max_gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
     if center is not None:
         center = fill_joint_gaps(center[:, None, :], fps, max_gap=max_gap, joint_names=["center"])[
             :, 0
         ]
         pos = pos + center[:, None, :]
     pos = fill_joint_gaps(pos, fps, max_gap=max_gap, joint_names=names)
-    units, units_det, up, up_det = _frame_of(pos, units, up)
+    units_source = "given" if units else "file" if file_frame[0] else "detected"
+    up_source = "given" if up else "file" if file_frame[1] else "detected"
+    units, up = _frame_of(pos, units or file_frame[0], up or file_frame[1])
     info = PositionInfo(
         bones=bones,
         layout=layout,
         units=units,
         up=up,
-        units_source="detected" if units_det else "given",
-        up_source="detected" if up_det else "given",
+        units_source=units_source,
+        up_source=up_source,
         center=None if center is None else to_canonical(center, units=units, up=up),
         key=key,
     )
@@ -228,8 +231,7 @@ def read_positions_json(
     are named ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
     """
     p = check_input_file(path, "JSON motion")
-    up = _check_choice(up, "up", ("y", "z"))
-    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    opts = _options(up, units, bones, max_gap)
     rate = _need_fps(
         fps, f"{str(p)!r} (JSON joint positions)", "; the Dance-with-Melody dataset is 25 fps"
     )
@@ -262,18 +264,7 @@ def read_positions_json(
             "(truncated or edited file?)"
         )
     name = p.parent.name if p.stem == "skeletons" else p.stem
-    return _build(
-        skel,
-        fps=rate,
-        name=name,
-        source=repr(str(p)),
-        layout="json",
-        units=units,
-        up=up,
-        bones=bones,
-        max_gap=max_gap,
-        center=center,
-    )
+    return _build(skel, rate, name, repr(str(p)), "json", center=center, **opts)
 
 
 def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
@@ -368,8 +359,7 @@ def read_positions_array(
     names the ``.npz`` array; the rest as for :func:`read_positions_json`.
     """
     p = check_input_file(path, "array")
-    up = _check_choice(up, "up", ("y", "z"))
-    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    opts = _options(up, units, bones, max_gap)
     suffix = p.suffix.lower()
     file_fps = None
     if suffix == ".npz":
@@ -398,19 +388,9 @@ def read_positions_array(
         except Exception as exc:
             raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
     rate = _file_rate(fps, file_fps, p) if file_fps is not None else _need_fps(fps, repr(str(p)))
-    return _build(
-        pos,
-        fps=rate,
-        name=p.stem,
-        source=repr(str(p)) + (f" array {key!r}" if key else ""),
-        layout=suffix.lstrip("."),
-        units=units,
-        up=up,
-        bones=bones,
-        max_gap=max_gap,
-        joint_names=joint_names,
-        key=key,
-    )
+    source = repr(str(p)) + (f" array {key!r}" if key else "")
+    layout = suffix.lstrip(".")
+    return _build(pos, rate, p.stem, source, layout, joint_names=joint_names, key=key, **opts)
 
 
 def _file_rate(fps: Any, file_fps: float, p: Path) -> float:
@@ -456,8 +436,7 @@ def read_c3d(
     import c3d
 
     p = check_input_file(path, "C3D")
-    up = _check_choice(up, "up", ("y", "z"))
-    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    opts = _options(up, units, bones, max_gap)
     try:
         with open(p, "rb") as fh, warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "No analog data found" and the like
@@ -491,35 +470,18 @@ def read_c3d(
             "beatsync needs 3-D points"
         )
     rate = _file_rate(fps, check_fps(rate, name=f"point rate of {p.name}"), p)
-    file_unit = {"m": "m", "cm": "cm", "mm": "mm"}.get(file_units.lower())
+    file_unit = file_units.lower() if file_units.lower() in UNIT_METRES else None
     file_up = screen[1].lower() if screen.upper() in ("+Y", "+Z") else None
-    motion = _build(
-        np.stack(frames),
-        fps=rate,
-        name=p.stem,
-        source=repr(str(p)),
-        layout="c3d",
-        units=units or file_unit,
-        up=up or file_up,
-        bones=bones,
-        max_gap=max_gap,
-        joint_names=labels if len(labels) == n_points else None,
+    names = labels if len(labels) == n_points else None
+    pos, frame = np.stack(frames), (file_unit, file_up)
+    return _build(
+        pos, rate, p.stem, repr(str(p)), "c3d", file_frame=frame, joint_names=names, **opts
     )
-    info = motion.position_info
-    info = replace(
-        info,
-        units_source="file" if units is None and file_unit else info.units_source,
-        up_source="file" if up is None and file_up else info.up_source,
-    )
-    return replace(motion, position_info=info, _cache={})
 
 
 def _param_str(reader: Any, name: str) -> str:
-    param = reader.get(name)
-    if param is None:
-        return ""
-    try:
-        return str(param.string_value).strip()
+    try:  # None (no such parameter) has no string_value either
+        return str(reader.get(name).string_value).strip()
     except Exception:
         return ""
 
