@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..validation import as_float, as_int, check_finite, check_fps
+from ..validation import as_int, check_finite, check_fps
 from ._files import atomic_write, check_input_file
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNELS"]
@@ -32,37 +32,26 @@ _FRAME_TIME_RE = re.compile(r"frame\s+time\s*:\s*(\S+)", re.IGNORECASE)
 _CHUNK_ROWS = 4096  # frame lines converted to floats at once
 
 
-class _Lines:
+_Lines = Iterator[tuple[int, str]]
+
+
+def _lines(fh, path: Path) -> _Lines:
     """Numbered UTF-8 lines of a binary file (BOM skipped; ``\\n``, ``\\r\\n`` or ``\\r``
     ends), decoded one at a time so a decoding error names its line."""
-
-    def __init__(self, fh, path: Path) -> None:
-        self._it = self._numbered(fh)
-        self.path = path
-        self.lineno = 0
-
-    def _numbered(self, fh) -> Iterator[tuple[int, str]]:
-        lineno = 0
-        for raw in fh:
-            if lineno == 0 and raw.startswith(b"\xef\xbb\xbf"):
-                raw = raw[3:]
-            parts = raw.rstrip(b"\r\n").split(b"\r") if b"\r" in raw else (raw,)
-            for part in parts:
-                lineno += 1
-                try:
-                    yield lineno, part.decode("utf-8")
-                except UnicodeDecodeError as exc:
-                    raise ParameterError(
-                        f"malformed BVH {str(self.path)!r}: line {lineno} is not UTF-8 text "
-                        f"({exc.reason}); is it a BVH file?"
-                    ) from None
-
-    def __iter__(self) -> Iterator[tuple[int, str]]:
-        return self
-
-    def __next__(self) -> tuple[int, str]:
-        self.lineno, line = next(self._it)
-        return self.lineno, line
+    lineno = 0
+    for raw in fh:
+        if lineno == 0 and raw.startswith(b"\xef\xbb\xbf"):
+            raw = raw[3:]
+        parts = raw.rstrip(b"\r\n").split(b"\r") if b"\r" in raw else (raw,)
+        for part in parts:
+            lineno += 1
+            try:
+                yield lineno, part.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                raise ParameterError(
+                    f"malformed BVH {str(path)!r}: line {lineno} is not UTF-8 text "
+                    f"({exc.reason}); is it a BVH file?"
+                ) from None
 
 
 @dataclass
@@ -246,7 +235,10 @@ def _is_plain_number(tok: str) -> bool:
     )
 
 
-def _header_value(lines: _Lines, pattern: re.Pattern[str], what: str, path: Path) -> str:
+def _header_value(
+    lines: _Lines, pattern: re.Pattern[str], what: str, path: Path
+) -> tuple[str, int]:
+    """The number on the next non-blank line ``<what> <value>``, and its line number."""
     for lineno, line in lines:
         s = line.strip()
         if not s:
@@ -257,7 +249,12 @@ def _header_value(lines: _Lines, pattern: re.Pattern[str], what: str, path: Path
                 f"malformed BVH {str(path)!r}, line {lineno}: expected '{what} <value>', got "
                 f"{s[:60]!r}"
             )
-        return match.group(1)
+        if not _is_plain_number(match.group(1)):
+            raise ParameterError(
+                f"malformed BVH {str(path)!r}: line {lineno}: {what[:-1]}={match.group(1)!r} is "
+                "not a number"
+            )
+        return match.group(1), lineno
     raise ParameterError(f"malformed BVH {str(path)!r}: no '{what}' line (file truncated?)")
 
 
@@ -266,30 +263,15 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
     p = check_input_file(path, "BVH")
     try:
         with open(p, "rb") as fh:
-            lines = _Lines(fh, p)
+            lines = _lines(fh, p)
             skeleton = _HierarchyParser(lines, p).parse()
-            n_text = _header_value(lines, _FRAMES_RE, "Frames:", p)
-            frames_line = lines.lineno
-            t_text = _header_value(lines, _FRAME_TIME_RE, "Frame Time:", p)
-            t_line = lines.lineno
-            names = skeleton.channel_names()
+            n_text, n_line = _header_value(lines, _FRAMES_RE, "Frames:", p)
             try:
-                if not _is_plain_number(n_text):
-                    raise ParameterError(f"line {frames_line}: Frames={n_text!r} is not a number")
-                n_declared = as_int(
-                    n_text, name=f"line {frames_line}: Frames", minimum=0, text=True
-                )
-                if not _is_plain_number(t_text):
-                    raise ParameterError(f"line {t_line}: Frame Time={t_text!r} is not a number")
-                frame_time = as_float(
-                    t_text,
-                    name=f"line {t_line}: Frame Time",
-                    unit="s",
-                    allow_nonfinite=True,
-                    text=True,
-                )
+                n_declared = as_int(n_text, name=f"line {n_line}: Frames", minimum=0, text=True)
             except ParameterError as exc:
                 raise ParameterError(f"malformed BVH {str(p)!r}: {exc}") from None
+            frame_time = float(_header_value(lines, _FRAME_TIME_RE, "Frame Time:", p)[0])
+            names = skeleton.channel_names()
             if n_declared == 0:
                 raise ParameterError(f"BVH {str(p)!r} has no frames (Frames: 0)")
             if not names:
