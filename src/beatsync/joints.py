@@ -24,15 +24,16 @@ def check_bones(bones: Any, n_joints: int) -> np.ndarray:
         )
     if not np.issubdtype(arr.dtype, np.integer):
         if not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr)):
-            raise ParameterError("bones must be integer joint indices (pairs of indices)")
+            raise ParameterError(f"bones={arr.tolist()} must be integer joint indices")
     arr = arr.astype(np.int64)
     if arr.min() < 0 or arr.max() >= n_joints:
         raise ParameterError(
             f"bones refer to joint {int(arr.max()) if arr.max() >= n_joints else int(arr.min())}"
             f" but the motion has joints 0..{n_joints - 1} (indices, from 0)"
         )
-    if np.any(arr[:, 0] == arr[:, 1]):
-        raise ParameterError("a bone joins a joint to itself; give pairs of two joints")
+    loops = arr[arr[:, 0] == arr[:, 1]]
+    if loops.size:
+        raise ParameterError(f"bone {loops[0].tolist()} joins a joint to itself; give two joints")
     return arr
 
 

@@ -176,7 +176,7 @@ class Motion:
             if not self.is_positional:
                 raise ParameterError(
                     "position_info is only for position-only motion (no skeleton, channels "
-                    "<joint>_x/_y/_z); this motion has other channels"
+                    f"<joint>_x/_y/_z); this one has channels {list(self.channels[:6])}"
                 )
             if info.bones is not None:
                 object.__setattr__(

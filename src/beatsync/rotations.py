@@ -152,5 +152,5 @@ def blend_values(motion: Motion, a: np.ndarray, b: np.ndarray, w: np.ndarray) ->
             f"got {a.shape}, {b.shape}, {w.shape}"
         )
     if np.any((w < 0) | (w > 1)):
-        raise ParameterError("blend weights w must lie in [0, 1]")
+        raise ParameterError(f"blend weights w must lie in [0, 1], got {w.min():g} to {w.max():g}")
     return _interp_values(motion, a, b, w)
