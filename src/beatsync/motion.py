@@ -263,14 +263,7 @@ class Motion:
     # -- derived motions ---------------------------------------------------
     def with_values(self, values: np.ndarray, fps: float | None = None) -> Motion:
         """Same channels and skeleton, new values (and optionally a new frame rate)."""
-        return Motion(
-            values=values,
-            fps=self.fps if fps is None else fps,
-            channels=self.channels,
-            skeleton=self.skeleton,
-            name=self.name,
-            position_info=self.position_info,
-        )
+        return replace(self, values=values, fps=self.fps if fps is None else fps, _cache={})
 
     def select(self, names: list[str] | tuple[str, ...]) -> Motion:
         """A motion with only the named channels (no skeleton)."""

@@ -63,15 +63,7 @@ def _unit(unit: str) -> str:
 def as_float(
     value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False, text: bool = False
 ) -> float:
-    """Return ``value`` as a float, refusing bools, text (unless ``text``), arrays, NaN/inf.
-
-    Examples
-    --------
-    >>> as_float(0.5, name="delta", unit="s")
-    0.5
-    >>> as_float("0.5", name="delta", unit="s", text=True)
-    0.5
-    """
+    """Return ``value`` as a float, refusing bools, text (unless ``text``), arrays, NaN/inf."""
     if isinstance(value, (bool, np.bool_)):
         raise ParameterError(f"{name}={value!r} is a bool, not a number{_unit(unit)}")
     if not text and isinstance(value, (str, bytes, np.str_, np.bytes_)):
@@ -285,13 +277,7 @@ def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float
 
 
 def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
-    """Return a sample rate [Hz]: finite and at least :data:`MIN_PLAUSIBLE_SR` (not kHz).
-
-    Examples
-    --------
-    >>> check_sample_rate(22050)
-    22050.0
-    """
+    """Return a sample rate [Hz]: finite and at least :data:`MIN_PLAUSIBLE_SR` (not kHz)."""
     v = as_float(sr, name=name, unit="Hz", allow_nonfinite=True, text=True)
     if not np.isfinite(v) or v <= 0:
         raise ParameterError(
@@ -308,13 +294,7 @@ def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
 
 
 def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
-    """Return a tempo [bpm] in [:data:`MIN_BPM`, :data:`MAX_BPM`].
-
-    Examples
-    --------
-    >>> check_bpm(120)
-    120.0
-    """
+    """Return a tempo [bpm] in [:data:`MIN_BPM`, :data:`MAX_BPM`]."""
     v = as_float(bpm, name=name, unit="bpm", allow_nonfinite=True, text=True)
     if not np.isfinite(v):
         raise ParameterError(
@@ -404,13 +384,7 @@ def beat_phase(events: Any, beats: Any) -> np.ndarray:
 
 
 def check_interval(pair: Any, *, name: str, unit: str) -> tuple[float, float]:
-    """:func:`check_range` of one pair ``(lo, hi)``, refusing what is not a pair.
-
-    Examples
-    --------
-    >>> check_interval((0.5, 2.0), name="period_range", unit="s")
-    (0.5, 2.0)
-    """
+    """:func:`check_range` of one pair ``(lo, hi)``, refusing what is not a pair."""
     if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
         raise ParameterError(
             f"{name}={pair!r} must be two numbers (lower, upper) [{unit}], e.g. (0.5, 2.0)"

@@ -111,15 +111,6 @@ def write_json(path: str | os.PathLike[str], obj: Any, *, float_digits: int | No
 
     ``float_digits`` rounds floats so that a committed file's last digits do not change
     when another BLAS or CPU computes the same numbers (10 digits: a relative 5e-11).
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.json"
-    >>> _ = write_json(p, {"r": 0.1 + 0.2}, float_digits=10)
-    >>> import json
-    >>> json.loads(p.read_text())
-    {'r': 0.3}
     """
     data = to_jsonable(obj, float_digits=float_digits)
     with atomic_write(path) as fh:

@@ -1,19 +1,13 @@
 """Joint-position motion files: Dance-with-Melody JSON, ``.npy``/``.npz`` arrays, C3D.
 
 Readers return a position-only :class:`~beatsync.motion.Motion` in the canonical frame
-(metres, z up) with a :class:`~beatsync.motion.PositionInfo` recording the file's
-layout, units and vertical axis, which the writers here restore.
-
-Layouts
--------
-- ``.json`` (Dance-with-Melody): ``{"length": N, "center": [N][3], "skeletons":
-  [N][J][3]}``, joints relative to the per-frame root ``center`` (no rate stored; the
-  bundled dancers are 25 fps, cm, y up). The motion holds ``skeletons + center``.
-- ``.npy``: one ``(n_frames, n_joints, 3)`` array (e.g. AIST++ ``keypoints3d``).
-- ``.npz``: such an array under a key (named, ``keypoints3d`` or the only one); a
-  scalar ``fps`` in the archive is the rate.
-- ``.c3d``: marker points, with the file's rate, labels and ``POINT:UNITS``; points
-  with a negative residual are gaps.
+(metres, z up) whose :class:`~beatsync.motion.PositionInfo` records the file's layout,
+units and vertical axis, which the writers restore. ``.json`` (Dance-with-Melody):
+``{"length": N, "center": [N][3], "skeletons": [N][J][3]}``, joints relative to the
+root track ``center``, no rate (the bundled dancers: 25 fps, cm, y up); ``.npy``: one
+``(n_frames, n_joints, 3)`` array (AIST++ ``keypoints3d``); ``.npz``: such an array
+under a key, with an optional scalar ``fps``; ``.c3d``: marker points (a negative
+residual is a gap) with the file's rate, labels and ``POINT:UNITS``.
 
 Units (``"m"``, ``"cm"``, ``"mm"``) and vertical axis (``"y"``, ``"z"``) are given or
 detected: up is whichever of y and z the body extends along most (median over
