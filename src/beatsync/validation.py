@@ -71,11 +71,7 @@ def as_float(
             f"{name}={value!r} is text, not a number{_unit(unit)}; pass a number (convert "
             "values read from text first)"
         )
-    if isinstance(value, np.ndarray) and value.ndim > 0:
-        raise ParameterError(
-            f"{name} must be a single number{_unit(unit)}, got an array of shape {value.shape}"
-        )
-    if isinstance(value, (list, tuple, dict, set)):
+    if isinstance(value, (list, tuple, dict, set)) or getattr(value, "ndim", 0) > 0:
         raise ParameterError(
             f"{name}={value!r} must be a single number{_unit(unit)}, not a {type(value).__name__}"
         )

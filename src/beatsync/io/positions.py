@@ -181,24 +181,14 @@ def _build(
         raise ParameterError(f"{source} has {n} frame(s); need at least 2")
     names = _names(n_j, joint_names)
     if center is not None:
-        center = fill_joint_gaps(center[:, None, :], fps, max_gap=max_gap, joint_names=["center"])[
-            :, 0
-        ]
-        pos = pos + center[:, None, :]
+        center = fill_joint_gaps(center[:, None], fps, max_gap=max_gap, joint_names=["center"])
+        pos, center = pos + center, center[:, 0]
     pos = fill_joint_gaps(pos, fps, max_gap=max_gap, joint_names=names)
     units_source = "given" if units else "file" if file_frame[0] else "detected"
     up_source = "given" if up else "file" if file_frame[1] else "detected"
     units, up = _frame_of(pos, units or file_frame[0], up or file_frame[1])
-    info = PositionInfo(
-        bones=bones,
-        layout=layout,
-        units=units,
-        up=up,
-        units_source=units_source,
-        up_source=up_source,
-        center=None if center is None else to_canonical(center, units=units, up=up),
-        key=key,
-    )
+    center = None if center is None else to_canonical(center, units=units, up=up)
+    info = PositionInfo(bones, layout, units, up, units_source, up_source, center, key)
     values = to_canonical(pos, units=units, up=up).reshape(n, 3 * n_j)
     channels = tuple(f"{j}_{a}" for j in names for a in "xyz")
     return Motion(values, fps, channels, None, name, position_info=info)
@@ -447,21 +437,17 @@ def read_c3d(
                     xyz = np.array(points[:, :3], dtype=np.float64)
                     xyz[points[:, 3] < 0] = np.nan
                     frames.append(xyz)
-        if frames and len(frames) < declared:
-            # the c3d package stops at the end of the file with a warning (ignored above)
-            raise ParameterError(
-                f"C3D file {str(p)!r} is cut short: its header declares {declared} frames "
-                f"but it holds {len(frames)}; an interrupted copy or download? Copy the "
-                "file again"
-            )
-    except ParameterError:
-        raise
     except Exception as exc:  # the c3d package raises several types for bad files
         raise ParameterError(f"cannot read {str(p)!r} as a C3D file: {exc}") from None
     if n_points == 0 or not frames:
         raise ParameterError(
             f"{str(p)!r} is a C3D file without marker points (only analog data?); "
             "beatsync needs 3-D points"
+        )
+    if len(frames) < declared:  # the c3d package stops at the end with a warning (ignored)
+        raise ParameterError(
+            f"C3D file {str(p)!r} is cut short: its header declares {declared} frames "
+            f"but it holds {len(frames)}; an interrupted copy or download? Copy the file again"
         )
     rate = _file_rate(fps, check_fps(rate, name=f"point rate of {p.name}"), p)
     file_unit = file_units.lower() if file_units.lower() in UNIT_METRES else None
