@@ -185,7 +185,6 @@ class Motion:
                     replace(info, bones=check_bones(info.bones, self.values.shape[1] // 3)),
                 )
 
-    # -- position-only motion ---------------------------------------------
     @property
     def is_positional(self) -> bool:
         """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples."""
@@ -221,7 +220,6 @@ class Motion:
             self._cache["bones"] = infer_bones(self.positions())
         return self._cache["bones"]
 
-    # -- basic properties -------------------------------------------------
     @property
     def n_frames(self) -> int:
         return int(self.values.shape[0])
@@ -260,7 +258,6 @@ class Motion:
                 f"channel {name!r} not found; channels look like {list(self.channels[:6])}..."
             ) from None
 
-    # -- derived motions ---------------------------------------------------
     def with_values(self, values: np.ndarray, fps: float | None = None) -> Motion:
         """Same channels and skeleton, new values (and optionally a new frame rate)."""
         return replace(self, values=values, fps=self.fps if fps is None else fps, _cache={})
@@ -287,7 +284,6 @@ class Motion:
     def rename(self, name: str) -> Motion:
         return replace(self, name=name, _cache={})
 
-    # -- rotations and kinematics -----------------------------------------
     def rotation_triples(self) -> list[tuple[str, tuple[int, int, int], str]]:
         """``(joint, channel indices, order)`` of each joint with three rotation channels.
 
@@ -347,13 +343,9 @@ class Motion:
             local = (
                 quat_from_euler(self.values[:, rot_cols], "".join(rot_axes)) if rot_axes else None
             )
-            if joint.parent < 0:
-                pos[:, j_idx] = trans
-                glob.append(local)
-                continue
-            parent_rot = glob[joint.parent]
+            parent_rot = glob[joint.parent] if joint.parent >= 0 else None
             moved = trans if parent_rot is None else quat_rotate(parent_rot, trans)
-            pos[:, j_idx] = pos[:, joint.parent] + moved
+            pos[:, j_idx] = moved if joint.parent < 0 else pos[:, joint.parent] + moved
             if parent_rot is None or local is None:
                 glob.append(local if parent_rot is None else parent_rot)
             else:

@@ -289,9 +289,6 @@ def write_audio(path: str | os.PathLike[str], y: np.ndarray, sr: int) -> Path:
     return dest
 
 
-# ----------------------------------------------------------------------- beats
-
-
 def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
     """Read event times [s] from the first column of a text file (``#`` comments skipped)."""
     p = check_input_file(path, "beat annotation")

@@ -135,14 +135,10 @@ def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, 
 def _names(n_joints: int, names: Any = None) -> tuple[str, ...]:
     if names is None:
         return tuple(f"j{i}" for i in range(n_joints))
-    out = []
-    seen: set[str] = set()
+    out: list[str] = []
     for i, n in enumerate(names):
         clean = "_".join(str(n).split()) or f"j{i}"
-        if clean in seen:
-            clean = f"{clean}_{i}"
-        seen.add(clean)
-        out.append(clean)
+        out.append(f"{clean}_{i}" if clean in out else clean)
     return tuple(out)
 
 
