@@ -136,8 +136,7 @@ class PositionInfo:
         """One line stating units and vertical axis and whether they were detected."""
         return (
             f"{self.layout} file in {self.units} ({self.units_source}), {self.up} up "
-            f"({self.up_source}); "
-            f"read as {CANONICAL_UNITS}, {CANONICAL_UP} up"
+            f"({self.up_source}); read as {CANONICAL_UNITS}, {CANONICAL_UP} up"
         )
 
 

@@ -84,11 +84,10 @@ def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
     w = np.asarray(w, dtype=np.float64)[:, None]
     theta = np.arccos(np.clip(dot, -1.0, 1.0))[:, None]
     sin_t = np.sin(theta)
-    small = sin_t[:, 0] < 1e-9
-    s0 = np.where(
-        small[:, None], 1.0 - w, np.sin((1.0 - w) * theta) / np.where(small[:, None], 1.0, sin_t)
-    )
-    s1 = np.where(small[:, None], w, np.sin(w * theta) / np.where(small[:, None], 1.0, sin_t))
+    small = sin_t < 1e-9  # (nearly) the same rotation: linear weights
+    safe = np.where(small, 1.0, sin_t)
+    s0 = np.where(small, 1.0 - w, np.sin((1.0 - w) * theta) / safe)
+    s1 = np.where(small, w, np.sin(w * theta) / safe)
     q = s0 * q0 + s1 * q1
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 

@@ -42,7 +42,6 @@ from .audio import (
 )
 from .bvh import read_bvh, write_bvh
 from .positions import (
-    is_position_array,
     read_c3d,
     read_positions_array,
     read_positions_json,
@@ -122,11 +121,9 @@ def read_motion(
     """
     p = Path(path)
     suffix = p.suffix.lower()
-    if suffix == ".npy":
-        check_npy_header(p)  # an .npz renamed, strings, records...: refused before any load
-    positional = suffix in (".json", ".npz", ".c3d") or (
-        suffix == ".npy" and p.is_file() and is_position_array(p)
-    )
+    # an .npz renamed, strings, records...: refused before any load
+    shape = check_npy_header(p)[0] if suffix == ".npy" else ()
+    positional = suffix in (".json", ".npz", ".c3d") or (len(shape) == 3 and shape[-1] == 3)
     if not positional and (up is not None or units is not None):
         given = ", ".join(f"{k}={v!r}" for k, v in (("up", up), ("units", units)) if v)
         raise ParameterError(

@@ -43,7 +43,6 @@ __all__ = [
     "write_positions_json",
     "write_positions_array",
     "write_c3d",
-    "is_position_array",
     "detect_up",
     "detect_units",
     "to_canonical",
@@ -307,19 +306,6 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
         )
     info = motion.position_info
     return info if info is not None else PositionInfo()
-
-
-def is_position_array(path: str | os.PathLike[str]) -> bool:
-    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only)."""
-    p = check_input_file(path, ".npy")
-    try:
-        arr = np.load(p, mmap_mode="r", allow_pickle=False)
-    except Exception:  # not a plain numeric .npy array: the table reader says why
-        return False
-    if not isinstance(arr, np.ndarray):  # an .npz archive renamed .npy
-        arr.close()
-        return False
-    return arr.ndim == 3 and arr.shape[-1] == 3 and arr.dtype.kind in "iuf"
 
 
 def read_positions_array(
