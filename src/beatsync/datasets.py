@@ -90,11 +90,7 @@ _verified: set[str] = set()
 
 def data_dir() -> Path:
     """The folder holding the bundled data."""
-    env = os.environ.get("BEATSYNC_DATA")
-    if env:
-        d = Path(env)
-    else:
-        d = Path(__file__).resolve().parents[2] / "data"
+    d = Path(os.environ.get("BEATSYNC_DATA") or Path(__file__).resolve().parents[2] / "data")
     if not (d / "motion").is_dir():
         raise ParameterError(
             f"bundled data folder {str(d)!r} not found; run from a clone of the beatsync "

@@ -69,8 +69,7 @@ def rotation_to_euler(rot: Rotation, order: str, reference: np.ndarray | None = 
         # at gimbal lock scipy warns and sets the third angle to 0: the same rotation
         warnings.filterwarnings("ignore", message="Gimbal lock detected", category=UserWarning)
         e = rot.as_euler(order.upper(), degrees=True)
-    if e.ndim == 1:
-        e = e[None, :]
+    e = np.atleast_2d(e)
     if reference is None:
         return e
     return nearest_euler(e, reference)

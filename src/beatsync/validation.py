@@ -123,13 +123,7 @@ def check_positive(value: Any, *, name: str, unit: str, allow_zero: bool = False
 
 
 def frames_to_time(frames: Any, *, fps: float) -> np.ndarray:
-    """Convert frame indices to times [s]: ``t = frames / fps``.
-
-    Examples
-    --------
-    >>> frames_to_time([0, 30, 60], fps=60.0)
-    array([0. , 0.5, 1. ])
-    """
+    """Convert frame indices to times [s]: ``t = frames / fps``."""
     fps = check_fps(fps)
     return np.asarray(frames, dtype=np.float64) / fps
 
@@ -141,11 +135,6 @@ def time_to_frames(
 
     ``round_to_int=False`` gives fractional frames; ``mode`` "floor"/"ceil" give the
     frame at or before/after the time (1e-9 frames of tolerance for float error).
-
-    Examples
-    --------
-    >>> time_to_frames([0.0, 0.5, 1.0], fps=60.0)
-    array([ 0, 30, 60])
     """
     fps = check_fps(fps)
     frames = np.asarray(times, dtype=np.float64) * fps
@@ -335,14 +324,12 @@ def check_audio(
             f"{name} contains {int(bad.sum())} NaN or infinite sample(s) "
             f"(first at sample {int(np.argmax(bad))}); repair or trim the audio"
         )
-    if min_duration is not None:
-        duration = arr.size / sr_f
-        if duration < min_duration:
-            raise ParameterError(
-                f"the audio is only {duration:.3f} s long ({arr.size} samples at sr={sr_f:g} "
-                f"Hz); at least {min_duration:.3g} s is needed (give a longer excerpt, or "
-                "check the sample rate)"
-            )
+    if min_duration is not None and arr.size / sr_f < min_duration:
+        raise ParameterError(
+            f"the audio is only {arr.size / sr_f:.3f} s long ({arr.size} samples at sr={sr_f:g} "
+            f"Hz); at least {min_duration:.3g} s is needed (give a longer excerpt, or check "
+            "the sample rate)"
+        )
     if silence_peak is not None:
         top, bottom = float(arr.max()), float(arr.min())
         peak = max(top, -bottom)  # the largest magnitude, without an array of them

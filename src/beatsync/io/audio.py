@@ -68,7 +68,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
             # libsndfile reads these formats itself: a failure is a damaged file, and
             # audioread (through librosa, seconds to import) would fail the same way
             _check_wav_header_rate(p)
-            detail = _first_line(sf_exc)
+            detail = (str(sf_exc).strip().splitlines() or [type(sf_exc).__name__])[0]
             if "does not exist" in detail:  # libsndfile's words for content it cannot decode
                 detail = "its content is not decodable audio"
             raise ParameterError(
@@ -255,11 +255,6 @@ def _check_wav_header_rate(p: Path) -> None:
         _integral_rate(rate, name="sample rate")
     except ParameterError as exc:
         raise ParameterError(f"audio file {str(p)!r} has a broken header: {exc}") from None
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()
-    return text[0] if text else type(exc).__name__
 
 
 def _integral_rate(sr: object, *, name: str) -> int:

@@ -306,32 +306,24 @@ def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.nd
     """
     capacity = min(n_declared, path.stat().st_size // (2 * n_ch) + 1)
     values = np.empty((capacity, n_ch), dtype=np.float64)
-    chunk: list[str] = []
-    chunk_lines: list[int] = []
-    stored = 0  # frame lines converted into values
-    row = 0  # frame lines seen
+    chunk: list[tuple[int, str]] = []  # (line number, text) of lines not yet converted
+    stored = row = 0  # frame lines converted into values; frame lines seen
 
     def flush() -> None:
         nonlocal stored
-        block = _parse_chunk(chunk, chunk_lines, stored, n_ch, path)
-        values[stored : stored + len(chunk)] = block
+        values[stored : stored + len(chunk)] = _parse_chunk(chunk, stored, n_ch, path)
         stored += len(chunk)
         chunk.clear()
-        chunk_lines.clear()
 
     for lineno, line in lines:
         if not line.strip():
             continue
-        if row >= capacity:  # more frame lines than declared: count them, store nothing
-            if chunk:
-                flush()
-            row += 1
+        row += 1
+        if row > capacity:  # more frame lines than declared: counted, not stored
             continue
         if not line.isascii() or "_" in line:  # Python and numpy read "1_0" and Unicode digits
             _refuse_non_numeric(line.split(), lineno, path)
-        chunk.append(line)
-        chunk_lines.append(lineno)
-        row += 1
+        chunk.append((lineno, line))
         if len(chunk) == _CHUNK_ROWS:
             flush()
     if chunk:
@@ -346,18 +338,16 @@ def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.nd
     return values
 
 
-def _parse_chunk(
-    chunk: list[str], linenos: list[int], first_row: int, n_ch: int, path: Path
-) -> np.ndarray:
+def _parse_chunk(chunk: list[tuple[int, str]], first_row: int, n_ch: int, path: Path) -> np.ndarray:
     """Frame lines as a ``(len(chunk), n_ch)`` array, or the first bad line named."""
     try:
-        block = np.loadtxt(chunk, dtype=np.float64, comments=None, ndmin=2)
+        block = np.loadtxt([line for _, line in chunk], dtype=np.float64, comments=None, ndmin=2)
         if block.shape == (len(chunk), n_ch):
             return block
     except ValueError:
         pass
     rows = []
-    for k, (lineno, line) in enumerate(zip(linenos, chunk, strict=True)):
+    for k, (lineno, line) in enumerate(chunk):
         toks = line.split()
         if len(toks) != n_ch:
             raise ParameterError(
@@ -375,10 +365,6 @@ def _refuse_non_numeric(toks: list[str], lineno: int, path: Path) -> None:
         raise ParameterError(
             f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a frame line"
         )
-
-
-def _fmt(x: float) -> str:
-    return repr(float(x))
 
 
 def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
@@ -414,14 +400,14 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
         else:
             out.append(f"{ind}{'ROOT' if j.parent < 0 else 'JOINT'} {j.name}")
         out.append(f"{ind}{{")
-        out.append(f"{ind}\tOFFSET {' '.join(_fmt(v) for v in j.offset)}")
+        out.append(f"{ind}\tOFFSET {' '.join(repr(float(v)) for v in j.offset)}")
         if not j.is_end_site:
             out.append(f"{ind}\tCHANNELS {len(j.channels)} {' '.join(j.channels)}")
         todo.append((i, depth, False))
         todo.extend((c, depth + 1, True) for c in reversed(children[i]))
     out.append("MOTION")
     out.append(f"Frames: {motion.n_frames}")
-    out.append(f"Frame Time: {_fmt(1.0 / motion.fps)}")
+    out.append(f"Frame Time: {1.0 / motion.fps!r}")
     with atomic_write(path) as fh:
         fh.write("\n".join(out) + "\n")
         for start in range(0, motion.n_frames, _CHUNK_ROWS):

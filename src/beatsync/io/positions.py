@@ -34,21 +34,7 @@ from ..motion import (
 )
 from ..validation import check_fps, check_positive
 from ._files import atomic_write, check_input_file
-from .tables import read_npz
-
-__all__ = [
-    "read_positions_json",
-    "read_positions_array",
-    "read_c3d",
-    "write_positions_json",
-    "write_positions_array",
-    "write_c3d",
-    "detect_up",
-    "detect_units",
-    "to_canonical",
-    "from_canonical",
-    "POSITION_SUFFIXES",
-]
+from .tables import need_fps, read_npz
 
 POSITION_SUFFIXES = (".json", ".npy", ".npz", ".c3d")
 #: Plausible body height range [m] for detecting units.
@@ -189,12 +175,6 @@ def _build(
     return Motion(values, fps, channels, None, name, position_info=info)
 
 
-def _need_fps(fps: Any, source: str, hint: str = "") -> float:
-    if fps is None:
-        raise ParameterError(f"{source} stores no frame rate: give it with fps= (--fps){hint}")
-    return check_fps(fps)
-
-
 def read_positions_json(
     path: str | os.PathLike[str],
     *,
@@ -211,7 +191,7 @@ def read_positions_json(
     """
     p = check_input_file(path, "JSON motion")
     opts = _options(up, units, bones, max_gap)
-    rate = _need_fps(
+    rate = need_fps(
         fps, f"{str(p)!r} (JSON joint positions)", "; the Dance-with-Melody dataset is 25 fps"
     )
     try:
@@ -353,7 +333,7 @@ def read_positions_array(
             pos = np.asarray(np.load(p, allow_pickle=False), dtype=np.float64)
         except Exception as exc:
             raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
-    rate = _file_rate(fps, file_fps, p) if file_fps is not None else _need_fps(fps, repr(str(p)))
+    rate = _file_rate(fps, file_fps, p) if file_fps is not None else need_fps(fps, repr(str(p)))
     source = repr(str(p)) + (f" array {key!r}" if key else "")
     layout = suffix.lstrip(".")
     return _build(pos, rate, p.stem, source, layout, joint_names=joint_names, key=key, **opts)

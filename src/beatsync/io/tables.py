@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -11,6 +12,13 @@ from ..errors import ParameterError
 from ..motion import Motion
 from ..validation import as_float, as_float_array, check_finite, check_fps
 from ._files import atomic_write, check_input_file, write_csv
+
+
+def need_fps(fps: Any, source: str, hint: str = "") -> float:
+    """``fps`` [Hz], required for a file that stores no frame rate."""
+    if fps is None:
+        raise ParameterError(f"{source} stores no frame rate: give it with fps= (--fps){hint}")
+    return check_fps(fps)
 
 
 def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) -> Motion:
@@ -80,11 +88,7 @@ def read_table(
     """Read a joint-angle table at ``fps`` [Hz]: ``.csv`` with a header row, or ``.npy``
     ``(n, c)`` (columns ``channels``, default ``"ch0"``, ``"ch1"``, ...)."""
     p = check_input_file(path, "table")
-    if fps is None:
-        raise ParameterError(
-            f"{str(p)!r} is a plain table without a frame rate: give it with fps= (--fps)"
-        )
-    rate = check_fps(fps)
+    rate = need_fps(fps, f"{str(p)!r} (a plain table)")
     if p.suffix.lower() == ".npy":
         values = _read_npy(p)
         names = tuple(channels) if channels else tuple(f"ch{i}" for i in range(values.shape[1]))
