@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from itertools import combinations
 from typing import Any
 
 import numpy as np
@@ -483,12 +484,7 @@ def bone_angles(motion: Motion) -> Motion:
     for a, b in motion.bones:
         neighbours.setdefault(int(a), []).append(int(b))
         neighbours.setdefault(int(b), []).append(int(a))
-    triples = [
-        (nb[i], v, nb[k])
-        for v, nb in sorted(neighbours.items())
-        for i in range(len(nb))
-        for k in range(i + 1, len(nb))
-    ]
+    triples = [(a, v, b) for v, nb in sorted(neighbours.items()) for a, b in combinations(nb, 2)]
     if not triples:
         raise ParameterError(
             f"motion {motion.name!r} has {len(names)} joint(s) and no two bones meet at a "

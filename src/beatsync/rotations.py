@@ -139,12 +139,7 @@ def blend_values(motion: Motion, a: np.ndarray, b: np.ndarray, w: np.ndarray) ->
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     w = np.asarray(w, dtype=np.float64)
-    if (
-        a.shape != b.shape
-        or a.ndim != 2
-        or a.shape[1] != motion.n_channels
-        or w.shape != (a.shape[0],)
-    ):
+    if w.ndim != 1 or a.shape != b.shape or a.shape != (w.size, motion.n_channels):
         raise ParameterError(
             f"blend_values needs a, b of shape (n, {motion.n_channels}) and w of shape (n,); "
             f"got {a.shape}, {b.shape}, {w.shape}"

@@ -311,17 +311,13 @@ def read_positions_array(
     if suffix == ".npz":
         arrays = read_npz(p)
         cands = [k for k, v in arrays.items() if v.ndim == 3 and v.shape[-1] == 3]
-        if key is None:
-            pref = [k for k in _KEYPOINT_KEYS if k in cands]
-            if pref:
-                key = pref[0]
-            elif len(cands) == 1:
-                key = cands[0]
-            else:
-                raise ParameterError(
-                    f"{str(p)!r} holds {'no' if not cands else 'several'} (frames, joints, 3) "
-                    f"arrays {cands} among {sorted(arrays)}; name one with key= (--variable)"
-                )
+        found = [k for k in _KEYPOINT_KEYS if k in cands] or (cands if len(cands) == 1 else [])
+        if key is None and not found:
+            raise ParameterError(
+                f"{str(p)!r} holds {'no' if not cands else 'several'} (frames, joints, 3) "
+                f"arrays {cands} among {sorted(arrays)}; name one with key= (--variable)"
+            )
+        key = found[0] if key is None else key
         if key not in arrays:
             raise ParameterError(f"{str(p)!r} has no array {key!r}; it holds {sorted(arrays)}")
         pos = np.asarray(arrays[key], dtype=np.float64)
