@@ -11,6 +11,7 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -131,10 +132,14 @@ def verify_all() -> dict[str, bool]:
     return out
 
 
+def _known(name: str, known: Any, what: str) -> None:
+    if name not in known:
+        raise ParameterError(f"unknown {what} {name!r}; choose from {list(known)}")
+
+
 def load_salsa(take: str = "60_01") -> Motion:
     """A CMU salsa clip (``"60_01"``, ``"61_01"``, ``"60_04"``, ``"61_04"``) at 60 fps."""
-    if take not in SALSA_CLIPS:
-        raise ParameterError(f"unknown salsa take {take!r}; choose from {SALSA_CLIPS}")
+    _known(take, SALSA_CLIPS, "salsa take")
     m = io.read_bvh(path(f"motion/cmu_salsa/{take}_scaled.bvh"), fps=CMU_FPS)
     return m.rename(f"salsa_{take}")
 
@@ -142,24 +147,21 @@ def load_salsa(take: str = "60_01") -> Motion:
 def load_walk(clip: str = "007_01") -> Motion:
     """A CMU subject 7 walk (``"007_01"``, ``"007_02"``, ``"007_12"``) or the 5 pirouette
     (``"005_02"``, not periodic) at 60 fps."""
-    if clip not in WALK_CLIPS:
-        raise ParameterError(f"unknown clip {clip!r}; choose from {WALK_CLIPS}")
+    _known(clip, WALK_CLIPS, "clip")
     m = io.read_bvh(path(f"motion/cmu_walk_modern/{clip}.bvh"), fps=CMU_FPS)
     return m.rename(f"cmu_{clip}")
 
 
 def load_mocap_toolbox(variable: str = "dance2") -> Motion:
     """MoCap Toolbox demo markers (``"dance1"``, ``"dance2"``, ``"walk1"``, ``"walk2"``), 60 Hz, metres."""
-    if variable not in ("dance1", "dance2", "walk1", "walk2"):
-        raise ParameterError(f"unknown MoCap Toolbox recording {variable!r}")
+    _known(variable, ("dance1", "dance2", "walk1", "walk2"), "MoCap Toolbox recording")
     return io.read_mocap_mat(path("motion/mocaptoolbox/mcdemodata.mat"), variable)
 
 
 def load_madmom_sample() -> tuple[np.ndarray, int, np.ndarray]:
     """The madmom test recording (2.8 s, 44.1 kHz) and its 4 hand-annotated beats [s]."""
     y, sr = io.read_audio(path("audio/madmom/sample.wav"))
-    beats = io.read_beats(path("audio/madmom/sample.beats"))
-    return y, sr, beats
+    return y, sr, io.read_beats(path("audio/madmom/sample.beats"))
 
 
 def load_click_808() -> tuple[np.ndarray, int]:
@@ -195,32 +197,21 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
 
     Frame ``i`` of the motion plays at time ``audio_offset + i / fps`` of ``y``.
     """
-    if name not in DANCE_PAIRS:
-        raise ParameterError(f"unknown Dance-with-Melody pair {name!r}; choose from {DANCE_PAIRS}")
+    _known(name, DANCE_PAIRS, "Dance-with-Melody pair")
     folder = f"motion/dance_with_melody/{name}"
     excerpt = json.loads(path(f"{folder}/excerpt.json").read_text(encoding="utf-8"))
     motion = io.read_motion(
         path(f"{folder}/skeletons.json"), fps=excerpt["fps"], up="y", units="cm"
     )
     y, sr = io.read_audio(path(f"{folder}/audio.ogg"))
-    return DancePair(
-        name=name,
-        style=_DANCE_STYLE[name.split("_")[1]],
-        motion=motion.rename(name),
-        y=y,
-        sr=sr,
-        audio_offset=float(excerpt["audio_offset_s"]),
-        excerpt=excerpt,
-    )
+    style, offset = _DANCE_STYLE[name.split("_")[1]], float(excerpt["audio_offset_s"])
+    return DancePair(name, style, motion.rename(name), y, sr, offset, excerpt)
 
 
 def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
     """``(y, sr, beats [s])`` of a real recording with human beat annotations: Hainsworth
     excerpt 001 (4/4, about 100 BPM) or ``"ballroom_waltz"`` (Media-105901, 3/4, 84 BPM)."""
-    if name not in REAL_DEV_ITEMS:
-        raise ParameterError(
-            f"unknown development recording {name!r}; choose from {sorted(REAL_DEV_ITEMS)}"
-        )
+    _known(name, REAL_DEV_ITEMS, "development recording")
     audio, beats = REAL_DEV_ITEMS[name]
     y, sr = io.read_audio(path(f"audio/real_dev/{audio}"))
     return y, sr, io.read_beats(path(f"audio/real_dev/{beats}"))
