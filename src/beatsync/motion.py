@@ -116,13 +116,10 @@ class Skeleton:
 
 @dataclass(frozen=True, eq=False)
 class PositionInfo:
-    """What a position-only motion needs beyond its values: bones and its file's layout.
-
-    ``bones`` ``None``: inferred. ``layout``: ``"json"``, ``"npy"``, ``"npz"``, ``"c3d"``
-    or ``"array"`` (made in memory); ``units``/``up`` of that file, each ``"given"``,
-    ``"detected"`` or read from the ``"file"``; ``center`` [m]: the JSON layout's root
-    track; ``key``: the array's name in an ``.npz``.
-    """
+    """What a position-only motion needs beyond its values: bones (``None``: inferred) and
+    its file's layout (``"json"``, ``"npy"``, ``"npz"``, ``"c3d"``; ``"array"``: made in
+    memory), ``units`` and ``up`` (each ``"given"``, ``"detected"`` or from the ``"file"``),
+    the JSON root track ``center`` [m] and the ``.npz`` array ``key``."""
 
     bones: np.ndarray | None = None
     layout: str = "array"
@@ -355,11 +352,9 @@ class Motion:
 
 
 def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
-    """Refuse offsets or translations so large that forward kinematics would overflow.
-
-    A world position is at most the chain's sum of ``|x| + |y| + |z|`` of offsets and
-    translations (rotations keep lengths); times 2 sqrt(3) it must stay finite.
-    """
+    """Refuse offsets or translations so large that forward kinematics would overflow: a
+    world position is at most the chain's sum of ``|x| + |y| + |z|`` of offsets and
+    translations (rotations keep lengths), which times 2 sqrt(3) must stay finite."""
     joints = skeleton.joints
     with np.errstate(over="ignore"):  # an overflow is inf: refused below
         sizes = np.abs([j.offset for j in joints]).sum(axis=1).tolist()
@@ -511,11 +506,9 @@ def is_marker_motion(motion: Motion) -> bool:
 
 
 def segmentation_view(motion: Motion) -> Motion:
-    """The joint-angle motion that segmentation works on (paper A works on joint angles).
-
-    BVH and angle tables as they are; markers through :func:`marker_angles`, other
-    position-only motion through :func:`bone_angles`.
-    """
+    """The joint-angle motion that segmentation works on (paper A works on joint angles):
+    BVH and tables as they are, markers through :func:`marker_angles`, other joint
+    positions through :func:`bone_angles`."""
     if not is_marker_motion(motion):
         return motion
     if motion.is_positional and not has_marker_set(motion):

@@ -235,9 +235,7 @@ def check_times(
             f"<= time #{i} ({float(arr[i])!r} s); sort them and drop duplicates"
         )
     if duration is not None and arr[-1] > duration + 1e-9:
-        hint = ""
-        if arr[-1] > 2 * duration:
-            hint = " (these look like frame indices or milliseconds, not seconds)"
+        hint = " (frame indices or milliseconds, not seconds?)" if arr[-1] > 2 * duration else ""
         raise ParameterError(
             f"{name} ends at {arr[-1]:g} s, after the signal's duration {duration:.3f} s{hint}"
         )

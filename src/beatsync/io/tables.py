@@ -139,13 +139,9 @@ def check_npy_header(path: str | os.PathLike[str]) -> tuple[tuple[int, ...], np.
             raise ParameterError(f"{str(p)!r} is not a .npy file (no NumPy header)")
         fh.seek(0)
         try:
-            version = np.lib.format.read_magic(fh)
-            read_header = (
-                np.lib.format.read_array_header_1_0
-                if version == (1, 0)
-                else np.lib.format.read_array_header_2_0
-            )
-            shape, _, dtype = read_header(fh)
+            fmt = np.lib.format
+            v1 = fmt.read_magic(fh) == (1, 0)
+            shape, _, dtype = (fmt.read_array_header_1_0 if v1 else fmt.read_array_header_2_0)(fh)
         except Exception as exc:  # numpy raises several types for broken headers
             raise ParameterError(f"{str(p)!r} has a broken .npy header: {exc}") from None
     if dtype.hasobject:
