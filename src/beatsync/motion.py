@@ -401,8 +401,7 @@ def _marker(motion: Motion, names: tuple[str, ...]) -> np.ndarray:
 
 def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Angle ABC [deg] at vertex b between segments b->a and b->c, per frame."""
-    u = a - b
-    v = c - b
+    u, v = a - b, c - b
     cosang = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
     return np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
 

@@ -101,9 +101,7 @@ def _interp_values(motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray
         out[:, partial] = v0[:, partial] + w[:, None] * d
     for _joint, idx, order in motion.rotation_triples():
         cols = list(idx)
-        q0 = quat_from_euler(v0[:, cols], order)
-        q1 = quat_from_euler(v1[:, cols], order)
-        q = slerp(q0, q1, w)
+        q = slerp(quat_from_euler(v0[:, cols], order), quat_from_euler(v1[:, cols], order), w)
         ref = np.where(w[:, None] < 0.5, v0[:, cols], v1[:, cols])
         out[:, cols] = rotation_to_euler(Rotation.from_quat(q), order, reference=ref)
     return out
@@ -125,8 +123,7 @@ def sample_motion(motion: Motion, times: np.ndarray) -> np.ndarray:
     t = check_finite(times, name="times")
     if t.ndim != 1:
         raise ParameterError(f"times must be 1-D [s], got shape {t.shape}")
-    f = time_to_frames(t, fps=motion.fps, round_to_int=False)
-    f = np.clip(f, 0.0, motion.n_frames - 1)
+    f = np.clip(time_to_frames(t, fps=motion.fps, round_to_int=False), 0.0, motion.n_frames - 1)
     i0 = np.floor(f).astype(np.int64)
     i1 = np.minimum(i0 + 1, motion.n_frames - 1)
     w = f - i0

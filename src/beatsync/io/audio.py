@@ -51,8 +51,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
     import soundfile as sf
 
     p = check_input_file(path, "audio")
-    if sr is not None:
-        sr = _integral_rate(sr, name="sr")
+    sr = None if sr is None else _integral_rate(sr, name="sr")
     decoder: list[str] = []
     try:
         # libmpg123 prints its own warnings to the process's stderr ("Xing stream size
@@ -102,8 +101,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
         raise ParameterError(f"audio file {str(p)!r} has a broken header: {exc}") from None
     y, _ = check_audio(y, file_sr, name=f"audio file {str(p)!r}")
     if sr is not None and sr != file_sr:
-        y = resample(y, file_sr, sr)
-        file_sr = sr
+        return resample(y, file_sr, sr), sr
     return y, file_sr
 
 

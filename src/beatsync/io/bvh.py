@@ -405,9 +405,7 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
             out.append(f"{ind}\tCHANNELS {len(j.channels)} {' '.join(j.channels)}")
         todo.append((i, depth, False))
         todo.extend((c, depth + 1, True) for c in reversed(children[i]))
-    out.append("MOTION")
-    out.append(f"Frames: {motion.n_frames}")
-    out.append(f"Frame Time: {1.0 / motion.fps!r}")
+    out += ["MOTION", f"Frames: {motion.n_frames}", f"Frame Time: {1.0 / motion.fps!r}"]
     with atomic_write(path) as fh:
         fh.write("\n".join(out) + "\n")
         for start in range(0, motion.n_frames, _CHUNK_ROWS):
