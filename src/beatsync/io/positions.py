@@ -297,7 +297,6 @@ def read_positions_array(
     units: str | None = None,
     bones: Any = None,
     max_gap: float = 0.25,
-    joint_names: Any = None,
 ) -> Motion:
     """Read joint positions ``(n_frames, n_joints, 3)`` from ``.npy`` or ``.npz``.
 
@@ -332,7 +331,7 @@ def read_positions_array(
     rate = _file_rate(fps, file_fps, p) if file_fps is not None else need_fps(fps, repr(str(p)))
     source = repr(str(p)) + (f" array {key!r}" if key else "")
     layout = suffix.lstrip(".")
-    return _build(pos, rate, p.stem, source, layout, joint_names=joint_names, key=key, **opts)
+    return _build(pos, rate, p.stem, source, layout, key=key, **opts)
 
 
 def _file_rate(fps: Any, file_fps: float, p: Path) -> float:

@@ -82,20 +82,14 @@ def _scalar(value: object) -> object:
     return arr.reshape(()).item() if arr.size == 1 and arr.dtype.kind in "iuf" else value
 
 
-def read_table(
-    path: str | os.PathLike[str], *, fps: float | None, channels: list[str] | None = None
-) -> Motion:
+def read_table(path: str | os.PathLike[str], *, fps: float | None) -> Motion:
     """Read a joint-angle table at ``fps`` [Hz]: ``.csv`` with a header row, or ``.npy``
-    ``(n, c)`` (columns ``channels``, default ``"ch0"``, ``"ch1"``, ...)."""
+    ``(n, c)`` (channels ``"ch0"``, ``"ch1"``, ...)."""
     p = check_input_file(path, "table")
     rate = need_fps(fps, f"{str(p)!r} (a plain table)")
     if p.suffix.lower() == ".npy":
         values = _read_npy(p)
-        names = tuple(channels) if channels else tuple(f"ch{i}" for i in range(values.shape[1]))
-        if len(names) != values.shape[1]:
-            raise ParameterError(
-                f"{len(names)} channel names given for the {values.shape[1]} columns of {str(p)!r}"
-            )
+        names = tuple(f"ch{i}" for i in range(values.shape[1]))
     else:
         import pandas as pd
 
