@@ -444,11 +444,8 @@ _MCT_ANGLES = {
 
 
 def marker_angles(motion: Motion) -> Motion:
-    """Joint angles [deg] (:data:`_MCT_ANGLES`) from the MoCap Toolbox 28-marker set.
-
-    Each is the interior angle at a joint between its two segments (180 deg =
-    straight). NaN gaps in markers are filled linearly first.
-    """
+    """Interior joint angles [deg] (180 = straight; :data:`_MCT_ANGLES`) from the MoCap
+    Toolbox 28-marker set, marker gaps filled linearly first."""
     motion = fill_gaps(motion)
     try:
         points = {k: _marker(motion, v) for k, v in _MCT_POINTS.items()}
@@ -465,12 +462,9 @@ def marker_angles(motion: Motion) -> Motion:
 
 
 def bone_angles(motion: Motion) -> Motion:
-    """Interior angles [deg] between every two bones that meet at a joint, as a motion.
-
-    Channels ``"<a>-<joint>-<b>_angle"``. Unchanged by travel, turns, body size and
-    units, so they suit paper A's segmentation of position-only motion without a
-    known marker set. NaN gaps are filled linearly first.
-    """
+    """Interior angles [deg] between every two bones that meet at a joint (channels
+    ``"<a>-<joint>-<b>_angle"``, gaps filled linearly first): unchanged by travel, turns,
+    body size and units, they suit paper A's segmentation of joint positions."""
     motion = fill_gaps(motion)
     pos = motion.positions()
     names = motion.joint_names

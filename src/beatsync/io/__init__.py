@@ -111,14 +111,10 @@ def read_motion(
     units: str | None = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read any supported motion file, chosen by its suffix.
-
-    ``.bvh`` (``fps`` overrides the header), ``.mat`` markers (``variable`` names the
-    recording), ``.csv`` and 2-D ``.npy`` angle tables (``fps`` required), joint
-    positions (:mod:`beatsync.io.positions`: ``.json``, 3-D ``.npy``, ``.npz`` with
-    ``variable`` naming the array, ``.c3d``). ``up`` and ``units`` apply to joint
-    positions; marker and joint gaps up to ``max_gap`` [s] are filled.
-    """
+    """Read any supported motion file, chosen by its suffix: ``.bvh`` (``fps`` overrides the
+    header), ``.mat`` markers (``variable``: the recording), ``.csv``/2-D ``.npy`` tables
+    (``fps`` required), joint positions (:mod:`beatsync.io.positions`; ``variable``: an
+    ``.npz`` array; ``up``, ``units``). Gaps up to ``max_gap`` [s] are filled."""
     p = Path(path)
     suffix = p.suffix.lower()
     # an .npz renamed, strings, records...: refused before any load

@@ -52,7 +52,6 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
 
     p = check_input_file(path, "audio")
     sr = None if sr is None else _integral_rate(sr, name="sr")
-    decoder: list[str] = []
     try:
         # libmpg123 prints its own warnings to the process's stderr ("Xing stream size
         # off by more than 1%"): kept apart, then said once the read is judged
@@ -150,12 +149,9 @@ def _c_stderr_captured(active: bool = True) -> Iterator[list[str]]:
 
 
 def _check_complete(p: Path, info: Any, n_read: int, rate: float) -> None:
-    """Refuse a file cut short: fewer samples than its header announces.
-
-    libsndfile reads what is there silently, but logs each size a header declares
-    beyond the bytes present (``data : 661500 (should be 165342)``) in
-    ``info.extra_info``; an MP3's Xing length is ``info.frames``; Ogg: :func:`_ogg_is_cut`.
-    """
+    """Refuse a file cut short. libsndfile reads what is there silently, but logs each size
+    a header declares beyond the bytes present (``data : 661500 (should be 165342)``) in
+    ``info.extra_info``; an MP3's Xing length is ``info.frames``; Ogg: :func:`_ogg_is_cut`."""
     announced = int(info.frames)
     missing = [
         int(declared) - int(present)

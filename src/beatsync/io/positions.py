@@ -184,11 +184,8 @@ def read_positions_json(
     bones: Any = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read the Dance-with-Melody JSON layout; ``fps`` [Hz] is required (the file has none).
-
-    ``up``, ``units``: detected unless given; ``bones``: inferred unless given; joints
-    are named ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
-    """
+    """Read the Dance-with-Melody JSON layout at ``fps`` [Hz] (the file has none); ``up``,
+    ``units`` detected and ``bones`` inferred unless given; joints ``j0``, ``j1``, ..."""
     p = check_input_file(path, "JSON motion")
     opts = _options(up, units, bones, max_gap)
     rate = need_fps(
@@ -259,11 +256,8 @@ def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
 
 
 def write_positions_json(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write a position-only motion in the Dance-with-Melody JSON layout (atomic).
-
-    In the units and axis of ``position_info``; ``center`` is the motion's root track
-    if it has one per frame, else the joints' per-frame mean.
-    """
+    """Write a position-only motion in the Dance-with-Melody JSON layout (atomic), in its
+    file's units and axis; ``center``: its root track, else the joints' per-frame mean."""
     info = _positional_info(motion, ".json")
     pos = motion.positions()
     center = info.center
@@ -284,8 +278,7 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
             f"it cannot be written as {suffix} joint positions; write .bvh (rotation "
             "data with a skeleton) or a .csv table"
         )
-    info = motion.position_info
-    return info if info is not None else PositionInfo()
+    return motion.position_info or PositionInfo()
 
 
 def read_positions_array(
@@ -369,11 +362,8 @@ def read_c3d(
     bones: Any = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read the marker points of a C3D file (its own rate, labels and unit).
-
-    ``fps`` must equal the file's rate if given; ``units`` defaults to ``POINT:UNITS``,
-    ``up`` to ``POINT:Y_SCREEN`` (``+Y``/``+Z``), else both are detected.
-    """
+    """Read the marker points of a C3D file at its own rate (a given ``fps`` must agree);
+    ``units``/``up`` default to ``POINT:UNITS``/``POINT:Y_SCREEN``, else are detected."""
     import c3d
 
     p = check_input_file(path, "C3D")

@@ -22,11 +22,8 @@ def need_fps(fps: Any, source: str, hint: str = "") -> float:
 
 
 def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) -> Motion:
-    """Read markers of a MoCap Toolbox ``.mat`` struct (``variable``, e.g. ``"dance2"``).
-
-    Positions in metres (the toolbox stores mm), z up, rate from ``freq``; NaN gaps kept.
-    ``variable`` may be left out if the file holds one recording.
-    """
+    """Read markers of a MoCap Toolbox ``.mat`` struct (``variable``, e.g. ``"dance2"``; may
+    be left out if there is one) in metres (stored: mm), z up, rate ``freq``, gaps kept."""
     import scipy.io
 
     p = check_input_file(path, "MAT")
