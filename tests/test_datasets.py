@@ -22,12 +22,12 @@ def test_corrupted_copy_is_refused(tmp_path, monkeypatch):
     target.write_text(target.read_text() + "9.9\n")
     monkeypatch.setenv("BEATSYNC_DATA", str(tmp_path / "data"))
     monkeypatch.setattr(datasets, "_verified", set())
-    with pytest.raises(ParameterError, match="SHA-256"):
+    with pytest.raises(ParameterError, match=r"sample\.beats"):
         datasets.path("audio/madmom/sample.beats")
 
 
 def test_unknown_names():
-    with pytest.raises(ParameterError, match="salsa"):
+    with pytest.raises(ParameterError, match="'99_99'"):
         datasets.load_salsa("99_99")
-    with pytest.raises(ParameterError, match="not a bundled"):
+    with pytest.raises(ParameterError, match=r"'motion/nope\.bvh'"):
         datasets.path("motion/nope.bvh")

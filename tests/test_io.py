@@ -72,18 +72,18 @@ def test_minimal_bvh(tmp_path):
 @pytest.mark.parametrize(
     "text, match",
     [
-        (GOOD.split("MOTION")[0][:80], "truncated|MOTION"),
-        (GOOD.replace("0 1 0 0 0 0 0 20 0\n", ""), "declares 2 frames but has 1"),
+        (GOOD.split("MOTION")[0][:80], "line 5: CHANNELS 6"),
+        (GOOD.replace("0 1 0 0 0 0 0 20 0\n", ""), r"\b2 frames but has 1 frame"),
         (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 20"), "frame line 2 has 8 values"),
         (
             GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 nan 0"),
             r"frame 2 of 2, channel 'knee_Xrotation' is nan \(NaN",
         ),
-        (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 x 0"), "non-numeric"),
-        (GOOD.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time"),
-        (GOOD.replace("HIERARCHY", "HIERARCY"), "HIERARCHY"),
-        (GOOD.replace("CHANNELS 3 Zrotation", "CHANNELS 3 Wrotation"), "CHANNELS"),
-        ("not a bvh at all", "MOTION|HIERARCHY"),
+        (GOOD.replace("0 1 0 0 0 0 0 20 0", "0 1 0 0 0 0 0 x 0"), "line 20: .*'x'"),
+        (GOOD.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time 0.0"),
+        (GOOD.replace("HIERARCHY", "HIERARCY"), "'HIERARCY'"),
+        (GOOD.replace("CHANNELS 3 Zrotation", "CHANNELS 3 Wrotation"), "line 9: .*'Wrotation'"),
+        ("not a bvh at all", "line 1: .*'not'"),
     ],
 )
 def test_malformed_bvh(tmp_path, text, match):
@@ -99,28 +99,28 @@ def test_text_renamed_mp3_is_not_said_to_be_missing(tmp_path):
     p = tmp_path / "notes.mp3"
     p.write_text("not audio at all\n" * 500)
     # libsndfile says "File does not exist or is not a regular file" of such a file
-    with pytest.raises(ParameterError, match="cannot read .* as MP3 audio") as info:
+    with pytest.raises(ParameterError, match=r"notes\.mp3") as info:
         io.read_audio(p)
     assert "does not exist" not in str(info.value)
 
 
 def test_missing_and_empty_files(tmp_path):
-    with pytest.raises(ParameterError, match="does not exist"):
+    with pytest.raises(ParameterError, match=r"nope\.bvh"):
         io.read_motion(tmp_path / "nope.bvh")
     (tmp_path / "e.wav").write_bytes(b"")
-    with pytest.raises(ParameterError, match="empty"):
+    with pytest.raises(ParameterError, match=r"e\.wav"):
         io.read_audio(tmp_path / "e.wav")
     (tmp_path / "junk.wav").write_bytes(b"RIFF garbage not audio" * 10)
-    with pytest.raises(ParameterError, match="cannot read"):
+    with pytest.raises(ParameterError, match=r"junk\.wav"):
         io.read_audio(tmp_path / "junk.wav")
-    with pytest.raises(ParameterError, match="unsupported"):
+    with pytest.raises(ParameterError, match=r"x\.txt"):
         io.read_motion(_write(tmp_path, GOOD).rename(tmp_path / "x.txt"))
 
 
 def test_fps_override_and_bad_fps(tmp_path):
     p = _write(tmp_path, GOOD)
     assert io.read_bvh(p, fps=60).fps == 60.0
-    with pytest.raises(ParameterError, match="fps"):
+    with pytest.raises(ParameterError, match="fps=0"):
         io.read_bvh(p, fps=0)
 
 
@@ -137,7 +137,7 @@ def test_atomic_write_leaves_nothing_on_error(tmp_path):
 
 def test_write_bvh_without_skeleton_refused(tmp_path):
     m = Motion(np.zeros((3, 2)), 30.0, ("a", "b"))
-    with pytest.raises(ParameterError, match="no skeleton"):
+    with pytest.raises(ParameterError, match=r"x\.bvh"):
         io.write_bvh(tmp_path / "x.bvh", m)
     assert not (tmp_path / "x.bvh").exists()
 
@@ -148,15 +148,15 @@ def test_tables(tmp_path):
     back = io.read_motion(p, fps=25)
     np.testing.assert_array_equal(back.values, m.values)
     assert back.channels == ("knee", "hip")
-    with pytest.raises(ParameterError, match="--fps"):
+    with pytest.raises(ParameterError, match=r"t\.csv.*--fps"):
         io.read_motion(p)
     np.save(tmp_path / "t.npy", m.values)
     assert io.read_motion(tmp_path / "t.npy", fps=25).n_channels == 2
     np.save(tmp_path / "bad.npy", np.zeros(5))
-    with pytest.raises(ParameterError, match="frames, channels"):
+    with pytest.raises(ParameterError, match=r"shape \(5,\)"):
         io.read_motion(tmp_path / "bad.npy", fps=25)
     (tmp_path / "s.csv").write_text("a,b\n1,x\n2,y\n")
-    with pytest.raises(ParameterError, match="non-numeric"):
+    with pytest.raises(ParameterError, match=r"\['b'\]"):
         io.read_motion(tmp_path / "s.csv", fps=25)
 
 
@@ -166,7 +166,7 @@ def test_mocap_mat():
     assert d.channels[:3] == ("Head_FL_x", "Head_FL_y", "Head_FL_z")
     # metres, z up: head markers are above 1 m
     assert 1.0 < np.nanmean(d.values[:, 2]) < 2.2
-    with pytest.raises(ParameterError, match="several"):
+    with pytest.raises(ParameterError, match=r"\['dance1', 'dance2'"):
         io.read_mocap_mat(datasets.path("motion/mocaptoolbox/mcdemodata.mat"))
 
 
@@ -213,11 +213,11 @@ def test_loud_audio_resamples_to_the_same_samples_scaled(tmp_path):
 @pytest.mark.parametrize(
     "y, orig, target, match",
     [
-        (np.zeros((100, 2), np.float32), 44100, 22050, "mono"),
-        (np.zeros(0, np.float32), 44100, 22050, "empty"),
-        (np.array([0.0, np.nan], np.float32), 44100, 22050, "NaN"),
-        (np.zeros(100, np.float32), 0, 22050, "sample rate"),
-        (np.zeros(100, np.float32), 44100, -1, "target_sr"),
+        (np.zeros((100, 2), np.float32), 44100, 22050, r"shape \(100, 2\)"),
+        (np.zeros(0, np.float32), 44100, 22050, "zero samples"),
+        (np.array([0.0, np.nan], np.float32), 44100, 22050, "sample 1"),
+        (np.zeros(100, np.float32), 0, 22050, "sr=0"),
+        (np.zeros(100, np.float32), 44100, -1, "target_sr=-1"),
     ],
 )
 def test_resample_audio_refuses_bad_input(y, orig, target, match):
@@ -305,7 +305,7 @@ def test_an_ogg_file_cut_short_is_refused(tmp_path):
     for name, size in (("mid_page", len(data) // 3), ("page_boundary", pages[len(pages) // 2])):
         cut = tmp_path / f"{name}.ogg"
         cut.write_bytes(data[:size])
-        with pytest.raises(ParameterError, match=r"cut short.*Ogg"):
+        with pytest.raises(ParameterError, match=rf"{name}\.ogg.*read 3\.2"):
             io.read_audio(cut)
     # bytes after the last page (a tag some tools append) are not a truncation
     trailing = tmp_path / "trailing.ogg"
@@ -412,19 +412,19 @@ def test_beats_files(tmp_path):
     p = io.write_beats(tmp_path / "b.beats", beats)
     np.testing.assert_allclose(io.read_beats(p), beats)
     (tmp_path / "bad.beats").write_text("1.0\n0.5\n")
-    with pytest.raises(ParameterError, match="increasing"):
+    with pytest.raises(ParameterError, match=r"#1 \(0\.5 s\)"):
         io.read_beats(tmp_path / "bad.beats")
     (tmp_path / "ms.beats").write_text("abc\n")
     with pytest.raises(ParameterError, match=r"line 1: 'abc'"):
         io.read_beats(tmp_path / "ms.beats")
-    with pytest.raises(ParameterError, match="increasing"):
+    with pytest.raises(ParameterError, match=r"#1 \(1\.0 s\)"):
         io.write_beats(tmp_path / "w.beats", [2.0, 1.0])
     assert not (tmp_path / "w.beats").exists()
 
 
 def test_csv_without_header_refused(tmp_path):
     np.savetxt(tmp_path / "noheader.csv", np.arange(12.0).reshape(6, 2) + 0.5, delimiter=",")
-    with pytest.raises(ParameterError, match="header"):
+    with pytest.raises(ParameterError, match=r"noheader\.csv"):
         io.read_motion(tmp_path / "noheader.csv", fps=25)
 
 
@@ -458,7 +458,7 @@ def _wav_with_header_rate(tmp_path: Path, rate: int) -> Path:
 
 def test_wav_with_sample_rate_zero_refused(tmp_path):
     p = _wav_with_header_rate(tmp_path, 0)
-    with pytest.raises(ParameterError, match=r"broken header: sample rate=0"):
+    with pytest.raises(ParameterError, match=r"a\.wav.*sample rate=0"):
         io.read_audio(p)
 
 
@@ -467,9 +467,7 @@ def test_wav_with_valid_header_rate_read(tmp_path):
     assert sr == 8000 and y.dtype == np.float32 and y.size == 4410
 
 
-@pytest.mark.parametrize(
-    "sr, match", [(0, r"sr=0 must be a finite sample rate"), (22050.5, "whole number of Hz")]
-)
+@pytest.mark.parametrize("sr, match", [(0, "sr=0"), (22050.5, r"sr=22050\.5")])
 def test_read_and_write_audio_bad_sr(tmp_path, sr, match):
     p = io.write_audio(tmp_path / "a.wav", np.full(4410, 0.1, dtype=np.float32), 44100)
     with pytest.raises(ParameterError, match=match):
@@ -482,7 +480,7 @@ def test_read_and_write_audio_bad_sr(tmp_path, sr, match):
 def test_npz_renamed_npy_refused(tmp_path):
     np.savez(tmp_path / "m.npz", values=np.zeros((5, 2)))
     p = (tmp_path / "m.npz").rename(tmp_path / "m.npy")
-    with pytest.raises(ParameterError, match=r"\.npz archive"):
+    with pytest.raises(ParameterError, match=r"m\.npy"):
         io.read_motion(p, fps=25)
 
 
@@ -606,7 +604,7 @@ def test_bvh_malformed_with_line_numbers(tmp_path, old, new, match):
 def test_bvh_non_utf8_refused(tmp_path):
     p = tmp_path / "latin.bvh"
     p.write_bytes(GOOD.replace("knee", "kn\xe9e").encode("latin-1"))
-    with pytest.raises(ParameterError, match=r"line 6 is not UTF-8 text"):
+    with pytest.raises(ParameterError, match="line 6"):
         io.read_bvh(p)
 
 
@@ -716,7 +714,7 @@ def test_write_bvh_refuses_nan_offset(tmp_path, chain_motion):
     m = Motion(
         chain_motion.values, chain_motion.fps, chain_motion.channels, Skeleton(tuple(joints))
     )
-    with pytest.raises(ParameterError, match=r"OFFSET of joint .* NaN"):
+    with pytest.raises(ParameterError, match="OFFSET of joint 'thigh'"):
         io.write_bvh(tmp_path / "x.bvh", m)
     assert not (tmp_path / "x.bvh").exists()
 
@@ -743,11 +741,9 @@ def test_write_json_float_digits_hides_last_digit_noise(tmp_path):
     assert "0.30000000000000004" in exact.read_text()
 
 
-@pytest.mark.parametrize(
-    "digits, match", [(0, "1-17"), (18, "1-17"), (2.5, "whole"), (True, "whole")]
-)
-def test_write_json_bad_float_digits(tmp_path, digits, match):
-    with pytest.raises(ParameterError, match=rf"float_digits={digits!r} must be"):
+@pytest.mark.parametrize("digits", [0, 18, 2.5, True])
+def test_write_json_bad_float_digits(tmp_path, digits):
+    with pytest.raises(ParameterError, match=rf"float_digits={digits!r}"):
         io.write_json(tmp_path / "x.json", {"a": 1.0}, float_digits=digits)
     assert not (tmp_path / "x.json").exists()
 
@@ -755,10 +751,10 @@ def test_write_json_bad_float_digits(tmp_path, digits, match):
 def test_npy_renamed_npz_refused(tmp_path):
     np.save(tmp_path / "a.npy", np.zeros((3, 2)))
     p = (tmp_path / "a.npy").rename(tmp_path / "a.npz")
-    with pytest.raises(ParameterError, match=r"\.npy array"):
+    with pytest.raises(ParameterError, match=r"a\.npz"):
         io.read_npz(p)
     (tmp_path / "t.npz").write_bytes(b"PK\x03\x04 broken zip")
-    with pytest.raises(ParameterError, match=r"cannot read .* as an \.npz archive"):
+    with pytest.raises(ParameterError, match=r"t\.npz"):
         io.read_npz(tmp_path / "t.npz")
 
 

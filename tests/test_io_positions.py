@@ -100,24 +100,23 @@ def test_json_nan_short_gap_filled(tmp_path):
     [
         (
             lambda d: {"frames": d["skeletons"]},
-            r"JSON of another layout \(keys \['frames'\]\); expected the Dance-with-Melody "
-            r"layout: an object with 'skeletons'",
+            r"\['frames'\]",
         ),
-        (lambda d: d["skeletons"], r"JSON of another layout \(list\)"),
+        (lambda d: d["skeletons"], r"bad\.json.*\(list\)"),
         (
             lambda d: {
                 **d,
                 "skeletons": d["skeletons"][:2] + [d["skeletons"][2][:4]] + d["skeletons"][3:],
             },
-            r"'skeletons' is ragged: frame 2 has 4 joints, frame 0 has 7",
+            r"'skeletons' .*frame 2 has 4 joints, frame 0 has 7",
         ),
         (
             lambda d: {**d, "skeletons": [f[:1] for f in d["skeletons"]]},
-            r"1 joint\(s\); a position-only motion needs at least 2 joints",
+            r"bad\.json' has 1 joint",
         ),
         (
             lambda d: {**d, "skeletons": [[p[:2] for p in f] for f in d["skeletons"]]},
-            r"frame 0 joint 0 has 2 coordinates; need 3",
+            r"frame 0 joint 0 has 2 coordinates",
         ),
         (
             lambda d: {
@@ -143,13 +142,13 @@ def test_json_bad_input(tmp_path, edit, match):
 
 def test_json_needs_fps(tmp_path):
     src = _dwm_json(tmp_path / "a.json", _body())
-    with pytest.raises(ParameterError, match=r"stores no frame rate.*dataset is 25 fps"):
+    with pytest.raises(ParameterError, match=r"a\.json.*fps="):
         io.read_motion(src)
 
 
 @pytest.mark.parametrize(
     ("kw", "match"),
-    [({"up": "x"}, r"up='x' must be one of 'y', 'z'"), ({"units": "in"}, r"units='in'")],
+    [({"up": "x"}, r"up='x'"), ({"units": "in"}, r"units='in'")],
 )
 def test_bad_up_or_units(tmp_path, kw, match):
     src = _dwm_json(tmp_path / "a.json", _body())
@@ -159,16 +158,16 @@ def test_bad_up_or_units(tmp_path, kw, match):
 
 def test_wrong_given_unit_refused(tmp_path):
     src = _dwm_json(tmp_path / "a.json", _body())  # centimetres
-    with pytest.raises(ParameterError, match=r"units='m' the body is 167 m tall"):
+    with pytest.raises(ParameterError, match=r"units='m' .*167 m"):
         io.read_motion(src, fps=FPS, units="m")
 
 
 def test_detection_refuses_ambiguous_bodies():
     cube = np.random.default_rng(0).uniform(0, 1, size=(20, 8, 3))
     cube[..., 2] = cube[..., 1]  # as tall as deep
-    with pytest.raises(ParameterError, match=r"cannot tell the vertical axis.*up='y'"):
+    with pytest.raises(ParameterError, match=r"0\.734 along y and 0\.734 along z"):
         detect_up(cube)
-    with pytest.raises(ParameterError, match=r"cannot tell the length unit.*units="):
+    with pytest.raises(ParameterError, match=r"16\.7 file units"):
         detect_units(_body() * 10.0, "z")  # 17 units tall: not m, cm or mm
     np.testing.assert_allclose(
         from_canonical(to_canonical(_body(), units="cm", up="y"), units="cm", up="y"), _body()
@@ -189,7 +188,7 @@ def test_npy_positions_round_trip_and_tables_unchanged(tmp_path):
     # a 2-D .npy is still an angle table, and up/units do not apply to it
     np.save(tmp_path / "table.npy", np.zeros((10, 4)))
     assert not io.read_motion(tmp_path / "table.npy", fps=30.0).is_positional
-    with pytest.raises(ParameterError, match=r"up='y' apply to joint-position files"):
+    with pytest.raises(ParameterError, match=r"up='y'.*table\.npy"):
         io.read_motion(tmp_path / "table.npy", fps=30.0, up="y")
 
 
@@ -200,12 +199,12 @@ def test_npz_key_found_named_and_fps_stored(tmp_path):
     assert m.fps == 60.0 and m.position_info.key == "keypoints3d"
     m2 = io.read_motion(tmp_path / "aist.npz", variable="other", fps=60.0)
     assert m2.joint_names == ["j0", "j1", "j2"]
-    with pytest.raises(ParameterError, match=r"fps=25.0 contradicts the frame rate stored"):
+    with pytest.raises(ParameterError, match=r"fps=25\.0 .*\(60 Hz\)"):
         io.read_motion(tmp_path / "aist.npz", fps=25.0)
-    with pytest.raises(ParameterError, match=r"has no array 'pose'; it holds"):
+    with pytest.raises(ParameterError, match=r"'pose'"):
         io.read_motion(tmp_path / "aist.npz", variable="pose")
     np.savez(tmp_path / "two.npz", a=pos_cm, b=pos_cm)
-    with pytest.raises(ParameterError, match=r"several \(frames, joints, 3\) arrays"):
+    with pytest.raises(ParameterError, match=r"two\.npz.*\['a', 'b'\]"):
         io.read_motion(tmp_path / "two.npz", fps=FPS)
     back = io.read_motion(io.write_motion(tmp_path / "out.npz", m))
     assert back.fps == 60.0 and back.position_info.key == "keypoints3d"
@@ -223,7 +222,7 @@ def test_c3d_round_trip_rate_labels_units(tmp_path):
     assert back.fps == FPS and back.joint_names == m.joint_names
     assert back.position_info.units_source == "file"  # POINT:UNITS
     np.testing.assert_allclose(back.positions(), m.positions(), atol=1e-5)  # float32
-    with pytest.raises(ParameterError, match=r"fps=30 contradicts the frame rate stored"):
+    with pytest.raises(ParameterError, match=r"fps=30 .*\(25 Hz\)"):
         io.read_motion(out, fps=30)
     assert io.read_motion(out, fps=FPS).fps == FPS  # agreeing is fine
 
@@ -235,7 +234,7 @@ def test_c3d_cut_short_is_refused(tmp_path):
     whole = io.write_motion(tmp_path / "whole.c3d", m).read_bytes()
     cut = tmp_path / "cut.c3d"
     cut.write_bytes(whole[: len(whole) * 2 // 3])
-    with pytest.raises(ParameterError, match=rf"cut short: its header declares {m.n_frames} "):
+    with pytest.raises(ParameterError, match=rf"cut\.c3d.*{m.n_frames} frames"):
         io.read_motion(cut)
 
 
@@ -248,7 +247,7 @@ def test_c3d_without_points_refused(tmp_path):
     with open(tmp_path / "analog.c3d", "wb") as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         w.write(fh)
-    with pytest.raises(ParameterError, match=r"C3D file without marker points"):
+    with pytest.raises(ParameterError, match=r"analog\.c3d"):
         io.read_motion(tmp_path / "analog.c3d")
 
 
@@ -284,8 +283,7 @@ def test_bvh_output_of_positions_refused_with_alternative(tmp_path):
     m = io.read_motion(_dwm_json(tmp_path / "a.json", _body()), fps=FPS)
     with pytest.raises(
         ParameterError,
-        match=r"joint positions without joint rotations.*"
-        r"write \.json, \.npy or \.c3d",
+        match=r"out\.bvh.*write \.json, \.npy or \.c3d",
     ):
         io.write_motion(tmp_path / "out.bvh", m)
     assert not (tmp_path / "out.bvh").exists()
@@ -296,7 +294,7 @@ def test_write_motion_tables_and_bvh(tmp_path, chain_motion):
     assert io.read_motion(out).skeleton.same_structure(chain_motion.skeleton)
     csv = io.write_motion(tmp_path / "c.csv", chain_motion)
     assert io.read_motion(csv, fps=chain_motion.fps).n_channels == chain_motion.n_channels
-    with pytest.raises(ParameterError, match=r"not joint positions.*cannot be written as \.json"):
+    with pytest.raises(ParameterError, match=r"'chain' .*\.json"):
         io.write_motion(tmp_path / "c.json", chain_motion)
-    with pytest.raises(ParameterError, match=r"choose a suffix from"):
+    with pytest.raises(ParameterError, match=r"c\.txt"):
         io.write_motion(tmp_path / "c.txt", chain_motion)

@@ -53,14 +53,14 @@ def test_rotation_triples(chain_motion):
 
 
 def test_shape_errors():
-    with pytest.raises(ParameterError, match="transposed"):
+    with pytest.raises(ParameterError, match="5 value columns but 3 channel"):
         Motion(np.zeros((3, 5)), 30.0, ("a", "b", "c"))
-    with pytest.raises(ParameterError, match="fps"):
+    with pytest.raises(ParameterError, match="fps=0.0"):
         Motion(np.zeros((3, 1)), 0.0, ("a",))
-    with pytest.raises(ParameterError, match="frame indices"):
+    with pytest.raises(ParameterError, match="0:10 is outside 0:3"):
         Motion(np.zeros((3, 1)), 30.0, ("a",)).slice_frames(0, 10)
-    with pytest.raises(ParameterError, match="no skeleton"):
-        Motion(np.zeros((3, 1)), 30.0, ("a",)).positions()
+    with pytest.raises(ParameterError, match="'tab'"):
+        Motion(np.zeros((3, 1)), 30.0, ("a",), name="tab").positions()
 
 
 def test_marker_angles_dance2():
@@ -124,17 +124,17 @@ def test_is_positional_false_for_bvh_tables_and_partial_triples(chain_motion):
 
 
 def test_position_info_refused_on_other_channels():
-    with pytest.raises(ParameterError, match="position-only"):
+    with pytest.raises(ParameterError, match=r"\['a', 'b'\]"):
         Motion(np.zeros((3, 2)), 30.0, ("a", "b"), position_info=PositionInfo())
 
 
 @pytest.mark.parametrize(
     ("bones", "match"),
     [
-        ([[0, 1, 2]], r"shape \(n_bones, 2\)"),
+        ([[0, 1, 2]], r"shape \(1, 3\)"),
         ([[0, 5]], r"joint 5 .*0\.\.4"),
-        ([[2, 2]], "itself"),
-        ([[0.5, 1]], "integer joint indices"),
+        ([[2, 2]], r"\[2, 2\]"),
+        ([[0.5, 1]], r"0\.5"),
     ],
 )
 def test_bad_bones(bones, match):
@@ -143,7 +143,7 @@ def test_bad_bones(bones, match):
 
 
 def test_infer_bones_needs_two_joints():
-    with pytest.raises(ParameterError, match="at least 2 joints"):
+    with pytest.raises(ParameterError, match="got 1"):
         infer_bones(np.zeros((10, 1, 3)))
 
 

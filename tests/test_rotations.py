@@ -45,11 +45,11 @@ def test_blend_endpoints_and_errors(chain_motion):
     b = chain_motion.values[10:20]
     np.testing.assert_allclose(blend_values(chain_motion, a, b, np.zeros(10)), a, atol=1e-9)
     np.testing.assert_allclose(blend_values(chain_motion, a, b, np.ones(10)), b, atol=1e-9)
-    with pytest.raises(ParameterError, match="shape"):
+    with pytest.raises(ParameterError, match=r"\(5, 12\)"):
         blend_values(chain_motion, a, b[:5], np.zeros(10))
-    with pytest.raises(ParameterError, match=r"\[0, 1\]"):
+    with pytest.raises(ParameterError, match="got 2 to 2"):
         blend_values(chain_motion, a, b, np.full(10, 2.0))
-    with pytest.raises(ParameterError, match="NaN"):
+    with pytest.raises(ParameterError, match=r"times .*index \(0,\)"):
         sample_motion(chain_motion, np.array([np.nan]))
 
 
@@ -105,7 +105,7 @@ def test_quaternions_match_scipy(axes):
 def test_quat_from_euler_refuses_bad_axes_or_shapes(axes, shape):
     from beatsync.quaternions import quat_from_euler
 
-    with pytest.raises(ParameterError, match="axes"):
+    with pytest.raises(ParameterError, match=f"'{axes}'"):
         quat_from_euler(np.zeros(shape), axes)
 
 

@@ -1,3 +1,4 @@
+import re
 import warnings
 
 import numpy as np
@@ -37,18 +38,18 @@ def test_fractional_frames():
 
 @pytest.mark.parametrize("fps", [0, -25, np.nan, np.inf, "x", None])
 def test_bad_fps(fps):
-    with pytest.raises(ParameterError, match="fps"):
+    with pytest.raises(ParameterError, match=re.escape(f"fps={fps!r}")):
         check_fps(fps)
 
 
 @pytest.mark.parametrize(
     "times, match",
     [
-        ([1.0, 0.5], "strictly increasing"),
-        ([0.0, 0.0], "strictly increasing"),
-        ([[0.0, 1.0]], "1-D"),
-        ([-1.0, 2.0], "negative"),
-        ([0.1, np.nan], "NaN"),
+        ([1.0, 0.5], r"#1 \(0\.5 s\) <= time #0 \(1\.0 s\)"),
+        ([0.0, 0.0], r"#1 \(0\.0 s\)"),
+        ([[0.0, 1.0]], r"shape \(1, 2\)"),
+        ([-1.0, 2.0], "-1.0"),
+        ([0.1, np.nan], r"index \(1,\)"),
     ],
 )
 def test_bad_times(times, match):
@@ -73,26 +74,26 @@ def test_bad_times_message_shows_plain_numbers(times, match):
 @pytest.mark.parametrize("fps", [1e5, 44100])
 def test_implausibly_high_motion_fps_is_refused(fps):
     # --out-fps 100000 made sync resample a 28 s dance to 2.8 million frames (10 GB)
-    with pytest.raises(ParameterError, match=r"out_fps=.* implausibly high.*2000 Hz"):
+    with pytest.raises(ParameterError, match=rf"out_fps={fps!r} Hz .*2000 Hz"):
         check_motion_fps(fps, name="out_fps")
     assert check_motion_fps(2000) == 2000.0
     assert check_fps(fps) == fps  # audio sample rates stay valid for check_fps
 
 
 def test_times_that_look_like_frames():
-    with pytest.raises(ParameterError, match="frame indices"):
+    with pytest.raises(ParameterError, match="900 s.*frame indices"):
         check_times([30.0, 60.0, 900.0], duration=10.0)
 
 
 def test_empty_times_policy():
     assert check_times([]).size == 0
-    with pytest.raises(ParameterError, match="empty"):
+    with pytest.raises(ParameterError, match="times is empty"):
         check_times([], allow_empty=False)
 
 
 def test_range():
     assert check_range(0.25, 1.25, name="period_range", unit="s") == (0.25, 1.25)
-    with pytest.raises(ParameterError, match="reversed"):
+    with pytest.raises(ParameterError, match=r"\(1\.25, 0\.25\)"):
         check_range(1.25, 0.25, name="period_range", unit="s")
 
 
@@ -106,11 +107,11 @@ def test_range():
         ("0.5", r"delta='0\.5'.*text"),
         (None, r"delta=None.*not a number"),
         (True, r"delta=True.*bool"),
-        (np.array([0.5, 0.6]), r"single number \[s\], got an array of shape \(2,\)"),
+        (np.array([0.5, 0.6]), r"delta=array\(\[0\.5, 0\.6\]\)"),
         ([0.5], r"delta=\[0\.5\].*list"),
         (np.nan, r"delta=nan.*finite"),
-        (np.inf, r"finite"),
-        (1e999, r"finite"),
+        (np.inf, "delta=inf"),
+        (1e999, "delta=inf"),
     ],
 )
 def test_as_float_refuses(value, match):
@@ -120,7 +121,7 @@ def test_as_float_refuses(value, match):
 
 def test_as_float_accepts_numbers_and_numpy_scalars():
     assert as_float("0.5", name="d", unit="s", text=True) == 0.5
-    with pytest.raises(ParameterError, match="not a number"):
+    with pytest.raises(ParameterError, match="d='abc'"):
         as_float("abc", name="d", unit="s", text=True)
     assert as_float(np.float32(2), name="d", unit="s") == 2.0
     assert as_float(np.array(3.0), name="d", unit="s") == 3.0
@@ -128,7 +129,7 @@ def test_as_float_accepts_numbers_and_numpy_scalars():
 
 
 @pytest.mark.parametrize(
-    "value, match", [(2.5, "whole number"), (1, "integer >= 2"), ("x", "not a number")]
+    "value, match", [(2.5, "n_periods=2.5"), (1, "n_periods=1 .*>= 2"), ("x", "n_periods='x'")]
 )
 def test_as_int_refuses(value, match):
     with pytest.raises(ParameterError, match=match):
@@ -142,11 +143,11 @@ def test_as_int_accepts_integral_floats():
 @pytest.mark.parametrize(
     "value, match",
     [
-        (0, r"> 0 \[s\]"),
-        (-1, r"> 0 \[s\]"),
-        (np.nan, r"> 0 \[s\]"),
-        ("x", r"not a number \[s\]"),
-        (False, "bool"),
+        (0, r"win_s=0 .*> 0 \[s\]"),
+        (-1, "win_s=-1"),
+        (np.nan, "win_s=nan"),
+        ("x", "win_s='x'"),
+        (False, "win_s=False"),
     ],
 )
 def test_check_positive_refuses(value, match):
@@ -157,12 +158,12 @@ def test_check_positive_refuses(value, match):
 @pytest.mark.parametrize(
     "sr, match",
     [
-        (0, r"sr=0 .*> 0"),
-        (-22050, "> 0"),
-        (np.nan, "> 0"),
-        ("fast", r"sr='fast'.*not a number"),
+        (0, "sr=0"),
+        (-22050, "sr=-22050"),
+        (np.nan, "sr=nan"),
+        ("fast", "sr='fast'"),
         (44.1, r"sr=44\.1 .*sr=44100"),
-        (None, "not a number"),
+        (None, "sr=None"),
     ],
 )
 def test_check_sample_rate_refuses(sr, match):
@@ -179,14 +180,14 @@ def test_check_sample_rate_accepts():
     "bpm, match",
     [
         (0.5, r"bpm=0\.5 .*beat period"),
-        (2.0, "beats per second"),
-        (1000, "sub-beats"),
-        (0, r"bpm=0 .*positive"),
-        (-5, "a tempo is a positive number"),
-        (np.nan, r"bpm=nan .*finite"),
-        (np.inf, "not a finite number"),
-        ("inf", "not a finite number"),
-        ("x", r"not a number \[bpm\]"),
+        (2.0, "bpm=2.0 .*beats per second"),
+        (1000, "bpm=1000 .*sub-beats"),
+        (0, "bpm=0 .*positive"),
+        (-5, "bpm=-5 .*positive"),
+        (np.nan, "bpm=nan"),
+        (np.inf, "bpm=inf"),
+        ("inf", "bpm='inf'"),
+        ("x", "bpm='x'"),
     ],
 )
 def test_check_bpm_refuses(bpm, match):
@@ -215,7 +216,7 @@ _Y = np.full(2205, 0.1, dtype=np.float32)
 @pytest.mark.parametrize(
     "y, sr, kwargs, match",
     [
-        (np.stack([_Y, _Y]), 22050, {}, r"mono \(1-D\), got shape \(2, 2205\); mix down"),
+        (np.stack([_Y, _Y]), 22050, {}, r"shape \(2, 2205\).*mean\(axis=0\)"),
         (_Y[:0], 22050, {}, "zero samples"),
         (
             np.where(np.arange(2205) == 7, np.nan, _Y),
@@ -227,7 +228,7 @@ _Y = np.full(2205, 0.1, dtype=np.float32)
         (_Y + 1j, 22050, {}, "complex"),
         (["a"] * 5, 22050, {}, "strings"),
         (_Y, 22050, {"min_duration": 1.0}, r"0\.100 s .*2205 samples"),
-        (_Y * 0, 22050, {"silence_peak": 1e-7}, "all silent"),
+        (_Y * 0, 22050, {"silence_peak": 1e-7}, "silent .*1e-07"),
         (_Y, 22050, {"silence_peak": 1e-7}, r"constant at 0\.1 "),
         (_Y - 0.3, 22050, {"silence_peak": 1e-7}, r"constant at -0\.2"),
     ],
@@ -274,13 +275,13 @@ def test_check_audio_near_the_float64_maximum_warns_nothing():
 @pytest.mark.parametrize(
     "values, match",
     [
-        ([[1.0, 2.0], [3.0]], "ragged"),
+        ([[1.0, 2.0], [3.0]], "values .*ragged"),
         (np.array([1 + 2j]), "complex"),
         (np.array(["1.0"]), "strings"),
         (np.array([b"1"]), "bytes"),
         (np.array([True, False]), "booleans"),
         (np.array(["2020-01-01"], dtype="datetime64[D]"), "dates"),
-        (np.zeros(2, dtype=[("a", "f8"), ("b", "f8")]), "structured"),
+        (np.zeros(2, dtype=[("a", "f8"), ("b", "f8")]), "records"),
         ([1.0, None], "None"),
     ],
 )
@@ -310,10 +311,10 @@ def test_check_helpers_accept_numbers_written_as_text():
     "pair, match",
     [
         (0.5, r"period_range=0\.5 .*two numbers"),
-        ((0.5, 1.0, 2.0), "two numbers"),
-        ("ab", "two numbers"),
-        ((2.0, 0.5), "reversed"),
-        ((0.0, 1.0), "finite and > 0"),
+        ((0.5, 1.0, 2.0), r"period_range=\(0\.5, 1\.0, 2\.0\)"),
+        ("ab", "period_range='ab'"),
+        ((2.0, 0.5), r"period_range=\(2\.0, 0\.5\)"),
+        ((0.0, 1.0), r"period_range=\(0\.0, 1\.0\)"),
     ],
 )
 def test_check_interval_refuses(pair, match):

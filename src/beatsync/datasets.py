@@ -1,22 +1,21 @@
-"""Bundled real data (the repository's ``data/`` folder), verified by SHA-256.
+"""Bundled real data (``<repo>/data``, or ``$BEATSYNC_DATA``), verified by SHA-256.
 
-Every file was copied byte for byte from a public source; ``data/README.md`` gives
-origins, licences and the checksums repeated in :data:`CHECKSUMS`. Loading a file
-through this module verifies its checksum once per process, so a corrupted or
-edited file is refused rather than silently used.
-
-The data folder is found next to the source tree (``<repo>/data``) or from the
-environment variable ``BEATSYNC_DATA``.
+Every file is a byte-for-byte copy from a public source (``data/README.md``: origins,
+licences, checksums). Each file's checksum is verified once per process, so a
+corrupted or edited file is refused rather than silently used.
 """
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from . import io
 from .errors import ParameterError
 from .motion import Motion
 
@@ -92,11 +91,7 @@ _verified: set[str] = set()
 
 def data_dir() -> Path:
     """The folder holding the bundled data."""
-    env = os.environ.get("BEATSYNC_DATA")
-    if env:
-        d = Path(env)
-    else:
-        d = Path(__file__).resolve().parents[2] / "data"
+    d = Path(os.environ.get("BEATSYNC_DATA") or Path(__file__).resolve().parents[2] / "data")
     if not (d / "motion").is_dir():
         raise ParameterError(
             f"bundled data folder {str(d)!r} not found; run from a clone of the beatsync "
@@ -106,22 +101,14 @@ def data_dir() -> Path:
 
 
 def path(relpath: str, *, verify: bool = True) -> Path:
-    """Path of a bundled data file (relative to ``data/``), checksum-verified.
-
-    Raises
-    ------
-    ParameterError
-        Unknown file, missing file, or checksum mismatch.
-    """
+    """Path of a bundled data file (relative to ``data/``), checksum-verified."""
     if relpath not in CHECKSUMS:
         raise ParameterError(f"{relpath!r} is not a bundled data file; known: {sorted(CHECKSUMS)}")
     p = data_dir() / relpath
     if not p.is_file():
         raise ParameterError(f"bundled data file {str(p)!r} is missing")
     if verify and relpath not in _verified:
-        from .io import sha256_file
-
-        digest = sha256_file(p)
+        digest = io.sha256_file(p)
         if digest != CHECKSUMS[relpath]:
             raise ParameterError(
                 f"bundled data file {str(p)!r} fails its SHA-256 check ({digest[:12]}... != "
@@ -145,12 +132,14 @@ def verify_all() -> dict[str, bool]:
     return out
 
 
+def _known(name: str, known: Any, what: str) -> None:
+    if name not in known:
+        raise ParameterError(f"unknown {what} {name!r}; choose from {list(known)}")
+
+
 def load_salsa(take: str = "60_01") -> Motion:
     """A CMU salsa clip (``"60_01"``, ``"61_01"``, ``"60_04"``, ``"61_04"``) at 60 fps."""
-    from . import io
-
-    if take not in SALSA_CLIPS:
-        raise ParameterError(f"unknown salsa take {take!r}; choose from {SALSA_CLIPS}")
+    _known(take, SALSA_CLIPS, "salsa take")
     m = io.read_bvh(path(f"motion/cmu_salsa/{take}_scaled.bvh"), fps=CMU_FPS)
     return m.rename(f"salsa_{take}")
 
@@ -158,36 +147,25 @@ def load_salsa(take: str = "60_01") -> Motion:
 def load_walk(clip: str = "007_01") -> Motion:
     """A CMU subject 7 walk (``"007_01"``, ``"007_02"``, ``"007_12"``) or the 5 pirouette
     (``"005_02"``, not periodic) at 60 fps."""
-    from . import io
-
-    if clip not in WALK_CLIPS:
-        raise ParameterError(f"unknown clip {clip!r}; choose from {WALK_CLIPS}")
+    _known(clip, WALK_CLIPS, "clip")
     m = io.read_bvh(path(f"motion/cmu_walk_modern/{clip}.bvh"), fps=CMU_FPS)
     return m.rename(f"cmu_{clip}")
 
 
 def load_mocap_toolbox(variable: str = "dance2") -> Motion:
     """MoCap Toolbox demo markers (``"dance1"``, ``"dance2"``, ``"walk1"``, ``"walk2"``), 60 Hz, metres."""
-    from . import io
-
-    if variable not in ("dance1", "dance2", "walk1", "walk2"):
-        raise ParameterError(f"unknown MoCap Toolbox recording {variable!r}")
+    _known(variable, ("dance1", "dance2", "walk1", "walk2"), "MoCap Toolbox recording")
     return io.read_mocap_mat(path("motion/mocaptoolbox/mcdemodata.mat"), variable)
 
 
 def load_madmom_sample() -> tuple[np.ndarray, int, np.ndarray]:
     """The madmom test recording (2.8 s, 44.1 kHz) and its 4 hand-annotated beats [s]."""
-    from . import io
-
     y, sr = io.read_audio(path("audio/madmom/sample.wav"))
-    beats = io.read_beats(path("audio/madmom/sample.beats"))
-    return y, sr, beats
+    return y, sr, io.read_beats(path("audio/madmom/sample.beats"))
 
 
 def load_click_808() -> tuple[np.ndarray, int]:
     """The BeatNet 808 kick loop (10 s, 120 BPM; tempo only, no beat list)."""
-    from . import io
-
     return io.read_audio(path("audio/click_808_120bpm/808kick120bpm.mp3"))
 
 
@@ -200,22 +178,9 @@ _DANCE_STYLE = {"C": "cha-cha", "R": "rumba", "W": "waltz"}
 class DancePair:
     """A real dancer with the song they danced to (a bundled 24 s excerpt).
 
-    Attributes
-    ----------
-    name : str
-        ``"DANCE_C_4"``, ...
-    style : str
-        ``"cha-cha"``, ``"rumba"`` or ``"waltz"``.
-    motion : Motion
-        Joint positions, 23 joints, 25 fps, metres, z up (file: cm, y up).
-    y : np.ndarray [shape=(n,)]
-        The matching part of the song, mono.
-    sr : int [Hz]
-    audio_offset : float [s]
-        Time in ``y`` of motion frame 0 (the excerpt's audio starts this much earlier;
-        the dataset's own alignment of dance and song is approximate).
-    excerpt : dict
-        What was cut: original ``config``, first frame, song time of frame 0.
+    ``motion``: 23 joints, 25 fps, metres, z up; ``y``: the song's matching part, mono;
+    ``audio_offset`` [s]: time in ``y`` of motion frame 0 (the dataset's own alignment
+    is approximate); ``excerpt``: what was cut (``config``, first frame, song time).
     """
 
     name: str
@@ -232,40 +197,21 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
 
     Frame ``i`` of the motion plays at time ``audio_offset + i / fps`` of ``y``.
     """
-    import json
-
-    from . import io
-
-    if name not in DANCE_PAIRS:
-        raise ParameterError(f"unknown Dance-with-Melody pair {name!r}; choose from {DANCE_PAIRS}")
+    _known(name, DANCE_PAIRS, "Dance-with-Melody pair")
     folder = f"motion/dance_with_melody/{name}"
     excerpt = json.loads(path(f"{folder}/excerpt.json").read_text(encoding="utf-8"))
     motion = io.read_motion(
         path(f"{folder}/skeletons.json"), fps=excerpt["fps"], up="y", units="cm"
     )
     y, sr = io.read_audio(path(f"{folder}/audio.ogg"))
-    return DancePair(
-        name=name,
-        style=_DANCE_STYLE[name.split("_")[1]],
-        motion=motion.rename(name),
-        y=y,
-        sr=sr,
-        audio_offset=float(excerpt["audio_offset_s"]),
-        excerpt=excerpt,
-    )
+    style, offset = _DANCE_STYLE[name.split("_")[1]], float(excerpt["audio_offset_s"])
+    return DancePair(name, style, motion.rename(name), y, sr, offset, excerpt)
+
+
 def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
-    """A real development recording and its human beat annotations [s].
-
-    ``"hainsworth_001"`` (Hainsworth dataset excerpt 001, 56.5 s, about 100 BPM, 4/4) or
-    ``"ballroom_waltz"`` (Ballroom dataset, Waltz, Media-105901, 31.8 s, about 84 BPM,
-    3/4); both 44.1 kHz. Returns ``(y, sr, beats)``.
-    """
-    from . import io
-
-    if name not in REAL_DEV_ITEMS:
-        raise ParameterError(
-            f"unknown development recording {name!r}; choose from {sorted(REAL_DEV_ITEMS)}"
-        )
+    """``(y, sr, beats [s])`` of a real recording with human beat annotations: Hainsworth
+    excerpt 001 (4/4, about 100 BPM) or ``"ballroom_waltz"`` (Media-105901, 3/4, 84 BPM)."""
+    _known(name, REAL_DEV_ITEMS, "development recording")
     audio, beats = REAL_DEV_ITEMS[name]
     y, sr = io.read_audio(path(f"audio/real_dev/{audio}"))
     return y, sr, io.read_beats(path(f"audio/real_dev/{beats}"))

@@ -1,14 +1,5 @@
-"""Joint positions as arrays: bones, bone lengths, gap filling.
-
-Functions on ``(n_frames, n_joints, 3)`` arrays used by position-only
-:class:`beatsync.motion.Motion` and by the readers of :mod:`beatsync.io.positions`.
-
-Data contract
--------------
-- Positions are ``(n_frames, n_joints, 3)`` float64, time first, in one length unit.
-- Bones are joint-index pairs ``(n_bones, 2)`` (``(joint, parent)`` when inferred).
-- Frame rates ``fps > 0`` [Hz]; gap lengths in seconds.
-"""
+"""Joint positions ``(n_frames, n_joints, 3)`` (one length unit) as arrays: bones
+(joint-index pairs ``(n_bones, 2)``), bone lengths, gap filling."""
 
 from __future__ import annotations
 
@@ -33,15 +24,16 @@ def check_bones(bones: Any, n_joints: int) -> np.ndarray:
         )
     if not np.issubdtype(arr.dtype, np.integer):
         if not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr)):
-            raise ParameterError("bones must be integer joint indices (pairs of indices)")
+            raise ParameterError(f"bones={arr.tolist()} must be integer joint indices")
     arr = arr.astype(np.int64)
     if arr.min() < 0 or arr.max() >= n_joints:
         raise ParameterError(
             f"bones refer to joint {int(arr.max()) if arr.max() >= n_joints else int(arr.min())}"
             f" but the motion has joints 0..{n_joints - 1} (indices, from 0)"
         )
-    if np.any(arr[:, 0] == arr[:, 1]):
-        raise ParameterError("a bone joins a joint to itself; give pairs of two joints")
+    loops = arr[arr[:, 0] == arr[:, 1]]
+    if loops.size:
+        raise ParameterError(f"bone {loops[0].tolist()} joins a joint to itself; give two joints")
     return arr
 
 
@@ -64,27 +56,12 @@ def _distance_stats(pos: np.ndarray, max_frames: int) -> tuple[np.ndarray, np.nd
 
 
 def infer_bones(positions: Any, *, max_frames: int = 2000) -> np.ndarray:
-    """Bones of a position-only motion from joint distances that stay short and constant.
+    """``(joint, parent)`` bones from joint distances that stay short and constant.
 
-    A bone joins two joints whose distance is both short and steady; the bones are
-    the minimum spanning tree of the joint-to-joint cost ``mean + 2 std`` of the
-    distance over frames, oriented from the most central joint (the joint with the
-    smallest mean distance to the others) outwards. On the four Dance-with-Melody
-    dancers (23 joints, noisy markerless data) this finds the limbs, spine and hips;
-    where the knees stay close together it may join the knees instead of one thigh
-    (checked on all four against the anatomy, not tuned to one). Give the bones
-    explicitly (``bones=`` of the readers) when they are known.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)], finite, n_joints >= 2
-    max_frames : int
-        At most this many evenly spaced frames are used.
-
-    Returns
-    -------
-    bones : np.ndarray [shape=(n_joints - 1, 2)], int
-        ``(joint, parent)`` pairs.
+    The minimum spanning tree of the cost ``mean + 2 std`` of each joint-to-joint
+    distance (over at most ``max_frames`` evenly spaced frames), rooted at the most
+    central joint. Where knees stay close it may join them instead of a thigh: give
+    ``bones=`` to the readers when they are known.
     """
     from scipy.sparse.csgraph import breadth_first_order, minimum_spanning_tree
 
@@ -121,36 +98,14 @@ def fill_joint_gaps(
     max_gap: float = 0.25,
     joint_names: list[str] | tuple[str, ...] | None = None,
 ) -> np.ndarray:
-    """Fill short gaps (NaN) of each joint by linear interpolation; refuse long ones.
-
-    A joint is missing in a frame if any of its coordinates is NaN or infinite.
-    Gaps at the start or end are held at the nearest valid frame.
-
-    Parameters
-    ----------
-    positions : np.ndarray [shape=(n_frames, n_joints, 3)]
-    fps : float > 0 [Hz]
-    max_gap : float >= 0 [s]
-        Longest gap filled; a longer one raises.
-    joint_names : sequence of str, optional
-        Used in the error message.
-
-    Raises
-    ------
-    ParameterError
-        A gap longer than ``max_gap`` (the joint and the frames named), or a joint
-        that is never seen.
-    """
+    """Fill gaps (a NaN/inf coordinate) up to ``max_gap`` [s] per joint linearly, refuse
+    longer ones; gaps at the ends hold the nearest valid frame."""
     pos = np.array(positions, dtype=np.float64)
     rate = check_fps(fps)
     missing = ~np.all(np.isfinite(pos), axis=2)
     if not missing.any():
         return pos
-    names = (
-        list(joint_names)
-        if joint_names is not None
-        else [f"joint {j}" for j in range(pos.shape[1])]
-    )
+    names = list(joint_names or [f"joint {j}" for j in range(pos.shape[1])])
     t = np.arange(pos.shape[0])
     limit = int(np.floor(max_gap * rate + 1e-9))
     for j in np.flatnonzero(missing.any(axis=0)):

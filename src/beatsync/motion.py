@@ -2,31 +2,25 @@
 
 Data contract
 -------------
-- ``Motion.values`` is ``(n_frames, n_channels)`` float64, time first, sampled at
-  ``fps > 0`` [Hz]. Frame ``i`` is at time ``i / fps`` [s].
-- Channels are named ``"<joint>_<dof>"`` (``"rShin_Xrotation"``, ``"hip_Xposition"``)
-  for skeletal data, ``"<marker>_x"`` for marker positions, ``"<name>_angle"`` for
-  derived joint angles. Rotation channels are degrees, as in BVH; positions are in
-  the file's units (the bundled CMU salsa files are in metres, marker data is
-  converted to metres on reading).
-- A :class:`Skeleton` (from BVH) gives forward kinematics; marker data and plain
-  tables have ``skeleton=None``.
-- A *position-only* motion (``skeleton=None``, channels ``"<joint>_x/_y/_z"`` in
-  joint order; :attr:`Motion.is_positional`) holds world joint positions directly:
-  :meth:`Motion.positions` reshapes them (no forward kinematics) and
-  :attr:`Motion.bones` gives joint-index pairs, given or inferred from constant joint
-  distances (:func:`infer_bones`). Canonical frame of joint positions read by
-  :mod:`beatsync.io.positions`: **metres, z up** (right-handed), the frame of the
-  MoCap Toolbox and most C3D files, and the one ``render`` assumes for skeleton-less
-  motion; files in centimetres or y up are converted on reading and back on writing.
-  :attr:`Motion.position_info` (a :class:`PositionInfo`) keeps what is needed to
-  write the motion back in its input's layout.
+- ``Motion.values`` is ``(n_frames, n_channels)`` float64 at ``fps > 0`` [Hz]; frame
+  ``i`` is at ``i / fps`` [s].
+- Channels are ``"<joint>_<dof>"`` (``"rShin_Xrotation"``) for BVH, ``"<marker>_x"``
+  for positions, ``"<name>_angle"`` for joint angles. Rotations are degrees;
+  positions in the file's units (markers and joint positions: metres).
+- A :class:`Skeleton` (from BVH) gives forward kinematics; other motion has
+  ``skeleton=None``.
+- A *position-only* motion (:attr:`Motion.is_positional`: no skeleton, channels
+  ``"<joint>_x/_y/_z"``) holds world joint positions in the canonical frame,
+  **metres, z up** (right-handed; files in cm or y up are converted on reading and
+  back on writing); :attr:`Motion.bones` are given or inferred (:func:`infer_bones`),
+  and :attr:`Motion.position_info` keeps the input's layout for writing it back.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from itertools import combinations
 from typing import Any
 
 import numpy as np
@@ -67,19 +61,8 @@ _POS_DOFS = ("Xposition", "Yposition", "Zposition")
 
 @dataclass(frozen=True, eq=False)
 class Joint:
-    """One joint (or end site) of a BVH hierarchy.
-
-    Attributes
-    ----------
-    name : str
-    parent : int
-        Index of the parent joint in :attr:`Skeleton.joints`; -1 for the root.
-    offset : np.ndarray [shape=(3,)]
-        Offset from the parent, in the file's length units.
-    channels : tuple of str
-        BVH channel names in file order (``()`` for end sites).
-    is_end_site : bool
-    """
+    """One joint (or end site) of a BVH hierarchy: ``parent`` index (-1: root), ``offset``
+    from it [file units], BVH channel names in file order."""
 
     name: str
     parent: int
@@ -133,28 +116,10 @@ class Skeleton:
 
 @dataclass(frozen=True, eq=False)
 class PositionInfo:
-    """What a position-only motion needs beyond its values: bones and its file's layout.
-
-    Parameters
-    ----------
-    bones : np.ndarray [shape=(n_bones, 2)], int, optional
-        Joint-index pairs; ``None``: inferred from the data (:func:`infer_bones`).
-    layout : str
-        Layout of the file it came from: ``"json"`` (Dance-with-Melody ``skeletons`` +
-        ``center``), ``"npy"``, ``"npz"``, ``"c3d"``, or ``"array"`` (made in memory).
-    units : {"m", "cm", "mm"}
-        Length unit of that file (the motion itself is in metres).
-    up : {"y", "z"}
-        Vertical axis of that file (the motion itself is z up).
-    units_source, up_source : {"given", "detected", "file"}
-        Whether the unit / axis was given by the caller, detected from the body's
-        size and shape, or read from the file's own parameters.
-    center : np.ndarray [shape=(n_frames, 3)] [m], optional
-        The JSON layout's per-frame root track, in the canonical frame; joint
-        positions of the motion are absolute (file ``skeletons`` + ``center``).
-    key : str, optional
-        Array name in an ``.npz`` file.
-    """
+    """What a position-only motion needs beyond its values: bones (``None``: inferred) and
+    its file's layout (``"json"``, ``"npy"``, ``"npz"``, ``"c3d"``; ``"array"``: made in
+    memory), ``units`` and ``up`` (each ``"given"``, ``"detected"`` or from the ``"file"``),
+    the JSON root track ``center`` [m] and the ``.npz`` array ``key``."""
 
     bones: np.ndarray | None = None
     layout: str = "array"
@@ -169,26 +134,13 @@ class PositionInfo:
         """One line stating units and vertical axis and whether they were detected."""
         return (
             f"{self.layout} file in {self.units} ({self.units_source}), {self.up} up "
-            f"({self.up_source}); "
-            f"read as {CANONICAL_UNITS}, {CANONICAL_UP} up"
+            f"({self.up_source}); read as {CANONICAL_UNITS}, {CANONICAL_UP} up"
         )
 
 
 @dataclass(frozen=True, eq=False)
 class Motion:
-    """Multi-channel motion sampled at a constant frame rate.
-
-    Parameters
-    ----------
-    values : np.ndarray [shape=(n_frames, n_channels)]
-        Rotations in degrees; positions in the file's units.
-    fps : float > 0 [Hz]
-    channels : tuple of str [len = n_channels]
-    skeleton : Skeleton or None
-    name : str
-    position_info : PositionInfo or None
-        Bones and file layout of a position-only motion (see :attr:`is_positional`).
-    """
+    """Multi-channel motion sampled at a constant frame rate (see the module's contract)."""
 
     values: np.ndarray
     fps: float
@@ -221,7 +173,7 @@ class Motion:
             if not self.is_positional:
                 raise ParameterError(
                     "position_info is only for position-only motion (no skeleton, channels "
-                    "<joint>_x/_y/_z); this motion has other channels"
+                    f"<joint>_x/_y/_z); this one has channels {list(self.channels[:6])}"
                 )
             if info.bones is not None:
                 object.__setattr__(
@@ -230,34 +182,24 @@ class Motion:
                     replace(info, bones=check_bones(info.bones, self.values.shape[1] // 3)),
                 )
 
-    # -- position-only motion ---------------------------------------------
     @property
     def is_positional(self) -> bool:
-        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples.
-
-        MoCap Toolbox markers and joint positions read by :mod:`beatsync.io.positions`
-        are position-only; BVH motion and angle tables are not.
-        """
+        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples."""
         if "positional" not in self._cache:
             ch = self.channels
-            ok = self.skeleton is None and len(ch) >= 3 and len(ch) % 3 == 0
-            if ok:
-                for i in range(0, len(ch), 3):
-                    stems = {c.rpartition("_")[0] for c in ch[i : i + 3]}
-                    axes = tuple(c.rpartition("_")[2] for c in ch[i : i + 3])
-                    if len(stems) != 1 or axes != ("x", "y", "z") or "" in stems:
-                        ok = False
-                        break
-            self._cache["positional"] = ok
+            stems = [c.rpartition("_")[0] for c in ch[::3]]
+            self._cache["positional"] = (
+                self.skeleton is None
+                and len(ch) % 3 == 0
+                and "" not in stems
+                and len(ch) >= 3
+                and ch == tuple(f"{s}_{a}" for s in stems for a in "xyz")
+            )
         return self._cache["positional"]
 
     @property
     def bones(self) -> np.ndarray:
-        """Joint-index pairs ``(n_bones, 2)`` into axis 1 of :meth:`positions`.
-
-        BVH: ``(joint, parent)`` from the skeleton. Position-only motion: the given
-        bones, else inferred from constant joint distances (:func:`infer_bones`).
-        """
+        """Joint-index pairs ``(n_bones, 2)``: BVH ``(joint, parent)``, else given or inferred."""
         if self.skeleton is not None:
             return np.array(
                 [(i, j.parent) for i, j in enumerate(self.skeleton.joints) if j.parent >= 0],
@@ -275,7 +217,6 @@ class Motion:
             self._cache["bones"] = infer_bones(self.positions())
         return self._cache["bones"]
 
-    # -- basic properties -------------------------------------------------
     @property
     def n_frames(self) -> int:
         return int(self.values.shape[0])
@@ -314,17 +255,9 @@ class Motion:
                 f"channel {name!r} not found; channels look like {list(self.channels[:6])}..."
             ) from None
 
-    # -- derived motions ---------------------------------------------------
     def with_values(self, values: np.ndarray, fps: float | None = None) -> Motion:
         """Same channels and skeleton, new values (and optionally a new frame rate)."""
-        return Motion(
-            values=values,
-            fps=self.fps if fps is None else fps,
-            channels=self.channels,
-            skeleton=self.skeleton,
-            name=self.name,
-            position_info=self.position_info,
-        )
+        return replace(self, values=values, fps=self.fps if fps is None else fps, _cache={})
 
     def select(self, names: list[str] | tuple[str, ...]) -> Motion:
         """A motion with only the named channels (no skeleton)."""
@@ -348,31 +281,23 @@ class Motion:
     def rename(self, name: str) -> Motion:
         return replace(self, name=name, _cache={})
 
-    # -- rotations and kinematics -----------------------------------------
     def rotation_triples(self) -> list[tuple[str, tuple[int, int, int], str]]:
-        """Each joint with three rotation channels: ``(joint, channel indices, order)``.
+        """``(joint, channel indices, order)`` of each joint with three rotation channels.
 
-        ``order`` is the intrinsic Euler order as listed in the file, e.g. ``"ZXY"``
-        for ``Zrotation Xrotation Yrotation`` (R = Rz @ Rx @ Ry).
+        ``order`` is the intrinsic Euler order of the file: ``"ZXY"`` is R = Rz @ Rx @ Ry.
         """
         if "triples" in self._cache:
             return self._cache["triples"]
-        out: list[tuple[str, tuple[int, int, int], str]] = []
-        by_joint: dict[str, list[tuple[int, str]]] = {}
-        order_seen: list[str] = []
+        by_joint: dict[str, list[tuple[int, str]]] = {}  # in order of first appearance
         for i, ch in enumerate(self.channels):
             joint, _, dof = ch.rpartition("_")
             if dof in _ROT_DOFS:
-                if joint not in by_joint:
-                    by_joint[joint] = []
-                    order_seen.append(joint)
-                by_joint[joint].append((i, dof[0]))
-        for joint in order_seen:
-            items = by_joint[joint]
-            if len(items) == 3:
-                idx = tuple(i for i, _ in items)
-                order = "".join(a for _, a in items)
-                out.append((joint, idx, order))  # type: ignore[arg-type]
+                by_joint.setdefault(joint, []).append((i, dof[0]))
+        out = [
+            (joint, tuple(i for i, _ in items), "".join(a for _, a in items))
+            for joint, items in by_joint.items()
+            if len(items) == 3
+        ]
         self._cache["triples"] = out
         return out
 
@@ -386,27 +311,16 @@ class Motion:
         ]
 
     def positions(self) -> np.ndarray:
-        """World positions of every joint and end site by forward kinematics.
+        """World positions ``(n_frames, n_joints, 3)`` [file units] along :attr:`joint_names`.
 
-        Position-only motion: the values reshaped (a view), no kinematics.
-
-        Returns
-        -------
-        positions : np.ndarray [shape=(n_frames, n_joints, 3)]
-            In the file's length units (position-only motion: metres, z up); axis 1
-            follows :attr:`joint_names`.
+        Forward kinematics for BVH; position-only motion: the values reshaped (a view).
         """
         if "positions" in self._cache:
             return self._cache["positions"]
-        if self.skeleton is None and self.is_positional:
-            pos = self.values.reshape(self.n_frames, -1, 3)
+        if self.skeleton is None:  # joint_names refuses a plain table
+            pos = self.values.reshape(self.n_frames, len(self.joint_names), 3)
             self._cache["positions"] = pos
             return pos
-        if self.skeleton is None:
-            raise ParameterError(
-                f"motion {self.name!r} has no skeleton (marker data or a plain table); "
-                "joint positions need a BVH file"
-            )
         n = self.n_frames
         joints = self.skeleton.joints
         pos = np.zeros((n, len(joints), 3))
@@ -426,13 +340,9 @@ class Motion:
             local = (
                 quat_from_euler(self.values[:, rot_cols], "".join(rot_axes)) if rot_axes else None
             )
-            if joint.parent < 0:
-                pos[:, j_idx] = trans
-                glob.append(local)
-                continue
-            parent_rot = glob[joint.parent]
+            parent_rot = glob[joint.parent] if joint.parent >= 0 else None
             moved = trans if parent_rot is None else quat_rotate(parent_rot, trans)
-            pos[:, j_idx] = pos[:, joint.parent] + moved
+            pos[:, j_idx] = moved if joint.parent < 0 else pos[:, joint.parent] + moved
             if parent_rot is None or local is None:
                 glob.append(local if parent_rot is None else parent_rot)
             else:
@@ -442,13 +352,9 @@ class Motion:
 
 
 def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
-    """Refuse offsets or translations so large that forward kinematics would overflow.
-
-    A joint's world position is at most the sum, along its chain, of the offsets and
-    translations (rotations keep lengths; each summed as ``|x| + |y| + |z|``, which
-    bounds the length); that sum, times 2 sqrt(3) so that every coordinate of a
-    position and of a difference of two stays finite, must be a finite float.
-    """
+    """Refuse offsets or translations so large that forward kinematics would overflow: a
+    world position is at most the chain's sum of ``|x| + |y| + |z|`` of offsets and
+    translations (rotations keep lengths), which times 2 sqrt(3) must stay finite."""
     joints = skeleton.joints
     with np.errstate(over="ignore"):  # an overflow is inf: refused below
         sizes = np.abs([j.offset for j in joints]).sum(axis=1).tolist()
@@ -476,15 +382,7 @@ def _check_reach(skeleton: Skeleton, values: np.ndarray) -> None:
 
 
 def fill_gaps(motion: Motion) -> Motion:
-    """Fill NaN gaps in every channel by linear interpolation (edges held constant).
-
-    Marker data often has short dropouts (e.g. MoCap Toolbox ``walk1``).
-
-    Raises
-    ------
-    ParameterError
-        If a channel has no finite value at all.
-    """
+    """Fill NaN gaps in every channel by linear interpolation (edges held constant)."""
     values = motion.values.copy()
     t = np.arange(motion.n_frames)
     for c in range(values.shape[1]):
@@ -497,18 +395,13 @@ def fill_gaps(motion: Motion) -> Motion:
 
 
 def _marker(motion: Motion, names: tuple[str, ...]) -> np.ndarray:
-    cols = []
-    for n in names:
-        cols.append(
-            np.stack([motion.values[:, motion.channel_index(f"{n}_{a}")] for a in "xyz"], axis=1)
-        )
-    return np.mean(cols, axis=0)
+    idx = [[motion.channel_index(f"{n}_{a}") for a in "xyz"] for n in names]
+    return motion.values[:, idx].mean(axis=1)
 
 
 def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Angle ABC [deg] at vertex b between segments b->a and b->c, per frame."""
-    u = a - b
-    v = c - b
+    u, v = a - b, c - b
     cosang = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
     return np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
 
@@ -551,24 +444,8 @@ _MCT_ANGLES = {
 
 
 def marker_angles(motion: Motion) -> Motion:
-    """Joint angles [deg] from MoCap Toolbox markers (the 28-marker demo set).
-
-    Each angle is the interior angle at a joint between its two segments
-    (180 deg = straight), e.g. the knee angle between hip centre -> knee and
-    ankle -> knee. NaN gaps in markers are filled linearly first.
-
-    Parameters
-    ----------
-    motion : Motion
-        Marker positions with channels ``"<marker>_x/_y/_z"`` (see
-        :func:`beatsync.io.read_mocap_mat`).
-
-    Returns
-    -------
-    Motion
-        Channels ``knee_L_angle``, ``knee_R_angle``, ``hip_*``, ``ankle_*``,
-        ``elbow_*``, ``shoulder_*``, ``neck_angle`` at the same frame rate.
-    """
+    """Interior joint angles [deg] (180 = straight; :data:`_MCT_ANGLES`) from the MoCap
+    Toolbox 28-marker set, marker gaps filled linearly first."""
     motion = fill_gaps(motion)
     try:
         points = {k: _marker(motion, v) for k, v in _MCT_POINTS.items()}
@@ -585,20 +462,9 @@ def marker_angles(motion: Motion) -> Motion:
 
 
 def bone_angles(motion: Motion) -> Motion:
-    """Angles [deg] between every two bones that meet at a joint, as a motion.
-
-    For a position-only motion without a known marker set: each joint with two or
-    more bones (:attr:`Motion.bones`) gives the interior angle between each pair of
-    them (180 deg = straight), e.g. hip-knee-ankle. Such angles do not change when
-    the dancer travels or turns, nor with body size or units, so they suit paper A's
-    segmentation (which works on joint angles) where root-relative positions would
-    follow every turn of a ballroom dance. NaN gaps are filled linearly first.
-
-    Returns
-    -------
-    Motion
-        Channels ``"<a>-<joint>-<b>_angle"`` at the same frame rate, no skeleton.
-    """
+    """Interior angles [deg] between every two bones that meet at a joint (channels
+    ``"<a>-<joint>-<b>_angle"``, gaps filled linearly first): unchanged by travel, turns,
+    body size and units, they suit paper A's segmentation of joint positions."""
     motion = fill_gaps(motion)
     pos = motion.positions()
     names = motion.joint_names
@@ -606,12 +472,7 @@ def bone_angles(motion: Motion) -> Motion:
     for a, b in motion.bones:
         neighbours.setdefault(int(a), []).append(int(b))
         neighbours.setdefault(int(b), []).append(int(a))
-    triples = [
-        (nb[i], v, nb[k])
-        for v, nb in sorted(neighbours.items())
-        for i in range(len(nb))
-        for k in range(i + 1, len(nb))
-    ]
+    triples = [(a, v, b) for v, nb in sorted(neighbours.items()) for a, b in combinations(nb, 2)]
     if not triples:
         raise ParameterError(
             f"motion {motion.name!r} has {len(names)} joint(s) and no two bones meet at a "
@@ -638,13 +499,9 @@ def is_marker_motion(motion: Motion) -> bool:
 
 
 def segmentation_view(motion: Motion) -> Motion:
-    """The joint-angle motion that segmentation works on (paper A works on joint angles).
-
-    BVH motion and angle tables are returned as they are; MoCap Toolbox markers are
-    turned into joint angles with :func:`marker_angles`; other position-only motion
-    (e.g. keypoints without marker names) into the angles between its bones with
-    :func:`bone_angles` (travel- and turn-invariant, see there).
-    """
+    """The joint-angle motion that segmentation works on (paper A works on joint angles):
+    BVH and tables as they are, markers through :func:`marker_angles`, other joint
+    positions through :func:`bone_angles`."""
     if not is_marker_motion(motion):
         return motion
     if motion.is_positional and not has_marker_set(motion):

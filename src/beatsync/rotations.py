@@ -1,13 +1,11 @@
 """Rotation-aware sampling and blending of motion.
 
-Anything that interpolates joint rotations does it on rotations (quaternion slerp),
-never by linear interpolation of Euler angles, which fails across the +-180 deg wrap.
-Euler angles produced here are chosen, among the equivalent triples, as the one
-closest to the source frame's own angles, so a motion sampled at its own frame times
-comes back unchanged and curves stay continuous.
-
-Data contract: times are seconds in the source motion's timeline (frame ``i`` at
-``i / fps``); values are ``(n_frames, n_channels)`` with rotations in degrees.
+Joint rotations are interpolated as quaternions (slerp), never as Euler angles (which
+fail across the +-180 deg wrap). Of the equivalent Euler triples a rotation has,
+``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)`` each up to multiples of 360 deg,
+the one nearest a reference (the source frame's own angles) is returned, so a motion
+sampled at its own frame times comes back unchanged and curves stay continuous.
+Times are seconds of the source motion's timeline; rotations are degrees.
 """
 
 from __future__ import annotations
@@ -40,38 +38,19 @@ def wrap_degrees(angle: np.ndarray) -> np.ndarray:
 
 
 def nearest_euler(euler: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """Of the equivalent Tait-Bryan triples of each row, the one nearest ``reference``.
-
-    A rotation has two Euler triples, ``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)``,
-    each defined up to multiples of 360 deg per angle; this returns, row by row, the
-    candidate with the smallest squared distance to the reference row.
-
-    Parameters
-    ----------
-    euler, reference : np.ndarray [shape=(n, 3)] [deg]
-    """
+    """Row by row, of the equivalent Euler triples ``(n, 3)`` [deg], the one nearest
+    ``reference`` (smallest squared distance)."""
     e = np.atleast_2d(np.asarray(euler, dtype=np.float64))
     ref = np.asarray(reference, dtype=np.float64).reshape(e.shape)
     alt = np.stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0], axis=1)
-    best = best_d = None
-    for cand in (e, alt):
-        cand = cand + 360.0 * np.round((ref - cand) / 360.0)
-        d = np.sum((cand - ref) ** 2, axis=1)
-        if best is None:
-            best, best_d = cand, d
-        else:
-            take = d < best_d
-            best = np.where(take[:, None], cand, best)
-            best_d = np.where(take, d, best_d)
-    return best
+    a, b = (c + 360.0 * np.round((ref - c) / 360.0) for c in (e, alt))
+    take_b = np.sum((b - ref) ** 2, axis=1) < np.sum((a - ref) ** 2, axis=1)
+    return np.where(take_b[:, None], b, a)
 
 
 def continuous_euler(euler: np.ndarray) -> np.ndarray:
-    """Make an Euler-triple curve ``(n, 3)`` [deg] continuous frame to frame.
-
-    Each frame takes the equivalent triple (see :func:`nearest_euler`) nearest the
-    previous output frame, so a BVH curve has no 360 deg jumps or gimbal flips.
-    """
+    """An Euler-triple curve ``(n, 3)`` [deg] without 360 deg jumps or gimbal flips: each
+    frame's triple nearest the previous one."""
     e = np.asarray(euler, dtype=np.float64)
     out = e.copy()
     for i in range(1, e.shape[0]):
@@ -80,29 +59,17 @@ def continuous_euler(euler: np.ndarray) -> np.ndarray:
 
 
 def euler_to_rotation(angles_deg: np.ndarray, order: str) -> Rotation:
-    """Rotations from intrinsic Euler angles [deg] in BVH channel ``order`` (e.g. ``"ZXY"``).
-
-    Built from :func:`beatsync.quaternions.quat_from_euler` (the same rotations as
-    ``Rotation.from_euler(order.upper(), ...)``, several times faster).
-    """
+    """Rotations from intrinsic Euler angles [deg] in BVH channel ``order`` (e.g. ``"ZXY"``)."""
     return Rotation.from_quat(quat_from_euler(angles_deg, order))
 
 
 def rotation_to_euler(rot: Rotation, order: str, reference: np.ndarray | None = None) -> np.ndarray:
-    """Intrinsic Euler angles [deg] of ``rot``; nearest to ``reference`` if given.
-
-    Of the two Euler triples of a rotation (``(a, b, c)`` and
-    ``(a + 180, 180 - b, c + 180)`` for Tait-Bryan orders), each shifted by multiples
-    of 360 deg, the one closest to ``reference`` (shape ``(n, 3)``) is returned.
-    """
+    """Intrinsic Euler angles ``(n, 3)`` [deg] of ``rot``; nearest ``reference`` if given."""
     with warnings.catch_warnings():
-        # at gimbal lock (middle angle +-90 deg) scipy warns and sets the third angle to
-        # 0: the triple still gives the same rotation, which is all a BVH frame needs;
-        # the warning only cluttered the output of long runs (batch workers)
+        # at gimbal lock scipy warns and sets the third angle to 0: the same rotation
         warnings.filterwarnings("ignore", message="Gimbal lock detected", category=UserWarning)
         e = rot.as_euler(order.upper(), degrees=True)
-    if e.ndim == 1:
-        e = e[None, :]
+    e = np.atleast_2d(e)
     if reference is None:
         return e
     return nearest_euler(e, reference)
@@ -116,22 +83,17 @@ def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
     w = np.asarray(w, dtype=np.float64)[:, None]
     theta = np.arccos(np.clip(dot, -1.0, 1.0))[:, None]
     sin_t = np.sin(theta)
-    small = sin_t[:, 0] < 1e-9
-    s0 = np.where(
-        small[:, None], 1.0 - w, np.sin((1.0 - w) * theta) / np.where(small[:, None], 1.0, sin_t)
-    )
-    s1 = np.where(small[:, None], w, np.sin(w * theta) / np.where(small[:, None], 1.0, sin_t))
+    small = sin_t < 1e-9  # (nearly) the same rotation: linear weights
+    safe = np.where(small, 1.0, sin_t)
+    s0 = np.where(small, 1.0 - w, np.sin((1.0 - w) * theta) / safe)
+    s1 = np.where(small, w, np.sin(w * theta) / safe)
     q = s0 * q0 + s1 * q1
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
 def _interp_values(motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Per-row interpolation from ``v0`` (w=0) to ``v1`` (w=1): slerp on rotation triples.
-
-    Joints with one or two rotation channels turn about fixed axes: each angle is
-    interpolated along its shortest difference (the 1-axis slerp), never across the
-    +-180 deg wrap the long way.
-    """
+    """Per-row interpolation from ``v0`` (w=0) to ``v1`` (w=1): slerp on rotation triples,
+    the shortest way round on lone rotation channels, linear on the rest."""
     out = v0 * (1.0 - w[:, None]) + v1 * w[:, None]
     partial = motion.partial_rotation_columns()
     if partial:
@@ -139,30 +101,17 @@ def _interp_values(motion: Motion, v0: np.ndarray, v1: np.ndarray, w: np.ndarray
         out[:, partial] = v0[:, partial] + w[:, None] * d
     for _joint, idx, order in motion.rotation_triples():
         cols = list(idx)
-        q0 = quat_from_euler(v0[:, cols], order)
-        q1 = quat_from_euler(v1[:, cols], order)
-        q = slerp(q0, q1, w)
+        q = slerp(quat_from_euler(v0[:, cols], order), quat_from_euler(v1[:, cols], order), w)
         ref = np.where(w[:, None] < 0.5, v0[:, cols], v1[:, cols])
         out[:, cols] = rotation_to_euler(Rotation.from_quat(q), order, reference=ref)
     return out
 
 
 def sample_motion(motion: Motion, times: np.ndarray) -> np.ndarray:
-    """Evaluate ``motion`` at arbitrary times [s] of its own timeline.
+    """Values ``(m, n_channels)`` of ``motion`` at any times [s], clipped to its span.
 
-    Rotation triples are slerped between the two neighbouring frames; every other
-    channel (root translation, marker positions, angles of plain tables) is
-    interpolated linearly. Times are clipped to ``[0, (n_frames - 1) / fps]``.
-
-    Parameters
-    ----------
-    motion : Motion
-    times : np.ndarray [shape=(m,)] [s]
-        Need not be uniform or increasing.
-
-    Returns
-    -------
-    values : np.ndarray [shape=(m, n_channels)]
+    Rotation triples are slerped between the neighbouring frames, other channels
+    interpolated linearly.
 
     Examples
     --------
@@ -174,8 +123,7 @@ def sample_motion(motion: Motion, times: np.ndarray) -> np.ndarray:
     t = check_finite(times, name="times")
     if t.ndim != 1:
         raise ParameterError(f"times must be 1-D [s], got shape {t.shape}")
-    f = time_to_frames(t, fps=motion.fps, round_to_int=False)
-    f = np.clip(f, 0.0, motion.n_frames - 1)
+    f = np.clip(time_to_frames(t, fps=motion.fps, round_to_int=False), 0.0, motion.n_frames - 1)
     i0 = np.floor(f).astype(np.int64)
     i1 = np.minimum(i0 + 1, motion.n_frames - 1)
     w = f - i0
@@ -183,34 +131,16 @@ def sample_motion(motion: Motion, times: np.ndarray) -> np.ndarray:
 
 
 def blend_values(motion: Motion, a: np.ndarray, b: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Blend two pose sequences of ``motion``'s channel layout frame by frame.
-
-    Parameters
-    ----------
-    motion : Motion
-        Supplies the channel layout (which columns are rotation triples).
-    a, b : np.ndarray [shape=(n, n_channels)]
-    w : np.ndarray [shape=(n,)]
-        Weight of ``b``, 0 (all ``a``) to 1 (all ``b``).
-
-    Returns
-    -------
-    np.ndarray [shape=(n, n_channels)]
-        Slerp on rotation triples, linear on the other channels.
-    """
+    """Blend pose sequences ``a``, ``b`` ``(n, n_channels)`` of ``motion``'s channel layout
+    frame by frame; ``w`` ``(n,)`` is the weight of ``b`` in [0, 1]."""
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     w = np.asarray(w, dtype=np.float64)
-    if (
-        a.shape != b.shape
-        or a.ndim != 2
-        or a.shape[1] != motion.n_channels
-        or w.shape != (a.shape[0],)
-    ):
+    if w.ndim != 1 or a.shape != b.shape or a.shape != (w.size, motion.n_channels):
         raise ParameterError(
             f"blend_values needs a, b of shape (n, {motion.n_channels}) and w of shape (n,); "
             f"got {a.shape}, {b.shape}, {w.shape}"
         )
     if np.any((w < 0) | (w > 1)):
-        raise ParameterError("blend weights w must lie in [0, 1]")
+        raise ParameterError(f"blend weights w must lie in [0, 1], got {w.min():g} to {w.max():g}")
     return _interp_values(motion, a, b, w)

@@ -1,31 +1,12 @@
-"""Validation of every input of beatsync, and its one frames/seconds conversion.
+"""Checks of every input, once at the public boundary, and the frames/seconds conversion.
 
-The lowest layer but ``errors``.
-
-Every public entry of the package checks its inputs here, once; private functions
-trust them. The ``check_*`` helpers accept a number written as text (``"2.5"``, as
-the checks they replaced did); :func:`as_float` and :func:`as_int` refuse text unless
-``text=True`` (a count passed as ``"2"`` is a likely mistake in a call). Each helper
-raises :class:`~beatsync.errors.ParameterError` naming the value and the likely
-mistake (a period given for a rate, frames for seconds, kHz for Hz, a percentage for a
-fraction) and returns the value converted to its working type.
-
-Helpers
--------
-- numbers: :func:`as_float`, :func:`as_int`, :func:`check_positive`,
-  :func:`check_range`, :func:`check_interval` (one pair);
-- rates: :func:`check_fps` [Hz], :func:`check_sample_rate` [Hz], :func:`check_bpm`
-  [bpm] (one range, :data:`MIN_BPM`-:data:`MAX_BPM`);
-- arrays: :func:`check_finite`, :func:`check_times` [s], :func:`check_audio`;
-- parallel runs: :func:`check_workers`, :func:`check_cluster_options`.
-
-Data contract
--------------
-- Event times (beats, period boundaries, motion beats) are 1-D ``float64`` arrays in
-  seconds, strictly increasing.
-- Frames appear only inside a stage or at I/O; every conversion between frames and
-  seconds goes through :func:`frames_to_time` and :func:`time_to_frames`.
-- A frame rate ``fps`` is a finite number > 0 [Hz].
+The lowest layer but ``errors``. Each helper raises
+:class:`~beatsync.errors.ParameterError` naming the value and the likely mistake (a
+period for a rate, frames for seconds, kHz for Hz) and returns the value converted.
+The ``check_*`` helpers accept a number written as text (``"2.5"``); :func:`as_float`
+and :func:`as_int` only with ``text=True``. Event times are 1-D float64 seconds,
+strictly increasing; frames and seconds convert only through :func:`frames_to_time`
+and :func:`time_to_frames`.
 """
 
 from __future__ import annotations
@@ -82,34 +63,7 @@ def _unit(unit: str) -> str:
 def as_float(
     value: Any, *, name: str, unit: str = "", allow_nonfinite: bool = False, text: bool = False
 ) -> float:
-    """Return ``value`` as a Python float, refusing what is not one finite number.
-
-    Parameters
-    ----------
-    value : number
-        A bool, a string or an array (even of one element) is refused: all are likely
-        mistakes in a call.
-    name : str
-        The parameter's name, used in messages.
-    unit : str
-        Its unit (``"s"``, ``"Hz"``, ``"bpm"``), used in messages.
-    allow_nonfinite : bool
-        Accept NaN and +-inf (default: refused).
-    text : bool
-        Accept a number written as text (``"0.5"``), as when reading a file.
-
-    Raises
-    ------
-    ParameterError
-        Not a number, or not finite.
-
-    Examples
-    --------
-    >>> as_float(0.5, name="delta", unit="s")
-    0.5
-    >>> as_float("0.5", name="delta", unit="s", text=True)
-    0.5
-    """
+    """Return ``value`` as a float, refusing bools, text (unless ``text``), arrays, NaN/inf."""
     if isinstance(value, (bool, np.bool_)):
         raise ParameterError(f"{name}={value!r} is a bool, not a number{_unit(unit)}")
     if not text and isinstance(value, (str, bytes, np.str_, np.bytes_)):
@@ -117,11 +71,7 @@ def as_float(
             f"{name}={value!r} is text, not a number{_unit(unit)}; pass a number (convert "
             "values read from text first)"
         )
-    if isinstance(value, np.ndarray) and value.ndim > 0:
-        raise ParameterError(
-            f"{name} must be a single number{_unit(unit)}, got an array of shape {value.shape}"
-        )
-    if isinstance(value, (list, tuple, dict, set)):
+    if isinstance(value, (list, tuple, dict, set)) or getattr(value, "ndim", 0) > 0:
         raise ParameterError(
             f"{name}={value!r} must be a single number{_unit(unit)}, not a {type(value).__name__}"
         )
@@ -137,11 +87,7 @@ def as_float(
 def as_int(
     value: Any, *, name: str, unit: str = "", minimum: int | None = None, text: bool = False
 ) -> int:
-    """Return ``value`` as an int, refusing fractions (``2.5``) and values below ``minimum``.
-
-    Integral floats (``3.0``) are accepted; text only with ``text=True`` (see
-    :func:`as_float`). Raises :class:`ParameterError`.
-    """
+    """Return ``value`` as an int, refusing fractions (``2.5``) and values below ``minimum``."""
     v = as_float(value, name=name, unit=unit, text=text)
     if v != np.floor(v):
         raise ParameterError(f"{name}={value!r} must be a whole number{_unit(unit)}")
@@ -152,13 +98,7 @@ def as_int(
 
 
 def check_fps(fps: Any, *, name: str = "fps") -> float:
-    """Return ``fps`` as a float after checking it is finite and > 0 [Hz].
-
-    Raises
-    ------
-    ParameterError
-        If ``fps`` is not a finite positive number.
-    """
+    """Return ``fps`` [Hz] as a float: finite, > 0, not a period in seconds (< 1 Hz)."""
     value = as_float(fps, name=name, unit="Hz", allow_nonfinite=True, text=True)
     if not np.isfinite(value) or value <= 0:
         raise ParameterError(
@@ -174,11 +114,7 @@ def check_fps(fps: Any, *, name: str = "fps") -> float:
 
 
 def check_positive(value: Any, *, name: str, unit: str, allow_zero: bool = False) -> float:
-    """Return ``value`` as a float after checking it is finite and > 0 (or >= 0) [unit].
-
-    Use for durations, widths, window lengths: anything positive that is not a rate
-    (see :func:`check_fps`, :func:`check_sample_rate`, :func:`check_bpm`).
-    """
+    """Return ``value`` as a float: finite and > 0 (or >= 0) [unit]; for anything not a rate."""
     v = as_float(value, name=name, unit=unit, allow_nonfinite=True, text=True)
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         bound = ">= 0" if allow_zero else "> 0"
@@ -187,22 +123,7 @@ def check_positive(value: Any, *, name: str, unit: str, allow_zero: bool = False
 
 
 def frames_to_time(frames: Any, *, fps: float) -> np.ndarray:
-    """Convert frame indices to times in seconds: ``t = frames / fps``.
-
-    Parameters
-    ----------
-    frames : array_like [frames]
-    fps : float > 0 [Hz]
-
-    Returns
-    -------
-    times : np.ndarray [s], float64
-
-    Examples
-    --------
-    >>> frames_to_time([0, 30, 60], fps=60.0)
-    array([0. , 0.5, 1. ])
-    """
+    """Convert frame indices to times [s]: ``t = frames / fps``."""
     fps = check_fps(fps)
     return np.asarray(frames, dtype=np.float64) / fps
 
@@ -210,23 +131,10 @@ def frames_to_time(frames: Any, *, fps: float) -> np.ndarray:
 def time_to_frames(
     times: Any, *, fps: float, round_to_int: bool = True, mode: str = "round"
 ) -> np.ndarray:
-    """Convert times in seconds to frame indices: ``frames = round(t * fps)``.
+    """Convert times [s] to frame indices: ``frames = round(t * fps)``.
 
-    Parameters
-    ----------
-    times : array_like [s]
-    fps : float > 0 [Hz]
-    round_to_int : bool
-        Return integer frames (``int64``); otherwise fractional frames (``float64``).
-    mode : {"round", "floor", "ceil"}
-        How times between frames become integer frames: the nearest frame, the last
-        frame at or before the time, or the first frame at or after it. A tolerance of
-        1e-9 frames absorbs floating-point error (``ceil(3 * (1/3) * 3)`` is 3).
-
-    Examples
-    --------
-    >>> time_to_frames([0.0, 0.5, 1.0], fps=60.0)
-    array([ 0, 30, 60])
+    ``round_to_int=False`` gives fractional frames; ``mode`` "floor"/"ceil" give the
+    frame at or before/after the time (1e-9 frames of tolerance for float error).
     """
     fps = check_fps(fps)
     frames = np.asarray(times, dtype=np.float64) * fps
@@ -254,24 +162,10 @@ _KIND_NAMES = {
 
 
 def as_float_array(values: Any, *, name: str, dtype: Any = np.float64) -> np.ndarray:
-    """Return ``values`` as a floating-point array, refusing non-numeric data.
+    """Return ``values`` as a float array (``dtype=None``: a float array's own dtype).
 
-    Parameters
-    ----------
-    values : array_like
-        Integers or floats. Booleans, complex numbers, strings, bytes, dates and
-        structured records are refused (numeric strings are not parsed: a text column
-        usually means a header row or a wrong delimiter).
-    name : str
-        Used in messages.
-    dtype : numpy dtype or None
-        The result's dtype; ``None`` keeps a floating array's dtype (no copy) and
-        converts integers to float64.
-
-    Raises
-    ------
-    ParameterError
-        Ragged nested lists, or an array of a non-numeric kind.
+    Booleans, complex numbers, strings (numeric ones too: a text column usually means a
+    header row or a wrong delimiter), dates, records and ragged lists are refused.
     """
     try:
         arr = np.asarray(values)
@@ -298,11 +192,7 @@ def as_float_array(values: Any, *, name: str, dtype: Any = np.float64) -> np.nda
 
 
 def check_finite(values: Any, *, name: str, dtype: Any = np.float64) -> np.ndarray:
-    """Return ``values`` as a float array, refusing NaN or infinite entries.
-
-    ``dtype=None`` keeps a floating array's dtype (no conversion), see
-    :func:`as_float_array`, which also refuses non-numeric arrays.
-    """
+    """:func:`as_float_array`, refusing NaN or infinite entries."""
     arr = as_float_array(values, name=name, dtype=dtype)
     bad = ~np.isfinite(arr)
     if bad.any():
@@ -322,22 +212,7 @@ def check_times(
     allow_empty: bool = True,
     duration: float | None = None,
 ) -> np.ndarray:
-    """Validate event times: 1-D, finite, >= 0, strictly increasing, in seconds.
-
-    Parameters
-    ----------
-    times : array_like [s]
-    name : str
-        Used in error messages.
-    allow_empty : bool
-    duration : float, optional [s]
-        If given, times beyond it are refused (a hint that frames were passed).
-
-    Raises
-    ------
-    ParameterError
-        With the likely mistake: frames instead of seconds, milliseconds, unsorted.
-    """
+    """Event times [s]: 1-D, finite, >= 0, strictly increasing, not after ``duration``."""
     arr = as_float_array(times, name=name)
     if arr.ndim != 1:
         raise ParameterError(
@@ -360,9 +235,7 @@ def check_times(
             f"<= time #{i} ({float(arr[i])!r} s); sort them and drop duplicates"
         )
     if duration is not None and arr[-1] > duration + 1e-9:
-        hint = ""
-        if arr[-1] > 2 * duration:
-            hint = " (these look like frame indices or milliseconds, not seconds)"
+        hint = " (frame indices or milliseconds, not seconds?)" if arr[-1] > 2 * duration else ""
         raise ParameterError(
             f"{name} ends at {arr[-1]:g} s, after the signal's duration {duration:.3f} s{hint}"
         )
@@ -387,21 +260,7 @@ def check_range(lo: Any, hi: Any, *, name: str, unit: str) -> tuple[float, float
 
 
 def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
-    """Return an audio sample rate as a float after checking it is plausible [Hz].
-
-    A sample rate must be finite, > 0 and at least :data:`MIN_PLAUSIBLE_SR` (1000 Hz):
-    a smaller value is most likely a rate in kHz (``sr=44.1``) or a sample period.
-
-    Raises
-    ------
-    ParameterError
-        Not a number, not finite, <= 0, or implausibly small.
-
-    Examples
-    --------
-    >>> check_sample_rate(22050)
-    22050.0
-    """
+    """Return a sample rate [Hz]: finite and at least :data:`MIN_PLAUSIBLE_SR` (not kHz)."""
     v = as_float(sr, name=name, unit="Hz", allow_nonfinite=True, text=True)
     if not np.isfinite(v) or v <= 0:
         raise ParameterError(
@@ -418,25 +277,8 @@ def check_sample_rate(sr: Any, *, name: str = "sr") -> float:
 
 
 def check_bpm(bpm: Any, *, name: str = "bpm") -> float:
-    """Return a tempo as a float after checking it is in [:data:`MIN_BPM`, :data:`MAX_BPM`].
-
-    Raises
-    ------
-    ParameterError
-        Not a number, or outside the one plausible range (20-400 BPM); the message
-        names the likely mistake (a beat period in seconds, beats per second).
-
-    Examples
-    --------
-    >>> check_bpm(120)
-    120.0
-    """
-    v = as_float(bpm, name=name, unit="bpm", allow_nonfinite=True, text=True)
-    if not np.isfinite(v):
-        raise ParameterError(
-            f"{name}={bpm!r} is not a finite number; give a tempo in BPM from "
-            f"{MIN_BPM:g} to {MAX_BPM:g}"
-        )
+    """Return a tempo [bpm] in [:data:`MIN_BPM`, :data:`MAX_BPM`]."""
+    v = as_float(bpm, name=name, unit="bpm", text=True)
     if not MIN_BPM <= v <= MAX_BPM:
         hint = "did you give a beat period in seconds, or beats per second?"
         if v > MAX_BPM:
@@ -457,30 +299,10 @@ def check_audio(
     min_duration: float | None = None,
     silence_peak: float | None = None,
 ) -> tuple[np.ndarray, float]:
-    """Validate mono audio; return ``(y, sr)`` with ``y`` as a float array, unconverted.
+    """Check mono audio; return ``(y, sr)``, a float ``y`` as is (no copy).
 
-    A float32 (or float64) ``y`` is returned as is, without a copy; integers become
-    float64. Call it once at a public entry; private functions trust its result.
-
-    Parameters
-    ----------
-    y : array_like [shape=(n,)]
-        Mono samples, finite.
-    sr : float > 0 [Hz]
-        See :func:`check_sample_rate`.
-    name : str
-        Used in messages.
-    min_duration : float, optional [s]
-        Refuse audio shorter than this (the message gives the length).
-    silence_peak : float, optional
-        Refuse audio whose peak magnitude is below this (all silent), or that departs
-        from its mean by less than this (constant: a DC offset and no sound).
-
-    Raises
-    ------
-    ParameterError
-        Not 1-D (the message says how to mix down), empty, NaN/inf samples, a bad
-        sample rate, too short, silent or constant.
+    ``min_duration`` [s] refuses shorter audio; ``silence_peak`` refuses audio whose
+    peak, or whose departure from its mean (a DC offset), is below it.
     """
     sr_f = check_sample_rate(sr)
     arr = as_float_array(y, name=f"{name} (audio samples)", dtype=None)
@@ -491,8 +313,7 @@ def check_audio(
         )
     if arr.size == 0:
         raise ParameterError(f"{name} is empty: the audio has zero samples")
-    # one pass when every sample is finite (the sum is, unless it overflows: then the
-    # samples are checked one by one)
+    # one pass when every sample is finite (unless the sum overflows)
     with np.errstate(over="ignore", invalid="ignore"):
         total = arr.sum()
     if not np.isfinite(total) and not np.isfinite(arr).all():
@@ -501,14 +322,12 @@ def check_audio(
             f"{name} contains {int(bad.sum())} NaN or infinite sample(s) "
             f"(first at sample {int(np.argmax(bad))}); repair or trim the audio"
         )
-    if min_duration is not None:
-        duration = arr.size / sr_f
-        if duration < min_duration:
-            raise ParameterError(
-                f"the audio is only {duration:.3f} s long ({arr.size} samples at sr={sr_f:g} "
-                f"Hz); at least {min_duration:.3g} s is needed (give a longer excerpt, or "
-                "check the sample rate)"
-            )
+    if min_duration is not None and arr.size / sr_f < min_duration:
+        raise ParameterError(
+            f"the audio is only {arr.size / sr_f:.3f} s long ({arr.size} samples at sr={sr_f:g} "
+            f"Hz); at least {min_duration:.3g} s is needed (give a longer excerpt, or check "
+            "the sample rate)"
+        )
     if silence_peak is not None:
         top, bottom = float(arr.max()), float(arr.min())
         peak = max(top, -bottom)  # the largest magnitude, without an array of them
@@ -529,11 +348,9 @@ def check_audio(
 
 
 def beat_phase(events: Any, beats: Any) -> np.ndarray:
-    """Phase of each event inside the beat interval that holds it, in ``[0, 1)``.
+    """Phase in ``[0, 1)`` of each event [s] in its beat interval (0: on a beat).
 
-    0 is on a beat, 0.5 half-way to the next. Events before the first beat or at/after
-    the last one have no interval and are dropped. Inputs are event times [s], 1-D
-    and increasing (checked by the caller: this is a unit conversion, seconds to beats).
+    Events outside the beats are dropped; inputs are checked by the caller.
     """
     e = np.asarray(events, dtype=np.float64)
     b = np.asarray(beats, dtype=np.float64)
@@ -543,16 +360,7 @@ def beat_phase(events: Any, beats: Any) -> np.ndarray:
 
 
 def check_interval(pair: Any, *, name: str, unit: str) -> tuple[float, float]:
-    """Validate an interval given as one pair ``(lo, hi)``: see :func:`check_range`.
-
-    Refuses what is not a pair (a single number, three values, a string) with the
-    expected form in the message, so callers need no ``lo, hi = pair`` of their own.
-
-    Examples
-    --------
-    >>> check_interval((0.5, 2.0), name="period_range", unit="s")
-    (0.5, 2.0)
-    """
+    """:func:`check_range` of one pair ``(lo, hi)``, refusing what is not a pair."""
     if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
         raise ParameterError(
             f"{name}={pair!r} must be two numbers (lower, upper) [{unit}], e.g. (0.5, 2.0)"
@@ -566,12 +374,9 @@ MAX_MOTION_FPS = 2000.0
 
 
 def check_motion_fps(fps: Any, *, name: str = "fps") -> float:
-    """:func:`check_fps` for the frame rate of a motion to be computed, with an upper bound.
+    """:func:`check_fps` of a motion to compute, at most :data:`MAX_MOTION_FPS`.
 
-    Motion capture runs at a few hundred Hz (high-speed systems at about 2000); a motion
-    resampled to a much higher rate fills the memory (a 30 s song at 100 kHz is 3 million
-    frames), so rates above :data:`MAX_MOTION_FPS` are refused. (:func:`check_fps` itself
-    has no upper bound: it also checks audio sample rates.)
+    Capture runs at up to about 2000 Hz; a higher rate fills the memory.
     """
     value = check_fps(fps, name=name)
     if value > MAX_MOTION_FPS:
@@ -588,8 +393,7 @@ def default_workers() -> int:
 
 
 def check_workers(n_workers: Any) -> int | None:
-    """``None`` or a whole number of workers from 1 to 16 per core (at least 64: a typo
-    such as 10**12 would start workers until the machine hangs)."""
+    """``None`` or 1 to 16 workers per core (at least 64): a typo must not hang the machine."""
     most = max(16 * default_workers(), 64)
     if n_workers is not None and (
         isinstance(n_workers, bool)

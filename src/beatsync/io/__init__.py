@@ -1,20 +1,12 @@
 """Reading and writing files: the only package of beatsync that touches the disk.
 
 Modules: ``_files`` (atomic writes, JSON/CSV, checksums), ``bvh``, ``tables``
-(``.mat`` markers, CSV/NPY angle tables, ``.npz``), ``positions`` (joint positions:
-Dance-with-Melody JSON, ``(n_frames, n_joints, 3)`` arrays, C3D), ``audio`` (audio
-and beat files). :func:`read_motion` and :func:`write_motion` choose by suffix.
-
-Data contract
--------------
-- Motion files become a :class:`~beatsync.motion.Motion` (values ``(n_frames,
-  n_channels)``, ``fps`` [Hz], channel names, skeleton for BVH).
-- Audio becomes mono float32 ``y`` with its sample rate ``sr`` [Hz].
-- Beat annotation files hold one time in seconds per line (first column); extra
-  columns (e.g. beat-in-bar) are ignored.
-- Every write is atomic: data goes to a temporary file in the destination folder,
-  which is renamed over the destination only when complete. Nothing is written when
-  an error is raised.
+(``.mat`` markers, angle tables, ``.npz``), ``positions`` (joint positions), ``audio``
+(audio and beat files). :func:`read_motion` and :func:`write_motion` choose by suffix.
+Motion files become a :class:`~beatsync.motion.Motion`; audio mono float32 ``y`` at
+``sr`` [Hz]; beat files hold one time [s] per line (first column). Every write is
+atomic: a temporary file in the destination folder is renamed over the destination
+only when complete, so nothing is written when an error is raised.
 """
 
 from __future__ import annotations
@@ -50,7 +42,6 @@ from .audio import (
 )
 from .bvh import read_bvh, write_bvh
 from .positions import (
-    is_position_array,
     read_c3d,
     read_positions_array,
     read_positions_json,
@@ -120,25 +111,15 @@ def read_motion(
     units: str | None = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read any supported motion file, chosen by its suffix.
-
-    ``.bvh`` (``fps`` overrides the header), ``.mat`` (MoCap Toolbox markers;
-    ``variable`` names the recording; marker gaps up to ``max_gap`` seconds are
-    filled), ``.csv`` and 2-D ``.npy`` angle tables (``fps`` required); joint
-    positions (:mod:`beatsync.io.positions`): ``.json`` (Dance-with-Melody layout,
-    ``fps`` required), 3-D ``.npy`` ``(n_frames, n_joints, 3)`` (``fps`` required),
-    ``.npz`` (``variable`` names the array; ``fps`` unless stored), ``.c3d`` (its own
-    rate; a contradicting ``fps`` is refused). For joint positions, ``up``
-    (``"y"``/``"z"``) and ``units`` (``"m"``/``"cm"``/``"mm"``) of the file are
-    detected unless given, and gaps up to ``max_gap`` seconds are filled.
-    """
+    """Read any supported motion file, chosen by its suffix: ``.bvh`` (``fps`` overrides the
+    header), ``.mat`` markers (``variable``: the recording), ``.csv``/2-D ``.npy`` tables
+    (``fps`` required), joint positions (:mod:`beatsync.io.positions`; ``variable``: an
+    ``.npz`` array; ``up``, ``units``). Gaps up to ``max_gap`` [s] are filled."""
     p = Path(path)
     suffix = p.suffix.lower()
-    if suffix == ".npy":
-        check_npy_header(p)  # an .npz renamed, strings, records...: refused before any load
-    positional = suffix in (".json", ".npz", ".c3d") or (
-        suffix == ".npy" and p.is_file() and is_position_array(p)
-    )
+    # an .npz renamed, strings, records...: refused before any load
+    shape = check_npy_header(p)[0] if suffix == ".npy" else ()
+    positional = suffix in (".json", ".npz", ".c3d") or (len(shape) == 3 and shape[-1] == 3)
     if not positional and (up is not None or units is not None):
         given = ", ".join(f"{k}={v!r}" for k, v in (("up", up), ("units", units)) if v)
         raise ParameterError(
@@ -176,36 +157,12 @@ def read_motion(
 def write_motion(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write a motion in the format its suffix names, matching :func:`read_motion` (atomic).
 
-    ``.bvh``: rotation data with a skeleton. Joint positions (a position-only motion)
-    go back in their input's layout, units and vertical axis: ``.json``
-    (Dance-with-Melody), ``.npy`` ``(n_frames, n_joints, 3)``, ``.npz``, ``.c3d``.
-    ``.csv`` (and ``.npy`` for motion that is not joint positions): the values as a
-    table, one column per channel.
-
-    Raises
-    ------
-    ParameterError
-        BVH for motion without a skeleton (joint positions: the alternatives named),
-        joint-position formats for other motion, an unknown suffix.
+    Joint positions go back in their input's layout, units and vertical axis; ``.csv``
+    (and ``.npy`` for other motion) write the values as a table.
     """
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix == ".bvh":
-        if motion.skeleton is None:
-            what = (
-                "joint positions without joint rotations"
-                if motion.is_positional
-                else "a table without a skeleton"
-            )
-            alt = (
-                "write .json, .npy or .c3d (positions, in the input's layout) or .csv"
-                if motion.is_positional
-                else "write .csv"
-            )
-            raise ParameterError(
-                f"cannot write {str(p)!r} as BVH: motion {motion.name!r} is {what}, and "
-                f"BVH stores rotations of a skeleton; {alt}"
-            )
         return write_bvh(p, motion)
     if suffix == ".csv":
         return write_table(p, motion)

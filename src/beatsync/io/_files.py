@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import tempfile
@@ -16,10 +17,7 @@ from ..errors import ParameterError
 
 
 def check_input_file(path: str | os.PathLike[str], what: str) -> Path:
-    """Return ``path`` as a Path after checking it is an existing, non-empty file.
-
-    ``what`` names the kind of file in messages (``"BVH"``, ``"audio"``).
-    """
+    """``path`` as a Path, checked to be an existing, non-empty file (``what``: its kind)."""
     p = Path(path)
     if not p.exists():
         raise ParameterError(f"{what} file {str(p)!r} does not exist")
@@ -72,25 +70,19 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
 
 
 def to_jsonable(obj: Any, *, float_digits: int | None = None) -> Any:
-    """Convert numpy scalars/arrays and paths inside ``obj`` to plain JSON types.
+    """Numpy values and paths inside ``obj`` as plain JSON types; NaN/inf become ``None``.
 
-    Non-finite floats become ``None`` (``null``): strict JSON has no NaN.
-    ``float_digits`` rounds every float to that many significant digits (see
-    :func:`write_json`); ``None`` keeps floats exact.
+    ``float_digits`` rounds every float to that many significant digits (1-17).
     """
-    if float_digits is not None:
-        float_digits = _check_digits(float_digits)
-    return _jsonable(obj, float_digits)
-
-
-def _check_digits(digits: Any) -> int:
-    if isinstance(digits, bool) or not isinstance(digits, (int, np.integer)):
-        raise ParameterError(f"float_digits={digits!r} must be a whole number of digits, 1-17")
-    if not 1 <= int(digits) <= 17:
+    d = float_digits
+    if d is not None and (
+        isinstance(d, bool) or not isinstance(d, (int, np.integer)) or not 1 <= d <= 17
+    ):
         raise ParameterError(
-            f"float_digits={digits!r} must be in 1-17 significant digits (a float64 has 17)"
+            f"float_digits={d!r} must be a whole number of significant digits, 1-17 (a "
+            "float64 has 17)"
         )
-    return int(digits)
+    return _jsonable(obj, None if d is None else int(d))
 
 
 def _jsonable(obj: Any, digits: int | None) -> Any:
@@ -114,31 +106,11 @@ def _jsonable(obj: Any, digits: int | None) -> Any:
     return obj
 
 
-def write_json(
-    path: str | os.PathLike[str], obj: Any, *, float_digits: int | None = None
-) -> Path:
-    """Write ``obj`` as indented JSON (numpy values converted) (atomic).
+def write_json(path: str | os.PathLike[str], obj: Any, *, float_digits: int | None = None) -> Path:
+    """Write :func:`to_jsonable` of ``obj`` as indented JSON (atomic).
 
-    Parameters
-    ----------
-    path : path-like
-    obj : dict, list, numbers, strings, numpy arrays and scalars, paths
-        NaN and infinite floats are written as ``null``.
-    float_digits : int in 1-17, optional
-        Round every float to this many significant digits before writing, so a
-        committed file does not change in its last digits when the same numbers are
-        computed through another BLAS or CPU path (10 digits keep every value to a
-        relative 5e-11 and hide float64 rounding noise). ``None`` (default) writes each
-        float exactly (shortest round-trip decimal).
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> p = pathlib.Path(tempfile.mkdtemp()) / "a.json"
-    >>> _ = write_json(p, {"r": 0.1 + 0.2}, float_digits=10)
-    >>> import json
-    >>> json.loads(p.read_text())
-    {'r': 0.3}
+    ``float_digits`` rounds floats so that a committed file's last digits do not change
+    when another BLAS or CPU computes the same numbers (10 digits: a relative 5e-11).
     """
     data = to_jsonable(obj, float_digits=float_digits)
     with atomic_write(path) as fh:
@@ -147,9 +119,7 @@ def write_json(
     return Path(path)
 
 
-def write_csv(
-    path: str | os.PathLike[str], frame: Any, *, float_format: str | None = None
-) -> Path:
+def write_csv(path: str | os.PathLike[str], frame: Any, *, float_format: str | None = None) -> Path:
     """Write a pandas DataFrame as CSV without its index (atomic).
 
     ``float_format`` (a printf format such as ``"%.6g"``) fixes the precision of floats.
@@ -160,11 +130,7 @@ def write_csv(
 
 
 def read_jsonl(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
-    """The JSON objects of a JSON-lines file, one per line ([] if it does not exist).
-
-    A line that is not a complete JSON object (the torn last line of a run that was
-    killed while appending) is skipped.
-    """
+    """The JSON objects of a JSON-lines file ([] if none); a torn line (a killed run) is skipped."""
     p = Path(path)
     if not p.is_file():
         return []
@@ -193,11 +159,9 @@ def write_jsonl(path: str | os.PathLike[str], rows: Any) -> Path:
 
 
 def append_jsonl(path: str | os.PathLike[str], *rows: dict[str, Any]) -> Path:
-    """Append objects to a JSON-lines file, one per line, in one write, and flush it to
-    disk (``fsync``).
+    """Append objects to a JSON-lines file in one write, flushed to disk (``fsync``).
 
-    So a crash loses at most the lines being written; a torn last line left by an
-    earlier crash is ended first, so that it stays a line of its own.
+    A crash loses at most the lines being written; a torn last line is ended first.
     """
     p = Path(path)
     line = "".join(_jsonl_line(row) for row in rows)
@@ -215,15 +179,5 @@ def append_jsonl(path: str | os.PathLike[str], *rows: dict[str, Any]) -> Path:
 
 def sha256_file(path: str | os.PathLike[str]) -> str:
     """SHA-256 hex digest of a file's bytes."""
-    import hashlib
-
-    p = check_input_file(path, "input")
-    h = hashlib.sha256()
-    with open(p, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
-# The former private name, still imported by io.positions; new code uses check_input_file.
-_existing_file = check_input_file
+    with open(check_input_file(path, "input"), "rb") as fh:
+        return hashlib.file_digest(fh, "sha256").hexdigest()

@@ -21,9 +21,8 @@ from ..errors import ParameterError, warn
 from ..validation import as_float, check_audio, check_finite, check_sample_rate, check_times
 from ._files import atomic_write, check_input_file
 
-#: libsndfile's format for each suffix it reads (soundfile >= 0.12 with libsndfile >= 1.1
-#: reads MP3 too): a file with one of these suffixes that libsndfile cannot read, when
-#: the installed libsndfile has the format, is damaged (no audioread fallback).
+#: libsndfile's format for each suffix it reads: such a file it cannot read, when it has
+#: the format, is damaged (no audioread fallback).
 SOUNDFILE_SUFFIXES = MappingProxyType(
     {
         ".wav": "WAV",
@@ -44,35 +43,15 @@ SOUNDFILE_SUFFIXES = MappingProxyType(
 
 
 def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[np.ndarray, int]:
-    """Read an audio file as mono float32.
+    """Read an audio file as mono float32 ``(y, sr)``, resampled to ``sr`` [Hz] if given.
 
-    Parameters
-    ----------
-    path : path-like
-        WAV, FLAC, OGG, MP3, AIFF, ... (libsndfile); other formats (e.g. M4A) through
-        librosa/audioread. A file with a libsndfile suffix (:data:`SOUNDFILE_SUFFIXES`)
-        whose format the installed libsndfile has, but cannot read, is refused without
-        trying audioread.
-    sr : int > 0 [Hz], optional
-        Resample to this rate; default keeps the file's rate.
-
-    Returns
-    -------
-    y : np.ndarray [shape=(n,)], float32
-    sr : int [Hz]
-
-    Raises
-    ------
-    ParameterError
-        Missing, empty or unreadable file; a file cut short (fewer samples than its
-        header announces); no samples; NaN/inf samples.
+    libsndfile's formats (:data:`SOUNDFILE_SUFFIXES`) directly, others (M4A) through
+    librosa/audioread. A file cut short (fewer samples than its header says) is refused.
     """
     import soundfile as sf
 
     p = check_input_file(path, "audio")
-    if sr is not None:
-        sr = _integral_rate(sr, name="sr")
-    decoder: list[str] = []
+    sr = None if sr is None else _integral_rate(sr, name="sr")
     try:
         # libmpg123 prints its own warnings to the process's stderr ("Xing stream size
         # off by more than 1%"): kept apart, then said once the read is judged
@@ -87,7 +66,7 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
             # libsndfile reads these formats itself: a failure is a damaged file, and
             # audioread (through librosa, seconds to import) would fail the same way
             _check_wav_header_rate(p)
-            detail = _first_line(sf_exc)
+            detail = (str(sf_exc).strip().splitlines() or [type(sf_exc).__name__])[0]
             if "does not exist" in detail:  # libsndfile's words for content it cannot decode
                 detail = "its content is not decodable audio"
             raise ParameterError(
@@ -119,47 +98,33 @@ def read_audio(path: str | os.PathLike[str], *, sr: int | None = None) -> tuple[
         file_sr = _integral_rate(file_sr, name="sample rate")
     except ParameterError as exc:
         raise ParameterError(f"audio file {str(p)!r} has a broken header: {exc}") from None
-    if y.size == 0:
-        raise ParameterError(f"audio file {str(p)!r} has no samples")
     y, _ = check_audio(y, file_sr, name=f"audio file {str(p)!r}")
     if sr is not None and sr != file_sr:
-        y = resample(y, file_sr, sr)
-        file_sr = sr
+        return resample(y, file_sr, sr), sr
     return y, file_sr
 
 
 def resample_audio(y: np.ndarray, orig_sr: float, target_sr: float) -> np.ndarray:
     """Resample mono audio with soxr's high-quality filter (float32, ``ceil(n * ratio)`` samples).
 
-    The same samples as ``librosa.resample(y, orig_sr=, target_sr=)`` with its default
-    ``res_type="soxr_hq"``, without importing librosa (seconds, and a numba compilation
-    on a fresh installation).
-
-    Raises
-    ------
-    ParameterError
-        Not 1-D, empty or non-finite samples; an implausible rate.
+    The samples of ``librosa.resample`` (``res_type="soxr_hq"``), without importing librosa.
     """
     y, orig = check_audio(y, orig_sr)
     target = check_sample_rate(target_sr, name="target_sr")
     return resample(y, orig, target)
 
 
-#: A file that holds fewer samples than its header announces is refused when it lacks
-#: more than this fraction of them and at least :data:`SHORT_FILE_MIN_S`: an MP3's
-#: announced length (its Xing header) may be an estimate off by a frame or two.
+#: A file is cut short when it lacks more than this fraction of the samples its header
+#: announces and at least :data:`SHORT_FILE_MIN_S` [s] (an MP3's count is an estimate).
 SHORT_FILE_FRACTION = 0.01
 SHORT_FILE_MIN_S = 0.1
 
 
 @contextlib.contextmanager
 def _c_stderr_captured(active: bool = True) -> Iterator[list[str]]:
-    """The lines C code writes to file descriptor 2 inside the block, kept from the
-    terminal (and from ``--json`` output on stderr).
+    """The lines C code writes to file descriptor 2 inside the block, kept from the terminal.
 
-    Only in the main thread (the descriptor is the whole process's: a worker thread
-    would hide the other threads' output); elsewhere, or when not ``active``, nothing
-    is captured.
+    Only in the main thread (the descriptor is the whole process's).
     """
     lines: list[str] = []
     if not active or threading.current_thread() is not threading.main_thread():
@@ -184,15 +149,9 @@ def _c_stderr_captured(active: bool = True) -> Iterator[list[str]]:
 
 
 def _check_complete(p: Path, info: Any, n_read: int, rate: float) -> None:
-    """Refuse a file cut short: fewer samples than its header announces.
-
-    ``info`` is ``soundfile.info(p)``. libsndfile reads what is there without a word:
-    for a WAV, RF64, W64, AIFF or AU file it trims the length to the bytes present and
-    notes each size the header declares beyond them in its log (``data : 661500
-    (should be 165342)``); an MP3's declared length (from its Xing, Info or VBRI
-    header) is ``info.frames``; an Ogg stream it decodes until its last complete page
-    (:func:`_ogg_is_cut`).
-    """
+    """Refuse a file cut short. libsndfile reads what is there silently, but logs each size
+    a header declares beyond the bytes present (``data : 661500 (should be 165342)``) in
+    ``info.extra_info``; an MP3's Xing length is ``info.frames``; Ogg: :func:`_ogg_is_cut`."""
     announced = int(info.frames)
     missing = [
         int(declared) - int(present)
@@ -236,9 +195,8 @@ _SAMPLE_BYTES.update({"PCM_32": 4, "FLOAT": 4, "DOUBLE": 8})
 
 
 def _unknown_size(size: int) -> bool:
-    """Whether a declared size is a placeholder for "unknown" rather than a length: 0,
-    or what writers that cannot seek back leave (0xFFFFFFFF; SoX to a pipe 0x7FFFF000
-    in a WAV, 0x7F000000 in an AIFF; 0x7FFF...FF in a 64-bit size)."""
+    """Whether a declared size means "unknown" (0, 0xFFFFFFFF, 64-bit max; SoX to a pipe:
+    0x7FFFF000 in a WAV, 0x7F000000 in an AIFF)."""
     return size == 0 or 0x7F000000 <= size < 0x80000000 or size == 0xFFFFFFFF or size >= 2**62
 
 
@@ -259,9 +217,7 @@ _OGG_MAX_PAGE = 27 + 255 + 255 * 255
 
 
 def _ogg_is_cut(p: Path) -> bool:
-    """Whether an Ogg file stops inside a page, or after a page that does not end its
-    stream (no end-of-stream flag): a download cut short. False for other files and
-    for an Ogg file whose last page cannot be found (nothing is claimed then)."""
+    """Whether an Ogg file stops inside a page, or after one without the end-of-stream flag."""
     with open(p, "rb") as f:
         if f.read(4) != b"OggS":
             return False
@@ -295,11 +251,6 @@ def _check_wav_header_rate(p: Path) -> None:
         raise ParameterError(f"audio file {str(p)!r} has a broken header: {exc}") from None
 
 
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()
-    return text[0] if text else type(exc).__name__
-
-
 def _integral_rate(sr: object, *, name: str) -> int:
     """A sample rate that files can hold: a plausible whole number of Hz."""
     v = check_sample_rate(sr, name=name)
@@ -327,19 +278,8 @@ def write_audio(path: str | os.PathLike[str], y: np.ndarray, sr: int) -> Path:
     return dest
 
 
-# ----------------------------------------------------------------------- beats
-
-
 def read_beats(path: str | os.PathLike[str]) -> np.ndarray:
-    """Read beat (or any event) times in seconds from the first column of a text file.
-
-    Blank lines and lines starting with ``#`` are skipped; other columns are ignored.
-
-    Raises
-    ------
-    ParameterError
-        Unreadable file, non-numeric values, or times that are not increasing seconds.
-    """
+    """Read event times [s] from the first column of a text file (``#`` comments skipped)."""
     p = check_input_file(path, "beat annotation")
     times = []
     try:

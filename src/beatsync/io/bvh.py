@@ -1,11 +1,9 @@
 """BVH motion files: read (with a frame-rate override) and write (exact round trip).
 
-The reader is one pass over the file's lines in linear time: the hierarchy is parsed
-token by token (so a joint may be named ``MOTION``), and the MOTION block is streamed
-into a preallocated float64 array in chunks, so memory stays near the size of the
-values (an 86 MB file no longer needs a gigabyte). Every malformed header, hierarchy
-line or frame line is refused with its line number. The writer is iterative, so any
-hierarchy the reader accepts (however deep) can be written back.
+The reader is one linear pass: the hierarchy token by token (a joint may be named
+``MOTION``), the frames streamed in chunks into a preallocated array (memory near the
+values' size). Every malformed line is refused with its number. The writer is
+iterative, so any hierarchy the reader accepts (however deep) can be written back.
 """
 
 from __future__ import annotations
@@ -21,7 +19,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..validation import as_float, as_int, check_finite, check_fps
+from ..validation import as_int, check_finite, check_fps
 from ._files import atomic_write, check_input_file
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNELS"]
@@ -34,38 +32,26 @@ _FRAME_TIME_RE = re.compile(r"frame\s+time\s*:\s*(\S+)", re.IGNORECASE)
 _CHUNK_ROWS = 4096  # frame lines converted to floats at once
 
 
-class _Lines:
-    """Numbered text lines of a binary file: UTF-8 (an optional byte-order mark
-    skipped), ``\\n``, ``\\r\\n`` or ``\\r`` line ends, decoded one line at a time so a
-    decoding error is reported with its line number."""
+_Lines = Iterator[tuple[int, str]]
 
-    def __init__(self, fh, path: Path) -> None:
-        self._it = self._numbered(fh)
-        self.path = path
-        self.lineno = 0
 
-    def _numbered(self, fh) -> Iterator[tuple[int, str]]:
-        lineno = 0
-        for raw in fh:
-            if lineno == 0 and raw.startswith(b"\xef\xbb\xbf"):
-                raw = raw[3:]
-            parts = raw.rstrip(b"\r\n").split(b"\r") if b"\r" in raw else (raw,)
-            for part in parts:
-                lineno += 1
-                try:
-                    yield lineno, part.decode("utf-8")
-                except UnicodeDecodeError as exc:
-                    raise ParameterError(
-                        f"malformed BVH {str(self.path)!r}: line {lineno} is not UTF-8 text "
-                        f"({exc.reason}); is it a BVH file?"
-                    ) from None
-
-    def __iter__(self) -> Iterator[tuple[int, str]]:
-        return self
-
-    def __next__(self) -> tuple[int, str]:
-        self.lineno, line = next(self._it)
-        return self.lineno, line
+def _lines(fh, path: Path) -> _Lines:
+    """Numbered UTF-8 lines of a binary file (BOM skipped; ``\\n``, ``\\r\\n`` or ``\\r``
+    ends), decoded one at a time so a decoding error names its line."""
+    lineno = 0
+    for raw in fh:
+        if lineno == 0 and raw.startswith(b"\xef\xbb\xbf"):
+            raw = raw[3:]
+        parts = raw.rstrip(b"\r\n").split(b"\r") if b"\r" in raw else (raw,)
+        for part in parts:
+            lineno += 1
+            try:
+                yield lineno, part.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                raise ParameterError(
+                    f"malformed BVH {str(path)!r}: line {lineno} is not UTF-8 text "
+                    f"({exc.reason}); is it a BVH file?"
+                ) from None
 
 
 @dataclass
@@ -173,11 +159,7 @@ class _HierarchyParser:
                         f"OFFSET of {self.label(top)} is not finite ({' '.join(toks)}); a bone "
                         "length must be a number"
                     )
-                if self.pending:
-                    raise self.err(
-                        f"OFFSET is followed by {self.pending[-1][:40]!r} on its line (an "
-                        "OFFSET has three values)"
-                    )
+                self.line_ends("OFFSET", "an OFFSET has three values")
                 top.offset = off
             elif up == "CHANNELS":
                 assert top is not None
@@ -200,11 +182,7 @@ class _HierarchyParser:
                 if len(set(chans)) != len(chans):
                     dup = next(c for c in chans if chans.count(c) > 1)
                     raise self.err(f"channel {dup} listed twice in {self.label(top)}")
-                if self.pending:
-                    raise self.err(
-                        f"CHANNELS {count} is followed by {self.pending[-1][:40]!r} on its line "
-                        "(wrong channel count?)"
-                    )
+                self.line_ends(f"CHANNELS {count}", "wrong channel count?")
                 top.channels = chans
             elif tok == "}":
                 assert top is not None
@@ -229,6 +207,10 @@ class _HierarchyParser:
             )
         )
 
+    def line_ends(self, what: str, hint: str) -> None:
+        if self.pending:
+            raise self.err(f"{what} is followed by {self.pending[-1][:40]!r} on its line ({hint})")
+
     def expect_brace(self, what: str) -> None:
         brace = self.next_token(f"'{{' after {what}")
         if brace != "{":
@@ -245,8 +227,7 @@ _NUMBER_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 
 
 def _is_plain_number(tok: str) -> bool:
-    """A decimal number in ASCII (no underscores, no Unicode digits); also nan/inf,
-    refused later by the finite check with a clearer message."""
+    """An ASCII decimal number (no ``_``, no Unicode digits), or nan/inf (refused later)."""
     return _NUMBER_RE.fullmatch(tok) is not None or tok.lower().lstrip("+-") in (
         "nan",
         "inf",
@@ -254,7 +235,10 @@ def _is_plain_number(tok: str) -> bool:
     )
 
 
-def _header_value(lines: _Lines, pattern: re.Pattern[str], what: str, path: Path) -> str:
+def _header_value(
+    lines: _Lines, pattern: re.Pattern[str], what: str, path: Path
+) -> tuple[str, int]:
+    """The number on the next non-blank line ``<what> <value>``, and its line number."""
     for lineno, line in lines:
         s = line.strip()
         if not s:
@@ -265,61 +249,29 @@ def _header_value(lines: _Lines, pattern: re.Pattern[str], what: str, path: Path
                 f"malformed BVH {str(path)!r}, line {lineno}: expected '{what} <value>', got "
                 f"{s[:60]!r}"
             )
-        return match.group(1)
+        if not _is_plain_number(match.group(1)):
+            raise ParameterError(
+                f"malformed BVH {str(path)!r}: line {lineno}: {what[:-1]}={match.group(1)!r} is "
+                "not a number"
+            )
+        return match.group(1), lineno
     raise ParameterError(f"malformed BVH {str(path)!r}: no '{what}' line (file truncated?)")
 
 
 def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motion:
-    """Read a BVH file.
-
-    Parameters
-    ----------
-    path : path-like
-        A UTF-8 text file (a byte-order mark is allowed).
-    fps : float > 0 [Hz], optional
-        Override the frame rate declared by ``Frame Time`` (the CMU salsa BVH files
-        declare 120 fps but are 60 fps).
-
-    Returns
-    -------
-    Motion
-        Channels ``"<joint>_<dof>"`` in file order, rotations in degrees.
-
-    Raises
-    ------
-    ParameterError
-        With the line number: a missing, truncated or malformed file; a joint without
-        OFFSET or CHANNELS, a non-finite offset, duplicate joint or channel names;
-        frame lines with the wrong number of values or non-numeric values; a frame
-        count that does not match; NaN/inf values; a bad frame time.
-    """
+    """Read a BVH file; ``fps`` [Hz] overrides ``Frame Time`` (CMU salsa says 120, is 60)."""
     p = check_input_file(path, "BVH")
     try:
         with open(p, "rb") as fh:
-            lines = _Lines(fh, p)
+            lines = _lines(fh, p)
             skeleton = _HierarchyParser(lines, p).parse()
-            n_text = _header_value(lines, _FRAMES_RE, "Frames:", p)
-            frames_line = lines.lineno
-            t_text = _header_value(lines, _FRAME_TIME_RE, "Frame Time:", p)
-            t_line = lines.lineno
-            names = skeleton.channel_names()
+            n_text, n_line = _header_value(lines, _FRAMES_RE, "Frames:", p)
             try:
-                if not _is_plain_number(n_text):
-                    raise ParameterError(f"line {frames_line}: Frames={n_text!r} is not a number")
-                n_declared = as_int(
-                    n_text, name=f"line {frames_line}: Frames", minimum=0, text=True
-                )
-                if not _is_plain_number(t_text):
-                    raise ParameterError(f"line {t_line}: Frame Time={t_text!r} is not a number")
-                frame_time = as_float(
-                    t_text,
-                    name=f"line {t_line}: Frame Time",
-                    unit="s",
-                    allow_nonfinite=True,
-                    text=True,
-                )
+                n_declared = as_int(n_text, name=f"line {n_line}: Frames", minimum=0, text=True)
             except ParameterError as exc:
                 raise ParameterError(f"malformed BVH {str(p)!r}: {exc}") from None
+            frame_time = float(_header_value(lines, _FRAME_TIME_RE, "Frame Time:", p)[0])
+            names = skeleton.channel_names()
             if n_declared == 0:
                 raise ParameterError(f"BVH {str(p)!r} has no frames (Frames: 0)")
             if not names:
@@ -347,48 +299,31 @@ def read_bvh(path: str | os.PathLike[str], *, fps: float | None = None) -> Motio
 
 
 def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.ndarray:
-    """Stream the frame lines into a preallocated ``(n_declared, n_ch)`` array.
+    """Stream the frame lines, in chunks read by numpy, into an ``(n_declared, n_ch)`` array.
 
-    Lines are gathered in chunks; each chunk is parsed by numpy's C text reader, and
-    only a chunk it refuses (or reads to another shape) is split line by line in
-    Python to name the first bad line.
+    A frame line takes at least ``2 * n_ch`` bytes, so a huge declared count in a small
+    file allocates no more than the file could fill.
     """
-    # A frame line holds n_ch numbers: at least 2 * n_ch - 1 characters and a newline,
-    # so the file's size bounds the number of frames it can hold: a huge declared count
-    # in a small file allocates no more than the file could fill.
     capacity = min(n_declared, path.stat().st_size // (2 * n_ch) + 1)
     values = np.empty((capacity, n_ch), dtype=np.float64)
-    chunk: list[str] = []
-    chunk_lines: list[int] = []
-    stored = 0  # frame lines converted into values
-    row = 0  # frame lines seen
+    chunk: list[tuple[int, str]] = []  # (line number, text) of lines not yet converted
+    stored = row = 0  # frame lines converted into values; frame lines seen
 
     def flush() -> None:
         nonlocal stored
-        block = _parse_chunk(chunk, chunk_lines, stored, n_ch, path)
-        values[stored : stored + len(chunk)] = block
+        values[stored : stored + len(chunk)] = _parse_chunk(chunk, stored, n_ch, path)
         stored += len(chunk)
         chunk.clear()
-        chunk_lines.clear()
 
     for lineno, line in lines:
         if not line.strip():
             continue
-        if row >= capacity:  # more frame lines than declared: count them, store nothing
-            if chunk:
-                flush()
-            row += 1
+        row += 1
+        if row > capacity:  # more frame lines than declared: counted, not stored
             continue
         if not line.isascii() or "_" in line:  # Python and numpy read "1_0" and Unicode digits
-            bad = next((t for t in line.split() if not _is_plain_number(t)), None)
-            if bad is not None:
-                raise ParameterError(
-                    f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
-                    "frame line"
-                )
-        chunk.append(line)
-        chunk_lines.append(lineno)
-        row += 1
+            _refuse_non_numeric(line.split(), lineno, path)
+        chunk.append((lineno, line))
         if len(chunk) == _CHUNK_ROWS:
             flush()
     if chunk:
@@ -403,54 +338,45 @@ def _read_frames(lines: _Lines, n_declared: int, n_ch: int, path: Path) -> np.nd
     return values
 
 
-def _parse_chunk(
-    chunk: list[str], linenos: list[int], first_row: int, n_ch: int, path: Path
-) -> np.ndarray:
+def _parse_chunk(chunk: list[tuple[int, str]], first_row: int, n_ch: int, path: Path) -> np.ndarray:
     """Frame lines as a ``(len(chunk), n_ch)`` array, or the first bad line named."""
     try:
-        block = np.loadtxt(chunk, dtype=np.float64, comments=None, ndmin=2)
+        block = np.loadtxt([line for _, line in chunk], dtype=np.float64, comments=None, ndmin=2)
         if block.shape == (len(chunk), n_ch):
             return block
     except ValueError:
         pass
     rows = []
-    for k, (lineno, line) in enumerate(zip(linenos, chunk, strict=True)):
+    for k, (lineno, line) in enumerate(chunk):
         toks = line.split()
         if len(toks) != n_ch:
             raise ParameterError(
                 f"BVH {str(path)!r}, line {lineno}: frame line {first_row + k + 1} has "
                 f"{len(toks)} values but the hierarchy defines {n_ch} channels"
             )
-        bad = next((t for t in toks if not _is_plain_number(t)), None)
-        if bad is not None:
-            raise ParameterError(
-                f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a "
-                "frame line"
-            )
+        _refuse_non_numeric(toks, lineno, path)
         rows.append(toks)
     return np.array(rows, dtype=np.float64)
 
 
-def _fmt(x: float) -> str:
-    return repr(float(x))
+def _refuse_non_numeric(toks: list[str], lineno: int, path: Path) -> None:
+    bad = next((t for t in toks if not _is_plain_number(t)), None)
+    if bad is not None:
+        raise ParameterError(
+            f"BVH {str(path)!r}, line {lineno}: non-numeric value {bad[:40]!r} in a frame line"
+        )
 
 
 def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write ``motion`` as BVH with its skeleton; atomic.
-
-    Values are written with the shortest decimal that round-trips exactly, so
-    ``read_bvh(write_bvh(p, m))`` gives identical values and frame rate. The
-    hierarchy is written without recursion, so any depth the reader accepts works.
-
-    Raises
-    ------
-    ParameterError
-        No skeleton (marker data or a plain table), or NaN/inf values or offsets.
-    """
+    """Write ``motion`` as BVH (atomic), each value as its shortest exact decimal."""
     if motion.skeleton is None:
+        what, alt = ("a table without a skeleton", "write .csv (write_table)")
+        if motion.is_positional:
+            what = "joint positions without joint rotations"
+            alt = "write .json, .npy or .c3d (positions, in the input's layout) or .csv"
         raise ParameterError(
-            f"motion {motion.name!r} has no skeleton (marker data or a plain table) and "
-            "cannot be written as BVH; write it as CSV (write_table) instead"
+            f"cannot write {str(path)!r} as BVH: motion {motion.name!r} is {what}, and BVH "
+            f"stores rotations of a skeleton; {alt}"
         )
     check_finite(motion.values, name="motion values")
     joints = motion.skeleton.joints
@@ -474,14 +400,12 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
         else:
             out.append(f"{ind}{'ROOT' if j.parent < 0 else 'JOINT'} {j.name}")
         out.append(f"{ind}{{")
-        out.append(f"{ind}\tOFFSET {' '.join(_fmt(v) for v in j.offset)}")
+        out.append(f"{ind}\tOFFSET {' '.join(repr(float(v)) for v in j.offset)}")
         if not j.is_end_site:
             out.append(f"{ind}\tCHANNELS {len(j.channels)} {' '.join(j.channels)}")
         todo.append((i, depth, False))
         todo.extend((c, depth + 1, True) for c in reversed(children[i]))
-    out.append("MOTION")
-    out.append(f"Frames: {motion.n_frames}")
-    out.append(f"Frame Time: {_fmt(1.0 / motion.fps)}")
+    out += ["MOTION", f"Frames: {motion.n_frames}", f"Frame Time: {1.0 / motion.fps!r}"]
     with atomic_write(path) as fh:
         fh.write("\n".join(out) + "\n")
         for start in range(0, motion.n_frames, _CHUNK_ROWS):

@@ -1,28 +1,18 @@
 """Joint-position motion files: Dance-with-Melody JSON, ``.npy``/``.npz`` arrays, C3D.
 
-Every reader returns a position-only :class:`~beatsync.motion.Motion` in the canonical
-frame (metres, z up; see :mod:`beatsync.motion`) with a
-:class:`~beatsync.motion.PositionInfo` that records the file's layout, units and
-vertical axis, so that the writers here put the motion back in that layout.
+Readers return a position-only :class:`~beatsync.motion.Motion` in the canonical frame
+(metres, z up) whose :class:`~beatsync.motion.PositionInfo` records the file's layout,
+units and vertical axis, which the writers restore. ``.json`` (Dance-with-Melody):
+``{"length": N, "center": [N][3], "skeletons": [N][J][3]}``, joints relative to the
+root track ``center``, no rate (the bundled dancers: 25 fps, cm, y up); ``.npy``: one
+``(n_frames, n_joints, 3)`` array (AIST++ ``keypoints3d``); ``.npz``: such an array
+under a key, with an optional scalar ``fps``; ``.c3d``: marker points (a negative
+residual is a gap) with the file's rate, labels and ``POINT:UNITS``.
 
-Layouts
--------
-- ``.json`` (Dance-with-Melody): ``{"length": N, "center": [N][3], "skeletons":
-  [N][J][3]}``; ``skeletons`` are joint positions relative to ``center``, the
-  per-frame root position (the four bundled dancers: 23 joints, centimetres, y up,
-  25 fps, which the file does not store). The motion holds absolute positions
-  (``skeletons + center``).
-- ``.npy``: one array ``(n_frames, n_joints, 3)`` (e.g. AIST++ ``keypoints3d``).
-- ``.npz``: such an array under a key (named, or found: ``keypoints3d`` or the only
-  3-D array with 3 columns); a scalar ``fps`` in the archive is used as the rate.
-- ``.c3d``: marker points through the ``c3d`` package; the file's own rate, labels
-  and unit (``POINT:UNITS``); points flagged invalid (negative residual) are gaps.
-
-Units (``"m"``, ``"cm"``, ``"mm"``) and vertical axis (``"y"``, ``"z"``) are given
-or detected: the vertical axis is the one of y and z along which the body extends
-most (median over frames), the unit the one that makes that extent a human size
-(0.25-3 m). Short NaN gaps are filled (:func:`beatsync.motion.fill_joint_gaps`),
-long ones refused with the joint named.
+Units (``"m"``, ``"cm"``, ``"mm"``) and vertical axis (``"y"``, ``"z"``) are given or
+detected: up is whichever of y and z the body extends along most (median over
+frames), the unit the one that makes that extent 0.25-3 m. Gaps up to ``max_gap`` [s]
+are filled (:func:`beatsync.joints.fill_joint_gaps`), longer ones refused.
 """
 
 from __future__ import annotations
@@ -30,7 +20,6 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -45,21 +34,7 @@ from ..motion import (
 )
 from ..validation import check_fps, check_positive
 from ._files import atomic_write, check_input_file
-
-__all__ = [
-    "read_positions_json",
-    "read_positions_array",
-    "read_c3d",
-    "write_positions_json",
-    "write_positions_array",
-    "write_c3d",
-    "is_position_array",
-    "detect_up",
-    "detect_units",
-    "to_canonical",
-    "from_canonical",
-    "POSITION_SUFFIXES",
-]
+from .tables import need_fps, read_npz
 
 POSITION_SUFFIXES = (".json", ".npy", ".npz", ".c3d")
 #: Plausible body height range [m] for detecting units.
@@ -68,17 +43,15 @@ _HEIGHT_M = (0.25, 3.0)
 _KEYPOINT_KEYS = ("keypoints3d", "keypoints3d_optim", "positions", "joints")
 
 
-# --------------------------------------------------------------------------- frames
-
-
-def _check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str | None:
-    if value is None:
-        return None
-    if value not in choices:
-        raise ParameterError(
-            f"{name}={value!r} must be one of {', '.join(repr(c) for c in choices)}"
-        )
-    return str(value)
+def _options(up: Any, units: Any, bones: Any, max_gap: Any) -> dict[str, Any]:
+    """The readers' common options, checked (``up``/``units`` ``None``: detect)."""
+    for name, value, choices in (("up", up, ("y", "z")), ("units", units, tuple(UNIT_METRES))):
+        if value is not None and value not in choices:
+            raise ParameterError(
+                f"{name}={value!r} must be one of {', '.join(repr(c) for c in choices)}"
+            )
+    max_gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
+    return {"up": up, "units": units, "bones": bones, "max_gap": max_gap}
 
 
 def _extents(pos: np.ndarray) -> np.ndarray:
@@ -90,11 +63,7 @@ def _extents(pos: np.ndarray) -> np.ndarray:
 
 
 def detect_up(positions: Any) -> str:
-    """The vertical axis (``"y"`` or ``"z"``) of joint positions ``(n_frames, n_joints, 3)``.
-
-    The body of a standing or dancing person extends further along the vertical
-    than along the depth axis; an ambiguous case (extents within 15 %) is refused.
-    """
+    """The vertical axis (``"y"`` or ``"z"``): the longer body extent, by more than 15 %."""
     ext = _extents(np.asarray(positions, dtype=np.float64))
     ey, ez = float(ext[1]), float(ext[2])
     if ey > 1.15 * ez:
@@ -108,10 +77,7 @@ def detect_up(positions: Any) -> str:
 
 
 def detect_units(positions: Any, up: str) -> str:
-    """The length unit (``"m"``, ``"cm"``, ``"mm"``) that makes the body a human size.
-
-    The body's vertical extent (median over frames) must be 0.25-3 m in one unit.
-    """
+    """The length unit (``"m"``, ``"cm"``, ``"mm"``) that makes the body 0.25-3 m tall."""
     h = float(_extents(np.asarray(positions, dtype=np.float64))["xyz".index(up)])
     for unit, scale in UNIT_METRES.items():
         if _HEIGHT_M[0] <= h * scale <= _HEIGHT_M[1]:
@@ -139,10 +105,8 @@ def from_canonical(positions: Any, *, units: str, up: str) -> np.ndarray:
     return p / UNIT_METRES[units]
 
 
-def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, bool, str, bool]:
-    up_det = up is None
+def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, str]:
     up = detect_up(pos) if up is None else up
-    units_det = units is None
     units = detect_units(pos, up) if units is None else units
     h = float(_extents(pos)["xyz".index(up)]) * UNIT_METRES[units]
     if not 0.05 <= h <= 10.0:
@@ -150,42 +114,39 @@ def _frame_of(pos: np.ndarray, units: str | None, up: str | None) -> tuple[str, 
             f"with units={units!r} the body is {h:.3g} m tall: the unit looks wrong "
             f"(detected: {detect_units(pos, up) if h > 0 else '?'})"
         )
-    return units, units_det, up, up_det
-
-
-# --------------------------------------------------------------------------- building
+    return units, up
 
 
 def _names(n_joints: int, names: Any = None) -> tuple[str, ...]:
     if names is None:
         return tuple(f"j{i}" for i in range(n_joints))
-    out = []
-    seen: set[str] = set()
+    out: list[str] = []
     for i, n in enumerate(names):
         clean = "_".join(str(n).split()) or f"j{i}"
-        if clean in seen:
-            clean = f"{clean}_{i}"
-        seen.add(clean)
-        out.append(clean)
+        out.append(f"{clean}_{i}" if clean in out else clean)
     return tuple(out)
 
 
 def _build(
     pos: np.ndarray,
-    *,
     fps: float,
     name: str,
     source: str,
     layout: str,
+    *,
     units: str | None,
     up: str | None,
     bones: Any,
     max_gap: float,
+    file_frame: tuple[str | None, str | None] = (None, None),
     joint_names: Any = None,
     center: np.ndarray | None = None,
     key: str | None = None,
 ) -> Motion:
-    """Validate file positions ``(n, J, 3)``, fill gaps, convert, and make the Motion."""
+    """Check file positions ``(n, J, 3)``, fill gaps, convert, and make the Motion.
+
+    ``file_frame``: the units and vertical axis the file states, used unless given.
+    """
     if pos.ndim != 3 or pos.shape[2] != 3:
         raise ParameterError(
             f"{source} holds an array of shape {pos.shape}; joint positions must be "
@@ -200,36 +161,18 @@ def _build(
     if n < 2:
         raise ParameterError(f"{source} has {n} frame(s); need at least 2")
     names = _names(n_j, joint_names)
-    max_gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
     if center is not None:
-        center = fill_joint_gaps(center[:, None, :], fps, max_gap=max_gap, joint_names=["center"])[
-            :, 0
-        ]
-        pos = pos + center[:, None, :]
+        center = fill_joint_gaps(center[:, None], fps, max_gap=max_gap, joint_names=["center"])
+        pos, center = pos + center, center[:, 0]
     pos = fill_joint_gaps(pos, fps, max_gap=max_gap, joint_names=names)
-    units, units_det, up, up_det = _frame_of(pos, units, up)
-    info = PositionInfo(
-        bones=bones,
-        layout=layout,
-        units=units,
-        up=up,
-        units_source="detected" if units_det else "given",
-        up_source="detected" if up_det else "given",
-        center=None if center is None else to_canonical(center, units=units, up=up),
-        key=key,
-    )
+    units_source = "given" if units else "file" if file_frame[0] else "detected"
+    up_source = "given" if up else "file" if file_frame[1] else "detected"
+    units, up = _frame_of(pos, units or file_frame[0], up or file_frame[1])
+    center = None if center is None else to_canonical(center, units=units, up=up)
+    info = PositionInfo(bones, layout, units, up, units_source, up_source, center, key)
     values = to_canonical(pos, units=units, up=up).reshape(n, 3 * n_j)
     channels = tuple(f"{j}_{a}" for j in names for a in "xyz")
     return Motion(values, fps, channels, None, name, position_info=info)
-
-
-def _need_fps(fps: Any, source: str, hint: str = "") -> float:
-    if fps is None:
-        raise ParameterError(f"{source} stores no frame rate: give it with fps= (--fps){hint}")
-    return check_fps(fps)
-
-
-# --------------------------------------------------------------------------- JSON
 
 
 def read_positions_json(
@@ -241,31 +184,11 @@ def read_positions_json(
     bones: Any = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read the Dance-with-Melody JSON layout (``skeletons`` [N][J][3] + ``center`` [N][3]).
-
-    Parameters
-    ----------
-    fps : float > 0 [Hz]
-        Required (the layout stores no rate; the Dance-with-Melody dataset is 25 fps).
-    up : {"y", "z"}, optional
-        Vertical axis of the file; default detected.
-    units : {"m", "cm", "mm"}, optional
-        Length unit of the file; default detected.
-    bones : array_like [shape=(n_bones, 2)], optional
-        Joint-index pairs; default inferred from the data.
-    max_gap : float >= 0 [s]
-        Longest run of missing (``null``/NaN) values filled per joint.
-
-    Returns
-    -------
-    Motion
-        Absolute joint positions (``skeletons + center``) in metres, z up, joints
-        ``j0``, ``j1``, ...; ``position_info.center`` keeps the root track.
-    """
+    """Read the Dance-with-Melody JSON layout at ``fps`` [Hz] (the file has none); ``up``,
+    ``units`` detected and ``bones`` inferred unless given; joints ``j0``, ``j1``, ..."""
     p = check_input_file(path, "JSON motion")
-    up = _check_choice(up, "up", ("y", "z"))
-    units = _check_choice(units, "units", tuple(UNIT_METRES))
-    rate = _need_fps(
+    opts = _options(up, units, bones, max_gap)
+    rate = need_fps(
         fps, f"{str(p)!r} (JSON joint positions)", "; the Dance-with-Melody dataset is 25 fps"
     )
     try:
@@ -297,18 +220,7 @@ def read_positions_json(
             "(truncated or edited file?)"
         )
     name = p.parent.name if p.stem == "skeletons" else p.stem
-    return _build(
-        skel,
-        fps=rate,
-        name=name,
-        source=repr(str(p)),
-        layout="json",
-        units=units,
-        up=up,
-        bones=bones,
-        max_gap=max_gap,
-        center=center,
-    )
+    return _build(skel, rate, name, repr(str(p)), "json", center=center, **opts)
 
 
 def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
@@ -344,13 +256,8 @@ def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
 
 
 def write_positions_json(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write a position-only motion in the Dance-with-Melody JSON layout (atomic).
-
-    Positions go back to the units and vertical axis of ``motion.position_info``
-    (metres, z up without it). ``center`` is the motion's root track where it still
-    has one per frame (a motion read from such a file), else the per-frame mean of
-    the joints; ``skeletons`` are the positions relative to it.
-    """
+    """Write a position-only motion in the Dance-with-Melody JSON layout (atomic), in its
+    file's units and axis; ``center``: its root track, else the joints' per-frame mean."""
     info = _positional_info(motion, ".json")
     pos = motion.positions()
     center = info.center
@@ -371,27 +278,7 @@ def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
             f"it cannot be written as {suffix} joint positions; write .bvh (rotation "
             "data with a skeleton) or a .csv table"
         )
-    info = motion.position_info
-    return info if info is not None else PositionInfo()
-
-
-# --------------------------------------------------------------------------- arrays
-
-
-def is_position_array(path: str | os.PathLike[str]) -> bool:
-    """True if an ``.npy`` file holds an ``(n_frames, n_joints, 3)`` array (header only).
-
-    Other shapes are left to the table reader, which explains what it needs.
-    """
-    p = check_input_file(path, ".npy")
-    try:
-        arr = np.load(p, mmap_mode="r", allow_pickle=False)
-    except Exception:  # not a plain numeric .npy array: the table reader says why
-        return False
-    if not isinstance(arr, np.ndarray):  # an .npz archive renamed .npy
-        arr.close()
-        return False
-    return arr.ndim == 3 and arr.shape[-1] == 3 and arr.dtype.kind in "iuf"
+    return motion.position_info or PositionInfo()
 
 
 def read_positions_array(
@@ -403,46 +290,26 @@ def read_positions_array(
     units: str | None = None,
     bones: Any = None,
     max_gap: float = 0.25,
-    joint_names: Any = None,
 ) -> Motion:
     """Read joint positions ``(n_frames, n_joints, 3)`` from ``.npy`` or ``.npz``.
 
-    Parameters
-    ----------
-    fps : float > 0 [Hz], optional
-        Required unless an ``.npz`` holds a scalar ``fps``; a given rate that
-        contradicts the archive's is refused.
-    key : str, optional
-        Array name in an ``.npz``; default ``keypoints3d`` (AIST++) or the only
-        ``(n, J, 3)`` array.
-    up, units, bones, max_gap
-        As for :func:`read_positions_json`.
-    joint_names : sequence of str, optional
-        Default ``j0``, ``j1``, ...
+    ``fps`` [Hz] is required unless an ``.npz`` stores one (then it must agree); ``key``
+    names the ``.npz`` array; the rest as for :func:`read_positions_json`.
     """
     p = check_input_file(path, "array")
-    up = _check_choice(up, "up", ("y", "z"))
-    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    opts = _options(up, units, bones, max_gap)
     suffix = p.suffix.lower()
     file_fps = None
     if suffix == ".npz":
-        try:
-            with np.load(p, allow_pickle=False) as data:
-                arrays = {k: data[k] for k in data.files}
-        except Exception as exc:
-            raise ParameterError(f"cannot read {str(p)!r} as an .npz archive: {exc}") from None
+        arrays = read_npz(p)
         cands = [k for k, v in arrays.items() if v.ndim == 3 and v.shape[-1] == 3]
-        if key is None:
-            pref = [k for k in _KEYPOINT_KEYS if k in cands]
-            if pref:
-                key = pref[0]
-            elif len(cands) == 1:
-                key = cands[0]
-            else:
-                raise ParameterError(
-                    f"{str(p)!r} holds {'no' if not cands else 'several'} (frames, joints, 3) "
-                    f"arrays {cands} among {sorted(arrays)}; name one with key= (--variable)"
-                )
+        found = [k for k in _KEYPOINT_KEYS if k in cands] or (cands if len(cands) == 1 else [])
+        if key is None and not found:
+            raise ParameterError(
+                f"{str(p)!r} holds {'no' if not cands else 'several'} (frames, joints, 3) "
+                f"arrays {cands} among {sorted(arrays)}; name one with key= (--variable)"
+            )
+        key = found[0] if key is None else key
         if key not in arrays:
             raise ParameterError(f"{str(p)!r} has no array {key!r}; it holds {sorted(arrays)}")
         pos = np.asarray(arrays[key], dtype=np.float64)
@@ -454,20 +321,10 @@ def read_positions_array(
             pos = np.asarray(np.load(p, allow_pickle=False), dtype=np.float64)
         except Exception as exc:
             raise ParameterError(f"cannot read {str(p)!r} as a .npy array: {exc}") from None
-    rate = _file_rate(fps, file_fps, p) if file_fps is not None else _need_fps(fps, repr(str(p)))
-    return _build(
-        pos,
-        fps=rate,
-        name=p.stem,
-        source=repr(str(p)) + (f" array {key!r}" if key else ""),
-        layout=suffix.lstrip("."),
-        units=units,
-        up=up,
-        bones=bones,
-        max_gap=max_gap,
-        joint_names=joint_names,
-        key=key,
-    )
+    rate = _file_rate(fps, file_fps, p) if file_fps is not None else need_fps(fps, repr(str(p)))
+    source = repr(str(p)) + (f" array {key!r}" if key else "")
+    layout = suffix.lstrip(".")
+    return _build(pos, rate, p.stem, source, layout, key=key, **opts)
 
 
 def _file_rate(fps: Any, file_fps: float, p: Path) -> float:
@@ -483,12 +340,8 @@ def _file_rate(fps: Any, file_fps: float, p: Path) -> float:
 
 
 def write_positions_array(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write a position-only motion as ``(n_frames, n_joints, 3)`` (atomic).
-
-    ``.npy``: the array alone; ``.npz``: the array under the motion's key (default
-    ``keypoints3d``) and the scalar ``fps``. Units and vertical axis of
-    ``motion.position_info`` (metres, z up without it).
-    """
+    """Write a position-only motion as ``(n_frames, n_joints, 3)`` (atomic), in its file's
+    units and axis; ``.npz`` adds the scalar ``fps`` (array key default ``keypoints3d``)."""
     dest = Path(path)
     info = _positional_info(motion, dest.suffix.lower())
     arr = from_canonical(motion.positions(), units=info.units, up=info.up)
@@ -500,9 +353,6 @@ def write_positions_array(path: str | os.PathLike[str], motion: Motion) -> Path:
     return dest
 
 
-# --------------------------------------------------------------------------- C3D
-
-
 def read_c3d(
     path: str | os.PathLike[str],
     *,
@@ -512,18 +362,12 @@ def read_c3d(
     bones: Any = None,
     max_gap: float = 0.25,
 ) -> Motion:
-    """Read the marker points of a C3D file (its own rate, labels and unit).
-
-    Points with a negative residual (the C3D flag for 'not seen') are gaps, filled
-    up to ``max_gap`` seconds. ``fps`` may be given only if it equals the file's
-    rate. ``units`` defaults to the file's ``POINT:UNITS``; ``up`` to the file's
-    ``POINT:Y_SCREEN`` (``+Y``/``+Z``) or is detected.
-    """
+    """Read the marker points of a C3D file at its own rate (a given ``fps`` must agree);
+    ``units``/``up`` default to ``POINT:UNITS``/``POINT:Y_SCREEN``, else are detected."""
     import c3d
 
     p = check_input_file(path, "C3D")
-    up = _check_choice(up, "up", ("y", "z"))
-    units = _check_choice(units, "units", tuple(UNIT_METRES))
+    opts = _options(up, units, bones, max_gap)
     try:
         with open(p, "rb") as fh, warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "No analog data found" and the like
@@ -540,15 +384,6 @@ def read_c3d(
                     xyz = np.array(points[:, :3], dtype=np.float64)
                     xyz[points[:, 3] < 0] = np.nan
                     frames.append(xyz)
-        if frames and len(frames) < declared:
-            # the c3d package stops at the end of the file with a warning (ignored above)
-            raise ParameterError(
-                f"C3D file {str(p)!r} is cut short: its header declares {declared} frames "
-                f"but it holds {len(frames)}; an interrupted copy or download? Copy the "
-                "file again"
-            )
-    except ParameterError:
-        raise
     except Exception as exc:  # the c3d package raises several types for bad files
         raise ParameterError(f"cannot read {str(p)!r} as a C3D file: {exc}") from None
     if n_points == 0 or not frames:
@@ -556,48 +391,31 @@ def read_c3d(
             f"{str(p)!r} is a C3D file without marker points (only analog data?); "
             "beatsync needs 3-D points"
         )
+    if len(frames) < declared:  # the c3d package stops at the end with a warning (ignored)
+        raise ParameterError(
+            f"C3D file {str(p)!r} is cut short: its header declares {declared} frames "
+            f"but it holds {len(frames)}; an interrupted copy or download? Copy the file again"
+        )
     rate = _file_rate(fps, check_fps(rate, name=f"point rate of {p.name}"), p)
-    file_unit = {"m": "m", "cm": "cm", "mm": "mm"}.get(file_units.lower())
+    file_unit = file_units.lower() if file_units.lower() in UNIT_METRES else None
     file_up = screen[1].lower() if screen.upper() in ("+Y", "+Z") else None
-    motion = _build(
-        np.stack(frames),
-        fps=rate,
-        name=p.stem,
-        source=repr(str(p)),
-        layout="c3d",
-        units=units or file_unit,
-        up=up or file_up,
-        bones=bones,
-        max_gap=max_gap,
-        joint_names=labels if len(labels) == n_points else None,
+    names = labels if len(labels) == n_points else None
+    pos, frame = np.stack(frames), (file_unit, file_up)
+    return _build(
+        pos, rate, p.stem, repr(str(p)), "c3d", file_frame=frame, joint_names=names, **opts
     )
-    info = motion.position_info
-    if info is None:  # pragma: no cover - _build always sets it
-        raise RuntimeError("position reader lost its PositionInfo")
-    info = replace(
-        info,
-        units_source="file" if units is None and file_unit else info.units_source,
-        up_source="file" if up is None and file_up else info.up_source,
-    )
-    return replace(motion, position_info=info, _cache={})
 
 
 def _param_str(reader: Any, name: str) -> str:
-    param = reader.get(name)
-    if param is None:
-        return ""
-    try:
-        return str(param.string_value).strip()
+    try:  # None (no such parameter) has no string_value either
+        return str(reader.get(name).string_value).strip()
     except Exception:
         return ""
 
 
 def write_c3d(path: str | os.PathLike[str], motion: Motion) -> Path:
-    """Write a position-only motion as C3D points (float, the motion's rate) (atomic).
-
-    Units and vertical axis of ``motion.position_info`` (millimetres, z up without
-    one: the usual C3D convention); joint names become point labels.
-    """
+    """Write a position-only motion as C3D float points (atomic), in its file's units and
+    axis (without one: mm, z up, the usual C3D convention)."""
     import c3d
 
     info = _positional_info(motion, ".c3d")

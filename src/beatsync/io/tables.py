@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -13,22 +14,16 @@ from ..validation import as_float, as_float_array, check_finite, check_fps
 from ._files import atomic_write, check_input_file, write_csv
 
 
+def need_fps(fps: Any, source: str, hint: str = "") -> float:
+    """``fps`` [Hz], required for a file that stores no frame rate."""
+    if fps is None:
+        raise ParameterError(f"{source} stores no frame rate: give it with fps= (--fps){hint}")
+    return check_fps(fps)
+
+
 def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) -> Motion:
-    """Read marker data from a MoCap Toolbox ``.mat`` file (MATLAB v5 struct).
-
-    Parameters
-    ----------
-    path : path-like
-    variable : str
-        Name of the struct, e.g. ``"dance2"``; may be omitted if the file has only one.
-
-    Returns
-    -------
-    Motion
-        Marker positions in metres (the toolbox stores mm), channels
-        ``"<marker>_x"``, ``"_y"``, ``"_z"`` (z up), ``fps`` from the struct's
-        ``freq``, no skeleton. NaN gaps are kept (see :func:`beatsync.motion.fill_gaps`).
-    """
+    """Read markers of a MoCap Toolbox ``.mat`` struct (``variable``, e.g. ``"dance2"``; may
+    be left out if there is one) in metres (stored: mm), z up, rate ``freq``, gaps kept."""
     import scipy.io
 
     p = check_input_file(path, "MAT")
@@ -84,32 +79,14 @@ def _scalar(value: object) -> object:
     return arr.reshape(()).item() if arr.size == 1 and arr.dtype.kind in "iuf" else value
 
 
-def read_table(
-    path: str | os.PathLike[str], *, fps: float | None, channels: list[str] | None = None
-) -> Motion:
-    """Read a plain joint-angle table: ``.csv`` with a header row, or ``.npy`` ``(n, c)``.
-
-    Parameters
-    ----------
-    fps : float > 0 [Hz]
-        Required: tables carry no frame rate.
-    channels : list of str, optional
-        Names for ``.npy`` columns (default ``"ch0"``, ``"ch1"``, ...).
-    """
+def read_table(path: str | os.PathLike[str], *, fps: float | None) -> Motion:
+    """Read a joint-angle table at ``fps`` [Hz]: ``.csv`` with a header row, or ``.npy``
+    ``(n, c)`` (channels ``"ch0"``, ``"ch1"``, ...)."""
     p = check_input_file(path, "table")
-    if fps is None:
-        raise ParameterError(
-            f"{str(p)!r} is a plain table without a frame rate: give it with fps= (--fps)"
-        )
-    rate = check_fps(fps)
+    rate = need_fps(fps, f"{str(p)!r} (a plain table)")
     if p.suffix.lower() == ".npy":
         values = _read_npy(p)
-        names = tuple(channels) if channels else tuple(f"ch{i}" for i in range(values.shape[1]))
-        if len(names) != values.shape[1]:
-            raise ParameterError(
-                f"{len(names)} channel names given for the {values.shape[1]} columns of "
-                f"{str(p)!r}"
-            )
+        names = tuple(f"ch{i}" for i in range(values.shape[1]))
     else:
         import pandas as pd
 
@@ -140,15 +117,7 @@ def read_table(
 
 
 def check_npy_header(path: str | os.PathLike[str]) -> tuple[tuple[int, ...], np.dtype]:
-    """Return the shape and dtype of a ``.npy`` file from its header, nothing else read.
-
-    Raises
-    ------
-    ParameterError
-        Not a ``.npy`` file (an ``.npz`` archive renamed is named as such), a broken
-        header, or a dtype that is not integers or floats (strings, bytes, records,
-        complex numbers, dates, Python objects).
-    """
+    """Shape and dtype of a ``.npy`` file from its header alone; refuses non-numeric dtypes."""
     p = check_input_file(path, ".npy")
     with open(p, "rb") as fh:
         magic = fh.read(6)
@@ -161,13 +130,9 @@ def check_npy_header(path: str | os.PathLike[str]) -> tuple[tuple[int, ...], np.
             raise ParameterError(f"{str(p)!r} is not a .npy file (no NumPy header)")
         fh.seek(0)
         try:
-            version = np.lib.format.read_magic(fh)
-            read_header = (
-                np.lib.format.read_array_header_1_0
-                if version == (1, 0)
-                else np.lib.format.read_array_header_2_0
-            )
-            shape, _, dtype = read_header(fh)
+            fmt = np.lib.format
+            v1 = fmt.read_magic(fh) == (1, 0)
+            shape, _, dtype = (fmt.read_array_header_1_0 if v1 else fmt.read_array_header_2_0)(fh)
         except Exception as exc:  # numpy raises several types for broken headers
             raise ParameterError(f"{str(p)!r} has a broken .npy header: {exc}") from None
     if dtype.hasobject:
@@ -212,8 +177,7 @@ def write_table(path: str | os.PathLike[str], motion: Motion) -> Path:
 
 
 def _check_csv_rows(p: Path) -> None:
-    """Refuse a CSV row with more or fewer fields than the header, naming its line
-    (pandas would fill a short row with NaN, which reads as a gap in the motion)."""
+    """Refuse a row with another number of fields than the header (pandas fills NaN)."""
     import csv
 
     try:
