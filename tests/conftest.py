@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import signal
+import threading
+
 import matplotlib
 import numpy as np
 import pytest
@@ -63,3 +66,26 @@ def scheduler():
 
     with LocalCluster(n_workers=2, processes=False, **_LOCAL_TCP) as lc:
         yield lc.scheduler_address
+
+
+# A test that hangs (e.g. a Dask worker lost under a heavy load) fails after this long
+# instead of holding `make test` for ever.
+TEST_TIME_LIMIT = 900  # [s]
+
+
+@pytest.fixture(autouse=True)
+def _time_limit():
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signals reach the main thread only
+        return
+
+    def expired(signum, frame):
+        raise TimeoutError(f"the test ran longer than {TEST_TIME_LIMIT} s: it hangs")
+
+    before = signal.signal(signal.SIGALRM, expired)
+    signal.alarm(TEST_TIME_LIMIT)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, before)
