@@ -76,31 +76,17 @@ def _given(min_bpm: float | None, max_bpm: float | None) -> dict[str, float]:
     return {k: float(v) for k, v in bounds.items() if v is not None}
 
 
-def track_psf(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """Our tracker, :func:`beatsync.beats.track_beats` with its defaults."""
-    from .beats import track_beats
+def _ours(method: str) -> Callable[..., np.ndarray]:
+    """``track`` of :func:`beatsync.beats.track_beats` with ``method`` and its defaults."""
 
-    return _as_beats(track_beats(y, sr, **_given(min_bpm, max_bpm)).beats)
+    def track(
+        y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+    ) -> np.ndarray:
+        from .beats import track_beats
 
+        return _as_beats(track_beats(y, sr, method=method, **_given(min_bpm, max_bpm)).beats)
 
-def track_librosa(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """:func:`librosa.beat.beat_track` (hop 512); a tempo range replaces its log-normal tempo
-    prior with a flat one inside it (as ``track_beats(method="librosa")``).
-    """
-    import librosa
-
-    from .beats.tracker import LIBROSA_HOP, librosa_tempo_prior
-
-    prior = librosa_tempo_prior(**_given(min_bpm, max_bpm), sr=sr)  # None: the default
-    kwargs = {} if prior is None else {"prior": prior}
-    _, beats = librosa.beat.beat_track(
-        y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
-    )
-    return _as_beats(beats)
+    return track
 
 
 def prepare(name: str) -> None:
@@ -133,51 +119,43 @@ def _essentia():
     return es
 
 
-def _run_essentia(algorithm: str, y, sr, min_bpm, max_bpm):
-    """essentia's ``algorithm`` with its defaults (and a tempo range) on ``y`` at 44.1 kHz."""
-    tempo = {"minTempo": min_bpm, "maxTempo": max_bpm}
-    algo = getattr(_essentia(), algorithm)(
-        **{k: int(round(v)) for k, v in tempo.items() if v is not None}
-    )
-    y = np.asarray(y, dtype=np.float32)
-    if sr != ESSENTIA_SR:
-        y = resample_audio(y, sr, ESSENTIA_SR)
-    return algo(np.ascontiguousarray(y, dtype=np.float32))
+def _essentia_track(algorithm: str) -> Callable[..., np.ndarray]:
+    """``track`` of essentia's ``algorithm`` with its defaults (and a tempo range), at 44.1 kHz."""
 
+    def track(
+        y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+    ) -> np.ndarray:
+        tempo = {"minTempo": min_bpm, "maxTempo": max_bpm}
+        algo = getattr(_essentia(), algorithm)(
+            **{k: int(round(v)) for k, v in tempo.items() if v is not None}
+        )
+        y = np.asarray(y, dtype=np.float32)
+        if sr != ESSENTIA_SR:
+            y = resample_audio(y, sr, ESSENTIA_SR)
+        out = algo(np.ascontiguousarray(y, dtype=np.float32))
+        return _as_beats(out[0] if isinstance(out, tuple) else out)  # MultiFeature: + confidence
 
-def track_essentia_degara(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """essentia ``BeatTrackerDegara`` with its defaults (at 44.1 kHz)."""
-    return _as_beats(_run_essentia("BeatTrackerDegara", y, sr, min_bpm, max_bpm))
-
-
-def track_essentia_multifeature(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """essentia ``BeatTrackerMultiFeature`` with its defaults (at 44.1 kHz)."""
-    ticks, _confidence = _run_essentia("BeatTrackerMultiFeature", y, sr, min_bpm, max_bpm)
-    return _as_beats(ticks)
+    return track
 
 
 #: Every method by name, ours first.
 TRACKERS: dict[str, Tracker] = {
     p.name: p
     for p in (
-        Tracker("psf", "ours: phase-slope onsets, tempo/phase HMM (paper A)", track_psf),
+        Tracker("psf", "ours: phase-slope onsets, tempo/phase HMM (paper A)", _ours("psf")),
         Tracker(
-            "librosa", "librosa.beat.beat_track: dynamic programming (Ellis 2007)", track_librosa
+            "librosa", "librosa.beat.beat_track: dynamic programming (Ellis 2007)", _ours("librosa")
         ),
         Tracker(
             "essentia-degara",
             "essentia BeatTrackerDegara: probabilistic beat periods (Degara et al. 2012)",
-            track_essentia_degara,
+            _essentia_track("BeatTrackerDegara"),
             "essentia",
         ),
         Tracker(
             "essentia-multifeature",
             "essentia BeatTrackerMultiFeature: five onset features (Zapata et al. 2014)",
-            track_essentia_multifeature,
+            _essentia_track("BeatTrackerMultiFeature"),
             "essentia",
         ),
     )
