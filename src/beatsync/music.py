@@ -26,7 +26,7 @@ import numpy as np
 from .beats import check_audio, track_beats
 from .errors import ParameterError
 from .motion_beats import zscore
-from .validation import check_bpm, check_times, time_to_frames
+from .validation import check_times, time_to_frames
 
 __all__ = [
     "beat_rms_db",
@@ -79,16 +79,12 @@ def track_music_beats(
     fewer than two beats found.
     """
     y, sr = check_audio(y, sr)
-    if bpm is not None:
-        bpm = check_bpm(bpm)
-    kwargs: dict[str, Any] = {"method": method}
-    for name, value in (("bpm", bpm), ("min_bpm", min_bpm), ("max_bpm", max_bpm)):
-        if value is not None:
-            kwargs[name] = value
-    beats = np.asarray(track_beats(y, int(round(sr)), **kwargs).beats, dtype=np.float64)
+    given = {"bpm": bpm, "min_bpm": min_bpm, "max_bpm": max_bpm}
+    kwargs = {k: v for k, v in given.items() if v is not None}
+    beats = track_beats(y, int(round(sr)), method=method, **kwargs).beats
     if beats.size < 2:
         raise ParameterError(
             f"the beat tracker found {beats.size} beat(s) in the music: it needs a steady "
             "pulse (give --bpm, or a longer or louder piece)"
         )
-    return check_times(beats, name="music beats")
+    return beats

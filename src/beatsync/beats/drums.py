@@ -33,7 +33,6 @@ __all__ = [
     "MIN_CYCLES",
     "drum_envelopes",
     "alternation_cue",
-    "drum_cue",
 ]
 
 #: Weight of the alternation cue in the tactus observation (log-likelihood units).
@@ -132,16 +131,3 @@ def alternation_cue(
         score -= 0.5 * (np.interp(lags, k, auto[0]) + np.interp(lags, k, auto[1]))
         out[:, w] = np.where(lags * MIN_CYCLES <= n, np.maximum(score - NOISE_LEVEL, 0.0), 0.0)
     return out
-
-
-def drum_cue(
-    y: np.ndarray,
-    sr: float,
-    fps: float,
-    n_frames: int,
-    starts: np.ndarray,
-    stops: np.ndarray,
-    periods: np.ndarray,
-) -> np.ndarray:
-    """:func:`alternation_cue` of the audio's :func:`drum_envelopes`, (n_periods, n_windows)."""
-    return alternation_cue(drum_envelopes(y, sr, fps, n_frames), fps, starts, stops, periods)

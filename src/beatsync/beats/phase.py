@@ -52,26 +52,21 @@ def band_phase_weights(
     return conc / total
 
 
-def phase_hmm(
-    env: np.ndarray,
-    cycles: np.ndarray,
-    starts,
-    stops,
-    *,
-    n_phase: int,
-    pulse_width: float,
-    phase_sigma: float,
-    beta: float,
-) -> np.ndarray:
+#: Phase HMM: phase states per beat, pulse width and phase step sd [beats], sharpness.
+N_PHASE, PULSE_WIDTH, PHASE_SIGMA, PHASE_BETA = 64, 0.04, 0.03, 6.0
+
+
+def phase_hmm(env: np.ndarray, cycles: np.ndarray, starts, stops) -> np.ndarray:
     """Viterbi path of the beat phase (fraction of a beat) per window.
 
     Beats are where ``cycles + phase`` is an integer (``cycles``: the integrated tempo
     [beats] per frame); the observation is the correlation of the onset signal with a
     pulse train at those times (eq. 8).
     """
+    n_phase = N_PHASE
     frac = np.mod(cycles, 1.0)
     bins = np.rint(frac * n_phase).astype(np.int64) % n_phase
-    q, kf, log_trans = _phase_terms(n_phase, pulse_width, phase_sigma)
+    q, kf, log_trans = _phase_terms()
     hist = np.empty((len(starts), n_phase))
     for i, (a, b) in enumerate(zip(starts, stops, strict=True)):
         hist[i] = np.bincount(bins[a:b], weights=env[a:b], minlength=n_phase)
@@ -79,14 +74,15 @@ def phase_hmm(
     # windows in one batch of FFTs
     obs = np.fft.irfft(np.conj(np.fft.rfft(hist, axis=1)) * kf, n=n_phase, axis=1).T
     scale = np.maximum(obs.max(axis=0, keepdims=True), 1e-12)
-    log_like = beta * (obs / scale - 1.0)
+    log_like = PHASE_BETA * (obs / scale - 1.0)
     path = viterbi(log_like, log_trans)
     return q[path]
 
 
-@functools.lru_cache(maxsize=8)
-def _phase_terms(n_phase: int, pulse_width: float, phase_sigma: float):
-    """The phase grid, pulse kernel spectrum and log transitions of :func:`phase_hmm` (cached)."""
+@functools.lru_cache(maxsize=1)
+def _phase_terms():
+    """The phase grid, pulse kernel spectrum and log transitions of :func:`phase_hmm`."""
+    n_phase, pulse_width, phase_sigma = N_PHASE, PULSE_WIDTH, PHASE_SIGMA
     q = np.arange(n_phase) / n_phase
     dq = np.minimum(q, 1 - q)
     kernel = np.exp(-0.5 * (dq / pulse_width) ** 2)
@@ -107,8 +103,6 @@ def snap_to_onsets(
     times a Gaussian of its distance (sd ``reach / 2`` periods); onsets weaker than
     ``min_rel`` times the strongest are ignored.
     """
-    if onset_times.size == 0 or beats.size == 0:
-        return beats
     thresh = min_rel * np.max(onset_strengths)
     strong = onset_strengths >= thresh
     t, s = onset_times[strong], onset_strengths[strong]
@@ -137,27 +131,14 @@ def place_beats(
     fps = ons.fps
     n = ons.bands.shape[1]
     t_frames = np.arange(n) / fps
-    if centres.size > 1:
-        mids = (centres[1:] + centres[:-1]) / 2
-        period_f = period_w[np.searchsorted(mids, t_frames)]
-    else:
-        period_f = np.full(n, period_w[0])
+    period_f = period_w[np.searchsorted((centres[1:] + centres[:-1]) / 2, t_frames)]
     cycles = np.cumsum(1.0 / (period_f * fps))
     # band weights: phase concentration over tempo windows (see the module docstring)
     w_starts, w_stops, _ = analysis_windows(n, fps, tempo_win_s, tempo_win_s / 2)
     raw = band_phase_weights(ons.bands, cycles, w_starts, w_stops) @ ons.bands
     ph_win = float(np.clip(4.0 * np.median(period_w), 1.5, tempo_win_s))
     p_starts, p_stops, p_centres = analysis_windows(n, fps, ph_win, 0.25)
-    theta_w = phase_hmm(
-        raw,
-        cycles,
-        p_starts,
-        p_stops,
-        n_phase=64,
-        pulse_width=0.04,
-        phase_sigma=0.03,
-        beta=6.0,
-    )
+    theta_w = phase_hmm(raw, cycles, p_starts, p_stops)
     theta_u = np.unwrap(theta_w * 2 * np.pi) / (2 * np.pi)
     theta_f = np.interp(t_frames, p_centres, theta_u)
     total = cycles + theta_f

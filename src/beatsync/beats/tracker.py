@@ -23,7 +23,7 @@ from ..validation import (
     check_times,
     frames_to_time,
 )
-from .drums import DRUM_WEIGHT, drum_cue
+from .drums import DRUM_WEIGHT, alternation_cue, drum_envelopes
 from .filters import gaussian_smooth
 from .metrical import (
     METER_MODEL,
@@ -212,7 +212,6 @@ def track_beats(
             raise ParameterError(
                 f"front-end parameters {sorted(frontend_params)} only apply to method='psf'"
             )
-        y = np.asarray(y, dtype=np.float64)  # as librosa was always given it
         return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
     if method != "psf":
         raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
@@ -320,7 +319,8 @@ def observe(
     )
     if bpm is None and drum_weight > 0:
         y, sr = audio
-        log_obs = log_obs + drum_weight * drum_cue(y, sr, fps, n, starts, stops, periods)
+        cue = alternation_cue(drum_envelopes(y, sr, fps, n), fps, starts, stops, periods)
+        log_obs = log_obs + drum_weight * cue
     return Observation(starts, stops, centres, periods, max_hz, log_obs, salience, measure)
 
 
@@ -396,31 +396,26 @@ LIBROSA_MAX_TEMPO = 320.0
 LIBROSA_HOP = 512
 
 
-def librosa_tempo_steps(sr: float, hop: int = LIBROSA_HOP) -> np.ndarray:
+def librosa_tempo_steps(sr: float) -> np.ndarray:
     """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], ascending.
 
     One per whole lag of its 8 s onset autocorrelation, ``60 sr / (hop lag)``, below
     320 BPM (13.5 BPM apart near 190 BPM at 22.05 kHz).
     """
-    win = int(np.floor(8.0 * sr / hop))  # librosa.time_to_frames(ac_size=8, sr, hop)
-    lags = np.arange(1, win)
-    bpms = 60.0 * sr / (hop * lags)
+    win = int(np.floor(8.0 * sr / LIBROSA_HOP))  # librosa.time_to_frames(ac_size=8, ...)
+    bpms = 60.0 * sr / (LIBROSA_HOP * np.arange(1, win))
     return np.sort(bpms[bpms < LIBROSA_MAX_TEMPO])
 
 
 def librosa_tempo_prior(
-    min_bpm: float = DEFAULT_MIN_BPM,
-    max_bpm: float = DEFAULT_MAX_BPM,
-    *,
-    sr: float | None = None,
-    hop: int = LIBROSA_HOP,
+    min_bpm: float = DEFAULT_MIN_BPM, max_bpm: float = DEFAULT_MAX_BPM, *, sr: float
 ):
-    """The tempo prior for :func:`librosa.beat.beat_track`: ``None`` (librosa's own) for
-    the default range, else flat inside it (``scipy.stats.uniform``).
+    """The tempo prior for :func:`librosa.beat.beat_track` at ``sr`` [Hz]: ``None``
+    (librosa's own) for the default range, else flat inside it (``scipy.stats.uniform``).
 
-    Refuses (given ``sr``) a range holding none of :func:`librosa_tempo_steps`, e.g.
-    185-198 BPM at 22.05 kHz, or above 320 BPM: librosa would return one beat at an
-    infinite tempo. The message names the nearest tempi it can choose.
+    Refuses a range holding none of :func:`librosa_tempo_steps`, e.g. 185-198 BPM at
+    22.05 kHz, or above 320 BPM: librosa would return one beat at an infinite tempo. The
+    message names the nearest tempi it can choose.
     """
     if (min_bpm, max_bpm) == (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
         return None
@@ -429,23 +424,23 @@ def librosa_tempo_prior(
             f"min_bpm {min_bpm:g}: librosa's beat tracker does not search above "
             f"{LIBROSA_MAX_TEMPO:g} BPM; give a lower min_bpm (or track the half tempo)"
         )
-    if sr is not None:
-        steps = librosa_tempo_steps(sr, hop)
-        if not np.any((steps >= min_bpm) & (steps <= max_bpm)):
-            below = steps[steps < min_bpm]
-            above = steps[steps > max_bpm]
-            near = [f"{v:.1f}" for v in (below[-1:].tolist() + above[:1].tolist())]
-            verb = "is" if len(near) == 1 else "are"
-            nearest = (
-                f"the nearest {verb} {' and '.join(near)} BPM: widen the range to include one"
-                if near
-                else "it has none at this sample rate"
-            )
-            raise ParameterError(
-                f"tempo range {min_bpm:g}-{max_bpm:g} BPM holds none of the tempi librosa "
-                f"can choose at {sr:g} Hz (one lag of its onset autocorrelation, "
-                f"hop {hop}); {nearest}"
-            )
+    steps = librosa_tempo_steps(sr)
+    if not np.any((steps >= min_bpm) & (steps <= max_bpm)):
+        near = [
+            f"{v:.1f}"
+            for v in steps[steps < min_bpm][-1:].tolist() + steps[steps > max_bpm][:1].tolist()
+        ]
+        verb = "is" if len(near) == 1 else "are"
+        nearest = (
+            f"the nearest {verb} {' and '.join(near)} BPM: widen the range to include one"
+            if near
+            else "it has none at this sample rate"
+        )
+        raise ParameterError(
+            f"tempo range {min_bpm:g}-{max_bpm:g} BPM holds none of the tempi librosa "
+            f"can choose at {sr:g} Hz (one lag of its onset autocorrelation, "
+            f"hop {LIBROSA_HOP}); {nearest}"
+        )
     import scipy.stats  # noqa: PLC0415
 
     return scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
@@ -454,16 +449,14 @@ def librosa_tempo_prior(
 def _track_librosa(y, sr, *, bpm, min_bpm, max_bpm) -> BeatTrack:
     import librosa  # noqa: PLC0415 (heavy; only for the comparison method)
 
-    hop = LIBROSA_HOP
     kwargs: dict[str, Any] = {}
     if bpm is not None:
         kwargs["bpm"] = bpm
-    elif (prior := librosa_tempo_prior(min_bpm, max_bpm, sr=sr, hop=hop)) is not None:
+    elif (prior := librosa_tempo_prior(min_bpm, max_bpm, sr=sr)) is not None:
         kwargs["prior"] = prior
     tempo, beats = librosa.beat.beat_track(
-        y=y.astype(np.float32), sr=sr, hop_length=hop, units="time", **kwargs
+        y=y.astype(np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
     )
     tempo = float(np.atleast_1d(tempo)[0])
     beats = np.unique(np.asarray(beats, dtype=np.float64))
-    dur = y.size / sr
-    return BeatTrack(beats, tempo, np.array([dur / 2]), np.array([tempo]), "librosa")
+    return BeatTrack(beats, tempo, np.array([y.size / sr / 2]), np.array([tempo]), "librosa")

@@ -240,8 +240,6 @@ def evaluate(
     fewer than two music beats).
     """
     out: dict[str, float] = dict(alignment_scores(motion_beats, music_beats, sigma=sigma, **kwargs))
-    yb = validate(motion_beats, music_beats)[1]
-    out["phase_consistency"] = (
-        beat_phase_consistency(motion_beats, music_beats) if yb.size >= 2 else float("nan")
-    )
+    mb, yb = validate(motion_beats, music_beats)
+    out["phase_consistency"] = beat_phase_consistency(mb, yb) if yb.size >= 2 else float("nan")
     return out
