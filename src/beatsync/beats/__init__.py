@@ -10,12 +10,9 @@ librosa's ``onset`` / ``beat`` / ``sequence`` seams: :mod:`.onset` (the front en
 ``method="librosa"`` wraps :func:`librosa.beat.beat_track` for comparison.
 """
 
-from ..validation import check_bpm
 from .onset import FRONTEND_DEFAULTS, FrontEnd, OnsetSignal, onset_strength_psf, phase_slope
 from .tracker import (
     MIN_DURATION_S,
-    MIN_PATH_SALIENCE,
-    MIN_PULSE_CLARITY,
     SILENCE_PEAK,
     BeatTrack,
     beat_tempo,
@@ -33,13 +30,10 @@ __all__ = [
     "onset_strength_psf",
     "phase_slope",
     "check_audio",
-    "check_bpm",
     "check_duration",
     "beat_tempo",
     "mix_clicks",
     "FRONTEND_DEFAULTS",
     "MIN_DURATION_S",
     "SILENCE_PEAK",
-    "MIN_PATH_SALIENCE",
-    "MIN_PULSE_CLARITY",
 ]

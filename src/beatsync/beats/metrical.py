@@ -163,7 +163,7 @@ def resonator_saliences(
         seg = np.zeros((len(chunk), n_sets, n_bands, n_acf))
         for i, (a, b) in enumerate(chunk):
             x = bands[:, :, a:b]
-            seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * _hanning(b - a)
+            seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * np.hanning(b - a)
         spec = scipy.fft.rfft(seg, axis=3)
         acf = scipy.fft.irfft(spec.real**2 + spec.imag**2, n=n_acf, axis=3)[..., :length]
         acf = acf.reshape(-1, length).T  # (lag, window x set x band)
@@ -185,14 +185,6 @@ def resonator_saliences(
         r = r.reshape(r.shape[0], n_win, n_sets, n_bands).sum(axis=3)
         out.append(r if sets else r[:, :, 0])
     return out
-
-
-@functools.lru_cache(maxsize=8)
-def _hanning(n: int) -> np.ndarray:
-    """``np.hanning(n)``, cached (every tempo window of a song has the same length)."""
-    w = np.hanning(n)
-    w.flags.writeable = False
-    return w
 
 
 #: Analysis windows whose autocorrelations :func:`resonator_salience` holds at once.

@@ -86,12 +86,8 @@ def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     band that holds no FFT bin at the analysis rate.
     """
     sr = check_sample_rate(sr)
-    if not params:  # the defaults (an empty dict, or None)
-        defaults = tuple(FRONTEND_DEFAULTS.items())  # the key: they may have been changed
-        try:
-            return _default_frontend(sr, defaults)
-        except TypeError:  # a default changed to something unhashable
-            return _frontend_settings({}, sr)
+    if not params:  # the defaults, cached on their values (they may have been changed)
+        return _default_frontend(sr, tuple(FRONTEND_DEFAULTS.items()))
     return _frontend_settings(params, sr)
 
 
