@@ -197,20 +197,15 @@ def check_tempo_range(
     from .beats.tracker import LIBROSA_MAX_TEMPO
     from .validation import check_bpm
 
-    tracker = TRACKERS.get(name)
-    if tracker is None:
-        get(name)  # raises: unknown method
-    given = {
-        key: check_bpm(value, name=label)
-        for key, label, value in zip(("min_bpm", "max_bpm"), names, (min_bpm, max_bpm), strict=True)
-        if value is not None
-    }
+    tracker = TRACKERS.get(name) or get(name)  # get refuses an unknown method
+    label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
+    bounds = {"min_bpm": min_bpm, "max_bpm": max_bpm}
+    given = {k: check_bpm(v, name=label[k]) for k, v in bounds.items() if v is not None}
     if not given:
         return {}
     defaults = _default_range(tracker)
     essentia = tracker.requires == "essentia"
     span = ESSENTIA_TEMPO["span"] if essentia else 0
-    label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
     for key, value in given.items() if essentia else ():
         a, b = ESSENTIA_TEMPO[key[:3]]  # "min" or "max"
         if value != round(value) or not a <= value <= b:

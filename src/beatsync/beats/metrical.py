@@ -99,14 +99,9 @@ def resonator_salience(
     several sets at once (the draws of the pulse-clarity null; the result gets a last axis
     of n_sets). ``periods`` [s] need not be whole frames. Above ``max_hz`` [Hz] (where a
     smoothed accent signal has almost no energy) every resonator passes its mean gain
-    ``gamma`` instead of being filtered (saves time).
-
-    The energy ``sum_b P(b) |H_tau(b)|^2`` over the padded window's FFT bins
-    (:func:`resonator_fft_size`) is taken in the lag domain, ``sum_k a(k) c(k)`` with
-    ``a`` the window's autocorrelation (an FFT of ``2 L - 1`` points instead of ``n_fft``)
-    and ``c`` the cached lag weights (:func:`_resonator_lag_weights`). The product is taken
-    in float32 on autocorrelations divided by their lag-0 value (scale-free; about 1e-7 of
-    each band's range).
+    ``gamma`` instead of being filtered (saves time). The energy ``sum_b P(b) |H_tau(b)|^2``
+    is taken in the lag domain, ``sum_k a(k) c(k)``: ``a`` the window's autocorrelation
+    over its lag-0 value, ``c`` the cached lag weights (:func:`_resonator_lag_weights`).
     """
     return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
 

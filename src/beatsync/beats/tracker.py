@@ -175,12 +175,8 @@ def track_beats(
     ``frontend_params``: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
     ``flux_norm_s``, ``analysis_sr`` (see :func:`beatsync.beats.onset_strength_psf`).
 
-    Raises :class:`ParameterError` for empty, silent or non-finite audio, audio too short
-    for a pulse (:func:`check_duration`), a bad ``sr``, tempo bound or range, a ``bpm``
-    given with a range other than the default, an unknown method or front-end parameter.
-    Warns (:class:`~beatsync.errors.BeatsyncWarning`) when no onsets are found (no
-    beats) or when the pulse is unclear (:func:`pulse_clarity_null`; e.g. noise). A
-    steady tone has onsets and gets beats without a warning (see :mod:`.onset`).
+    Refuses empty, silent, non-finite or too short audio (:func:`check_duration`) and bad
+    settings; warns when no onsets are found or the pulse is unclear (e.g. noise).
 
     Examples
     --------
@@ -191,8 +187,7 @@ def track_beats(
     >>> round(bt.tempo)
     120
     """
-    # float32 audio stays float32 for our tracker (its front end runs in float32: the
-    # same samples, without a float64 copy); any other type becomes float64
+    # float32 stays float32 (the front end runs in float32); any other type becomes float64
     y, sr = _units_check_audio(y, sr, silence_peak=SILENCE_PEAK)
     if y.dtype != np.float32:
         y = np.asarray(y, dtype=np.float64)

@@ -72,14 +72,9 @@ def transition_jumps(
         return np.empty(0)
     if med <= 0:
         raise ParameterError("the motion does not move: velocity changes are all zero")
-    out = []
-    first = time_to_frames(tt, fps=fps, mode="floor") - 1
-    after = time_to_frames(tt + blend, fps=fps, mode="ceil") + 1
-    for f0, f1 in zip(first, after, strict=True):
-        j0 = max(0, int(f0))
-        j1 = min(dv.size, int(f1))
-        out.append(dv[j0:j1].max() / med if j1 > j0 else np.nan)
-    return np.asarray(out)
+    j0 = np.maximum(time_to_frames(tt, fps=fps, mode="floor") - 1, 0)
+    j1 = np.minimum(time_to_frames(tt + blend, fps=fps, mode="ceil") + 1, dv.size)
+    return np.array([dv[a:b].max() / med if b > a else np.nan for a, b in zip(j0, j1, strict=True)])
 
 
 def foot_joints(motion: Any) -> list[str]:

@@ -241,11 +241,6 @@ def add_noise(y: np.ndarray, *, snr_db: float, seed: int = 0) -> np.ndarray:
     return (0.5 * out / np.max(np.abs(out))).astype(np.float32)
 
 
-def _second_tempo(bpm: float) -> float:
-    """Tempo after the abrupt change: +1/3 for slow tempi, -1/4 for fast ones."""
-    return bpm * 4 / 3 if bpm <= 120 else bpm * 3 / 4
-
-
 def make_beat_test_set(
     *,
     sr: int = 22050,
@@ -274,12 +269,9 @@ def make_beat_test_set(
     duration = check_positive(duration, name="duration", unit="s")
     if duration < 4.0:
         raise ParameterError(f"duration={duration!r} s is too short for a test item (>= 4 s)")
-    for k in kinds:
-        if k not in KINDS:
-            raise ParameterError(f"unknown kind {k!r}; choose from {KINDS}")
-    for g in groups:
-        if g not in GROUPS:
-            raise ParameterError(f"unknown group {g!r}; choose from {GROUPS}")
+    for what, values, known in (("kind", kinds, KINDS), ("group", groups, GROUPS)):
+        for v in set(values) - set(known):
+            raise ParameterError(f"unknown {what} {v!r}; choose from {known}")
     rng = np.random.default_rng(seed)
     items = []
     for kind in kinds:
@@ -288,7 +280,9 @@ def make_beat_test_set(
                 bpm = check_bpm(bpm)
                 start = 0.2 + float(rng.uniform(0.0, 0.3))
                 item_seed = int(rng.integers(2**31))
-                bpm_end = _second_tempo(bpm) if group == "change" else bpm
+                bpm_end = bpm
+                if group == "change":  # +1/3 for slow tempi, -1/4 for fast ones
+                    bpm_end = bpm * 4 / 3 if bpm <= 120 else bpm * 3 / 4
                 beats = beat_times(
                     bpm,
                     duration=duration,
@@ -356,8 +350,7 @@ def drum_song(
     k = np.clip(np.searchsorted(beats, t, side="right") - 1, 0, beats.size - 1)
     env = 10.0 ** (gain_db[k] / 20.0)
     ramp = max(1, int(time_to_frames(0.005, fps=sr, mode="floor")))
-    env = np.convolve(np.pad(env, (ramp, ramp), mode="edge"), np.ones(ramp) / ramp, "same")[
-        ramp:-ramp
-    ]
+    padded = np.pad(env, (ramp, ramp), mode="edge")
+    env = np.convolve(padded, np.ones(ramp) / ramp, "same")[ramp:-ramp]
     y = (y * env).astype(np.float32)
     return DrumSong(y=y, sr=int(sr), beats=beats, bpm=bpm, gain_db=gain_db)
