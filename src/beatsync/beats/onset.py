@@ -179,10 +179,7 @@ BLOCK_FRAMES = 256
 
 def _frames(y32: np.ndarray, n_fft: int, hop: int) -> np.ndarray:
     """Frames (n_frames, n_fft) of the zero-padded signal, frame ``m`` centred on ``m * hop``."""
-    pad = n_fft // 2
-    yp = np.zeros(y32.size + 2 * pad, dtype=y32.dtype)  # np.pad's zeros, without its overhead
-    yp[pad : pad + y32.size] = y32
-    return np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]
+    return np.lib.stride_tricks.sliding_window_view(np.pad(y32, n_fft // 2), n_fft)[::hop]
 
 
 def _frame_window(window: np.ndarray, n_fft: int) -> np.ndarray:
