@@ -3,18 +3,9 @@
 Every method is ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``: mono audio at
 ``sr`` [Hz] in, beat times [s] out (1-D ``float64``, strictly increasing), with its
 published defaults. A tempo range narrows the tempi searched (:func:`check_tempo_range`);
-only ours keeps its beats inside it (:func:`track` warns otherwise). :data:`TRACKERS`:
-
-- ``"psf"``: ours, :func:`beatsync.beats.track_beats` (paper A, section 4).
-- ``"librosa"``: :func:`librosa.beat.beat_track` (Ellis 2007, dynamic programming),
-  hop 512.
-- ``"essentia-degara"``: essentia's ``BeatTrackerDegara`` (Degara et al. 2012), at the
-  44.1 kHz it requires.
-- ``"essentia-multifeature"``: essentia's ``BeatTrackerMultiFeature`` (Zapata et al.
-  2014), at 44.1 kHz.
-
-The essentia methods need the optional ``essentia`` package
-(``pip install 'beatsync[peers]'``; AGPL-3.0): :func:`get` refuses them without it.
+only ours keeps its beats inside it (:func:`track` warns otherwise). The methods are
+:data:`TRACKERS`; essentia's (at the 44.1 kHz they require) need the optional ``essentia``
+package (``pip install 'beatsync[peers]'``; AGPL-3.0).
 """
 
 from __future__ import annotations

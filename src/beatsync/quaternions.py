@@ -18,13 +18,9 @@ _AXIS = {"X": 0, "Y": 1, "Z": 2}
 
 
 def quat_from_euler(angles_deg: np.ndarray, axes: str) -> np.ndarray:
-    """Quaternions of intrinsic rotations about ``axes`` (e.g. ``"ZXY"``) [deg].
-
-    The BVH convention, and scipy's for upper-case axes: the rotation is
-    ``R = R_axes[0](a0) @ R_axes[1](a1) @ ...`` (each later rotation about the axes
-    already turned by the earlier ones).
-    ``angles_deg`` is ``(n, len(axes))``; ``axes`` is one to three of ``X``, ``Y``, ``Z``
-    (case-insensitive: always intrinsic). Returns ``(n, 4)`` quaternions, scalar last.
+    """Quaternions ``(n, 4)`` of intrinsic rotations about ``axes`` (one to three of X, Y, Z,
+    any case) by ``angles_deg`` ``(n, len(axes))`` [deg]: ``R = R_axes[0](a0) @ R_axes[1](a1)
+    @ ...``, the BVH convention (scipy's for upper-case axes).
 
     Examples
     --------

@@ -129,7 +129,7 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     band = _bin_bands(np.fft.rfftfreq(n_fft, d=1.0 / sr), edges)
     empty = np.flatnonzero(np.bincount(band[band >= 0], minlength=edges.size - 1) == 0)
     # the default top band (4-22 kHz) is empty below 8 kHz: only edges a user gave count
-    # (onset_strength_psf and phase_slope pass the defaults on explicitly)
+    # (phase_slope passes the defaults on explicitly)
     given = "band_edges_hz" in params and tuple(float(e) for e in params["band_edges_hz"]) != tuple(
         FRONTEND_DEFAULTS["band_edges_hz"]
     )
@@ -288,24 +288,14 @@ def phase_slope(
     return psf, energy, fps, mag.T
 
 
-def onset_strength_psf(
-    y: np.ndarray,
-    sr: float,
-    *,
-    win_s: float = FRONTEND_DEFAULTS["win_s"],
-    hop_s: float = FRONTEND_DEFAULTS["hop_s"],
-    n_fft: int | None = FRONTEND_DEFAULTS["n_fft"],
-    band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
-    flux_norm_s: float = FRONTEND_DEFAULTS["flux_norm_s"],
-    analysis_sr: float | None = FRONTEND_DEFAULTS["analysis_sr"],
-) -> OnsetSignal:
+def onset_strength_psf(y: np.ndarray, sr: float, **params: Any) -> OnsetSignal:
     """Onset signal from positive zero crossings of the band phase-slope function.
 
     Each crossing in band ``c`` is weighted by the band's spectral flux around it
     (half-wave rectified log-magnitude difference minus its local mean over
-    ``flux_norm_s`` [s]; eqs. 6-7); bands combined with weights ``6 - c``. ``hop_s`` is at
-    most ``win_s / 2``. Audio above ``analysis_sr`` [Hz] is first resampled to it (soxr),
-    so that 22.05, 44.1 and 48 kHz input behave alike; None analyses at the input rate.
+    ``flux_norm_s`` [s]; eqs. 6-7); bands combined with weights ``6 - c``. ``params``: the
+    front end's settings (:data:`FRONTEND_DEFAULTS`); audio above ``analysis_sr`` [Hz] is
+    first resampled to it (soxr), so that 22.05, 44.1 and 48 kHz input behave alike.
 
     Examples
     --------
@@ -315,9 +305,7 @@ def onset_strength_psf(
     >>> bool(abs(ons.onset_times[np.argmax(ons.onset_strengths)] - 0.5) < 0.01)
     True
     """
-    given = {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}
-    given.update(flux_norm_s=flux_norm_s, analysis_sr=analysis_sr)
-    return compute_onsets(*_validated(y, sr, given))
+    return compute_onsets(*_validated(y, sr, params))
 
 
 def _validated(y, sr, params: dict[str, Any]) -> tuple[np.ndarray, float, FrontEnd]:

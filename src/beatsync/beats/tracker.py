@@ -172,8 +172,7 @@ def track_beats(
     ``tempo_win_s``, ``tempo_hop_s`` [s]: the tempo HMM's windows; ``time_varying=False``
     forces one tempo for the whole piece. ``drum_weight``: weight of the drum-pattern cue
     of the metrical level (:mod:`beatsync.beats.drums`; 0 leaves it out).
-    ``frontend_params``: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
-    ``flux_norm_s``, ``analysis_sr`` (see :func:`beatsync.beats.onset_strength_psf`).
+    ``frontend_params``: the front end's settings (:data:`.onset.FRONTEND_DEFAULTS`).
 
     Refuses empty, silent, non-finite or too short audio (:func:`check_duration`) and bad
     settings; warns when no onsets are found or the pulse is unclear (e.g. noise).

@@ -9,11 +9,9 @@ kind, but average over different sets:
 - :func:`beat_alignment_music` averages over **music beats** (Siyao et al. 2022,
   Bailando "BAS"): is every beat of the song danced? Extra motion beats cost nothing.
 
-The papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (the default). Every table
-says which score it reports; :func:`alignment_scores` returns both. Beat times are 1-D
-float64 seconds, strictly increasing (as in ``mir_eval.beat``); scores lie in ``[0, 1]``.
-Empty input is degenerate but legal: a warning, and the score is 0. No stage runs here
-(mir_eval style: :func:`validate`, the metrics, :func:`evaluate`).
+The papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (the default). Beat times
+are 1-D float64 seconds, strictly increasing; scores lie in ``[0, 1]``, 0 (with a
+warning) for empty input.
 """
 
 from __future__ import annotations
