@@ -189,14 +189,8 @@ def drum_pattern(
     beats, sr, duration = _check_common(beats, sr, duration)
     if not 0.0 < swing < 1.0:
         raise ParameterError(f"swing={swing!r} must be a fraction of the beat in (0, 1)")
-    rng = np.random.default_rng(seed)
-    n = int(round(duration * sr))
-    y = _render(beats[0::2], _kick(sr), n, sr, 1.0)
-    y += _render(beats[1::2], _snare(sr, rng), n, sr, 0.8)
-    hat = _hihat(sr, rng)
-    y += _render(beats, hat, n, sr, 1.0)
-    y += _render(_offbeats(beats, swing), hat, n, sr, offbeat_gain)
-    return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
+    down = np.arange(beats.size) % 2 == 0
+    return _drums(beats, down, [swing], (0.8, 1.0, offbeat_gain), sr, duration, seed)
 
 
 def meter_pattern(
@@ -217,15 +211,23 @@ def meter_pattern(
         raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")
     beats, sr, duration = _check_common(beats, sr, duration)
     per_bar, eighths = METERS[meter]
+    down = np.arange(beats.size) % per_bar == 0
+    offsets = [k / eighths for k in range(1, eighths)]
+    return _drums(beats, down, offsets, (0.6, 0.5, 0.3), sr, duration, seed)
+
+
+def _drums(beats, down, offsets, gains, sr, duration, seed) -> np.ndarray:
+    """Kick on the ``down`` beats, snare on the others, hi-hat on every beat and at each
+    offset [beats]; ``gains`` of the snare, the hi-hat and the off-beat hi-hats."""
+    snare_gain, hat_gain, offbeat_gain = gains
     rng = np.random.default_rng(seed)
     n = int(round(duration * sr))
-    down = np.arange(beats.size) % per_bar == 0
     y = _render(beats[down], _kick(sr), n, sr, 1.0)
-    y += _render(beats[~down], _snare(sr, rng), n, sr, 0.6)
+    y += _render(beats[~down], _snare(sr, rng), n, sr, snare_gain)
     hat = _hihat(sr, rng)
-    y += _render(beats, hat, n, sr, 0.5)
-    for k in range(1, eighths):
-        y += _render(_offbeats(beats, k / eighths), hat, n, sr, 0.3)
+    y += _render(beats, hat, n, sr, hat_gain)
+    for offset in offsets:
+        y += _render(_offbeats(beats, offset), hat, n, sr, offbeat_gain)
     return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
 
 
