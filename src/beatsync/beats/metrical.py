@@ -19,9 +19,7 @@ onsets (its four bands play the paper's four accent bands):
    (:mod:`beatsync.beats.tempo`) decodes the tactus observation left.
 3. **Meter** (:func:`estimate_meter`): beats per bar.
 
-``beta``, the prior widths, the ratio weights (:data:`METER_MODEL`), the spectral
-sampling and the known limits of the per-window evaluation (it prefers the fastest
-pulse present; the tactus prior and the drum cue decide): docs/tuning.md#metrical-model.
+Tuning (:data:`METER_MODEL`) and known limits: docs/tuning.md#metrical-model.
 """
 
 from __future__ import annotations
@@ -46,16 +44,11 @@ __all__ = [
 
 @dataclass(frozen=True)
 class MeterModel:
-    """Constants of the metrical model (Klapuri et al. 2006, section IV).
-
-    ``half_time_s`` [s]: the comb filters' feedback half-time ``T0`` (paper: 3 s). The
-    ``*_median_s`` [s] and ``*_sigma`` [natural-log units] of the log-normal period priors
-    (paper medians: 0.18, 0.55, 2.1 s). ``ratio_weights``: ``w_l`` (l = 1..9) of the ratio
-    model for measure / tactus; ``tatum_ratio_weights`` for tactus / tatum, with
-    ``w_3 = 0.5`` so that a "beat" of three sixteenths does not beat a waltz's own beat
-    (docs/tuning.md#tatum-ratio-weight). ``beta``: the log likelihood of a period is
-    ``beta * s(tau)``. ``min_tatum_s``, ``max_measure_s`` [s]: the shortest tatum and
-    longest measure.
+    """Constants of the metrical model (Klapuri et al. 2006, section IV): ``half_time_s``
+    [s] is ``T0``; ``*_median_s`` [s] and ``*_sigma`` [natural-log units] are the period
+    priors'; ``ratio_weights`` the ``w_l`` (l = 1..9) of measure / tactus, and
+    ``tatum_ratio_weights`` of tactus / tatum (``w_3 = 0.5``: a "beat" of three sixteenths
+    must not beat a waltz's own beat, docs/tuning.md#tatum-ratio-weight).
     """
 
     half_time_s: float = 3.0

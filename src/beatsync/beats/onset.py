@@ -9,10 +9,8 @@
    slope, weighted by the band's locally normalised spectral flux (eqs. 6-7); bands
    combined with weights ``6 - c`` (c = 1..4, low bands count most).
 
-:data:`FRONTEND_DEFAULTS` (not published in the paper) are swept in
-``notebooks/paper_a_sec4_beat_tracking.ipynb``. Known limit: a steady tone has onsets
-(its leakage makes the phase slope cross zero at a steady rate in the other bands;
-docs/tuning.md#front-end-phase-slope-onsets).
+:data:`FRONTEND_DEFAULTS` are not the paper's; known limit (a steady tone has onsets):
+docs/tuning.md#front-end-phase-slope-onsets.
 """
 
 from __future__ import annotations
@@ -79,12 +77,9 @@ class FrontEnd:
 
 
 def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
-    """Validate front-end parameters (keys of :data:`FRONTEND_DEFAULTS`) for input rate ``sr``.
-
-    Refuses an unknown key, a window under 16 samples, a hop over half the window, an FFT
-    shorter than the window, band edges that do not increase, or given band edges with a
-    band that holds no FFT bin at the analysis rate.
-    """
+    """Validate front-end parameters (keys of :data:`FRONTEND_DEFAULTS`) for input rate ``sr``:
+    a window of 16 samples or more, a hop of at most half of it, increasing band edges each
+    holding an FFT bin at the analysis rate."""
     sr = check_sample_rate(sr)
     if not params:  # the defaults, cached on their values (they may have been changed)
         return _default_frontend(sr, tuple(FRONTEND_DEFAULTS.items()))
@@ -151,12 +146,10 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
 
 @dataclass(frozen=True)
 class OnsetSignal:
-    """Output of :func:`onset_strength_psf`.
-
-    ``envelope`` (n_frames,): band-weighted onset impulses at ``fps`` [Hz]; ``bands``
-    (n_bands, n_frames): per band, unweighted; ``onset_times`` [s] (sub-frame) and
-    ``onset_strengths`` (band-weighted) of every onset; ``band_weights``: ``6 - c``
-    normalised to sum 1; ``psf`` (n_bands, n_frames) [s]: the phase slope (NaN where silent).
+    """Output of :func:`onset_strength_psf`: ``envelope`` (n_frames,), band-weighted onset
+    impulses at ``fps`` [Hz]; ``bands`` (n_bands, n_frames), unweighted; ``onset_times`` [s]
+    (sub-frame) and ``onset_strengths`` (band-weighted) of every onset; ``band_weights``,
+    ``6 - c`` summing to 1; ``psf`` (n_bands, n_frames) [s], the phase slope (NaN if silent).
     """
 
     envelope: np.ndarray

@@ -302,10 +302,7 @@ def observe(
     n = ons.envelope.size
     accents = _accents(ons.bands, fps)
     starts, stops, centres = analysis_windows(n, fps, tempo_win_s, tempo_hop_s)
-    if bpm is not None:
-        periods = np.array([60.0 / bpm])
-    else:
-        periods = period_grid(min_bpm, max_bpm)
+    periods = period_grid(min_bpm, max_bpm) if bpm is None else np.array([60.0 / bpm])
     # above this the 10-ms smoothing leaves < 1 % of the accent power
     max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * _accent_sigma(fps) / fps)
     log_obs, salience, measure = tactus_observation(

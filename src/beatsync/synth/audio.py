@@ -1,15 +1,12 @@
 """Synthetic beat-tracking test signals with exact ground truth.
 
-Audio is mono ``float32`` at ``sr`` [Hz]; beats are 1-D ``float64`` seconds, strictly
-increasing, rendered sample-exactly (every beat is the onset of a click or a drum hit).
-
-The test set (:func:`make_beat_test_set`) crosses click tracks and drum patterns (kick
-on beats 1 and 3, snare on 2 and 4, hi-hat on every eighth) at 60-180 BPM with five
-:data:`GROUPS`: ``clean``, ``drift`` (sinusoidal tempo drift of +-5 %), ``swing``
-(off-beat eighths at 2/3 of the beat), ``noise`` (white noise at 10 dB SNR) and
-``change`` (an abrupt tempo change halfway). It stands in for the paper's test music.
-:func:`drum_song` renders a song for paper B's studies: the drum pattern with a gain
-that changes every few beats, like verses and choruses.
+Audio is mono ``float32`` at ``sr`` [Hz]; beats are 1-D ``float64`` seconds, every one
+the onset of a click or a drum hit (sample-exact). The test set (:func:`make_beat_test_set`,
+standing in for the paper's test music) crosses click tracks and drum patterns at 60-180
+BPM with five :data:`GROUPS`: ``clean``, ``drift`` (sinusoidal tempo drift of +-5 %),
+``swing`` (off-beat eighths at 2/3 of the beat), ``noise`` (white noise at 10 dB SNR) and
+``change`` (an abrupt tempo change halfway). :func:`drum_song`, for paper B's studies, has
+a gain that changes every few beats, like verses and choruses.
 """
 
 from __future__ import annotations
@@ -255,11 +252,8 @@ def make_beat_test_set(
     swing: float = 2 / 3,
     seed: int = 0,
 ) -> list[BeatTestItem]:
-    """The synthetic beat-tracking test set, in the order kinds x groups x bpms.
-
-    ``snr_db`` [dB] is the ``noise`` group's SNR, ``drift`` the ``drift`` group's relative
-    amplitude, ``swing`` the ``swing`` group's off-beat position; ``seed`` draws the first
-    beats and all noise.
+    """The synthetic beat-tracking test set, in the order kinds x groups x bpms; ``snr_db``
+    [dB], ``drift`` and ``swing`` set their groups, ``seed`` draws first beats and noise.
 
     Examples
     --------

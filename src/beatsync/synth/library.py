@@ -163,15 +163,14 @@ def synthetic_library(
         raise ParameterError(f"n_clips={n_clips!r} must be >= 1")
     rng = np.random.default_rng(seed)
     tempi = rng.uniform(bpm_range[0], bpm_range[1], size=int(n_clips))
-    clips, beats = [], []
-    for i, bpm in enumerate(tempi):
-        m, b = synthetic_dance(
+    dances = [
+        synthetic_dance(
             duration=duration,
             bpm=float(bpm),
             fps=fps,
             seed=seed * 1000 + i,
             name=f"synthetic_{i:02d}",
         )
-        clips.append(m)
-        beats.append(b)
-    return clips, beats
+        for i, bpm in enumerate(tempi)
+    ]
+    return [m for m, _ in dances], [b for _, b in dances]
