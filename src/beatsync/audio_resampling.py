@@ -24,12 +24,9 @@ def resample(
     *,
     keep_level: bool = True,
 ) -> np.ndarray:
-    """Resample mono audio from ``orig_sr`` to ``target_sr`` [Hz] (float32).
-
-    ``n_out`` samples (default ``ceil(n * target_sr / orig_sr)``, as librosa), trimmed or
-    zero-padded at the end. Trusts its input. Audio louder than :data:`LOUDEST` is filtered
-    at a level lowered by a power of two and raised again (exactly); ``keep_level=False``
-    leaves it lowered, for a caller that normalises.
+    """Resample mono audio from ``orig_sr`` to ``target_sr`` [Hz] to ``n_out`` samples
+    (float32; default ``ceil(n * target_sr / orig_sr)``, as librosa). Trusts its input;
+    ``keep_level=False`` leaves audio louder than :data:`LOUDEST` lowered (exactly).
     """
     import soxr  # noqa: PLC0415 (only where audio is resampled)
 

@@ -180,10 +180,8 @@ def check_tempo_range(
 ) -> dict[str, float]:
     """The tempo range [BPM] that method ``name`` will search, checked; ``{}`` if none.
 
-    A bound not given (or equal to the default) keeps the method's default: 40-240 BPM
-    within 20-400 for ``psf`` and ``librosa`` (which refuses a ``min_bpm`` of 320 or more),
-    essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers, at least 20
-    apart). ``names``: how the two bounds are named in the errors (e.g. ``--min-bpm``).
+    A bound not given (or equal to the default) keeps the method's default (essentia's:
+    :data:`ESSENTIA_TEMPO`). ``names``: the bounds' names in the errors (``--min-bpm``).
     """
     from .beats.tracker import LIBROSA_MAX_TEMPO
     from .validation import check_bpm
@@ -245,7 +243,8 @@ OUT_OF_RANGE_TEXT = "outside the range it was given"
 
 
 def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) -> None:
-    """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it."""
+    """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it
+    (essentia's beats can then differ from one call to the next; MTG/essentia issue 1097)."""
     if not tempo or beats.size < 3:
         return
     from .errors import warn
@@ -292,12 +291,9 @@ def track(
     min_bpm: float | None = None,
     max_bpm: float | None = None,
 ) -> np.ndarray:
-    """Run the method ``name`` on ``y`` at ``sr`` [Hz]; return beat times [s].
-
-    The audio is checked here for every method as ours checks it (and refused if shorter
-    than :data:`beatsync.beats.MIN_DURATION_S`). Warns when, given a range, the beats'
-    median tempo lies more than :data:`OUT_OF_RANGE_TOLERANCE` outside it (essentia's beats
-    can then differ from one call to the next; MTG/essentia issue 1097).
+    """Beat times [s] of the method ``name`` on ``y`` at ``sr`` [Hz], the audio checked as
+    ours checks it. Warns when the beats' median tempo lies more than
+    :data:`OUT_OF_RANGE_TOLERANCE` outside a given range (see :func:`_warn_out_of_range`).
     """
     from .beats import check_audio
     from .beats.tracker import check_duration

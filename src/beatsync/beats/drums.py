@@ -1,13 +1,11 @@
 """The drum-pattern cue of the metrical level: a bass drum and a snare drum that
 alternate mark the beat (Goto 2001, J. New Music Research 30(2), 159-171).
 
-The metrical model gives the same drum pattern at 60 and 180 BPM the same evidence in
-beat units, and its prior pulls both towards 110 BPM; this cue settles it:
+The metrical model's prior pulls a drum pattern at 60 or 180 BPM towards 110 BPM; this
+cue settles it:
 
-1. **Two envelopes** (:func:`drum_envelopes`): the rising energy of the bass drum's band
-   (:data:`LOW_BAND_HZ`) and of the snare drum's (:data:`MID_BAND_HZ`), from their own
-   STFT (the front end's 0-250 Hz band holds both), at the onset signal's frame rate.
-   Energy, not its log: on a log scale the decays count as much as the attacks.
+1. **Two envelopes** (:func:`drum_envelopes`): the rising energy (not its log: the decays
+   would count as much as the attacks) of the bass drum's and the snare drum's band.
 2. **Alternation** (:func:`alternation_cue`): per window and period ``tau``, ``A(tau) =
    (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``, normalised cross- minus
    autocorrelations of the two envelopes: near +0.7 at a drum pattern's beat, -0.7 at

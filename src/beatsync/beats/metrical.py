@@ -125,18 +125,11 @@ def resonator_saliences(
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
     # cached for lags up to the next multiple of LAG_BUCKET: clips under it share them
     n_lags = min(n_fft, -(-length // LAG_BUCKET) * LAG_BUCKET)
-    weights = [
-        _resonator_lag_weights(
-            np.ascontiguousarray(periods, dtype=np.float64).tobytes(),
-            fps,
-            n_fft,
-            n_bins,
-            half_time_s,
-            n_lags,
-        )
-        for periods in period_blocks
-    ]
-    weights = [(lag_w[:, :length], gamma) for lag_w, gamma in weights]
+    weights = []
+    for periods in period_blocks:
+        key = np.ascontiguousarray(periods, dtype=np.float64).tobytes()
+        lag_w, gamma = _resonator_lag_weights(key, fps, n_fft, n_bins, half_time_s, n_lags)
+        weights.append((lag_w[:, :length], gamma))
     # the lag weights of the window's total energy (every gain 1)
     total_w = _bin_cosine_sums(n_fft, length) * _lag_multiplicity(length)
     n_acf = scipy.fft.next_fast_len(2 * length - 1, real=True)  # linear, not circular

@@ -1,15 +1,10 @@
 """Beat placement: the phase HMM for a given tempo curve, and snapping to onsets.
 
 The onset signal is correlated with a pulse train that follows the decoded tempo curve
-(eq. 8), in 4-beat windows every 0.25 s, for 64 phase offsets; a circular phase HMM
-decoded with Viterbi picks the offset, and each beat is snapped to the nearby onset with
-the best strength x closeness.
-
-Each band is weighted by its **phase concentration** at the decoded tempo
-(:func:`band_phase_weights`), not paper A's ``6 - c`` (eq. 7, kept by
-:attr:`OnsetSignal.envelope`): the lowest band holds about half of the onset strength
-of real music, yet a bass line between the beats would pull the phase onto the
-off-beat. Weighted by its concentration, a band counts as much as it follows the beat
+(eq. 8), in 4-beat windows every 0.25 s; a circular phase HMM picks the phase, and each
+beat is snapped to the nearby onset with the best strength x closeness. Bands are weighted
+by their **phase concentration** at the decoded tempo (:func:`band_phase_weights`), not
+paper A's ``6 - c``: a bass line between the beats would pull the phase onto the off-beat
 (docs/tuning.md#band-phase-weights).
 """
 

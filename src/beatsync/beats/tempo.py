@@ -1,10 +1,8 @@
 """Tempo: the tempo HMM over beat periods, and a plain-numpy Viterbi decoder.
 
-The beat period is a hidden state per analysis window (8 s, 1 s hop), observed through
-the tactus salience of :mod:`beatsync.beats.metrical`; transitions are log-normal in
-the period ratio plus a small jump probability, so an abrupt tempo change is followed
-rather than averaged away. :func:`viterbi_banded` decodes only the band of transitions
-that differ from the uniform jump (the same path as :func:`viterbi`).
+The beat period is a hidden state per analysis window, observed through the tactus
+salience (:mod:`.metrical`); transitions are log-normal in the period ratio plus a small
+jump probability, so an abrupt tempo change is followed rather than averaged away.
 """
 
 from __future__ import annotations

@@ -258,12 +258,7 @@ def track_beats(
                 if abs(np.log(est / tempo_curve[i])) < 0.05:  # same metrical level
                     tempo_curve[i] = est
     return BeatTrack(
-        beats.astype(np.float64),
-        float(np.median(tempo_curve)),
-        centres.astype(np.float64),
-        tempo_curve,
-        "psf",
-        beats_per_bar,
+        beats, float(np.median(tempo_curve)), centres, tempo_curve, "psf", beats_per_bar
     )
 
 
@@ -323,13 +318,9 @@ def pulse_clarity_null(
     model: MeterModel,
     max_hz: float,
 ) -> float:
-    """Pulse clarity of the same onsets in random order: what no pulse looks like.
-
-    The band onsets are permuted in time (seeded), observed with the tactus terms alone
-    (:func:`beatsync.beats.metrical.beat_observation`) and decoded by the tempo HMM; the
-    mean path salience over enough draws for :data:`NULL_AUDIO_S` of audio (at most
-    :data:`NULL_MAX_DRAWS`). It keeps the audio's onset density, window lengths and
-    decoding bias.
+    """Pulse clarity of the same onsets in random order (seeded): what no pulse looks like,
+    at the audio's onset density, window lengths and decoding bias. The mean path salience
+    of the tactus terms alone over draws for :data:`NULL_AUDIO_S` of audio.
     """
     fps = ons.fps
     n = ons.bands.shape[1]
