@@ -217,9 +217,17 @@ def check_tempo_range(
     hi = given.get("max_bpm", defaults["max_bpm"])
     if not (hi - lo >= span if span else lo < hi):
         what = f"at least {span} BPM below" if span else "smaller than"
+        hint = ""  # the likely mistake: one bound given, crossing the other's default
+        if len(given) == 1:
+            (key,) = given
+            other = "max_bpm" if key == "min_bpm" else "min_bpm"
+            side = "below" if key == "max_bpm" else "above"
+            hint = (
+                f"; {label[key]} {given[key]:g} is {side} {name}'s default {label[other]} "
+                f"{defaults[other]:g}: give {label[other]} too"
+            )
         raise ParameterError(
-            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}"
-            f"{_one_bound_hint(given, label, defaults, name)}"
+            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}{hint}"
         )
     # a bound equal to the default is the same search as none: recorded as not given
     return {k: v for k, v in given.items() if v != defaults[k]}
@@ -267,19 +275,6 @@ def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) ->
         f"{name} tapped a median tempo of {bpm:.0f} BPM, {OUT_OF_RANGE_TEXT} "
         f"({lo:g}-{hi:g} BPM): {why}; check the beats{alt}",
         stacklevel=3,
-    )
-
-
-def _one_bound_hint(given, label, defaults, name) -> str:
-    """The likely mistake when only one bound was given and it crosses the other default."""
-    if len(given) != 1:
-        return ""
-    (key,) = given
-    other = "max_bpm" if key == "min_bpm" else "min_bpm"
-    side = "below" if key == "max_bpm" else "above"
-    return (
-        f"; {label[key]} {given[key]:g} is {side} {name}'s default {label[other]} "
-        f"{defaults[other]:g}: give {label[other]} too"
     )
 
 

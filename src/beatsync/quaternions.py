@@ -8,6 +8,8 @@ cost; these vectorised forms give the same rotations (checked against scipy in t
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .errors import ParameterError
@@ -38,14 +40,11 @@ def quat_from_euler(angles_deg: np.ndarray, axes: str) -> np.ndarray:
             f"angles of shape {np.shape(angles_deg)} do not match the {len(names)} axes {axes!r}"
         )
     half = np.radians(a) * 0.5
-    q = None
+    factors = np.zeros((len(names), a.shape[0], 4))  # one rotation about each axis
     for k, name in enumerate(names):
-        e = np.zeros((a.shape[0], 4))
-        e[:, _AXIS[name]] = np.sin(half[:, k])
-        e[:, 3] = np.cos(half[:, k])
-        q = e if q is None else quat_multiply(q, e)
-    assert q is not None
-    return q
+        factors[k, :, _AXIS[name]] = np.sin(half[:, k])
+        factors[k, :, 3] = np.cos(half[:, k])
+    return functools.reduce(quat_multiply, factors)
 
 
 def quat_multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
