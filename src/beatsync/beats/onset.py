@@ -112,8 +112,7 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
             f"hop_s={p['hop_s']!r} s must be at most half the window win_s={p['win_s']!r} s "
             "(the phase-slope zero crossings would be missed)"
         )
-    n_fft = p["n_fft"]
-    n_fft = int(2 ** np.ceil(np.log2(win))) if n_fft is None else int(n_fft)
+    n_fft = int(2 ** np.ceil(np.log2(win))) if p["n_fft"] is None else int(p["n_fft"])
     if n_fft < win:
         raise ParameterError(f"n_fft={n_fft} must be >= the window length {win} samples")
     edges = np.asarray(p["band_edges_hz"], dtype=np.float64)
@@ -124,10 +123,7 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     band = _bin_bands(np.fft.rfftfreq(n_fft, d=1.0 / sr), edges)
     empty = np.flatnonzero(np.bincount(band[band >= 0], minlength=edges.size - 1) == 0)
     # the default top band (4-22 kHz) is empty below 8 kHz: only edges a user gave count
-    # (phase_slope passes the defaults on explicitly)
-    given = "band_edges_hz" in params and tuple(float(e) for e in params["band_edges_hz"]) != tuple(
-        FRONTEND_DEFAULTS["band_edges_hz"]
-    )
+    given = tuple(edges.tolist()) != tuple(FRONTEND_DEFAULTS["band_edges_hz"])
     if empty.size and given:
         k = int(empty[0])
         why = (
