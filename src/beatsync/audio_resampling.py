@@ -40,12 +40,8 @@ def resample(
     y = np.asarray(y, dtype=np.float32)
     if n_out is None:
         n_out = int(np.ceil(y.size * float(target_sr) / orig_sr))
-    if orig_sr == target_sr:
-        out = y
-    else:
-        out = np.asarray(soxr.resample(y, orig_sr, target_sr, quality="HQ"), dtype=np.float32)
+    if orig_sr != target_sr:
+        y = np.asarray(soxr.resample(y, orig_sr, target_sr, quality="HQ"), dtype=np.float32)
     if shift and keep_level:
-        out = np.ldexp(out, -shift).astype(np.float32)
-    if out.size >= n_out:
-        return out[:n_out]
-    return np.concatenate([out, np.zeros(n_out - out.size, dtype=np.float32)])
+        y = np.ldexp(y, -shift).astype(np.float32)
+    return np.pad(y[:n_out], (0, max(n_out - y.size, 0)))  # trimmed or zero-padded
