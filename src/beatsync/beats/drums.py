@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .onset import _frames
+
 __all__ = [
     "DRUM_WEIGHT",
     "LOW_BAND_HZ",
@@ -74,9 +76,7 @@ def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.nd
     y = (np.asarray(y) / (peak if peak > 0 else 1.0)).astype(np.float32, copy=False)
     n_fft = int(2 ** np.round(np.log2(N_FFT_S * sr)))
     hop = max(int(round(HOP_S * sr)), 1)
-    half = n_fft // 2
-    yp = np.concatenate([np.zeros(half, np.float32), y, np.zeros(half, np.float32)])
-    frames = np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]  # centred
+    frames = _frames(y, n_fft, hop)  # centred, as the front end's
     freqs = np.arange(n_fft // 2 + 1) * sr / n_fft
     member = np.stack(
         [(freqs >= lo) & (freqs < hi) for lo, hi in (LOW_BAND_HZ, MID_BAND_HZ)], axis=1

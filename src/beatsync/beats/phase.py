@@ -91,15 +91,16 @@ def _phase_terms():
     return q, kf, log_trans
 
 
-def snap_to_onsets(
-    beats, periods_at_beats, onset_times, onset_strengths, reach: float, min_rel: float
-):
-    """Move each beat to the onset within ``reach`` beat periods with the best strength
-    times a Gaussian of its distance (sd ``reach / 2`` periods); onsets weaker than
-    ``min_rel`` times the strongest are ignored.
-    """
-    thresh = min_rel * np.max(onset_strengths)
-    strong = onset_strengths >= thresh
+#: Beats snap to onsets within this many beat periods, of at least this share of the
+#: strongest onset's strength (weaker onsets also do not count as activity).
+SNAP_REACH, MIN_REL_STRENGTH = 0.12, 0.05
+
+
+def snap_to_onsets(beats, periods_at_beats, onset_times, onset_strengths):
+    """Move each beat to the onset within :data:`SNAP_REACH` beat periods with the best
+    strength times a Gaussian of its distance (sd ``SNAP_REACH / 2`` periods)."""
+    reach = SNAP_REACH
+    strong = onset_strengths >= MIN_REL_STRENGTH * np.max(onset_strengths)
     t, s = onset_times[strong], onset_strengths[strong]
     out = beats.copy()
     lo = np.searchsorted(t, beats - reach * periods_at_beats)
@@ -143,11 +144,9 @@ def place_beats(
     frac = (k[idx + 1] - total[idx]) / (total[idx + 1] - total[idx])
     beats = t_frames[idx] + frac / fps
     periods = period_f[idx]
-    beats = snap_to_onsets(
-        beats, periods, ons.onset_times, ons.onset_strengths, reach=0.12, min_rel=0.05
-    )
+    beats = snap_to_onsets(beats, periods, ons.onset_times, ons.onset_strengths)
     # trim beats outside the region with onset activity
-    act = ons.onset_times[ons.onset_strengths >= 0.05 * ons.onset_strengths.max()]
+    act = ons.onset_times[ons.onset_strengths >= MIN_REL_STRENGTH * ons.onset_strengths.max()]
     keep = (beats >= act[0] - 0.5 * periods) & (beats <= act[-1] + 0.5 * periods)
     keep &= (beats >= 0) & (beats <= duration)
     beats, periods = beats[keep], periods[keep]

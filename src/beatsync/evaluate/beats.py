@@ -163,10 +163,7 @@ def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 
     if not (np.isfinite(estimated_bpm) and np.isfinite(reference_bpm)) or reference_bpm <= 0:
         return "other"
     r = estimated_bpm / reference_bpm
-    for name, target in TEMPO_RATIOS.items():
-        if abs(r / target - 1.0) <= tol:
-            return name
-    return "other"
+    return next((k for k, t in TEMPO_RATIOS.items() if abs(r / t - 1.0) <= tol), "other")
 
 
 def count_octave_errors(octaves: Any) -> int:

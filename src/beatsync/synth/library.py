@@ -99,9 +99,8 @@ def synthetic_dance(
             f"duration={duration} s at {bpm} BPM gives fewer than 3 beats; make it longer"
         )
     beats = frames_to_time(beat_frames, fps=fps)
-    lo, hi = level_range
     n_sec = int(np.ceil(beats.size / int(section_beats))) + 1
-    levels = rng.uniform(lo, hi, size=n_sec)
+    levels = rng.uniform(*level_range, size=n_sec)
     moves = rng.integers(0, int(n_moves), size=n_sec)
     sec = np.arange(beats.size) // int(section_beats)
     sign = (-1.0) ** np.arange(beats.size)
