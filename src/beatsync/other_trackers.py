@@ -81,12 +81,9 @@ def _ours(method: str) -> Callable[..., np.ndarray]:
 
 
 def prepare(name: str) -> None:
-    """Compile what method ``name`` needs into its on-disk cache, in this process.
-
-    Call it once before several processes track with it at once: processes compiling
-    librosa's numba functions at the same time can pair cache files written by different
-    processes and crash a later one (numba issue 10128). A no-op for the other methods.
-    """
+    """Compile what method ``name`` needs (librosa's numba functions) into its on-disk cache,
+    once before several processes track with it: processes compiling at the same time can
+    crash a later one (numba issue 10128)."""
     get(name)
     if name != "librosa":
         return

@@ -88,13 +88,10 @@ def resonator_salience(
 ) -> np.ndarray:
     """Normalised comb-filter resonator energy summed over bands, (n_periods, n_windows).
 
-    ``bands`` (n_bands, n_frames) are accent signals, or (n_sets, n_bands, n_frames) for
-    several sets at once (the draws of the pulse-clarity null; the result gets a last axis
-    of n_sets). ``periods`` [s] need not be whole frames. Above ``max_hz`` [Hz] (where a
-    smoothed accent signal has almost no energy) every resonator passes its mean gain
-    ``gamma`` instead of being filtered (saves time). The energy ``sum_b P(b) |H_tau(b)|^2``
-    is taken in the lag domain, ``sum_k a(k) c(k)``: ``a`` the window's autocorrelation
-    over its lag-0 value, ``c`` the cached lag weights (:func:`_resonator_lag_weights`).
+    ``bands`` (n_bands, n_frames) are accent signals, or (n_sets, n_bands, n_frames) (the
+    result gets a last axis of n_sets); ``periods`` [s] need not be whole frames. Above
+    ``max_hz`` [Hz] every resonator passes its mean gain ``gamma`` unfiltered (saves time).
+    The energy is taken in the lag domain (:func:`_resonator_lag_weights`).
     """
     return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
 

@@ -210,10 +210,8 @@ def _band_matrix(sr: float, fe: FrontEnd) -> np.ndarray:
 
 
 def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = True):
-    """``(psf, energy, fps, mag, flux, member)`` per band: ``psf`` [s], ``energy`` and the
-    spectral ``flux`` (mean half-wave rectified log-magnitude difference over the band's
-    bins) of shape (n_bands, n_frames); ``mag`` (frames x bins, unless not ``keep_mag``);
-    the bins' band membership. In blocks of :data:`BLOCK_FRAMES` frames.
+    """``(psf, energy, fps, mag, flux)``: :func:`phase_slope`'s and the band's spectral
+    ``flux`` (mean half-wave rectified log-magnitude difference), in blocks of frames.
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
 
@@ -253,7 +251,7 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
     centroid[energy_t <= floor] = np.nan
     psf = -centroid / sr  # frame centre minus energy centroid [s]
     counts = np.maximum(member.sum(axis=0)[:, None], 1.0)
-    return psf, energy_t, sr / hop, mag, flux.T.astype(np.float64) / counts, member
+    return psf, energy_t, sr / hop, mag, flux.T.astype(np.float64) / counts
 
 
 def phase_slope(
@@ -265,15 +263,12 @@ def phase_slope(
     n_fft: int | None = None,
     band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
 ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
-    """Phase-slope function per band: ``(psf, energy, fps, mag)``.
-
-    ``psf`` (n_bands, n_frames) [s]: frame centre minus the band's energy centroid in time
-    (negative before an impulse reaches the frame centre; NaN where the band is silent);
-    ``energy`` the band energy ``sum |X|^2``; ``mag`` (n_bins, n_frames) the STFT magnitude.
-    """
+    """Phase-slope function per band ``psf`` (n_bands, n_frames) [s], frame centre minus the
+    band's energy centroid (NaN where silent); with ``energy`` ``sum |X|^2``, ``fps`` and the
+    STFT magnitude ``mag`` (n_bins, n_frames)."""
     given = {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}
     y, sr, fe = _validated(y, sr, {**given, "analysis_sr": None})
-    psf, energy, fps, mag, _, _ = _phase_slope(y, sr, fe)
+    psf, energy, fps, mag, _ = _phase_slope(y, sr, fe)
     return psf, energy, fps, mag.T
 
 
@@ -313,7 +308,7 @@ def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     # float32 divided in float32: the same as in float64 rounded to float32 (double
     # rounding is innocuous for a division), without the float64 copies
     y = y / np.max(np.abs(y))
-    psf, _, fps, _, flux, _ = _phase_slope(y, sr, fe, keep_mag=False)
+    psf, _, fps, _, flux = _phase_slope(y, sr, fe, keep_mag=False)
     n_bands, n_frames = psf.shape
     if fe.flux_norm_s > 0:  # remove the fluctuation floor of sustained sounds
         size = max(int(time_to_frames(fe.flux_norm_s, fps=fps)), 3)

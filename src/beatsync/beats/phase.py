@@ -26,10 +26,9 @@ def band_phase_weights(
     """Each band's phase concentration over the beat cycle, normalised to sum to 1.
 
     In each window ``[a, b)`` (default: the whole signal) band ``c`` has the concentration
-    ``|sum_n x_c(n) exp(2 pi i cycles(n))| / sum_n x_c(n)``, ``cycles`` the integrated tempo
-    [beats] per frame: 1 when all of its onset strength falls at one phase of the beat. A
-    band's weight is the mean over windows weighted by its onset strength in each (a pause
-    or a phase slip does not cancel it out); equal weights if no band has any onset.
+    ``|sum_n x_c(n) exp(2 pi i cycles(n))| / sum_n x_c(n)`` (``cycles`` [beats] per frame);
+    its weight is their mean weighted by its onset strength per window (so a phase slip
+    does not cancel it out); equal weights if no band has any onset.
     """
     n_bands = bands.shape[0]
     if starts is None:
@@ -52,12 +51,9 @@ N_PHASE, PULSE_WIDTH, PHASE_SIGMA, PHASE_BETA = 64, 0.04, 0.03, 6.0
 
 
 def phase_hmm(env: np.ndarray, cycles: np.ndarray, starts, stops) -> np.ndarray:
-    """Viterbi path of the beat phase (fraction of a beat) per window.
-
-    Beats are where ``cycles + phase`` is an integer (``cycles``: the integrated tempo
-    [beats] per frame); the observation is the correlation of the onset signal with a
-    pulse train at those times (eq. 8).
-    """
+    """Viterbi path of the beat phase (fraction of a beat) per window: beats are where
+    ``cycles + phase`` is an integer, observed by correlating the onset signal ``env`` with
+    a pulse train at those times (eq. 8)."""
     n_phase = N_PHASE
     frac = np.mod(cycles, 1.0)
     bins = np.rint(frac * n_phase).astype(np.int64) % n_phase
@@ -119,10 +115,8 @@ def place_beats(
     tempo_win_s: float,
     duration: float,
 ):
-    """Beats [s] for a tempo curve (period per tempo window), and the period at each beat.
-
-    The tempo is step-wise between window centres; the phase is decoded in windows of 4
-    beats (1.5 s to ``tempo_win_s``), so that it follows tempo changes quickly.
+    """Beats [s] for a step-wise tempo curve (a period per tempo window) and the period at
+    each; the phase is decoded in 4-beat windows, so that it follows tempo changes quickly.
     """
     fps = ons.fps
     n = ons.bands.shape[1]

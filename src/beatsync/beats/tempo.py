@@ -124,11 +124,8 @@ def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
 def viterbi_banded(
     log_obs: np.ndarray, band_terms: tuple[np.ndarray, np.ndarray], log_jump: float
 ) -> np.ndarray:
-    """:func:`viterbi` for transitions that are a band (:func:`_band`) plus a uniform jump.
-
-    The transitions outside the band must equal ``log_jump`` (and be at least that
-    everywhere): each step costs ``(2 reach + 1) n`` instead of ``n**2``, with the dense
-    decoder's path (up to exact ties).
+    """:func:`viterbi` for transitions that are a band (:func:`_band`) plus a uniform jump
+    ``log_jump`` (the least of all): ``(2 reach + 1) n`` a step instead of ``n**2``.
     """
     n_states, n_steps = log_obs.shape
     band, src = band_terms

@@ -80,12 +80,9 @@ P_JUMP = 1e-4
 
 @dataclass(frozen=True)
 class BeatTrack:
-    """Result of :func:`track_beats`.
-
-    ``beats`` [s] strictly increasing; ``tempo`` [bpm] the median of ``tempo_curve``
-    [bpm] (NaN without beats), one value per window centred at ``tempo_times`` [s];
-    ``beats_per_bar`` the meter (0 if not estimated: ``method="librosa"`` or no beats).
-    """
+    """Result of :func:`track_beats`: ``tempo`` [bpm] is the median of ``tempo_curve`` [bpm]
+    (NaN without beats), one per window centred at ``tempo_times`` [s]; ``beats_per_bar``
+    is 0 if not estimated (``method="librosa"`` or no beats)."""
 
     beats: np.ndarray
     tempo: float
@@ -288,11 +285,8 @@ def observe(
     tempo_hop_s: float = 1.0,
     drum_weight: float = DRUM_WEIGHT,
 ) -> Observation:
-    """The metrical model's tactus observation plus the drum cue, per tempo window.
-
-    Trusts its inputs (also decoded by ``benchmarks/calibrate_pulse_clarity.py``). A
-    known ``bpm`` gives a grid of one period and no drum cue.
-    """
+    """The metrical model's tactus observation plus the drum cue, per tempo window (trusts
+    its inputs); a known ``bpm`` gives a grid of one period and no drum cue."""
     fps = ons.fps
     n = ons.envelope.size
     accents = _accents(ons.bands, fps)
@@ -379,11 +373,8 @@ LIBROSA_HOP = 512
 
 
 def librosa_tempo_steps(sr: float) -> np.ndarray:
-    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], ascending.
-
-    One per whole lag of its 8 s onset autocorrelation, ``60 sr / (hop lag)``, below
-    320 BPM (13.5 BPM apart near 190 BPM at 22.05 kHz).
-    """
+    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], ascending: one per
+    whole lag of its 8 s onset autocorrelation, ``60 sr / (hop lag)``, below 320 BPM."""
     win = int(np.floor(8.0 * sr / LIBROSA_HOP))  # librosa.time_to_frames(ac_size=8, ...)
     bpms = 60.0 * sr / (LIBROSA_HOP * np.arange(1, win))
     return np.sort(bpms[bpms < LIBROSA_MAX_TEMPO])
@@ -395,9 +386,8 @@ def librosa_tempo_prior(
     """The tempo prior for :func:`librosa.beat.beat_track` at ``sr`` [Hz]: ``None``
     (librosa's own) for the default range, else flat inside it (``scipy.stats.uniform``).
 
-    Refuses a range holding none of :func:`librosa_tempo_steps`, e.g. 185-198 BPM at
-    22.05 kHz, or above 320 BPM: librosa would return one beat at an infinite tempo. The
-    message names the nearest tempi it can choose.
+    Refuses a range holding none of :func:`librosa_tempo_steps` (e.g. 185-198 BPM at
+    22.05 kHz) or above 320 BPM: librosa would return one beat at an infinite tempo.
     """
     if (min_bpm, max_bpm) == (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
         return None

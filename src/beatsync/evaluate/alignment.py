@@ -154,10 +154,8 @@ def offset_control(
     n_trials: int = 200,
     seed: int = 0,
 ) -> dict[str, float]:
-    """Chance level: mean and sd of both scores with the motion beats shifted by random offsets.
-
-    Each of ``n_trials`` shifts all motion beats by one offset uniform in ``[-T/2, T/2)``,
-    ``T`` the median music beat period: the dance keeps its rhythm, its phase is random.
+    """Chance level: mean and sd of both scores over ``n_trials`` shifts of all motion beats
+    by one offset uniform in ``[-T/2, T/2)`` (``T`` the median music beat period).
     """
     mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     if yb.size < 2:
@@ -183,12 +181,9 @@ def offset_control(
 
 
 def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
-    """How consistently motion beats fall at one phase of the music's beat, in [0, 1].
-
-    The vector strength ``|mean exp(2 pi i phase)|`` of each motion beat's phase inside its
-    music beat interval (motion beats outside the music beats are ignored): 1 when
-    phase-locked at whatever phase, near 0 for a dance drifting against the music.
-    """
+    """How consistently motion beats fall at one phase of the music's beat: the vector
+    strength ``|mean exp(2 pi i phase)|`` of their phases in the music's beat intervals, 1
+    when phase-locked at whatever phase, near 0 for a dance drifting against the music."""
     mb, yb = validate(motion_beats, music_beats)
     if yb.size < 2:
         raise ParameterError("beat_phase_consistency needs at least 2 music beats")

@@ -15,9 +15,8 @@ def boundary_errors(estimated: Any, reference: Any, *, remove_offset: bool = Fal
     """Boundary error [frames] of estimated against reference boundary frames.
 
     Each reference boundary inside the estimated span is matched to the nearest estimated
-    one. ``remove_offset`` subtracts the median signed error first (for baselines whose
-    boundaries sit at another phase of the cycle). Returns ``mean``, ``max`` [frames],
-    ``n_matched``, ``count_error`` (estimated minus reference count) and ``offset`` [frames].
+    one; ``remove_offset`` subtracts the median signed error first (for baselines whose
+    boundaries sit at another phase of the cycle).
     """
     est = np.asarray(estimated, dtype=np.float64)
     ref = np.asarray(reference, dtype=np.float64)

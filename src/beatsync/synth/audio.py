@@ -198,11 +198,8 @@ def meter_pattern(
     duration: float,
     seed: int = 0,
 ) -> np.ndarray:
-    """A drum pattern in ``meter`` (:data:`METERS`) with eighth-note hi-hats (float32).
-
-    A kick on the first beat of every bar, snares on the others, a hi-hat on every eighth
-    (softer between the beats). ``beats`` are the tactus: quarter notes in 2/4 and 3/4,
-    dotted quarters in 6/8.
+    """A drum pattern in ``meter`` (:data:`METERS`; ``beats`` the tactus), float32: a kick on
+    the first beat of every bar, snares on the others, a hi-hat on every eighth.
     """
     if meter not in METERS:
         raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")

@@ -72,11 +72,9 @@ def synthetic_dance(
 ) -> tuple[Motion, np.ndarray]:
     """One synthetic dance clip and its exact beat times [s] (on frame times, inside the clip).
 
-    One extreme pose per beat at ``bpm``, from ``start`` [s] (the first pose held before).
-    ``seed`` draws each section's move and loudness ``a_k`` (uniform in ``level_range``) per
-    ``section_beats`` beats; ``vocabulary_seed`` draws the ``n_moves`` moves' joint
-    amplitudes (clips of one vocabulary share poses); ``scale`` scales the skeleton and the
-    root height.
+    One extreme pose per beat from ``start`` [s]; ``seed`` draws each ``section_beats``
+    section's move and loudness ``a_k`` (in ``level_range``), ``vocabulary_seed`` the
+    ``n_moves`` moves (clips of one vocabulary share poses).
     """
     fps = check_fps(fps)
     bpm = check_positive(bpm, name="bpm", unit="BPM")
