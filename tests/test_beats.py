@@ -639,11 +639,10 @@ def test_banded_tempo_decoder_equals_the_dense_viterbi(grid, p_jump):
             obs[rng.integers(periods.size), 20:] += 5 * scale  # a tempo change halfway
             path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=p_jump)
             np.testing.assert_array_equal(path, viterbi(obs, log_trans))
-    # one window (a short clip): no transition, with and without an initial distribution
-    for log_prior in (None, rng.normal(size=periods.size)):
-        obs = rng.normal(size=(periods.size, 1))
-        path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=p_jump, log_prior=log_prior)
-        np.testing.assert_array_equal(path, viterbi(obs, log_trans, log_prior))
+    # one window (a short clip): no transition
+    obs = rng.normal(size=(periods.size, 1))
+    path = tempo_hmm(obs, periods, trans_sigma=0.02, p_jump=p_jump)
+    np.testing.assert_array_equal(path, [np.argmax(obs[:, 0])])
 
 
 def test_front_end_blocks_equal_one_pass(monkeypatch):

@@ -24,12 +24,9 @@ def resample(
     *,
     keep_level: bool = True,
 ) -> np.ndarray:
-    """Resample mono audio from ``orig_sr`` to ``target_sr`` [Hz] (float32).
-
-    ``n_out`` samples (default ``ceil(n * target_sr / orig_sr)``, as librosa), trimmed or
-    zero-padded at the end. Trusts its input. Audio louder than :data:`LOUDEST` is filtered
-    at a level lowered by a power of two and raised again (exactly); ``keep_level=False``
-    leaves it lowered, for a caller that normalises.
+    """Resample mono audio from ``orig_sr`` to ``target_sr`` [Hz] to ``n_out`` samples
+    (float32; default ``ceil(n * target_sr / orig_sr)``, as librosa). Trusts its input;
+    ``keep_level=False`` leaves audio louder than :data:`LOUDEST` lowered (exactly).
     """
     import soxr  # noqa: PLC0415 (only where audio is resampled)
 
@@ -43,12 +40,8 @@ def resample(
     y = np.asarray(y, dtype=np.float32)
     if n_out is None:
         n_out = int(np.ceil(y.size * float(target_sr) / orig_sr))
-    if orig_sr == target_sr:
-        out = y
-    else:
-        out = np.asarray(soxr.resample(y, orig_sr, target_sr, quality="HQ"), dtype=np.float32)
+    if orig_sr != target_sr:
+        y = np.asarray(soxr.resample(y, orig_sr, target_sr, quality="HQ"), dtype=np.float32)
     if shift and keep_level:
-        out = np.ldexp(out, -shift).astype(np.float32)
-    if out.size >= n_out:
-        return out[:n_out]
-    return np.concatenate([out, np.zeros(n_out - out.size, dtype=np.float32)])
+        y = np.ldexp(y, -shift).astype(np.float32)
+    return np.pad(y[:n_out], (0, max(n_out - y.size, 0)))  # trimmed or zero-padded

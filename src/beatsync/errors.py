@@ -1,14 +1,10 @@
 """Exceptions and warnings of beatsync.
 
-Every check of user input raises :class:`ParameterError`, a :class:`ValueError`
-whose message names the offending value and the likely mistake (wrong units,
-frames instead of seconds, an unreadable file, silence, a clip too short).
-
-Every :class:`BeatsyncWarning` is issued through :func:`warn`, so that
-:func:`collect_warnings` can keep one thread's warnings apart from another's (the
-threads of a Dask worker run several tracks at once; :func:`warnings.catch_warnings`
-swaps process-wide state, and a warning could land on another track's record or be
-lost).
+Every check of user input raises :class:`ParameterError` (a :class:`ValueError` naming the
+offending value and the likely mistake). Every :class:`BeatsyncWarning` goes through
+:func:`warn`, so that :func:`collect_warnings` keeps one thread's warnings apart from
+another's (a Dask worker's threads run several tracks at once; :mod:`warnings`' state is
+process-wide).
 """
 
 from __future__ import annotations
@@ -33,11 +29,9 @@ class ParameterError(ValueError):
 
 
 class NotPeriodicError(ParameterError):
-    """The motion was not shown to be periodic: the periodicity test refused it, the clip
-    is too short to tell, or its periods cannot be searched while its joints move (no
-    joint angles to test). Its own motion beats can still sync it (``mode="beats"``, and
-    ``mode="auto"`` falls back to them); other errors (bad settings, a dancer who does
-    not move) cannot be helped that way."""
+    """The motion was not shown to be periodic (refused by the test, too short to tell, or
+    no joint angles to test); its own motion beats can still sync it (``mode="beats"``,
+    and ``mode="auto"`` falls back to them)."""
 
 
 class BeatsyncWarning(UserWarning):
@@ -48,10 +42,8 @@ _local = threading.local()
 
 
 def warn(message: str, *, stacklevel: int = 1) -> None:
-    """Issue a :class:`BeatsyncWarning`, or record it if this thread collects them.
-
-    ``stacklevel`` as for :func:`warnings.warn` called where this is called.
-    """
+    """Issue a :class:`BeatsyncWarning` (``stacklevel`` as for :func:`warnings.warn` called
+    here), or record it if this thread collects them."""
     if getattr(_local, "silent", 0):
         return
     collected = getattr(_local, "collected", None)
@@ -63,13 +55,9 @@ def warn(message: str, *, stacklevel: int = 1) -> None:
 
 @contextlib.contextmanager
 def collect_warnings() -> Iterator[list[str]]:
-    """Record the messages of the :class:`BeatsyncWarning` this thread issues inside the
-    block, in order, instead of issuing them (thread-safe; blocks may nest).
-
-    Every one is recorded, whatever the :mod:`warnings` filters say: they are
-    process-wide, and another thread's filters must not decide this thread's record.
-    Code that expects a warning and has nothing to say about it drops it with
-    :func:`silenced` (this thread's too), and then it is not recorded.
+    """Record, in order, the :class:`BeatsyncWarning` messages this thread issues inside the
+    block instead of issuing them, whatever the (process-wide) :mod:`warnings` filters say;
+    blocks may nest. Only :func:`silenced` keeps one out of the record.
     """
     outer = getattr(_local, "collected", None)
     _local.collected = []
@@ -81,12 +69,8 @@ def collect_warnings() -> Iterator[list[str]]:
 
 @contextlib.contextmanager
 def silenced() -> Iterator[None]:
-    """Drop the :class:`BeatsyncWarning` this thread issues inside the block: neither
-    issued nor recorded by :func:`collect_warnings` (thread-safe; blocks may nest).
-
-    For a step whose warning says nothing to its caller (no motion beats to count, a
-    constant intensity to standardise). Unlike :func:`warnings.catch_warnings`, it
-    leaves other threads' warnings alone.
+    """Drop the :class:`BeatsyncWarning` this thread issues inside the block (neither issued
+    nor recorded; blocks may nest), for a step whose warning says nothing to its caller.
     """
     depth = getattr(_local, "silent", 0)
     _local.silent = depth + 1

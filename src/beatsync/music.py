@@ -1,20 +1,9 @@
-"""Music intensity per beat interval, and a synthetic song with loud and quiet parts.
+"""Music intensity per beat interval (paper B section 3.3): the sound pressure level of
+``[b_i, b_{i+1})``, the RMS in dB re full scale 1.0, z-scored over the song for the search.
 
-Paper B matches the *intensity* of the dance with that of the music beat by beat.
-Music intensity of a beat interval ``[b_i, b_{i+1})`` is its sound pressure level,
-the RMS of the samples in dB (re full scale 1.0, floored at ``amin``); for the
-search it is z-scored over the song (:func:`music_intensity`). Beats come from
-:func:`beatsync.beats.track_beats` (:func:`track_music_beats`); audio is validated
-with :func:`beatsync.beats.check_audio`, the tracker's own check.
-
-A synthetic song with exact beats and loudness sections for the speed and quality
-studies is :func:`beatsync.synth.audio.drum_song` (stages never import ``synth``).
-
-Data contract: audio is mono float ``y`` with ``sr`` [Hz]; beats are 1-D float64
-seconds, strictly increasing; intensities are one value per beat interval.
-
-Notebooks: ``notebooks/paper_b_tab01_search_speed.ipynb``,
-``notebooks/paper_b_tab02_quality_proxies.ipynb``; paper B section 3.3.
+Audio is mono float ``y`` at ``sr`` [Hz], checked as the tracker checks it; beats are 1-D
+float64 seconds, strictly increasing (:func:`track_music_beats`). A synthetic song with
+loudness sections is :func:`beatsync.synth.audio.drum_song` (stages never import ``synth``).
 """
 
 from __future__ import annotations
@@ -26,7 +15,7 @@ import numpy as np
 from .beats import check_audio, track_beats
 from .errors import ParameterError
 from .motion_beats import zscore
-from .validation import check_bpm, check_times, time_to_frames
+from .validation import check_times, time_to_frames
 
 __all__ = [
     "beat_rms_db",
@@ -36,11 +25,8 @@ __all__ = [
 
 
 def beat_rms_db(y: Any, sr: float, beats: Any, *, amin: float = 1e-5) -> np.ndarray:
-    """Sound pressure level (RMS in dB re 1.0) of each interval between ``K+1`` beats [s].
-
-    Returns ``K`` levels [dB]; ``amin`` floors the RMS (silence reads ``20 log10(amin)``,
-    -100 dB by default).
-    """
+    """Sound pressure level [dB re 1.0] of each interval between ``K+1`` beats [s]; ``amin``
+    floors the RMS (silence reads ``20 log10(amin)``, -100 dB by default)."""
     y, sr = check_audio(y, sr, allow_silent=True)
     beats = check_times(beats, name="music beats", duration=y.size / sr)
     if beats.size < 2:
@@ -72,23 +58,15 @@ def track_music_beats(
     min_bpm: float | None = None,
     max_bpm: float | None = None,
 ) -> np.ndarray:
-    """Music beat times [s] from :func:`beatsync.beats.track_beats` (``method``, a known
-    ``bpm``, the tempo range ``min_bpm``-``max_bpm``): at least two, strictly increasing.
-
-    A :class:`ParameterError` for silence, audio too short for a pulse, a bad ``bpm``, or
-    fewer than two beats found.
-    """
+    """Music beat times [s] from :func:`beatsync.beats.track_beats`, at least two (else a
+    :class:`ParameterError`, as for silence, audio too short or a bad ``bpm``)."""
     y, sr = check_audio(y, sr)
-    if bpm is not None:
-        bpm = check_bpm(bpm)
-    kwargs: dict[str, Any] = {"method": method}
-    for name, value in (("bpm", bpm), ("min_bpm", min_bpm), ("max_bpm", max_bpm)):
-        if value is not None:
-            kwargs[name] = value
-    beats = np.asarray(track_beats(y, int(round(sr)), **kwargs).beats, dtype=np.float64)
+    given = {"bpm": bpm, "min_bpm": min_bpm, "max_bpm": max_bpm}
+    kwargs = {k: v for k, v in given.items() if v is not None}
+    beats = track_beats(y, int(round(sr)), method=method, **kwargs).beats
     if beats.size < 2:
         raise ParameterError(
             f"the beat tracker found {beats.size} beat(s) in the music: it needs a steady "
             "pulse (give --bpm, or a longer or louder piece)"
         )
-    return check_times(beats, name="music beats")
+    return beats

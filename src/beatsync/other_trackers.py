@@ -3,18 +3,9 @@
 Every method is ``track(y, sr, *, min_bpm=None, max_bpm=None) -> beats``: mono audio at
 ``sr`` [Hz] in, beat times [s] out (1-D ``float64``, strictly increasing), with its
 published defaults. A tempo range narrows the tempi searched (:func:`check_tempo_range`);
-only ours keeps its beats inside it (:func:`track` warns otherwise). :data:`TRACKERS`:
-
-- ``"psf"``: ours, :func:`beatsync.beats.track_beats` (paper A, section 4).
-- ``"librosa"``: :func:`librosa.beat.beat_track` (Ellis 2007, dynamic programming),
-  hop 512.
-- ``"essentia-degara"``: essentia's ``BeatTrackerDegara`` (Degara et al. 2012), at the
-  44.1 kHz it requires.
-- ``"essentia-multifeature"``: essentia's ``BeatTrackerMultiFeature`` (Zapata et al.
-  2014), at 44.1 kHz.
-
-The essentia methods need the optional ``essentia`` package
-(``pip install 'beatsync[peers]'``; AGPL-3.0): :func:`get` refuses them without it.
+only ours keeps its beats inside it (:func:`track` warns otherwise). The methods are
+:data:`TRACKERS`; essentia's (at the 44.1 kHz they require) need the optional ``essentia``
+package (``pip install 'beatsync[peers]'``; AGPL-3.0).
 """
 
 from __future__ import annotations
@@ -76,40 +67,23 @@ def _given(min_bpm: float | None, max_bpm: float | None) -> dict[str, float]:
     return {k: float(v) for k, v in bounds.items() if v is not None}
 
 
-def track_psf(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """Our tracker, :func:`beatsync.beats.track_beats` with its defaults."""
-    from .beats import track_beats
+def _ours(method: str) -> Callable[..., np.ndarray]:
+    """``track`` of :func:`beatsync.beats.track_beats` with ``method`` and its defaults."""
 
-    return _as_beats(track_beats(y, sr, **_given(min_bpm, max_bpm)).beats)
+    def track(
+        y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+    ) -> np.ndarray:
+        from .beats import track_beats
 
+        return _as_beats(track_beats(y, sr, method=method, **_given(min_bpm, max_bpm)).beats)
 
-def track_librosa(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """:func:`librosa.beat.beat_track` (hop 512); a tempo range replaces its log-normal tempo
-    prior with a flat one inside it (as ``track_beats(method="librosa")``).
-    """
-    import librosa
-
-    from .beats.tracker import LIBROSA_HOP, librosa_tempo_prior
-
-    prior = librosa_tempo_prior(**_given(min_bpm, max_bpm), sr=sr)  # None: the default
-    kwargs = {} if prior is None else {"prior": prior}
-    _, beats = librosa.beat.beat_track(
-        y=np.asarray(y, dtype=np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
-    )
-    return _as_beats(beats)
+    return track
 
 
 def prepare(name: str) -> None:
-    """Compile what method ``name`` needs into its on-disk cache, in this process.
-
-    Call it once before several processes track with it at once: processes compiling
-    librosa's numba functions at the same time can pair cache files written by different
-    processes and crash a later one (numba issue 10128). A no-op for the other methods.
-    """
+    """Compile what method ``name`` needs (librosa's numba functions) into its on-disk cache,
+    once before several processes track with it: processes compiling at the same time can
+    crash a later one (numba issue 10128)."""
     get(name)
     if name != "librosa":
         return
@@ -133,51 +107,43 @@ def _essentia():
     return es
 
 
-def _run_essentia(algorithm: str, y, sr, min_bpm, max_bpm):
-    """essentia's ``algorithm`` with its defaults (and a tempo range) on ``y`` at 44.1 kHz."""
-    tempo = {"minTempo": min_bpm, "maxTempo": max_bpm}
-    algo = getattr(_essentia(), algorithm)(
-        **{k: int(round(v)) for k, v in tempo.items() if v is not None}
-    )
-    y = np.asarray(y, dtype=np.float32)
-    if sr != ESSENTIA_SR:
-        y = resample_audio(y, sr, ESSENTIA_SR)
-    return algo(np.ascontiguousarray(y, dtype=np.float32))
+def _essentia_track(algorithm: str) -> Callable[..., np.ndarray]:
+    """``track`` of essentia's ``algorithm`` with its defaults (and a tempo range), at 44.1 kHz."""
 
+    def track(
+        y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
+    ) -> np.ndarray:
+        tempo = {"minTempo": min_bpm, "maxTempo": max_bpm}
+        algo = getattr(_essentia(), algorithm)(
+            **{k: int(round(v)) for k, v in tempo.items() if v is not None}
+        )
+        y = np.asarray(y, dtype=np.float32)
+        if sr != ESSENTIA_SR:
+            y = resample_audio(y, sr, ESSENTIA_SR)
+        out = algo(np.ascontiguousarray(y, dtype=np.float32))
+        return _as_beats(out[0] if isinstance(out, tuple) else out)  # MultiFeature: + confidence
 
-def track_essentia_degara(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """essentia ``BeatTrackerDegara`` with its defaults (at 44.1 kHz)."""
-    return _as_beats(_run_essentia("BeatTrackerDegara", y, sr, min_bpm, max_bpm))
-
-
-def track_essentia_multifeature(
-    y: np.ndarray, sr: float, *, min_bpm: float | None = None, max_bpm: float | None = None
-) -> np.ndarray:
-    """essentia ``BeatTrackerMultiFeature`` with its defaults (at 44.1 kHz)."""
-    ticks, _confidence = _run_essentia("BeatTrackerMultiFeature", y, sr, min_bpm, max_bpm)
-    return _as_beats(ticks)
+    return track
 
 
 #: Every method by name, ours first.
 TRACKERS: dict[str, Tracker] = {
     p.name: p
     for p in (
-        Tracker("psf", "ours: phase-slope onsets, tempo/phase HMM (paper A)", track_psf),
+        Tracker("psf", "ours: phase-slope onsets, tempo/phase HMM (paper A)", _ours("psf")),
         Tracker(
-            "librosa", "librosa.beat.beat_track: dynamic programming (Ellis 2007)", track_librosa
+            "librosa", "librosa.beat.beat_track: dynamic programming (Ellis 2007)", _ours("librosa")
         ),
         Tracker(
             "essentia-degara",
             "essentia BeatTrackerDegara: probabilistic beat periods (Degara et al. 2012)",
-            track_essentia_degara,
+            _essentia_track("BeatTrackerDegara"),
             "essentia",
         ),
         Tracker(
             "essentia-multifeature",
             "essentia BeatTrackerMultiFeature: five onset features (Zapata et al. 2014)",
-            track_essentia_multifeature,
+            _essentia_track("BeatTrackerMultiFeature"),
             "essentia",
         ),
     )
@@ -211,28 +177,21 @@ def check_tempo_range(
 ) -> dict[str, float]:
     """The tempo range [BPM] that method ``name`` will search, checked; ``{}`` if none.
 
-    A bound not given (or equal to the default) keeps the method's default: 40-240 BPM
-    within 20-400 for ``psf`` and ``librosa`` (which refuses a ``min_bpm`` of 320 or more),
-    essentia's own for its trackers (:data:`ESSENTIA_TEMPO`: whole numbers, at least 20
-    apart). ``names``: how the two bounds are named in the errors (e.g. ``--min-bpm``).
+    A bound not given (or equal to the default) keeps the method's default (essentia's:
+    :data:`ESSENTIA_TEMPO`). ``names``: the bounds' names in the errors (``--min-bpm``).
     """
     from .beats.tracker import LIBROSA_MAX_TEMPO
     from .validation import check_bpm
 
-    tracker = TRACKERS.get(name)
-    if tracker is None:
-        get(name)  # raises: unknown method
-    given = {
-        key: check_bpm(value, name=label)
-        for key, label, value in zip(("min_bpm", "max_bpm"), names, (min_bpm, max_bpm), strict=True)
-        if value is not None
-    }
+    tracker = TRACKERS.get(name) or get(name)  # get refuses an unknown method
+    label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
+    bounds = {"min_bpm": min_bpm, "max_bpm": max_bpm}
+    given = {k: check_bpm(v, name=label[k]) for k, v in bounds.items() if v is not None}
     if not given:
         return {}
     defaults = _default_range(tracker)
     essentia = tracker.requires == "essentia"
     span = ESSENTIA_TEMPO["span"] if essentia else 0
-    label = dict(zip(("min_bpm", "max_bpm"), names, strict=True))
     for key, value in given.items() if essentia else ():
         a, b = ESSENTIA_TEMPO[key[:3]]  # "min" or "max"
         if value != round(value) or not a <= value <= b:
@@ -255,9 +214,17 @@ def check_tempo_range(
     hi = given.get("max_bpm", defaults["max_bpm"])
     if not (hi - lo >= span if span else lo < hi):
         what = f"at least {span} BPM below" if span else "smaller than"
+        hint = ""  # the likely mistake: one bound given, crossing the other's default
+        if len(given) == 1:
+            (key,) = given
+            other = "max_bpm" if key == "min_bpm" else "min_bpm"
+            side = "below" if key == "max_bpm" else "above"
+            hint = (
+                f"; {label[key]} {given[key]:g} is {side} {name}'s default {label[other]} "
+                f"{defaults[other]:g}: give {label[other]} too"
+            )
         raise ParameterError(
-            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}"
-            f"{_one_bound_hint(given, label, defaults, name)}"
+            f"{label['min_bpm']} {lo:g} must be {what} {label['max_bpm']} {hi:g}{hint}"
         )
     # a bound equal to the default is the same search as none: recorded as not given
     return {k: v for k, v in given.items() if v != defaults[k]}
@@ -281,7 +248,8 @@ OUT_OF_RANGE_TEXT = "outside the range it was given"
 
 
 def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) -> None:
-    """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it."""
+    """Warn if ``beats`` (tracked with the range ``tempo``) hold a median tempo outside it
+    (essentia's beats can then differ from one call to the next; MTG/essentia issue 1097)."""
     if not tempo or beats.size < 3:
         return
     from .errors import warn
@@ -307,19 +275,6 @@ def _warn_out_of_range(name: str, beats: np.ndarray, tempo: dict[str, float]) ->
     )
 
 
-def _one_bound_hint(given, label, defaults, name) -> str:
-    """The likely mistake when only one bound was given and it crosses the other default."""
-    if len(given) != 1:
-        return ""
-    (key,) = given
-    other = "max_bpm" if key == "min_bpm" else "min_bpm"
-    side = "below" if key == "max_bpm" else "above"
-    return (
-        f"; {label[key]} {given[key]:g} is {side} {name}'s default {label[other]} "
-        f"{defaults[other]:g}: give {label[other]} too"
-    )
-
-
 def track(
     name: str,
     y: np.ndarray,
@@ -328,12 +283,9 @@ def track(
     min_bpm: float | None = None,
     max_bpm: float | None = None,
 ) -> np.ndarray:
-    """Run the method ``name`` on ``y`` at ``sr`` [Hz]; return beat times [s].
-
-    The audio is checked here for every method as ours checks it (and refused if shorter
-    than :data:`beatsync.beats.MIN_DURATION_S`). Warns when, given a range, the beats'
-    median tempo lies more than :data:`OUT_OF_RANGE_TOLERANCE` outside it (essentia's beats
-    can then differ from one call to the next; MTG/essentia issue 1097).
+    """Beat times [s] of the method ``name`` on ``y`` at ``sr`` [Hz], the audio checked as
+    ours checks it. Warns when the beats' median tempo lies more than
+    :data:`OUT_OF_RANGE_TOLERANCE` outside a given range (see :func:`_warn_out_of_range`).
     """
     from .beats import check_audio
     from .beats.tracker import check_duration

@@ -8,6 +8,8 @@ cost; these vectorised forms give the same rotations (checked against scipy in t
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .errors import ParameterError
@@ -18,13 +20,9 @@ _AXIS = {"X": 0, "Y": 1, "Z": 2}
 
 
 def quat_from_euler(angles_deg: np.ndarray, axes: str) -> np.ndarray:
-    """Quaternions of intrinsic rotations about ``axes`` (e.g. ``"ZXY"``) [deg].
-
-    The BVH convention, and scipy's for upper-case axes: the rotation is
-    ``R = R_axes[0](a0) @ R_axes[1](a1) @ ...`` (each later rotation about the axes
-    already turned by the earlier ones).
-    ``angles_deg`` is ``(n, len(axes))``; ``axes`` is one to three of ``X``, ``Y``, ``Z``
-    (case-insensitive: always intrinsic). Returns ``(n, 4)`` quaternions, scalar last.
+    """Quaternions ``(n, 4)`` of intrinsic rotations about ``axes`` (one to three of X, Y, Z,
+    any case) by ``angles_deg`` ``(n, len(axes))`` [deg]: ``R = R_axes[0](a0) @ R_axes[1](a1)
+    @ ...``, the BVH convention (scipy's for upper-case axes).
 
     Examples
     --------
@@ -42,14 +40,11 @@ def quat_from_euler(angles_deg: np.ndarray, axes: str) -> np.ndarray:
             f"angles of shape {np.shape(angles_deg)} do not match the {len(names)} axes {axes!r}"
         )
     half = np.radians(a) * 0.5
-    q = None
+    factors = np.zeros((len(names), a.shape[0], 4))  # one rotation about each axis
     for k, name in enumerate(names):
-        e = np.zeros((a.shape[0], 4))
-        e[:, _AXIS[name]] = np.sin(half[:, k])
-        e[:, 3] = np.cos(half[:, k])
-        q = e if q is None else quat_multiply(q, e)
-    assert q is not None
-    return q
+        factors[k, :, _AXIS[name]] = np.sin(half[:, k])
+        factors[k, :, 3] = np.cos(half[:, k])
+    return functools.reduce(quat_multiply, factors)
 
 
 def quat_multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:

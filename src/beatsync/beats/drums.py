@@ -1,13 +1,11 @@
 """The drum-pattern cue of the metrical level: a bass drum and a snare drum that
 alternate mark the beat (Goto 2001, J. New Music Research 30(2), 159-171).
 
-The metrical model gives the same drum pattern at 60 and 180 BPM the same evidence in
-beat units, and its prior pulls both towards 110 BPM; this cue settles it:
+The metrical model's prior pulls a drum pattern at 60 or 180 BPM towards 110 BPM; this
+cue settles it:
 
-1. **Two envelopes** (:func:`drum_envelopes`): the rising energy of the bass drum's band
-   (:data:`LOW_BAND_HZ`) and of the snare drum's (:data:`MID_BAND_HZ`), from their own
-   STFT (the front end's 0-250 Hz band holds both), at the onset signal's frame rate.
-   Energy, not its log: on a log scale the decays count as much as the attacks.
+1. **Two envelopes** (:func:`drum_envelopes`): the rising energy (not its log: the decays
+   would count as much as the attacks) of the bass drum's and the snare drum's band.
 2. **Alternation** (:func:`alternation_cue`): per window and period ``tau``, ``A(tau) =
    (x_LM(tau) + x_ML(tau)) / 2 - (r_L(tau) + r_M(tau)) / 2``, normalised cross- minus
    autocorrelations of the two envelopes: near +0.7 at a drum pattern's beat, -0.7 at
@@ -22,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .onset import _frames
+
 __all__ = [
     "DRUM_WEIGHT",
     "LOW_BAND_HZ",
@@ -33,7 +33,6 @@ __all__ = [
     "MIN_CYCLES",
     "drum_envelopes",
     "alternation_cue",
-    "drum_cue",
 ]
 
 #: Weight of the alternation cue in the tactus observation (log-likelihood units).
@@ -77,9 +76,7 @@ def drum_envelopes(y: np.ndarray, sr: float, fps: float, n_frames: int) -> np.nd
     y = (np.asarray(y) / (peak if peak > 0 else 1.0)).astype(np.float32, copy=False)
     n_fft = int(2 ** np.round(np.log2(N_FFT_S * sr)))
     hop = max(int(round(HOP_S * sr)), 1)
-    half = n_fft // 2
-    yp = np.concatenate([np.zeros(half, np.float32), y, np.zeros(half, np.float32)])
-    frames = np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]  # centred
+    frames = _frames(y, n_fft, hop)  # centred, as the front end's
     freqs = np.arange(n_fft // 2 + 1) * sr / n_fft
     member = np.stack(
         [(freqs >= lo) & (freqs < hi) for lo, hi in (LOW_BAND_HZ, MID_BAND_HZ)], axis=1
@@ -132,16 +129,3 @@ def alternation_cue(
         score -= 0.5 * (np.interp(lags, k, auto[0]) + np.interp(lags, k, auto[1]))
         out[:, w] = np.where(lags * MIN_CYCLES <= n, np.maximum(score - NOISE_LEVEL, 0.0), 0.0)
     return out
-
-
-def drum_cue(
-    y: np.ndarray,
-    sr: float,
-    fps: float,
-    n_frames: int,
-    starts: np.ndarray,
-    stops: np.ndarray,
-    periods: np.ndarray,
-) -> np.ndarray:
-    """:func:`alternation_cue` of the audio's :func:`drum_envelopes`, (n_periods, n_windows)."""
-    return alternation_cue(drum_envelopes(y, sr, fps, n_frames), fps, starts, stops, periods)

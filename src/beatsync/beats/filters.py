@@ -13,39 +13,28 @@ import numpy as np
 __all__ = ["moving_mean", "moving_max", "gaussian_smooth"]
 
 
-def _padded(x: np.ndarray, size: int, origin: int) -> tuple[np.ndarray, int]:
+def _padded(x: np.ndarray, size: int, origin: int) -> np.ndarray:
     """Pad the last axis symmetrically for a window of ``size`` shifted by ``origin``."""
     if size < 1:
         raise ValueError(f"size={size!r}: a filter window holds at least one sample")
     left = size // 2 + origin
     right = size - 1 - left
-    lo, hi = max(left, 0), max(right, 0)
-    n = x.shape[-1]
-    if lo > n or hi > n:  # wider than the signal: numpy's repeated reflections
-        width = [(0, 0)] * (x.ndim - 1) + [(lo, hi)]
-        return np.pad(x, width, mode="symmetric"), left
-    # np.pad's "symmetric" edges, without its bookkeeping (costly on short clips)
-    edges = (x[..., :lo][..., ::-1], x, x[..., n - hi :][..., ::-1])
-    return np.concatenate(edges, axis=-1), left
+    width = [(0, 0)] * (x.ndim - 1) + [(max(left, 0), max(right, 0))]
+    return np.pad(x, width, mode="symmetric")
 
 
 def moving_mean(x: np.ndarray, size: int, origin: int = 0) -> np.ndarray:
     """Mean over a window of ``size`` samples along the last axis (scipy's uniform_filter1d)."""
-    xp, _ = _padded(np.asarray(x, dtype=np.float64), size, origin)
-    cs = np.cumsum(xp, axis=-1)
-    cs = np.concatenate([np.zeros(cs.shape[:-1] + (1,)), cs], axis=-1)
+    xp = _padded(np.asarray(x, dtype=np.float64), size, origin)
+    cs = np.cumsum(np.insert(xp, 0, 0.0, axis=-1), axis=-1)
     n = x.shape[-1]
     return (cs[..., size : size + n] - cs[..., :n]) / size
 
 
 def moving_max(x: np.ndarray, size: int, origin: int = 0) -> np.ndarray:
     """Maximum over a window of ``size`` samples along the last axis (maximum_filter1d)."""
-    xp, _ = _padded(np.asarray(x), size, origin)
-    n = x.shape[-1]
-    out = xp[..., :n].copy()
-    for j in range(1, size):  # a few taps: one pass each (cheaper than the max of a
-        np.maximum(out, xp[..., j : j + n], out=out)  # strided window view over its last axis)
-    return out
+    xp = _padded(np.asarray(x), size, origin)
+    return np.lib.stride_tricks.sliding_window_view(xp, size, axis=-1).max(axis=-1)
 
 
 def gaussian_smooth(x: np.ndarray, sigma: float, truncate: float = 4.0) -> np.ndarray:
@@ -54,7 +43,7 @@ def gaussian_smooth(x: np.ndarray, sigma: float, truncate: float = 4.0) -> np.nd
     k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
     k /= k.sum()
     x = np.asarray(x, dtype=np.float64)
-    xp, _ = _padded(x, 2 * r + 1, 0)
+    xp = _padded(x, 2 * r + 1, 0)
     n = x.shape[-1]
     out = k[0] * xp[..., :n]
     for j in range(1, 2 * r + 1):  # a few taps: one pass over the whole array each

@@ -19,9 +19,7 @@ onsets (its four bands play the paper's four accent bands):
    (:mod:`beatsync.beats.tempo`) decodes the tactus observation left.
 3. **Meter** (:func:`estimate_meter`): beats per bar.
 
-``beta``, the prior widths, the ratio weights (:data:`METER_MODEL`), the spectral
-sampling and the known limits of the per-window evaluation (it prefers the fastest
-pulse present; the tactus prior and the drum cue decide): docs/tuning.md#metrical-model.
+Tuning (:data:`METER_MODEL`) and known limits: docs/tuning.md#metrical-model.
 """
 
 from __future__ import annotations
@@ -46,16 +44,11 @@ __all__ = [
 
 @dataclass(frozen=True)
 class MeterModel:
-    """Constants of the metrical model (Klapuri et al. 2006, section IV).
-
-    ``half_time_s`` [s]: the comb filters' feedback half-time ``T0`` (paper: 3 s). The
-    ``*_median_s`` [s] and ``*_sigma`` [natural-log units] of the log-normal period priors
-    (paper medians: 0.18, 0.55, 2.1 s). ``ratio_weights``: ``w_l`` (l = 1..9) of the ratio
-    model for measure / tactus; ``tatum_ratio_weights`` for tactus / tatum, with
-    ``w_3 = 0.5`` so that a "beat" of three sixteenths does not beat a waltz's own beat
-    (docs/tuning.md#tatum-ratio-weight). ``beta``: the log likelihood of a period is
-    ``beta * s(tau)``. ``min_tatum_s``, ``max_measure_s`` [s]: the shortest tatum and
-    longest measure.
+    """Constants of the metrical model (Klapuri et al. 2006, section IV): ``half_time_s``
+    [s] is ``T0``; ``*_median_s`` [s] and ``*_sigma`` [natural-log units] are the period
+    priors'; ``ratio_weights`` the ``w_l`` (l = 1..9) of measure / tactus, and
+    ``tatum_ratio_weights`` of tactus / tatum (``w_3 = 0.5``: a "beat" of three sixteenths
+    must not beat a waltz's own beat, docs/tuning.md#tatum-ratio-weight).
     """
 
     half_time_s: float = 3.0
@@ -95,18 +88,10 @@ def resonator_salience(
 ) -> np.ndarray:
     """Normalised comb-filter resonator energy summed over bands, (n_periods, n_windows).
 
-    ``bands`` (n_bands, n_frames) are accent signals, or (n_sets, n_bands, n_frames) for
-    several sets at once (the draws of the pulse-clarity null; the result gets a last axis
-    of n_sets). ``periods`` [s] need not be whole frames. Above ``max_hz`` [Hz] (where a
-    smoothed accent signal has almost no energy) every resonator passes its mean gain
-    ``gamma`` instead of being filtered (saves time).
-
-    The energy ``sum_b P(b) |H_tau(b)|^2`` over the padded window's FFT bins
-    (:func:`resonator_fft_size`) is taken in the lag domain, ``sum_k a(k) c(k)`` with
-    ``a`` the window's autocorrelation (an FFT of ``2 L - 1`` points instead of ``n_fft``)
-    and ``c`` the cached lag weights (:func:`_resonator_lag_weights`). The product is taken
-    in float32 on autocorrelations divided by their lag-0 value (scale-free; about 1e-7 of
-    each band's range).
+    ``bands`` (n_bands, n_frames) are accent signals, or (n_sets, n_bands, n_frames) (the
+    result gets a last axis of n_sets); ``periods`` [s] need not be whole frames. Above
+    ``max_hz`` [Hz] every resonator passes its mean gain ``gamma`` unfiltered (saves time).
+    The energy is taken in the lag domain (:func:`_resonator_lag_weights`).
     """
     return resonator_saliences(bands, fps, starts, stops, [periods], half_time_s, max_hz)[0]
 
@@ -137,18 +122,11 @@ def resonator_saliences(
         n_bins = min(n_bins, int(np.ceil(max_hz / fps * n_fft)) + 1)
     # cached for lags up to the next multiple of LAG_BUCKET: clips under it share them
     n_lags = min(n_fft, -(-length // LAG_BUCKET) * LAG_BUCKET)
-    weights = [
-        _resonator_lag_weights(
-            np.ascontiguousarray(periods, dtype=np.float64).tobytes(),
-            fps,
-            n_fft,
-            n_bins,
-            half_time_s,
-            n_lags,
-        )
-        for periods in period_blocks
-    ]
-    weights = [(lag_w[:, :length], gamma) for lag_w, gamma in weights]
+    weights = []
+    for periods in period_blocks:
+        key = np.ascontiguousarray(periods, dtype=np.float64).tobytes()
+        lag_w, gamma = _resonator_lag_weights(key, fps, n_fft, n_bins, half_time_s, n_lags)
+        weights.append((lag_w[:, :length], gamma))
     # the lag weights of the window's total energy (every gain 1)
     total_w = _bin_cosine_sums(n_fft, length) * _lag_multiplicity(length)
     n_acf = scipy.fft.next_fast_len(2 * length - 1, real=True)  # linear, not circular
@@ -163,7 +141,7 @@ def resonator_saliences(
         seg = np.zeros((len(chunk), n_sets, n_bands, n_acf))
         for i, (a, b) in enumerate(chunk):
             x = bands[:, :, a:b]
-            seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * _hanning(b - a)
+            seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * np.hanning(b - a)
         spec = scipy.fft.rfft(seg, axis=3)
         acf = scipy.fft.irfft(spec.real**2 + spec.imag**2, n=n_acf, axis=3)[..., :length]
         acf = acf.reshape(-1, length).T  # (lag, window x set x band)
@@ -185,14 +163,6 @@ def resonator_saliences(
         r = r.reshape(r.shape[0], n_win, n_sets, n_bands).sum(axis=3)
         out.append(r if sets else r[:, :, 0])
     return out
-
-
-@functools.lru_cache(maxsize=8)
-def _hanning(n: int) -> np.ndarray:
-    """``np.hanning(n)``, cached (every tempo window of a song has the same length)."""
-    w = np.hanning(n)
-    w.flags.writeable = False
-    return w
 
 
 #: Analysis windows whose autocorrelations :func:`resonator_salience` holds at once.

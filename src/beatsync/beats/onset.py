@@ -9,10 +9,8 @@
    slope, weighted by the band's locally normalised spectral flux (eqs. 6-7); bands
    combined with weights ``6 - c`` (c = 1..4, low bands count most).
 
-:data:`FRONTEND_DEFAULTS` (not published in the paper) are swept in
-``notebooks/paper_a_sec4_beat_tracking.ipynb``. Known limit: a steady tone has onsets
-(its leakage makes the phase slope cross zero at a steady rate in the other bands;
-docs/tuning.md#front-end-phase-slope-onsets).
+:data:`FRONTEND_DEFAULTS` are not the paper's; known limit (a steady tone has onsets):
+docs/tuning.md#front-end-phase-slope-onsets.
 """
 
 from __future__ import annotations
@@ -79,19 +77,12 @@ class FrontEnd:
 
 
 def frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
-    """Validate front-end parameters (keys of :data:`FRONTEND_DEFAULTS`) for input rate ``sr``.
-
-    Refuses an unknown key, a window under 16 samples, a hop over half the window, an FFT
-    shorter than the window, band edges that do not increase, or given band edges with a
-    band that holds no FFT bin at the analysis rate.
-    """
+    """Validate front-end parameters (keys of :data:`FRONTEND_DEFAULTS`) for input rate ``sr``:
+    a window of 16 samples or more, a hop of at most half of it, increasing band edges each
+    holding an FFT bin at the analysis rate."""
     sr = check_sample_rate(sr)
-    if not params:  # the defaults (an empty dict, or None)
-        defaults = tuple(FRONTEND_DEFAULTS.items())  # the key: they may have been changed
-        try:
-            return _default_frontend(sr, defaults)
-        except TypeError:  # a default changed to something unhashable
-            return _frontend_settings({}, sr)
+    if not params:  # the defaults, cached on their values (they may have been changed)
+        return _default_frontend(sr, tuple(FRONTEND_DEFAULTS.items()))
     return _frontend_settings(params, sr)
 
 
@@ -121,8 +112,7 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
             f"hop_s={p['hop_s']!r} s must be at most half the window win_s={p['win_s']!r} s "
             "(the phase-slope zero crossings would be missed)"
         )
-    n_fft = p["n_fft"]
-    n_fft = int(2 ** np.ceil(np.log2(win))) if n_fft is None else int(n_fft)
+    n_fft = int(2 ** np.ceil(np.log2(win))) if p["n_fft"] is None else int(p["n_fft"])
     if n_fft < win:
         raise ParameterError(f"n_fft={n_fft} must be >= the window length {win} samples")
     edges = np.asarray(p["band_edges_hz"], dtype=np.float64)
@@ -133,10 +123,7 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
     band = _bin_bands(np.fft.rfftfreq(n_fft, d=1.0 / sr), edges)
     empty = np.flatnonzero(np.bincount(band[band >= 0], minlength=edges.size - 1) == 0)
     # the default top band (4-22 kHz) is empty below 8 kHz: only edges a user gave count
-    # (onset_strength_psf and phase_slope pass the defaults on explicitly)
-    given = "band_edges_hz" in params and tuple(float(e) for e in params["band_edges_hz"]) != tuple(
-        FRONTEND_DEFAULTS["band_edges_hz"]
-    )
+    given = tuple(edges.tolist()) != tuple(FRONTEND_DEFAULTS["band_edges_hz"])
     if empty.size and given:
         k = int(empty[0])
         why = (
@@ -155,12 +142,10 @@ def _frontend_settings(params: dict[str, Any], sr: float) -> FrontEnd:
 
 @dataclass(frozen=True)
 class OnsetSignal:
-    """Output of :func:`onset_strength_psf`.
-
-    ``envelope`` (n_frames,): band-weighted onset impulses at ``fps`` [Hz]; ``bands``
-    (n_bands, n_frames): per band, unweighted; ``onset_times`` [s] (sub-frame) and
-    ``onset_strengths`` (band-weighted) of every onset; ``band_weights``: ``6 - c``
-    normalised to sum 1; ``psf`` (n_bands, n_frames) [s]: the phase slope (NaN where silent).
+    """Output of :func:`onset_strength_psf`: ``envelope`` (n_frames,), band-weighted onset
+    impulses at ``fps`` [Hz]; ``bands`` (n_bands, n_frames), unweighted; ``onset_times`` [s]
+    (sub-frame) and ``onset_strengths`` (band-weighted) of every onset; ``band_weights``,
+    ``6 - c`` summing to 1; ``psf`` (n_bands, n_frames) [s], the phase slope (NaN if silent).
     """
 
     envelope: np.ndarray
@@ -183,10 +168,7 @@ BLOCK_FRAMES = 256
 
 def _frames(y32: np.ndarray, n_fft: int, hop: int) -> np.ndarray:
     """Frames (n_frames, n_fft) of the zero-padded signal, frame ``m`` centred on ``m * hop``."""
-    pad = n_fft // 2
-    yp = np.zeros(y32.size + 2 * pad, dtype=y32.dtype)  # np.pad's zeros, without its overhead
-    yp[pad : pad + y32.size] = y32
-    return np.lib.stride_tricks.sliding_window_view(yp, n_fft)[::hop]
+    return np.lib.stride_tricks.sliding_window_view(np.pad(y32, n_fft // 2), n_fft)[::hop]
 
 
 def _frame_window(window: np.ndarray, n_fft: int) -> np.ndarray:
@@ -228,10 +210,8 @@ def _band_matrix(sr: float, fe: FrontEnd) -> np.ndarray:
 
 
 def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = True):
-    """``(psf, energy, fps, mag, flux, member)`` per band: ``psf`` [s], ``energy`` and the
-    spectral ``flux`` (mean half-wave rectified log-magnitude difference over the band's
-    bins) of shape (n_bands, n_frames); ``mag`` (frames x bins, unless not ``keep_mag``);
-    the bins' band membership. In blocks of :data:`BLOCK_FRAMES` frames.
+    """``(psf, energy, fps, mag, flux)``: :func:`phase_slope`'s and the band's spectral
+    ``flux`` (mean half-wave rectified log-magnitude difference), in blocks of frames.
     """
     import scipy.fft  # noqa: PLC0415 (batched real FFTs, much faster than numpy's here)
 
@@ -271,7 +251,7 @@ def _phase_slope(y: np.ndarray, sr: float, fe: FrontEnd, *, keep_mag: bool = Tru
     centroid[energy_t <= floor] = np.nan
     psf = -centroid / sr  # frame centre minus energy centroid [s]
     counts = np.maximum(member.sum(axis=0)[:, None], 1.0)
-    return psf, energy_t, sr / hop, mag, flux.T.astype(np.float64) / counts, member
+    return psf, energy_t, sr / hop, mag, flux.T.astype(np.float64) / counts
 
 
 def phase_slope(
@@ -283,36 +263,23 @@ def phase_slope(
     n_fft: int | None = None,
     band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
 ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
-    """Phase-slope function per band: ``(psf, energy, fps, mag)``.
-
-    ``psf`` (n_bands, n_frames) [s]: frame centre minus the band's energy centroid in time
-    (negative before an impulse reaches the frame centre; NaN where the band is silent);
-    ``energy`` the band energy ``sum |X|^2``; ``mag`` (n_bins, n_frames) the STFT magnitude.
-    """
+    """Phase-slope function per band ``psf`` (n_bands, n_frames) [s], frame centre minus the
+    band's energy centroid (NaN where silent); with ``energy`` ``sum |X|^2``, ``fps`` and the
+    STFT magnitude ``mag`` (n_bins, n_frames)."""
     given = {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}
     y, sr, fe = _validated(y, sr, {**given, "analysis_sr": None})
-    psf, energy, fps, mag, _, _ = _phase_slope(y, sr, fe)
+    psf, energy, fps, mag, _ = _phase_slope(y, sr, fe)
     return psf, energy, fps, mag.T
 
 
-def onset_strength_psf(
-    y: np.ndarray,
-    sr: float,
-    *,
-    win_s: float = FRONTEND_DEFAULTS["win_s"],
-    hop_s: float = FRONTEND_DEFAULTS["hop_s"],
-    n_fft: int | None = FRONTEND_DEFAULTS["n_fft"],
-    band_edges_hz=FRONTEND_DEFAULTS["band_edges_hz"],
-    flux_norm_s: float = FRONTEND_DEFAULTS["flux_norm_s"],
-    analysis_sr: float | None = FRONTEND_DEFAULTS["analysis_sr"],
-) -> OnsetSignal:
+def onset_strength_psf(y: np.ndarray, sr: float, **params: Any) -> OnsetSignal:
     """Onset signal from positive zero crossings of the band phase-slope function.
 
     Each crossing in band ``c`` is weighted by the band's spectral flux around it
     (half-wave rectified log-magnitude difference minus its local mean over
-    ``flux_norm_s`` [s]; eqs. 6-7); bands combined with weights ``6 - c``. ``hop_s`` is at
-    most ``win_s / 2``. Audio above ``analysis_sr`` [Hz] is first resampled to it (soxr),
-    so that 22.05, 44.1 and 48 kHz input behave alike; None analyses at the input rate.
+    ``flux_norm_s`` [s]; eqs. 6-7); bands combined with weights ``6 - c``. ``params``: the
+    front end's settings (:data:`FRONTEND_DEFAULTS`); audio above ``analysis_sr`` [Hz] is
+    first resampled to it (soxr), so that 22.05, 44.1 and 48 kHz input behave alike.
 
     Examples
     --------
@@ -322,9 +289,7 @@ def onset_strength_psf(
     >>> bool(abs(ons.onset_times[np.argmax(ons.onset_strengths)] - 0.5) < 0.01)
     True
     """
-    given = {"win_s": win_s, "hop_s": hop_s, "n_fft": n_fft, "band_edges_hz": band_edges_hz}
-    given.update(flux_norm_s=flux_norm_s, analysis_sr=analysis_sr)
-    return compute_onsets(*_validated(y, sr, given))
+    return compute_onsets(*_validated(y, sr, params))
 
 
 def _validated(y, sr, params: dict[str, Any]) -> tuple[np.ndarray, float, FrontEnd]:
@@ -343,7 +308,7 @@ def compute_onsets(y: np.ndarray, sr: float, fe: FrontEnd) -> OnsetSignal:
     # float32 divided in float32: the same as in float64 rounded to float32 (double
     # rounding is innocuous for a division), without the float64 copies
     y = y / np.max(np.abs(y))
-    psf, _, fps, _, flux, _ = _phase_slope(y, sr, fe, keep_mag=False)
+    psf, _, fps, _, flux = _phase_slope(y, sr, fe, keep_mag=False)
     n_bands, n_frames = psf.shape
     if fe.flux_norm_s > 0:  # remove the fluctuation floor of sustained sounds
         size = max(int(time_to_frames(fe.flux_norm_s, fps=fps)), 3)

@@ -1,10 +1,8 @@
 """Tempo: the tempo HMM over beat periods, and a plain-numpy Viterbi decoder.
 
-The beat period is a hidden state per analysis window (8 s, 1 s hop), observed through
-the tactus salience of :mod:`beatsync.beats.metrical`; transitions are log-normal in
-the period ratio plus a small jump probability, so an abrupt tempo change is followed
-rather than averaged away. :func:`viterbi_banded` decodes only the band of transitions
-that differ from the uniform jump (the same path as :func:`viterbi`).
+The beat period is a hidden state per analysis window, observed through the tactus
+salience (:mod:`.metrical`); transitions are log-normal in the period ratio plus a small
+jump probability, so an abrupt tempo change is followed rather than averaged away.
 """
 
 from __future__ import annotations
@@ -46,14 +44,12 @@ def period_grid(min_bpm: float, max_bpm: float, step: float = 0.005) -> np.ndarr
     return np.exp(np.linspace(lo, hi, n))
 
 
-def viterbi(
-    log_obs: np.ndarray, log_trans: np.ndarray, log_init: np.ndarray | None = None
-) -> np.ndarray:
-    """Most likely state path of an HMM, log domain: ``log_obs`` (n_states, n_steps),
-    ``log_trans[i, j]`` from ``i`` to ``j``, ``log_init`` (uniform if None).
+def viterbi(log_obs: np.ndarray, log_trans: np.ndarray) -> np.ndarray:
+    """Most likely state path of an HMM, log domain, uniform start: ``log_obs``
+    (n_states, n_steps), ``log_trans[i, j]`` from ``i`` to ``j``.
     """
     n_states, n_steps = log_obs.shape
-    value = log_obs[:, 0] + (0.0 if log_init is None else log_init)
+    value = log_obs[:, 0]
     back = np.empty((n_steps, n_states), dtype=np.int64)
     cols = np.arange(n_states)
     for t in range(1, n_steps):
@@ -96,26 +92,17 @@ def _log_transitions(
 
 
 def tempo_hmm(
-    log_obs: np.ndarray,
-    periods: np.ndarray,
-    *,
-    trans_sigma: float,
-    p_jump: float,
-    log_prior: np.ndarray | None = None,
+    log_obs: np.ndarray, periods: np.ndarray, *, trans_sigma: float, p_jump: float
 ) -> np.ndarray:
     """Viterbi path (state index per window) of the tempo HMM over the log-spaced ``periods``
     [s]: ``trans_sigma`` is the sd of the log period ratio between windows, ``p_jump`` the
     probability of an abrupt change to any period.
     """
-    if log_obs.shape[1] == 1:  # one window (a clip shorter than it): no transition
-        value = log_obs[:, 0] + (0.0 if log_prior is None else log_prior)
-        return np.array([int(np.argmax(value))], dtype=np.int64)
     periods = np.ascontiguousarray(periods, dtype=np.float64)
     log_trans, reach, band = _log_transitions(periods.tobytes(), float(trans_sigma), float(p_jump))
     if reach is not None and 2 * reach + 1 < periods.size:
-        log_jump = np.log(p_jump / periods.size)
-        return viterbi_banded(log_obs, log_trans, reach, log_jump, log_prior, band_terms=band)
-    return viterbi(log_obs, log_trans, log_prior)
+        return viterbi_banded(log_obs, band, np.log(p_jump / periods.size))
+    return viterbi(log_obs, log_trans)
 
 
 def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
@@ -135,24 +122,16 @@ def _band(log_trans: np.ndarray, reach: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def viterbi_banded(
-    log_obs: np.ndarray,
-    log_trans: np.ndarray,
-    reach: int,
-    log_jump: float,
-    log_init: np.ndarray | None = None,
-    *,
-    band_terms: tuple[np.ndarray, np.ndarray] | None = None,
+    log_obs: np.ndarray, band_terms: tuple[np.ndarray, np.ndarray], log_jump: float
 ) -> np.ndarray:
-    """:func:`viterbi` for transitions that are a band plus a uniform jump.
-
-    ``log_trans[i, j]`` must equal ``log_jump`` wherever ``|i - j| > reach`` (and be at
-    least that everywhere): each step costs ``(2 reach + 1) n`` instead of ``n**2``, with
-    the dense decoder's path (up to exact ties). ``band_terms``: :func:`_band`, if at hand.
+    """:func:`viterbi` for transitions that are a band (:func:`_band`) plus a uniform jump
+    ``log_jump`` (the least of all): ``(2 reach + 1) n`` a step instead of ``n**2``.
     """
     n_states, n_steps = log_obs.shape
-    band, src = _band(log_trans, reach) if band_terms is None else band_terms
+    band, src = band_terms
+    reach = band.shape[1] // 2
     cols = np.arange(n_states)
-    value = log_obs[:, 0] + (0.0 if log_init is None else log_init)
+    value = log_obs[:, 0]
     back = np.empty((n_steps, n_states), dtype=np.int64)
     pad = np.full(n_states + 2 * reach, -np.inf)
     for t in range(1, n_steps):

@@ -23,7 +23,7 @@ from ..validation import (
     check_times,
     frames_to_time,
 )
-from .drums import DRUM_WEIGHT, drum_cue
+from .drums import DRUM_WEIGHT, alternation_cue, drum_envelopes
 from .filters import gaussian_smooth
 from .metrical import (
     METER_MODEL,
@@ -80,12 +80,9 @@ P_JUMP = 1e-4
 
 @dataclass(frozen=True)
 class BeatTrack:
-    """Result of :func:`track_beats`.
-
-    ``beats`` [s] strictly increasing; ``tempo`` [bpm] the median of ``tempo_curve``
-    [bpm] (NaN without beats), one value per window centred at ``tempo_times`` [s];
-    ``beats_per_bar`` the meter (0 if not estimated: ``method="librosa"`` or no beats).
-    """
+    """Result of :func:`track_beats`: ``tempo`` [bpm] is the median of ``tempo_curve`` [bpm]
+    (NaN without beats), one per window centred at ``tempo_times`` [s]; ``beats_per_bar``
+    is 0 if not estimated (``method="librosa"`` or no beats)."""
 
     beats: np.ndarray
     tempo: float
@@ -172,15 +169,10 @@ def track_beats(
     ``tempo_win_s``, ``tempo_hop_s`` [s]: the tempo HMM's windows; ``time_varying=False``
     forces one tempo for the whole piece. ``drum_weight``: weight of the drum-pattern cue
     of the metrical level (:mod:`beatsync.beats.drums`; 0 leaves it out).
-    ``frontend_params``: ``win_s``, ``hop_s``, ``n_fft``, ``band_edges_hz``,
-    ``flux_norm_s``, ``analysis_sr`` (see :func:`beatsync.beats.onset_strength_psf`).
+    ``frontend_params``: the front end's settings (:data:`.onset.FRONTEND_DEFAULTS`).
 
-    Raises :class:`ParameterError` for empty, silent or non-finite audio, audio too short
-    for a pulse (:func:`check_duration`), a bad ``sr``, tempo bound or range, a ``bpm``
-    given with a range other than the default, an unknown method or front-end parameter.
-    Warns (:class:`~beatsync.errors.BeatsyncWarning`) when no onsets are found (no
-    beats) or when the pulse is unclear (:func:`pulse_clarity_null`; e.g. noise). A
-    steady tone has onsets and gets beats without a warning (see :mod:`.onset`).
+    Refuses empty, silent, non-finite or too short audio (:func:`check_duration`) and bad
+    settings; warns when no onsets are found or the pulse is unclear (e.g. noise).
 
     Examples
     --------
@@ -191,8 +183,7 @@ def track_beats(
     >>> round(bt.tempo)
     120
     """
-    # float32 audio stays float32 for our tracker (its front end runs in float32: the
-    # same samples, without a float64 copy); any other type becomes float64
+    # float32 stays float32 (the front end runs in float32); any other type becomes float64
     y, sr = _units_check_audio(y, sr, silence_peak=SILENCE_PEAK)
     if y.dtype != np.float32:
         y = np.asarray(y, dtype=np.float64)
@@ -212,7 +203,6 @@ def track_beats(
             raise ParameterError(
                 f"front-end parameters {sorted(frontend_params)} only apply to method='psf'"
             )
-        y = np.asarray(y, dtype=np.float64)  # as librosa was always given it
         return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
     if method != "psf":
         raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
@@ -265,12 +255,7 @@ def track_beats(
                 if abs(np.log(est / tempo_curve[i])) < 0.05:  # same metrical level
                     tempo_curve[i] = est
     return BeatTrack(
-        beats.astype(np.float64),
-        float(np.median(tempo_curve)),
-        centres.astype(np.float64),
-        tempo_curve,
-        "psf",
-        beats_per_bar,
+        beats, float(np.median(tempo_curve)), centres, tempo_curve, "psf", beats_per_bar
     )
 
 
@@ -300,19 +285,13 @@ def observe(
     tempo_hop_s: float = 1.0,
     drum_weight: float = DRUM_WEIGHT,
 ) -> Observation:
-    """The metrical model's tactus observation plus the drum cue, per tempo window.
-
-    Trusts its inputs (also decoded by ``benchmarks/calibrate_pulse_clarity.py``). A
-    known ``bpm`` gives a grid of one period and no drum cue.
-    """
+    """The metrical model's tactus observation plus the drum cue, per tempo window (trusts
+    its inputs); a known ``bpm`` gives a grid of one period and no drum cue."""
     fps = ons.fps
     n = ons.envelope.size
     accents = _accents(ons.bands, fps)
     starts, stops, centres = analysis_windows(n, fps, tempo_win_s, tempo_hop_s)
-    if bpm is not None:
-        periods = np.array([60.0 / bpm])
-    else:
-        periods = period_grid(min_bpm, max_bpm)
+    periods = period_grid(min_bpm, max_bpm) if bpm is None else np.array([60.0 / bpm])
     # above this the 10-ms smoothing leaves < 1 % of the accent power
     max_hz = np.sqrt(np.log(100.0)) / (2 * np.pi * _accent_sigma(fps) / fps)
     log_obs, salience, measure = tactus_observation(
@@ -320,7 +299,8 @@ def observe(
     )
     if bpm is None and drum_weight > 0:
         y, sr = audio
-        log_obs = log_obs + drum_weight * drum_cue(y, sr, fps, n, starts, stops, periods)
+        cue = alternation_cue(drum_envelopes(y, sr, fps, n), fps, starts, stops, periods)
+        log_obs = log_obs + drum_weight * cue
     return Observation(starts, stops, centres, periods, max_hz, log_obs, salience, measure)
 
 
@@ -332,13 +312,9 @@ def pulse_clarity_null(
     model: MeterModel,
     max_hz: float,
 ) -> float:
-    """Pulse clarity of the same onsets in random order: what no pulse looks like.
-
-    The band onsets are permuted in time (seeded), observed with the tactus terms alone
-    (:func:`beatsync.beats.metrical.beat_observation`) and decoded by the tempo HMM; the
-    mean path salience over enough draws for :data:`NULL_AUDIO_S` of audio (at most
-    :data:`NULL_MAX_DRAWS`). It keeps the audio's onset density, window lengths and
-    decoding bias.
+    """Pulse clarity of the same onsets in random order (seeded): what no pulse looks like,
+    at the audio's onset density, window lengths and decoding bias. The mean path salience
+    of the tactus terms alone over draws for :data:`NULL_AUDIO_S` of audio.
     """
     fps = ons.fps
     n = ons.bands.shape[1]
@@ -396,31 +372,22 @@ LIBROSA_MAX_TEMPO = 320.0
 LIBROSA_HOP = 512
 
 
-def librosa_tempo_steps(sr: float, hop: int = LIBROSA_HOP) -> np.ndarray:
-    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], ascending.
-
-    One per whole lag of its 8 s onset autocorrelation, ``60 sr / (hop lag)``, below
-    320 BPM (13.5 BPM apart near 190 BPM at 22.05 kHz).
-    """
-    win = int(np.floor(8.0 * sr / hop))  # librosa.time_to_frames(ac_size=8, sr, hop)
-    lags = np.arange(1, win)
-    bpms = 60.0 * sr / (hop * lags)
+def librosa_tempo_steps(sr: float) -> np.ndarray:
+    """The tempi [BPM] librosa's beat tracker can choose at ``sr`` [Hz], ascending: one per
+    whole lag of its 8 s onset autocorrelation, ``60 sr / (hop lag)``, below 320 BPM."""
+    win = int(np.floor(8.0 * sr / LIBROSA_HOP))  # librosa.time_to_frames(ac_size=8, ...)
+    bpms = 60.0 * sr / (LIBROSA_HOP * np.arange(1, win))
     return np.sort(bpms[bpms < LIBROSA_MAX_TEMPO])
 
 
 def librosa_tempo_prior(
-    min_bpm: float = DEFAULT_MIN_BPM,
-    max_bpm: float = DEFAULT_MAX_BPM,
-    *,
-    sr: float | None = None,
-    hop: int = LIBROSA_HOP,
+    min_bpm: float = DEFAULT_MIN_BPM, max_bpm: float = DEFAULT_MAX_BPM, *, sr: float
 ):
-    """The tempo prior for :func:`librosa.beat.beat_track`: ``None`` (librosa's own) for
-    the default range, else flat inside it (``scipy.stats.uniform``).
+    """The tempo prior for :func:`librosa.beat.beat_track` at ``sr`` [Hz]: ``None``
+    (librosa's own) for the default range, else flat inside it (``scipy.stats.uniform``).
 
-    Refuses (given ``sr``) a range holding none of :func:`librosa_tempo_steps`, e.g.
-    185-198 BPM at 22.05 kHz, or above 320 BPM: librosa would return one beat at an
-    infinite tempo. The message names the nearest tempi it can choose.
+    Refuses a range holding none of :func:`librosa_tempo_steps` (e.g. 185-198 BPM at
+    22.05 kHz) or above 320 BPM: librosa would return one beat at an infinite tempo.
     """
     if (min_bpm, max_bpm) == (DEFAULT_MIN_BPM, DEFAULT_MAX_BPM):
         return None
@@ -429,23 +396,23 @@ def librosa_tempo_prior(
             f"min_bpm {min_bpm:g}: librosa's beat tracker does not search above "
             f"{LIBROSA_MAX_TEMPO:g} BPM; give a lower min_bpm (or track the half tempo)"
         )
-    if sr is not None:
-        steps = librosa_tempo_steps(sr, hop)
-        if not np.any((steps >= min_bpm) & (steps <= max_bpm)):
-            below = steps[steps < min_bpm]
-            above = steps[steps > max_bpm]
-            near = [f"{v:.1f}" for v in (below[-1:].tolist() + above[:1].tolist())]
-            verb = "is" if len(near) == 1 else "are"
-            nearest = (
-                f"the nearest {verb} {' and '.join(near)} BPM: widen the range to include one"
-                if near
-                else "it has none at this sample rate"
-            )
-            raise ParameterError(
-                f"tempo range {min_bpm:g}-{max_bpm:g} BPM holds none of the tempi librosa "
-                f"can choose at {sr:g} Hz (one lag of its onset autocorrelation, "
-                f"hop {hop}); {nearest}"
-            )
+    steps = librosa_tempo_steps(sr)
+    if not np.any((steps >= min_bpm) & (steps <= max_bpm)):
+        near = [
+            f"{v:.1f}"
+            for v in steps[steps < min_bpm][-1:].tolist() + steps[steps > max_bpm][:1].tolist()
+        ]
+        verb = "is" if len(near) == 1 else "are"
+        nearest = (
+            f"the nearest {verb} {' and '.join(near)} BPM: widen the range to include one"
+            if near
+            else "it has none at this sample rate"
+        )
+        raise ParameterError(
+            f"tempo range {min_bpm:g}-{max_bpm:g} BPM holds none of the tempi librosa "
+            f"can choose at {sr:g} Hz (one lag of its onset autocorrelation, "
+            f"hop {LIBROSA_HOP}); {nearest}"
+        )
     import scipy.stats  # noqa: PLC0415
 
     return scipy.stats.uniform(min_bpm, max_bpm - min_bpm)
@@ -454,16 +421,14 @@ def librosa_tempo_prior(
 def _track_librosa(y, sr, *, bpm, min_bpm, max_bpm) -> BeatTrack:
     import librosa  # noqa: PLC0415 (heavy; only for the comparison method)
 
-    hop = LIBROSA_HOP
     kwargs: dict[str, Any] = {}
     if bpm is not None:
         kwargs["bpm"] = bpm
-    elif (prior := librosa_tempo_prior(min_bpm, max_bpm, sr=sr, hop=hop)) is not None:
+    elif (prior := librosa_tempo_prior(min_bpm, max_bpm, sr=sr)) is not None:
         kwargs["prior"] = prior
     tempo, beats = librosa.beat.beat_track(
-        y=y.astype(np.float32), sr=sr, hop_length=hop, units="time", **kwargs
+        y=y.astype(np.float32), sr=sr, hop_length=LIBROSA_HOP, units="time", **kwargs
     )
     tempo = float(np.atleast_1d(tempo)[0])
     beats = np.unique(np.asarray(beats, dtype=np.float64))
-    dur = y.size / sr
-    return BeatTrack(beats, tempo, np.array([dur / 2]), np.array([tempo]), "librosa")
+    return BeatTrack(beats, tempo, np.array([y.size / sr / 2]), np.array([tempo]), "librosa")

@@ -9,11 +9,9 @@ kind, but average over different sets:
 - :func:`beat_alignment_music` averages over **music beats** (Siyao et al. 2022,
   Bailando "BAS"): is every beat of the song danced? Extra motion beats cost nothing.
 
-The papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (the default). Every table
-says which score it reports; :func:`alignment_scores` returns both. Beat times are 1-D
-float64 seconds, strictly increasing (as in ``mir_eval.beat``); scores lie in ``[0, 1]``.
-Empty input is degenerate but legal: a warning, and the score is 0. No stage runs here
-(mir_eval style: :func:`validate`, the metrics, :func:`evaluate`).
+The papers' sigma of 3 frames at 60 fps is ``sigma = 0.05`` s (the default). Beat times
+are 1-D float64 seconds, strictly increasing; scores lie in ``[0, 1]``, 0 (with a
+warning) for empty input.
 """
 
 from __future__ import annotations
@@ -156,10 +154,8 @@ def offset_control(
     n_trials: int = 200,
     seed: int = 0,
 ) -> dict[str, float]:
-    """Chance level: mean and sd of both scores with the motion beats shifted by random offsets.
-
-    Each of ``n_trials`` shifts all motion beats by one offset uniform in ``[-T/2, T/2)``,
-    ``T`` the median music beat period: the dance keeps its rhythm, its phase is random.
+    """Chance level: mean and sd of both scores over ``n_trials`` shifts of all motion beats
+    by one offset uniform in ``[-T/2, T/2)`` (``T`` the median music beat period).
     """
     mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     if yb.size < 2:
@@ -185,12 +181,9 @@ def offset_control(
 
 
 def beat_phase_consistency(motion_beats: Any, music_beats: Any) -> float:
-    """How consistently motion beats fall at one phase of the music's beat, in [0, 1].
-
-    The vector strength ``|mean exp(2 pi i phase)|`` of each motion beat's phase inside its
-    music beat interval (motion beats outside the music beats are ignored): 1 when
-    phase-locked at whatever phase, near 0 for a dance drifting against the music.
-    """
+    """How consistently motion beats fall at one phase of the music's beat: the vector
+    strength ``|mean exp(2 pi i phase)|`` of their phases in the music's beat intervals, 1
+    when phase-locked at whatever phase, near 0 for a dance drifting against the music."""
     mb, yb = validate(motion_beats, music_beats)
     if yb.size < 2:
         raise ParameterError("beat_phase_consistency needs at least 2 music beats")
@@ -240,8 +233,6 @@ def evaluate(
     fewer than two music beats).
     """
     out: dict[str, float] = dict(alignment_scores(motion_beats, music_beats, sigma=sigma, **kwargs))
-    yb = validate(motion_beats, music_beats)[1]
-    out["phase_consistency"] = (
-        beat_phase_consistency(motion_beats, music_beats) if yb.size >= 2 else float("nan")
-    )
+    mb, yb = validate(motion_beats, music_beats)
+    out["phase_consistency"] = beat_phase_consistency(mb, yb) if yb.size >= 2 else float("nan")
     return out

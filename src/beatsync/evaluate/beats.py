@@ -1,11 +1,8 @@
 """Beat-tracking scores on arrays, in the style of :mod:`mir_eval.beat`.
 
-Reference and estimated beats are 1-D times in seconds, strictly increasing, >= 0;
-:func:`validate` diagnoses the usual mistake (frame indices or milliseconds).
-``min_beat_time`` [s] is always explicit: mir_eval's default (5 s) silently drops most
-of a short clip. :func:`evaluate` returns every metric of :func:`mir_eval.beat.evaluate`
-(:data:`METRICS`); :func:`tempo_octave` names the metrical relation of the estimated
-tempo to the reference. No tracker runs here (:mod:`beatsync.study` runs them).
+Reference and estimated beats are 1-D times in seconds, strictly increasing, >= 0
+(:func:`validate` diagnoses frame indices or milliseconds). ``min_beat_time`` [s] is
+always explicit: mir_eval's default (5 s) silently drops most of a short clip.
 """
 
 from __future__ import annotations
@@ -65,14 +62,9 @@ OCTAVE_ERRORS = ("double", "half", "triple", "third")
 
 
 def diagnose_times(times: np.ndarray) -> str | None:
-    """What finite increasing event times look like if not seconds, or ``None``.
-
-    ``None`` for plausible beat times (a median spacing of at most
-    :data:`MAX_BEAT_INTERVAL`, the last within mir_eval's limit); else ``"frame indices"``
-    (integers less than 150 apart), ``"milliseconds"`` (150-3000 apart), ``"sample
-    indices"`` (integers further apart), a recording too long for mir_eval, or something
-    slower than any beat.
-    """
+    """What finite increasing event times look like if not seconds (frame, sample indices,
+    milliseconds, ...), or ``None`` for plausible beat times (a median spacing of at most
+    :data:`MAX_BEAT_INTERVAL`, the last within mir_eval's limit)."""
     if times.size == 0:
         return None
     if times.size < 3:
@@ -171,10 +163,7 @@ def octave_relation(estimated_bpm: float, reference_bpm: float, *, tol: float = 
     if not (np.isfinite(estimated_bpm) and np.isfinite(reference_bpm)) or reference_bpm <= 0:
         return "other"
     r = estimated_bpm / reference_bpm
-    for name, target in TEMPO_RATIOS.items():
-        if abs(r / target - 1.0) <= tol:
-            return name
-    return "other"
+    return next((k for k, t in TEMPO_RATIOS.items() if abs(r / t - 1.0) <= tol), "other")
 
 
 def count_octave_errors(octaves: Any) -> int:

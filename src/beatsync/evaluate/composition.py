@@ -1,23 +1,9 @@
 """Objective quality proxies of a composed dance (stand-ins for paper B's user study).
 
-Paper B's Table 2 is a user study we cannot repeat; these are *proxies* for what
-viewers judged. Every function takes arrays computed by the caller
-(:mod:`beatsync.study.paper_b` runs the stages). Times are in seconds; positions
-``(n_frames, n_joints, 3)`` [position unit] at ``fps`` [Hz].
-
-- **Beat alignment** (:mod:`beatsync.evaluate.alignment`): both published scores on the
-  kinematic beats of the composed motion.
-- **Intensity correlation** (:func:`intensity_correlation`): Pearson r between the
-  motion's intensity per music beat interval and the music level (RMS dB).
-- **Transition smoothness** (:func:`transition_jumps`): the largest frame-to-frame
-  change of joint velocity (:func:`velocity_change`) within ``[T - 1 frame, T + blend]``
-  of each transition over its median over the whole dance (1: as smooth as ordinary
-  movement).
-- **Foot sliding** (:func:`foot_sliding`): mean horizontal foot speed during floor
-  contact (height below the foot's 5th percentile plus 10 % of its range).
-
-Physical plausibility is part of the composition's own report
-(:mod:`beatsync.graph.plausibility`).
+Paper B's Table 2 is a user study we cannot repeat: beat alignment, intensity correlation,
+transition smoothness and foot sliding stand in for what viewers judged. Every function
+takes arrays computed by the caller (:mod:`beatsync.study.paper_b` runs the stages); times
+in seconds, positions ``(n_frames, n_joints, 3)`` [position unit] at ``fps`` [Hz].
 """
 
 from __future__ import annotations
@@ -64,7 +50,9 @@ def velocity_change(positions: Any, *, fps: float) -> np.ndarray:
 def transition_jumps(
     positions: Any, transition_times: Any, *, fps: float, blend: float = 1.0 / 3.0
 ) -> np.ndarray:
-    """Velocity-jump ratio at each transition (see module docstring); empty if none."""
+    """Velocity-jump ratio at each transition ``T``: the largest :func:`velocity_change` in
+    ``[T - 1 frame, T + blend]`` over its median over the dance (1: as smooth as ordinary
+    movement); empty if none."""
     tt = np.asarray(transition_times, dtype=np.float64)
     dv = velocity_change(positions, fps=fps)
     med = float(np.median(dv))
@@ -72,14 +60,9 @@ def transition_jumps(
         return np.empty(0)
     if med <= 0:
         raise ParameterError("the motion does not move: velocity changes are all zero")
-    out = []
-    first = time_to_frames(tt, fps=fps, mode="floor") - 1
-    after = time_to_frames(tt + blend, fps=fps, mode="ceil") + 1
-    for f0, f1 in zip(first, after, strict=True):
-        j0 = max(0, int(f0))
-        j1 = min(dv.size, int(f1))
-        out.append(dv[j0:j1].max() / med if j1 > j0 else np.nan)
-    return np.asarray(out)
+    j0 = np.maximum(time_to_frames(tt, fps=fps, mode="floor") - 1, 0)
+    j1 = np.minimum(time_to_frames(tt + blend, fps=fps, mode="ceil") + 1, dv.size)
+    return np.array([dv[a:b].max() / med if b > a else np.nan for a, b in zip(j0, j1, strict=True)])
 
 
 def foot_joints(motion: Any) -> list[str]:
@@ -103,8 +86,7 @@ def foot_joints(motion: Any) -> list[str]:
 
 def foot_sliding(foot_positions: Any, *, fps: float, up_axis: str = "y") -> float:
     """Mean horizontal speed [position unit / s] of ``foot_positions`` (n_frames, n_feet, 3)
-    during floor contact.
-    """
+    during floor contact (height below the 5th percentile plus 10 % of the range)."""
     pos = np.asarray(foot_positions, dtype=np.float64)
     up = "xyz".index(up_axis)
     ground = [a for a in range(3) if a != up]
@@ -134,13 +116,8 @@ def quality_proxies(
     blend: float = 1.0 / 3.0,
     up_axis: str = "y",
 ) -> dict[str, float]:
-    """Every proxy of one composed dance (mir_eval style ``evaluate``).
-
-    Beats outside ``span`` [s] (the time both the dance and the music play) are not scored;
-    ``motion_intensity`` and ``music_level`` are per music beat interval; ``sigma`` [s] is
-    the alignment scores' width and ``blend`` [s] the transitions' (the velocity-jump
-    window). Returns ``alignment_motion``, ``alignment_music``, ``intensity_r``,
-    ``transition_jump_mean``, ``transition_jump_max`` and ``foot_sliding``.
+    """Every proxy of one composed dance (mir_eval style ``evaluate``); beats outside
+    ``span`` [s] (where both the dance and the music play) are not scored.
     """
     with silenced():
         al = alignment_scores(motion_beats, music_beats, sigma=sigma, span=span)

@@ -1,15 +1,12 @@
 """Synthetic beat-tracking test signals with exact ground truth.
 
-Audio is mono ``float32`` at ``sr`` [Hz]; beats are 1-D ``float64`` seconds, strictly
-increasing, rendered sample-exactly (every beat is the onset of a click or a drum hit).
-
-The test set (:func:`make_beat_test_set`) crosses click tracks and drum patterns (kick
-on beats 1 and 3, snare on 2 and 4, hi-hat on every eighth) at 60-180 BPM with five
-:data:`GROUPS`: ``clean``, ``drift`` (sinusoidal tempo drift of +-5 %), ``swing``
-(off-beat eighths at 2/3 of the beat), ``noise`` (white noise at 10 dB SNR) and
-``change`` (an abrupt tempo change halfway). It stands in for the paper's test music.
-:func:`drum_song` renders a song for paper B's studies: the drum pattern with a gain
-that changes every few beats, like verses and choruses.
+Audio is mono ``float32`` at ``sr`` [Hz]; beats are 1-D ``float64`` seconds, every one
+the onset of a click or a drum hit (sample-exact). The test set (:func:`make_beat_test_set`,
+standing in for the paper's test music) crosses click tracks and drum patterns at 60-180
+BPM with five :data:`GROUPS`: ``clean``, ``drift`` (sinusoidal tempo drift of +-5 %),
+``swing`` (off-beat eighths at 2/3 of the beat), ``noise`` (white noise at 10 dB SNR) and
+``change`` (an abrupt tempo change halfway). :func:`drum_song`, for paper B's studies, has
+a gain that changes every few beats, like verses and choruses.
 """
 
 from __future__ import annotations
@@ -189,14 +186,8 @@ def drum_pattern(
     beats, sr, duration = _check_common(beats, sr, duration)
     if not 0.0 < swing < 1.0:
         raise ParameterError(f"swing={swing!r} must be a fraction of the beat in (0, 1)")
-    rng = np.random.default_rng(seed)
-    n = int(round(duration * sr))
-    y = _render(beats[0::2], _kick(sr), n, sr, 1.0)
-    y += _render(beats[1::2], _snare(sr, rng), n, sr, 0.8)
-    hat = _hihat(sr, rng)
-    y += _render(beats, hat, n, sr, 1.0)
-    y += _render(_offbeats(beats, swing), hat, n, sr, offbeat_gain)
-    return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
+    down = np.arange(beats.size) % 2 == 0
+    return _drums(beats, down, [swing], (0.8, 1.0, offbeat_gain), sr, duration, seed)
 
 
 def meter_pattern(
@@ -207,25 +198,30 @@ def meter_pattern(
     duration: float,
     seed: int = 0,
 ) -> np.ndarray:
-    """A drum pattern in ``meter`` (:data:`METERS`) with eighth-note hi-hats (float32).
-
-    A kick on the first beat of every bar, snares on the others, a hi-hat on every eighth
-    (softer between the beats). ``beats`` are the tactus: quarter notes in 2/4 and 3/4,
-    dotted quarters in 6/8.
+    """A drum pattern in ``meter`` (:data:`METERS`; ``beats`` the tactus), float32: a kick on
+    the first beat of every bar, snares on the others, a hi-hat on every eighth.
     """
     if meter not in METERS:
         raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")
     beats, sr, duration = _check_common(beats, sr, duration)
     per_bar, eighths = METERS[meter]
+    down = np.arange(beats.size) % per_bar == 0
+    offsets = [k / eighths for k in range(1, eighths)]
+    return _drums(beats, down, offsets, (0.6, 0.5, 0.3), sr, duration, seed)
+
+
+def _drums(beats, down, offsets, gains, sr, duration, seed) -> np.ndarray:
+    """Kick on the ``down`` beats, snare on the others, hi-hat on every beat and at each
+    offset [beats]; ``gains`` of the snare, the hi-hat and the off-beat hi-hats."""
+    snare_gain, hat_gain, offbeat_gain = gains
     rng = np.random.default_rng(seed)
     n = int(round(duration * sr))
-    down = np.arange(beats.size) % per_bar == 0
     y = _render(beats[down], _kick(sr), n, sr, 1.0)
-    y += _render(beats[~down], _snare(sr, rng), n, sr, 0.6)
+    y += _render(beats[~down], _snare(sr, rng), n, sr, snare_gain)
     hat = _hihat(sr, rng)
-    y += _render(beats, hat, n, sr, 0.5)
-    for k in range(1, eighths):
-        y += _render(_offbeats(beats, k / eighths), hat, n, sr, 0.3)
+    y += _render(beats, hat, n, sr, hat_gain)
+    for offset in offsets:
+        y += _render(_offbeats(beats, offset), hat, n, sr, offbeat_gain)
     return (0.5 * y / max(np.max(np.abs(y)), 1e-12)).astype(np.float32)
 
 
@@ -241,11 +237,6 @@ def add_noise(y: np.ndarray, *, snr_db: float, seed: int = 0) -> np.ndarray:
     return (0.5 * out / np.max(np.abs(out))).astype(np.float32)
 
 
-def _second_tempo(bpm: float) -> float:
-    """Tempo after the abrupt change: +1/3 for slow tempi, -1/4 for fast ones."""
-    return bpm * 4 / 3 if bpm <= 120 else bpm * 3 / 4
-
-
 def make_beat_test_set(
     *,
     sr: int = 22050,
@@ -258,11 +249,8 @@ def make_beat_test_set(
     swing: float = 2 / 3,
     seed: int = 0,
 ) -> list[BeatTestItem]:
-    """The synthetic beat-tracking test set, in the order kinds x groups x bpms.
-
-    ``snr_db`` [dB] is the ``noise`` group's SNR, ``drift`` the ``drift`` group's relative
-    amplitude, ``swing`` the ``swing`` group's off-beat position; ``seed`` draws the first
-    beats and all noise.
+    """The synthetic beat-tracking test set, in the order kinds x groups x bpms; ``snr_db``
+    [dB], ``drift`` and ``swing`` set their groups, ``seed`` draws first beats and noise.
 
     Examples
     --------
@@ -274,12 +262,9 @@ def make_beat_test_set(
     duration = check_positive(duration, name="duration", unit="s")
     if duration < 4.0:
         raise ParameterError(f"duration={duration!r} s is too short for a test item (>= 4 s)")
-    for k in kinds:
-        if k not in KINDS:
-            raise ParameterError(f"unknown kind {k!r}; choose from {KINDS}")
-    for g in groups:
-        if g not in GROUPS:
-            raise ParameterError(f"unknown group {g!r}; choose from {GROUPS}")
+    for what, values, known in (("kind", kinds, KINDS), ("group", groups, GROUPS)):
+        for v in set(values) - set(known):
+            raise ParameterError(f"unknown {what} {v!r}; choose from {known}")
     rng = np.random.default_rng(seed)
     items = []
     for kind in kinds:
@@ -288,7 +273,9 @@ def make_beat_test_set(
                 bpm = check_bpm(bpm)
                 start = 0.2 + float(rng.uniform(0.0, 0.3))
                 item_seed = int(rng.integers(2**31))
-                bpm_end = _second_tempo(bpm) if group == "change" else bpm
+                bpm_end = bpm
+                if group == "change":  # +1/3 for slow tempi, -1/4 for fast ones
+                    bpm_end = bpm * 4 / 3 if bpm <= 120 else bpm * 3 / 4
                 beats = beat_times(
                     bpm,
                     duration=duration,
@@ -356,8 +343,7 @@ def drum_song(
     k = np.clip(np.searchsorted(beats, t, side="right") - 1, 0, beats.size - 1)
     env = 10.0 ** (gain_db[k] / 20.0)
     ramp = max(1, int(time_to_frames(0.005, fps=sr, mode="floor")))
-    env = np.convolve(np.pad(env, (ramp, ramp), mode="edge"), np.ones(ramp) / ramp, "same")[
-        ramp:-ramp
-    ]
+    padded = np.pad(env, (ramp, ramp), mode="edge")
+    env = np.convolve(padded, np.ones(ramp) / ramp, "same")[ramp:-ramp]
     y = (y * env).astype(np.float32)
     return DrumSong(y=y, sr=int(sr), beats=beats, bpm=bpm, gain_db=gain_db)

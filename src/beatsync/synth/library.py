@@ -72,11 +72,9 @@ def synthetic_dance(
 ) -> tuple[Motion, np.ndarray]:
     """One synthetic dance clip and its exact beat times [s] (on frame times, inside the clip).
 
-    One extreme pose per beat at ``bpm``, from ``start`` [s] (the first pose held before).
-    ``seed`` draws each section's move and loudness ``a_k`` (uniform in ``level_range``) per
-    ``section_beats`` beats; ``vocabulary_seed`` draws the ``n_moves`` moves' joint
-    amplitudes (clips of one vocabulary share poses); ``scale`` scales the skeleton and the
-    root height.
+    One extreme pose per beat from ``start`` [s]; ``seed`` draws each ``section_beats``
+    section's move and loudness ``a_k`` (in ``level_range``), ``vocabulary_seed`` the
+    ``n_moves`` moves (clips of one vocabulary share poses).
     """
     fps = check_fps(fps)
     bpm = check_positive(bpm, name="bpm", unit="BPM")
@@ -99,9 +97,8 @@ def synthetic_dance(
             f"duration={duration} s at {bpm} BPM gives fewer than 3 beats; make it longer"
         )
     beats = frames_to_time(beat_frames, fps=fps)
-    lo, hi = level_range
     n_sec = int(np.ceil(beats.size / int(section_beats))) + 1
-    levels = rng.uniform(lo, hi, size=n_sec)
+    levels = rng.uniform(*level_range, size=n_sec)
     moves = rng.integers(0, int(n_moves), size=n_sec)
     sec = np.arange(beats.size) // int(section_beats)
     sign = (-1.0) ** np.arange(beats.size)
@@ -163,15 +160,14 @@ def synthetic_library(
         raise ParameterError(f"n_clips={n_clips!r} must be >= 1")
     rng = np.random.default_rng(seed)
     tempi = rng.uniform(bpm_range[0], bpm_range[1], size=int(n_clips))
-    clips, beats = [], []
-    for i, bpm in enumerate(tempi):
-        m, b = synthetic_dance(
+    dances = [
+        synthetic_dance(
             duration=duration,
             bpm=float(bpm),
             fps=fps,
             seed=seed * 1000 + i,
             name=f"synthetic_{i:02d}",
         )
-        clips.append(m)
-        beats.append(b)
-    return clips, beats
+        for i, bpm in enumerate(tempi)
+    ]
+    return [m for m, _ in dances], [b for _, b in dances]

@@ -51,14 +51,11 @@ def periodic_motion(
     n_constant: int = 0,
     seed: int | None = 0,
 ) -> SyntheticMotion:
-    """Generate a periodic joint-angle signal with known period boundaries.
+    """A periodic joint-angle signal with known period boundaries (see the module docstring).
 
     Each channel is ``offset_c + amp_c * f_c(phase)``, ``f_c`` a sum of ``n_harmonics``
-    random harmonics of the cycle and the phase rising linearly by one within every period.
-    Period durations are uniform within ``+-jitter`` (a fraction, < 0.5) of the nominal
-    period, in whole frames. ``variation`` changes every harmonic's amplitude and phase
-    from period to period; ``snr_db`` [dB] adds white noise (None: none); ``n_constant``
-    channels are exactly constant (to exercise the exclusion rule).
+    random harmonics and the phase rising by one within every period; ``variation`` changes
+    the harmonics from period to period; ``n_constant`` channels are exactly constant.
 
     Examples
     --------
