@@ -70,3 +70,12 @@ def test_constant_channels_and_seed():
 def test_bad_parameters(kwargs):
     with pytest.raises(ParameterError):
         periodic_motion(**kwargs)
+
+
+@pytest.mark.parametrize("kwargs", [{"n_moves": 0}, {"section_beats": 0}, {"n_moves": 2.5}])
+def test_synthetic_dance_refuses_bad_counts_naming_them(kwargs):
+    from beatsync.synth.library import synthetic_dance
+
+    (name,) = kwargs
+    with pytest.raises(ParameterError, match=name):
+        synthetic_dance(duration=5, **kwargs)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
-from ..validation import check_fps, check_positive, frames_to_time, time_to_frames
+from ..validation import as_int, check_fps, check_positive, frames_to_time, time_to_frames
 
 __all__ = ["dance_skeleton", "synthetic_dance", "synthetic_library"]
 
@@ -79,8 +79,8 @@ def synthetic_dance(
     fps = check_fps(fps)
     bpm = check_positive(bpm, name="bpm", unit="BPM")
     duration = check_positive(duration, name="duration", unit="s")
-    if int(section_beats) < 1:
-        raise ParameterError(f"section_beats={section_beats!r} must be >= 1")
+    section_beats = as_int(section_beats, name="section_beats", minimum=1)
+    n_moves = as_int(n_moves, name="n_moves", minimum=1)
     rng = np.random.default_rng(seed)
     skel = dance_skeleton(scale)
     channels = skel.channel_names()
@@ -97,12 +97,12 @@ def synthetic_dance(
             f"duration={duration} s at {bpm} BPM gives fewer than 3 beats; make it longer"
         )
     beats = frames_to_time(beat_frames, fps=fps)
-    n_sec = int(np.ceil(beats.size / int(section_beats))) + 1
+    n_sec = int(np.ceil(beats.size / section_beats)) + 1
     levels = rng.uniform(*level_range, size=n_sec)
-    moves = rng.integers(0, int(n_moves), size=n_sec)
-    sec = np.arange(beats.size) // int(section_beats)
+    moves = rng.integers(0, n_moves, size=n_sec)
+    sec = np.arange(beats.size) // section_beats
     sign = (-1.0) ** np.arange(beats.size)
-    vocab = _move_vocabulary(channels, int(n_moves), vocabulary_seed)  # (n_moves, C)
+    vocab = _move_vocabulary(channels, n_moves, vocabulary_seed)  # (n_moves, C)
     keys = vocab[moves[sec]] * (levels[sec] * sign)[:, None]  # (n_beats, C) key poses
     root_y = channels.index("hip_Yposition")
     keys[:, root_y] = (0.9 + 0.04 * levels[sec] * sign) * scale
@@ -135,8 +135,6 @@ _AMP = {
 
 def _move_vocabulary(channels: tuple[str, ...], n_moves: int, seed: int) -> np.ndarray:
     """Joint amplitudes [deg] of each move, shape ``(n_moves, n_channels)``."""
-    if n_moves < 1:
-        raise ParameterError(f"n_moves={n_moves!r} must be >= 1")
     rng = np.random.default_rng(10_000 + seed)
     out = np.zeros((n_moves, len(channels)))
     for ci, ch in enumerate(channels):
