@@ -46,6 +46,8 @@ import numpy as np
 from ..datasets import DANCE_PAIRS, DancePair, load_dance_pair
 from ..errors import BeatsyncWarning, ParameterError
 from ..evaluate.alignment import DEFAULT_SIGMA, alignment_scores, offset_control
+from ..motion_beats import kinematic_beats
+from ..sync.quality import instantaneous_speed
 from .artifacts import write_artifacts
 
 __all__ = [
@@ -54,7 +56,6 @@ __all__ = [
     "track_songs",
     "song_table",
     "own_song_scores",
-    "resynchronise",
     "resync_scores",
     "dancer_table",
     "period_table",
@@ -77,28 +78,14 @@ OTHER_SONG = {
 }
 
 
-def _kinematic_beats(motion: Any) -> np.ndarray:
-    from ..motion_beats import kinematic_beats
-
-    return kinematic_beats(motion)
-
-
 def load_pairs(names: list[str] | tuple[str, ...] = DANCE_PAIRS) -> dict[str, DancePair]:
     """The bundled dancer + song excerpts, checksum-verified, by name."""
-    unknown = [n for n in names if n not in DANCE_PAIRS]
-    if unknown:
-        raise ParameterError(f"unknown dance pair(s) {unknown}; choose from {DANCE_PAIRS}")
     return {n: load_dance_pair(n) for n in names}
 
 
 def track_songs(pairs: dict[str, DancePair]) -> dict[str, dict[str, Any]]:
-    """Beats of every song (tracked; times in the excerpt's audio [s]) and its meter.
-
-    Returns
-    -------
-    dict
-        name -> ``{"beats", "tempo_bpm", "beats_per_bar", "warning"}``.
-    """
+    """Beats of every song (tracked; times in the excerpt's audio [s]) and its meter:
+    name -> ``{"beats", "tempo_bpm", "beats_per_bar", "warning"}``."""
     from ..beats import track_beats
 
     songs = {}
@@ -168,43 +155,10 @@ def own_song_scores(
     Motion beats are moved to the excerpt's audio time (``+ pair.audio_offset``) and
     compared with the song's beats while the dance plays.
     """
-    mb = _kinematic_beats(pair.motion) + pair.audio_offset
+    mb = kinematic_beats(pair.motion) + pair.audio_offset
     yb = np.asarray(beats, dtype=np.float64)
     span = (pair.audio_offset, pair.audio_offset + float(pair.motion.duration))
     return _scores(mb, yb, span, sigma=sigma, n_control=n_control, seed=seed)
-
-
-def resynchronise(
-    pair: DancePair,
-    beats: Any,
-    *,
-    mode: str = "beats",
-    land: str = "boundaries",
-    period_range: tuple[float, float] = (0.8, 5.0),
-    beats_per_bar: int | None = None,
-) -> Any:
-    """(b): :func:`beatsync.sync.synchronize` the dancer to a song, covering it (loop).
-
-    Returns the :class:`~beatsync.sync.SyncResult`; frame ``k`` of its motion plays at
-    time ``k / fps`` of the song's audio. Warnings (e.g. ``mode="auto"`` falling back)
-    are kept in ``report["warnings"]``.
-    """
-    from ..sync import synchronize
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", BeatsyncWarning)
-        res = synchronize(
-            pair.motion,
-            None,
-            np.asarray(beats, dtype=np.float64),
-            mode=mode,
-            land=land,
-            fill="loop",
-            period_range=period_range,
-            beats_per_bar=beats_per_bar,
-        )
-    res.report["warnings"] = [str(w.message) for w in caught]
-    return res
 
 
 def resync_scores(
@@ -213,7 +167,7 @@ def resync_scores(
     """(b) and (c): scores of the re-synchronised dancer on the song's beats it covers."""
     yb = np.asarray(beats, dtype=np.float64)
     span = (float(yb[0]), min(float(yb[-1]), float(result.motion.duration)))
-    mb = _kinematic_beats(result.motion)
+    mb = kinematic_beats(result.motion)
     return _scores(mb, yb, span, sigma=sigma, n_control=n_control, seed=seed)
 
 
@@ -232,15 +186,13 @@ def dancer_table(
     Columns ``own_*`` are the dancer with their own song, ``after_*`` re-synchronised
     to :data:`OTHER_SONG`, ``*_control_*`` the random-offset control of each; ``_motion``
     averages over motion beats (Li et al. 2021), ``_music`` over music beats (Siyao et
-    al. 2022); ``sigma`` in seconds.
-
-    Returns
-    -------
-    table : pandas.DataFrame
-    results : dict
-        ``(dancer, mode) -> SyncResult``.
+    al. 2022); ``sigma`` in seconds. Returns the table and ``(dancer, mode) -> SyncResult``
+    (:func:`beatsync.sync.synchronize` with ``fill="loop"``; its warnings, e.g. ``"auto"``
+    falling back, in ``report["warnings"]``).
     """
     import pandas as pd
+
+    from ..sync import synchronize
 
     rows, results = [], {}
     kw = {"sigma": sigma, "n_control": n_control, "seed": seed}
@@ -250,13 +202,18 @@ def dancer_table(
             raise ParameterError(f"{name} is re-synchronised to {other}'s song: load {other} too")
         own = own_song_scores(pair, songs[name]["beats"], **kw)
         for mode in modes:
-            res = resynchronise(
-                pair,
-                songs[other]["beats"],
-                mode=mode,
-                period_range=period_range,
-                beats_per_bar=songs[other]["beats_per_bar"],
-            )
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", BeatsyncWarning)
+                res = synchronize(
+                    pair.motion,
+                    None,
+                    songs[other]["beats"],
+                    mode=mode,
+                    fill="loop",
+                    period_range=period_range,
+                    beats_per_bar=songs[other]["beats_per_bar"],
+                )
+            res.report["warnings"] = [str(w.message) for w in caught]
             results[(name, mode)] = res
             after = resync_scores(res, songs[other]["beats"], **kw)
             rep = res.report
@@ -269,14 +226,12 @@ def dancer_table(
                     "mode used": rep["mode"],
                     "beats per unit": rep["beats_per_period"],
                     "repetitions": rep["repetitions"],
-                    "own_motion": own["motion"],
-                    "own_control_motion": own["control_motion"],
-                    "after_motion": after["motion"],
-                    "after_control_motion": after["control_motion"],
-                    "own_music": own["music"],
-                    "own_control_music": own["control_music"],
-                    "after_music": after["music"],
-                    "after_control_music": after["control_music"],
+                    **{
+                        f"{w}_{c}{s}": sc[f"{c}{s}"]
+                        for s in ("motion", "music")
+                        for w, sc in (("own", own), ("after", after))
+                        for c in ("", "control_")
+                    },
                     "sigma_s": sigma,
                     "note": "; ".join(rep["warnings"])[:160],
                 }
@@ -305,7 +260,7 @@ def period_table(
     rows = []
     for name, pair in pairs.items():
         seg = segment(segmentation_view(pair.motion), period_range=period_range)
-        mb = _kinematic_beats(pair.motion)
+        mb = kinematic_beats(pair.motion)
         beat = 60.0 / songs[name]["tempo_bpm"]
         period = float(np.mean(np.diff(seg.boundaries)))
         interval = float(np.median(np.diff(mb)))
@@ -337,12 +292,9 @@ def summary_table(table: Any, *, mode: str = "beats") -> Any:
     return t[cols + ["beats_motion_target", "beats_music_target"]].reset_index(drop=True)
 
 
-def _playback_speed(result: Any) -> np.ndarray:
-    """Source seconds per output second between output frames, where the warp is live."""
-    fps = result.motion.fps
-    t = np.arange(result.warp_src_times.size) / fps
-    live = (t[1:] > result.warp.tgt[0]) & (t[1:] <= result.warp.tgt[-1] + 1e-9)
-    return np.diff(result.warp_src_times)[live] * fps
+def _playback_speed(res: Any) -> np.ndarray:
+    covered = (res.warp.tgt[0], res.warp.tgt[-1])
+    return instantaneous_speed(res.warp_src_times, res.motion.fps, covered)
 
 
 def motion_table(
@@ -390,12 +342,11 @@ def motion_table(
                 "peak / own peak": ratio["peak_joint_speed"],
                 "joins": len(joins),
                 "join peak / own peak": float(np.max(joins) / own_peak) if joins else np.nan,
-                "after_motion": t.loc[name, "after_motion"],
-                "control_motion": t.loc[name, "after_control_motion"],
-                "own_motion": t.loc[name, "own_motion"],
-                "after_music": t.loc[name, "after_music"],
-                "control_music": t.loc[name, "after_control_music"],
-                "own_music": t.loc[name, "own_music"],
+                **{
+                    f"{w}_{s}": t.loc[name, f"{col}_{s}"]
+                    for s in ("motion", "music")
+                    for w, col in (("after", "after"), ("control", "after_control"), ("own", "own"))
+                },
             }
         )
     return pd.DataFrame(rows)
@@ -430,12 +381,11 @@ def before_table(path: str | Path, pairs: dict[str, DancePair] | None = None) ->
                 "p99 speed / own": r["p99_speed_ratio"],
                 "p99 accel / own": r["p99_accel_ratio"],
                 "peak / own peak": r["peak_ratio"],
-                "after_motion": r["after"]["motion"],
-                "control_motion": r["control"]["motion"],
-                "own_motion": r["own"]["motion"],
-                "after_music": r["after"]["music"],
-                "control_music": r["control"]["music"],
-                "own_music": r["own"]["music"],
+                **{
+                    f"{w}_{s}": r[w][s]
+                    for s in ("motion", "music")
+                    for w in ("after", "control", "own")
+                },
             }
         )
     return pd.DataFrame(rows)
@@ -479,11 +429,11 @@ def beats_figure(
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 1, figsize=(10, 3.6), sharex=False)
-    before = _kinematic_beats(pair.motion) + pair.audio_offset
+    before = kinematic_beats(pair.motion) + pair.audio_offset
     lo = pair.audio_offset
     panels = [
         (axes[0], before, np.asarray(own_beats), lo, f"{pair.name} with its own song"),
-        (axes[1], _kinematic_beats(result.motion), np.asarray(new_beats), 0.0,
+        (axes[1], kinematic_beats(result.motion), np.asarray(new_beats), 0.0,
          f"{pair.name} re-synchronised ({result.report['mode']} mode) to another song"),
     ]  # fmt: skip
     for ax, mb, yb, t0, title in panels:

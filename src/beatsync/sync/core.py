@@ -8,10 +8,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
+from ..rotations import sample_motion
 from ..validation import (
+    as_float,
     as_int,
     check_interval,
     check_motion_fps,
+    check_positive,
     check_times,
     frames_to_time,
     time_to_frames,
@@ -89,6 +92,10 @@ def _choice(value: Any, options: tuple[str, ...], name: str) -> str:
     if not isinstance(value, str) or value not in options:
         raise ParameterError(f"{name}={value!r} must be one of {', '.join(options)}")
     return value
+
+
+def _count(value: Any, name: str) -> int | None:
+    return None if value is None else as_int(value, name=name, minimum=1)
 
 
 def _events(
@@ -322,10 +329,6 @@ def synchronize(
         ``"beats"``, which aligned the real dancers with a new song clearly better
         (:mod:`beatsync.study.paper_a_dancers`).
 
-    Returns
-    -------
-    SyncResult
-
     Raises
     ------
     ParameterError
@@ -362,30 +365,15 @@ def synchronize(
         raise ParameterError(
             f"first_beat={first_beat} but the music has only {beats.size} beats (indices from 0)"
         )
-    override = (
-        None
-        if beats_per_period is None
-        else as_int(beats_per_period, name="beats_per_period", minimum=1)
-    )
-    bar = None if beats_per_bar is None else as_int(beats_per_bar, name="beats_per_bar", minimum=1)
-    dance = (
-        None
-        if dance_beats_per_period is None
-        else as_int(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
-    )
-    try:
-        phase_offset = float(phase_offset)
-    except (TypeError, ValueError):
-        raise ParameterError(f"phase_offset={phase_offset!r} must be a time in seconds") from None
-    if not np.isfinite(phase_offset):
-        raise ParameterError(f"phase_offset={phase_offset!r} must be finite [s]")
+    override = _count(beats_per_period, "beats_per_period")
+    bar = _count(beats_per_bar, "beats_per_bar")
+    dance = _count(dance_beats_per_period, "dance_beats_per_period")
+    phase_offset = as_float(phase_offset, name="phase_offset", unit="s")
     if land == "accents" and phase_offset != 0.0:
         raise ParameterError(
             "land='accents' measures the phase offset itself; do not also give phase_offset"
         )
     if delta is not None:
-        from ..validation import check_positive
-
         delta = check_positive(delta, name="delta", unit="s")
     beat_period = float(np.median(np.diff(beats)))
     if abs(phase_offset) >= beat_period:
@@ -551,7 +539,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
                 f"{int(counts[0])} beat(s) ({float(events[1] - events[0]):.2f} s of motion); use "
                 "a longer song, an earlier first_beat or fewer beats_per_period"
             )
-        p = min(n_avail if looped is None else events.size - 1, n_fit)
+        p = min(events.size - 1, n_fit)
         targets = beats[first_beat + cum[: p + 1]] + phase_offset
         check_start(targets, phase_offset)
         used = events[: p + 1]
@@ -577,12 +565,9 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
     out_times = frames_to_time(np.arange(n_out), fps=out_fps)
     src_times = warp.to_source(out_times)
-    if looped is None:
-        from ..rotations import sample_motion
-
-        values = sample_motion(motion, src_times)
-    else:
-        values = looped.sample(motion, src_times)
+    values = (
+        sample_motion(motion, src_times) if looped is None else looped.sample(motion, src_times)
+    )
     bones = position_bones(motion)
     if bones is not None:  # position-only: linear resampling, then bone lengths restored
         a, b, w = (src_times, None, None) if looped is None else looped.source_times(src_times)

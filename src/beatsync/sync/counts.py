@@ -20,9 +20,10 @@ step's count so that its speed change can be charged. Cost of a path:
 - with the dance's meter ``N`` and the music's bar, ``W_BAR`` per phrase start (every
   ``N``-th motion beat) off a bar line.
 
-``fill="loop"`` ends on the song's last beat after any number of intervals;
-``fill="stop"`` with the clip's last interval (or on the last beat if the song ends
-first). Times in seconds; counts in half beats inside, in beats in the result.
+``end="last_beat"`` (``fill="loop"``) ends on the song's last beat after any number of
+intervals; ``"last_event"`` (``fill="stop"``) with the clip's last interval (or on the
+last beat if the song ends first). Times in seconds; counts in half beats inside, in
+beats in the result.
 """
 
 from __future__ import annotations
@@ -93,33 +94,13 @@ def plan_counts(
     band: tuple[float, float] = DEFAULT_SCALE_BOUND,
     max_speed: np.ndarray | None = None,
 ) -> CountPlan:
-    """Place motion events on a song's (half) beats for the whole dance at once.
+    """Place motion ``events`` [s] on the song's (half) ``beats`` [s] (from the one the
+    first event lands on) for the whole dance at once; ``end`` as in the module docstring.
 
-    Parameters
-    ----------
-    events : np.ndarray [shape=(P+1,)] [s]
-        Motion events (increasing), e.g. a looped timeline's motion beats.
-    beats : np.ndarray [shape=(n,), n >= 2] [s]
-        Music beats from the one the first event lands on.
-    end : {"last_beat", "last_event"}
-        Cover the song to its last beat (``fill="loop"``), or place the events up to
-        the last one (``fill="stop"``; the last beat if the song ends first).
-    dance : int >= 1, optional
-        Motion beats per dance bar: phrase starts prefer the music's bar lines.
-    bar : int >= 1, optional
-        Music beats per bar.
-    phrase_index : np.ndarray [int], optional
-        Each event's index within its dance (its index in the clip, for a looped
-        timeline); phrase starts are those ``% dance == 0``. Default ``arange``.
-    band : (float, float)
-        Playback speeds outside which steps are heavily charged (narrowed by ``MARGIN``).
-    max_speed : np.ndarray [shape=(P,)], optional
-        Each interval's fastest playback that keeps its joints within the dancer's own
-        peak: it lowers the band's top for the intervals with the fastest moments.
-
-    Returns
-    -------
-    CountPlan
+    ``dance`` motion beats make a dance bar and ``bar`` music beats a bar; each event's
+    ``phrase_index`` (its index in the clip, for a looped timeline; default ``arange``)
+    marks phrase starts (``% dance == 0``). ``max_speed`` per interval, the fastest
+    playback keeping its joints within the dancer's own peak, lowers the band's top.
     """
     d = np.diff(events)
     p = d.size
@@ -231,18 +212,15 @@ def plan_counts(
                 kf = int(reached[-1])
                 c_, m_ = np.unravel_index(np.argmin(nxt[kf]), nxt[kf].shape)
                 furthest = (kf, -j, float(nxt[kf, c_, m_]), int(c_), int(m_))
-            if end == "last_beat" or j == p:
-                cand = nxt[k_max] if end == "last_beat" else None
-                if end == "last_beat":
-                    c_, m_ = np.unravel_index(np.argmin(cand), cand.shape)
-                    if cand[c_, m_] < best_end[0]:
-                        best_end = (float(cand[c_, m_]), j, k_max, int(c_), int(m_))
-                else:
-                    flat = nxt.reshape(-1)
-                    a = int(np.argmin(flat))
-                    if flat[a] < best_end[0]:
-                        k_, c_, m_ = np.unravel_index(a, shape)
-                        best_end = (float(flat[a]), j, int(k_), int(c_), int(m_))
+            if end == "last_beat":
+                c_, m_ = np.unravel_index(np.argmin(nxt[k_max]), nxt[k_max].shape)
+                if nxt[k_max, c_, m_] < best_end[0]:
+                    best_end = (float(nxt[k_max, c_, m_]), j, k_max, int(c_), int(m_))
+            elif j == p:
+                a = int(np.argmin(nxt))
+                if nxt.flat[a] < best_end[0]:
+                    k_, c_, m_ = np.unravel_index(a, shape)
+                    best_end = (float(nxt.flat[a]), j, int(k_), int(c_), int(m_))
     if end == "last_event" and not np.isfinite(best_end[0]):
         # the song ends first: the furthest event that reached the last beat
         for j in sorted(at_last, reverse=True):

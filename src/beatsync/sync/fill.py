@@ -49,7 +49,7 @@ from scipy.spatial.transform import Rotation
 
 from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
 
-__all__ = ["LOOP_BLEND_S", "MIN_SPAN", "LoopedClip", "choose_loop", "loop_events", "with_center"]
+__all__ = ["LoopedClip", "choose_loop", "joint_positions", "loop_events", "with_center"]
 
 #: width of the blended window at each join [s]
 LOOP_BLEND_S = 0.6
@@ -225,7 +225,7 @@ def _root_rotation(motion: object) -> tuple[list[int], str] | None:
     return None
 
 
-def _positions(motion: object) -> tuple[np.ndarray, int] | None:
+def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
     """Joint positions and the index of their vertical axis, or None (angle tables)."""
     from ..errors import ParameterError
     from ..motion_beats import motion_positions
@@ -254,11 +254,16 @@ def choose_loop(
 
     p = events.size - 1
     duration = (motion.n_frames - 1) / motion.fps
-    got = _positions(motion)
+    got = joint_positions(motion)
     half_t = 0.5 * join
     room = (events - half_t >= 0) & (events + half_t <= duration)
     idx = np.nonzero(room)[0]
-    if got is None or idx.size < 2:
+    ii, jj = np.meshgrid(idx, idx, indexing="ij")
+    ok = jj - ii >= max(1, int(np.ceil(MIN_SPAN * p)))
+    if dance is not None:
+        ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
+    ok &= events[jj] - events[ii] > 2.0 * join
+    if got is None or not ok.any():
         # nothing to compare or no room: the whole span, blended over what fits
         fit = float(min(join, 0.5 * np.min(np.diff(events))))
         return 0, p, 0.0, None, float("nan"), fit
@@ -268,14 +273,6 @@ def choose_loop(
     half = max(1, int(round(half_t * fps / 2)))
     clouds = point_clouds(pos, frames, half)
     dist = aligned_distance_matrix(clouds, clouds, up=up)
-    ii, jj = np.meshgrid(idx, idx, indexing="ij")
-    ok = jj - ii >= max(1, int(np.ceil(MIN_SPAN * p)))
-    if dance is not None:
-        ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
-    ok &= events[jj] - events[ii] > 2.0 * join
-    if not ok.any():
-        fit = float(min(join, 0.5 * np.min(np.diff(events))))
-        return 0, p, 0.0, None, float("nan"), fit
     score = np.where(ok, dist, np.inf)
     # the most alike pair; among equals the longest span
     best = np.flatnonzero(score == score.min())
@@ -305,15 +302,15 @@ def loop_events(
     n_needed: int,
     *,
     join: float,
-    span: tuple[int, int] | None = None,
+    span: tuple[int, int],
     angle: float = 0.0,
     shift: np.ndarray | None = None,
     distance: float = float("nan"),
 ) -> LoopedClip:
-    """Repeat the span ``events[a] .. events[b]`` (``span``, default the whole clip) until
+    """Repeat the span ``events[a] .. events[b]`` (``span``) until
     the looped timeline holds ``n_needed`` intervals; ``join`` [s] is the blend width,
     ``angle``, ``shift`` and ``distance`` the floor transform of :func:`choose_loop`."""
-    a, b = (0, events.size - 1) if span is None else span
+    a, b = span
     head = events[: b + 1]
     per = b - a
     reps = 1 + max(0, -(-(int(n_needed) - b) // per))  # the clip, then enough passes

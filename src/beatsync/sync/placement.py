@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .counts import plan_counts
-from .fill import _positions, choose_loop, loop_events
+from .fill import choose_loop, joint_positions, loop_events
 
 __all__ = ["LOOP_REACH", "check_start", "peak_headroom", "place_whole_dance"]
 
@@ -87,7 +87,7 @@ def peak_headroom(motion: Any, events: np.ndarray) -> np.ndarray | None:
     """Per interval of ``events``: the dancer's peak joint speed over the interval's
     peak, the fastest playback that keeps its joints within the dancer's own peak
     (None without joint positions)."""
-    got = _positions(motion)
+    got = joint_positions(motion)
     if got is None:
         return None
     v = np.linalg.norm(np.diff(got[0], axis=0), axis=-1).max(axis=1)  # per frame step

@@ -50,12 +50,6 @@ def bone_tree(bones: np.ndarray, n_joints: int) -> list[tuple[int, int]]:
     return order
 
 
-def _lengths(pos: np.ndarray, tree: list[tuple[int, int]]) -> np.ndarray:
-    par = np.array([p for p, _ in tree], dtype=np.int64)
-    chi = np.array([c for _, c in tree], dtype=np.int64)
-    return np.linalg.norm(pos[:, chi] - pos[:, par], axis=-1)
-
-
 def restore_bone_lengths(
     out_pos: np.ndarray,
     src_pos: np.ndarray,
@@ -72,7 +66,8 @@ def restore_bone_lengths(
     tree = bone_tree(bones, src_pos.shape[1])
     if not tree:
         return out_pos
-    lengths = _lengths(src_pos, tree)  # (n, n_tree)
+    par, chi = np.array(tree, dtype=np.int64).T
+    lengths = np.linalg.norm(src_pos[:, chi] - src_pos[:, par], axis=-1)  # (n, n_tree)
     frames = np.arange(src_pos.shape[0], dtype=np.float64)
 
     def at(t: np.ndarray) -> np.ndarray:

@@ -25,7 +25,14 @@ import numpy as np
 from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 
-__all__ = ["joint_kinematics", "speed_figures", "join_figures", "fitting_tempo", "report_entries"]
+__all__ = [
+    "instantaneous_speed",
+    "joint_kinematics",
+    "speed_figures",
+    "join_figures",
+    "fitting_tempo",
+    "report_entries",
+]
 
 
 def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict[str, float]:
@@ -38,6 +45,15 @@ def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict
     }
 
 
+def instantaneous_speed(
+    src_times: np.ndarray, out_fps: float, covered: tuple[float, float]
+) -> np.ndarray:
+    """Source seconds per output second between output frames within ``covered`` [s]."""
+    t = np.arange(1, src_times.size) / out_fps
+    live = (t > covered[0]) & (t <= covered[1] + 1e-9)
+    return np.diff(src_times)[live] * out_fps
+
+
 def speed_figures(
     src_times: np.ndarray,
     out_fps: float,
@@ -47,10 +63,9 @@ def speed_figures(
     band: tuple[float, float] = DEFAULT_SCALE_BOUND,
 ) -> dict[str, Any]:
     """Instantaneous and per-interval playback speed (see the module docstring)."""
-    t = np.arange(src_times.size) / out_fps
-    live = (t[1:] > covered[0]) & (t[1:] <= covered[1] + 1e-9)
-    inst = np.diff(src_times)[live] * out_fps
+    inst = instantaneous_speed(src_times, out_fps, covered)
     per = np.diff(used) / np.diff(targets)
+    t = np.arange(src_times.size) / out_fps
     return {
         "band": list(band),
         "instantaneous": _stats(inst, np.ones_like(inst), band) if inst.size else None,

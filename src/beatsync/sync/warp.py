@@ -28,11 +28,10 @@ BLEND_REACH = 8.0
 _CHUNK = 4096
 
 
-def correction_bump(u: np.ndarray, taper: float | None = None) -> np.ndarray:
+def correction_bump(u: np.ndarray) -> np.ndarray:
     """Correction shape on the period phase ``u`` in [0, 1]: 0 at both ends, 1 in the
-    middle, with raised-cosine ramps over ``taper`` of the period at each end."""
-    taper = TAPER if taper is None else taper
-    ramp = np.minimum(u, 1.0 - u) / taper
+    middle, with raised-cosine ramps over ``TAPER`` of the period at each end."""
+    ramp = np.minimum(u, 1.0 - u) / TAPER
     return np.where(ramp >= 1.0, 1.0, np.sin(0.5 * np.pi * np.clip(ramp, 0.0, 1.0)) ** 2)
 
 
