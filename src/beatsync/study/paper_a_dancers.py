@@ -307,11 +307,8 @@ def motion_table(
 ) -> Any:
     """(e) Per dancer re-synchronised to :data:`OTHER_SONG` (one sync ``mode``): playback
     speed, joint kinematics against the dancer's own, the joins, and the alignment
-    scores of :func:`dancer_table` (after, random-offset control, own song).
-
-    Speeds and kinematics are computed here from the output frames, with the sync
-    report's own functions (:func:`beatsync.sync.quality.joint_kinematics`), not read
-    from the report; finite differences over all joints and frames.
+    scores of :func:`dancer_table` (after, random-offset control, own song); speeds and
+    kinematics computed from the output frames (:mod:`beatsync.sync.quality`).
     """
     import pandas as pd
 
@@ -413,12 +410,7 @@ def speed_figure(results: dict[tuple[str, str], Any], *, mode: str = "beats") ->
 
 
 def beats_figure(
-    pair: DancePair,
-    own_beats: Any,
-    result: Any,
-    new_beats: Any,
-    *,
-    seconds: float = 12.0,
+    pair: DancePair, own_beats: Any, result: Any, new_beats: Any, *, seconds: float = 12.0
 ) -> Any:
     """Motion beats against music beats, before (own song) and after re-synchronisation.
 

@@ -8,7 +8,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
+from ..motion import segmentation_view
+from ..motion_beats import kinematic_beats, motion_positions
 from ..rotations import sample_motion
+from ..segment.checks import check_alpha, check_period_range
+from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_count
 from ..validation import (
     as_float,
     as_int,
@@ -23,7 +27,7 @@ from .fill import LoopedClip, choose_loop, loop_events, with_center
 from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
-from .quality import report_entries
+from .quality import fitting_tempo, report_entries
 from .warp import TimeWarp, integrate_warp
 
 __all__ = [
@@ -147,10 +151,6 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     ParameterError
         Bad ``alpha`` or ``period_range``, or a dancer whose joints do not move.
     """
-    from ..motion import segmentation_view
-    from ..segment.checks import check_alpha, check_period_range
-    from ..segment.core import PeriodicityRefused, _segment_motion
-
     alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
     period_range = check_period_range(period_range)
     try:
@@ -162,10 +162,14 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     except NotPeriodicError:  # too short to tell: its own message
         raise
     except ParameterError as exc:  # no angles to test, or angles that never change
-        moves = _joints_move(motion)
-        if moves is None:  # no joint positions either: the segmentation's own message
-            raise
-        if not moves:
+        try:
+            pos = motion_positions(motion)
+        except ParameterError:  # no joint positions either: the segmentation's own message
+            raise exc from None
+        with np.errstate(invalid="ignore"):
+            span = float(np.nanmax(np.abs(pos - pos[:1]))) if pos.size else 0.0
+            scale = float(np.nanmax(np.abs(pos))) if pos.size else 0.0
+        if not (np.isfinite(span) and span > 1e-9 * max(scale, 1e-300)):
             raise ParameterError(
                 f"the dancer does not move: every joint keeps its position over the "
                 f"{motion.n_frames} frames, so there is nothing to synchronise"
@@ -176,23 +180,7 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     return seg
 
 
-def _joints_move(motion: Any) -> bool | None:
-    """Whether any joint position changes over the motion (None: no joint positions)."""
-    from ..motion_beats import motion_positions
-
-    try:
-        pos = motion_positions(motion)
-    except ParameterError:
-        return None
-    with np.errstate(invalid="ignore"):
-        span = float(np.nanmax(np.abs(pos - pos[:1]))) if pos.size else 0.0
-        scale = float(np.nanmax(np.abs(pos))) if pos.size else 0.0
-    return bool(np.isfinite(span) and span > 1e-9 * max(scale, 1e-300))
-
-
 def _motion_beats(motion: Any, what: str) -> np.ndarray:
-    from ..motion_beats import kinematic_beats
-
     try:
         mb = kinematic_beats(motion)
     except ParameterError as exc:
@@ -215,8 +203,6 @@ def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
     real dance (a real waltz bar shows 2 of its 3 steps), so this count is reported,
     never used to choose the beats per period: give the dance's meter instead.
     """
-    from ..motion_beats import kinematic_beats
-
     try:
         with silenced():  # no beats: no count, no news
             mb = kinematic_beats(motion)
@@ -236,17 +222,11 @@ def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict 
     """The dance's own phrase in motion beats ``mb`` [s], for ``dance_beats_per_period``
     when the user gives none: ``(count or None, what was found)``.
 
-    Paper A's period ``T`` (:func:`beatsync.segment.core.estimate_period_count`, the
-    spectral peak: cheap on a long dance) over 1.5-8.5 median motion-beat intervals
-    ``b``; the phrase is ``N = round(T / b)`` motion beats. It is used only when every
-    ``N`` consecutive motion beats span ``T`` to within half an interval: the phrase
-    starts are every ``N``-th motion beat (:mod:`.counts`), so a single phrase of
-    another count would put every later one off its bar. None when that is not clear,
-    or without joint angles or positions to search.
+    Paper A's period ``T`` (the spectral peak of
+    :func:`beatsync.segment.core.estimate_period_count`) over ``PHRASE_BEATS`` median
+    motion-beat intervals ``b``; ``N = round(T / b)``, used only when every ``N``
+    consecutive motion beats span ``T`` to within ``b / 2`` (why: ``docs/tuning.md``).
     """
-    from ..motion import segmentation_view
-    from ..segment.core import estimate_period_count
-
     iv = np.diff(mb)
     step = float(np.median(iv))
     try:
@@ -309,11 +289,8 @@ def synchronize(
     beats_per_bar : int >= 1, optional
         The music's meter.
     dance_beats_per_period : int >= 1, optional
-        The dance's meter (3 for a waltz step). Periods: the count is a multiple of it
-        (or it halved), with a warning when ``beats_per_bar`` cannot also be kept.
-        Beats: every such group of motion beats starts on a bar line where the speed
-        band allows and a loop holds whole groups; without it, the dance's own phrase
-        is used when it is clear (:func:`estimate_dance_meter`).
+        The dance's meter (3 for a waltz step; see :mod:`beatsync.sync`); in beats mode
+        without it, the dance's own phrase when clear (:func:`estimate_dance_meter`).
     first_beat : int >= 0
         Index of the beat the first boundary lands on.
     out_fps : float > 0, optional [Hz]
@@ -323,11 +300,8 @@ def synchronize(
     phase_offset : float [s]
         Land the boundaries this long after their beats (negative: before).
     period_range : (float, float) [s], optional
-        Periods searched when segmenting here: default one to eight of the music's
-        beats (``PERIOD_BEATS``: real dance cycles) in ``"periods"``, paper A's
-        0.25-1.25 s (``AUTO_PERIOD_RANGE``) in ``"auto"``, so ballroom figures go to
-        ``"beats"``, which aligned the real dancers with a new song clearly better
-        (:mod:`beatsync.study.paper_a_dancers`).
+        Periods searched when segmenting here: default ``PERIOD_BEATS`` of the music's
+        beats in ``"periods"``, ``AUTO_PERIOD_RANGE`` in ``"auto"`` (see :mod:`beatsync.sync`).
 
     Raises
     ------
@@ -434,8 +408,6 @@ def synchronize(
     lag = 0.0
     res = _resample(plan, phase_offset)
     if land == "accents":
-        from ..motion_beats import kinematic_beats
-
         try:
             mb = kinematic_beats(res.motion)
         except ParameterError as exc:
@@ -489,8 +461,6 @@ BAND_SHARE = 0.95
 def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
     """Warn when the song cannot be followed within the speed band, naming a tempo
     that would fit."""
-    from .quality import fitting_tempo
-
     sp = report["playback_speed"]
     share = (sp["instantaneous"] or sp["per_interval"])["in_band"]
     report["speed_warning"] = ""
@@ -570,7 +540,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     )
     bones = position_bones(motion)
     if bones is not None:  # position-only: linear resampling, then bone lengths restored
-        a, b, w = (src_times, None, None) if looped is None else looped.source_times(src_times)
+        a, b, w = (src_times, None, None) if looped is None else looped.locate(src_times)[:3]
         pos = restore_bone_lengths(
             values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
         )
@@ -627,9 +597,8 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             float(targets[0]),
             float(min(tau_end, frames_to_time(n_out - 1, fps=out_fps))),
         ],
+        "first_boundary_frame": int(time_to_frames(targets[0], fps=out_fps)),  # for trimming
     }
-    # the first boundary frame index in the output, for users who trim
-    report["first_boundary_frame"] = int(time_to_frames(targets[0], fps=out_fps))
     report.update(
         report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed)
     )

@@ -76,9 +76,7 @@ class CountPlan:
 
 
 def _speed_cost(ls: np.ndarray, dur: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """Cost of steps at log speed ``ls`` lasting ``dur`` [s], aimed band ``lo .. hi``:
-    ``(log s)^2`` per second inside; outside, ``W_OUT`` per second plus ``W_EXCESS``
-    per second times the squared log distance to the band."""
+    """Speed cost (module docstring) of steps at log speed ``ls`` lasting ``dur`` [s]."""
     excess = np.maximum(0.0, np.maximum(ls - hi, lo - ls))
     return dur * (ls * ls + W_OUT * (excess > 0) + W_EXCESS * excess * excess)
 

@@ -25,14 +25,9 @@ Aligned and blended joins
     previous one ended, so a dancer who travels or turns goes on instead of jumping
     back. Within ``join / 2`` of a join the pose blends the ending pass's continuation
     (clip time ``e_b + d``, moved by ``M^(r-1)``) into the starting pass's lead
-    (``e_a + d``, moved by ``M^r``) with a weight of two raised-cosine half-ramps
-    (:func:`join_weight`), whose derivative vanishes at both ends of the window and at
-    the join: both motions carry their own velocity, so the velocity is continuous,
-    the blend adds only ``w'`` times the (small) remaining pose difference, and
-    nothing at the join itself (a motion beat, whose speed minimum stays put). A
-    skeleton's root is turned (its rotation channels and its floor position) and moved;
-    joint positions are rotated and translated. Rotation channels are blended by slerp,
-    positions linearly.
+    (``e_a + d``, moved by ``M^r``) with :func:`join_weight`. A skeleton's root is
+    turned and moved (rotation channels and floor position), joint positions rotated
+    and translated; rotations are blended by slerp, positions linearly.
 
 Data contract: times in seconds of the clip (``e``) or of the looped timeline
 (``t``); positions ``(frames, joints, 3)`` with z up (position-only motion) or the
@@ -47,6 +42,9 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..errors import ParameterError
+from ..graph.distance import aligned_distance_matrix, ground_axes, point_clouds
+from ..motion_beats import motion_positions
 from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
 
 __all__ = ["LoopedClip", "choose_loop", "joint_positions", "loop_events", "with_center"]
@@ -83,15 +81,9 @@ class LoopedClip:
         """Looped times of the joins [s]."""
         return self.last + np.arange(self.repetitions - 1) * self.length
 
-    def source_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Clip times for looped times ``t``: ``(a, b, w)``, pose = blend(a, b, w).
-
-        ``w`` is 0 away from joins (pose at clip time ``a``).
-        """
-        return self._locate(t)[:3]
-
-    def _locate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(a, b, w, ra, rb)``: clip times, blend weight and repetitions at ``t``."""
+    def locate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(a, b, w, ra, rb)`` at looped times ``t``: the pose blends clip times ``a`` and
+        ``b`` with weight ``w`` (0 away from joins) of repetitions ``ra`` and ``rb``."""
         t = np.asarray(t, dtype=np.float64)
         r = np.floor((t - self.last) / self.length) + 1.0  # repetition index (0: the clip)
         r = np.clip(r, 0.0, self.repetitions - 1.0)
@@ -130,7 +122,7 @@ class LoopedClip:
     def sample_positions(self, pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
         """Positions ``(frames, points, 3)`` (z up) at looped times ``t``: interpolated
         linearly, each pass moved by ``M^r``, blended at the joins."""
-        a, b, w, ra, rb = self._locate(t)
+        a, b, w, ra, rb = self.locate(t)
         out = _move(_interp(pos, fps, a), *self._moves(ra))
         blend = w > 0
         if blend.any():
@@ -145,7 +137,7 @@ class LoopedClip:
         if motion.is_positional:
             pos = motion.values.reshape(motion.n_frames, -1, 3)
             return self.sample_positions(pos, motion.fps, t).reshape(len(t), -1)
-        a, b, w, ra, rb = self._locate(t)
+        a, b, w, ra, rb = self.locate(t)
         values = self._move_root(motion, sample_motion(motion, a), ra)
         blend = w > 0
         if blend.any():
@@ -227,9 +219,6 @@ def _root_rotation(motion: object) -> tuple[list[int], str] | None:
 
 def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
     """Joint positions and the index of their vertical axis, or None (angle tables)."""
-    from ..errors import ParameterError
-    from ..motion_beats import motion_positions
-
     if motion.is_positional:
         return motion.values.reshape(motion.n_frames, -1, 3), 2
     if _root_floor_columns(motion) is None:
@@ -250,8 +239,6 @@ def choose_loop(
     ``e_b``; ``distance`` is their motion-graph distance; ``join`` the blend width [s]
     (shortened only when the clip leaves no room for it). See the module docstring.
     """
-    from ..graph.distance import aligned_distance_matrix, ground_axes, point_clouds
-
     p = events.size - 1
     duration = (motion.n_frames - 1) / motion.fps
     got = joint_positions(motion)

@@ -54,15 +54,12 @@ def _candidates(dance: int | None, bar: int | None, limit: int) -> list[int]:
     the bar (dividing it, or whole bars), up to ``limit``."""
     out = []
     for m in range(1, limit + 1):
-        dance_ok = dance is None or m % dance == 0 or (dance % m == 0 and _power_of_two(dance // m))
+        halved = dance is not None and dance % m == 0 and (dance // m) & (dance // m - 1) == 0
+        dance_ok = dance is None or m % dance == 0 or halved
         bar_ok = bar is None or m % bar == 0 or bar % m == 0
         if dance_ok and bar_ok:
             out.append(m)
     return out
-
-
-def _power_of_two(k: int) -> bool:
-    return k >= 1 and (k & (k - 1)) == 0
 
 
 def _nearest(cands: list[int], ideal: float) -> int:

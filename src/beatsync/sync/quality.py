@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
+from ..motion_beats import motion_positions
 
 __all__ = [
     "instantaneous_speed",
@@ -127,8 +128,6 @@ def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND
 
 def report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed) -> dict:
     """Report entries computed from the output frames (see the module docstring)."""
-    from ..motion_beats import motion_positions
-
     out_fps = float(out_motion.fps)
     counts, n = np.unique(np.asarray(placed["beats"], dtype=np.float64), return_counts=True)
     rep: dict[str, Any] = {

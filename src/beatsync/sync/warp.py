@@ -35,13 +35,7 @@ def correction_bump(u: np.ndarray) -> np.ndarray:
     return np.where(ramp >= 1.0, 1.0, np.sin(0.5 * np.pi * np.clip(ramp, 0.0, 1.0)) ** 2)
 
 
-def blended_rate(
-    t: Any,
-    centres: Any,
-    rates: Any,
-    *,
-    delta: float,
-) -> np.ndarray:
+def blended_rate(t: Any, centres: Any, rates: Any, *, delta: float) -> np.ndarray:
     """Gaussian-blended rate (paper A, eq. 9, our reading) at source times ``t`` [s]:
     ``r(t) = sum_i w_i(t) r_i / sum_i w_i(t)``, ``w_i(t) = exp(-(t - c_i)^2 / (2 delta^2))``
     with ``c_i`` the period centres [s], ``r_i`` the per-period rates (target / source)
