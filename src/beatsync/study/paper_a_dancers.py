@@ -15,21 +15,14 @@ dancer:
 (c) a random-offset control (:func:`beatsync.evaluate.alignment.offset_control`: the
     motion beats shifted by one random offset within a beat period), for (a) and (b);
 (d) the dance's period and motion-beat interval against the song's beat period;
-(e) whether the re-synchronised dancer still moves like the dancer
-    (:func:`motion_table`): the playback speed (instantaneous and per interval, share
-    of the output within 0.8-1.25), p99 joint speed and acceleration against the
-    dancer's own, the peak joint speed at the loop joins and overall, next to the
-    alignment scores of (a)-(c); and the same figures for the code before the
-    whole-dance beat counts and seamless loops (:func:`before_table`, read from the
-    record of ``benchmarks/bench_resync.py --label before``).
+(e) whether the re-synchronised dancer still moves like the dancer (:func:`motion_table`:
+    playback speed, joint speed and acceleration against the dancer's own, the joins),
+    and the same before the whole-dance counts and seamless loops (:func:`before_table`).
 
-What the data can and cannot show: the dataset says which part of each song was
-danced (25 fps frame ranges), not that the steps sit on its beats; its own
-alignment of dance and music is approximate, and the songs' beats here are tracked,
-not annotated. So (a) is a measurement of this data, not of the dancers' skill, and
-four 24 s excerpts are four examples, not a benchmark. The songs are short (28 s), so
-the re-synchronised dancer covers at most that; the scores count only beats inside
-the span both the dance and the song play.
+The dataset says which part of each song was danced, not that the steps sit on its
+(here tracked, not annotated) beats: (a) measures this data, not the dancers' skill, and
+four excerpts are four examples, not a benchmark. The scores count only beats inside the
+span both the dance and the song (28 s) play.
 
 Notebook: ``notebooks/paper_a_ext_real_dancers.ipynb``.
 """
@@ -123,9 +116,8 @@ def song_table(pairs: dict[str, DancePair], songs: dict[str, dict[str, Any]]) ->
     )
 
 
-def _scores(mb: np.ndarray, yb: np.ndarray, span: tuple[float, float], **kw: Any) -> dict:
+def _scores(mb: np.ndarray, yb: np.ndarray, span: tuple[float, float], *, sigma, n_control, seed):
     """Both scores and their random-offset control, on the beats inside ``span``."""
-    sigma, n_control, seed = kw["sigma"], kw["n_control"], kw["seed"]
     sc = alignment_scores(mb, yb, sigma=sigma, span=span)
     inside = (mb >= span[0]) & (mb <= span[1])
     ctrl = offset_control(
@@ -245,13 +237,8 @@ def period_table(
     *,
     period_range: tuple[float, float] = (0.8, 5.0),
 ) -> Any:
-    """(d) The dance's period and motion-beat interval against its song's beat period.
-
-    The period comes from paper A's segmentation of the dancer's joint angles (angles
-    between inferred bones, :func:`beatsync.motion.segmentation_view`) searched in
-    ``period_range``; the motion-beat interval is the median interval of its
-    kinematic beats; the song's beat period is the median interval of its tracked beats.
-    """
+    """(d) The dance's period (paper A's segmentation of its joint angles over
+    ``period_range``) and median motion-beat interval against its song's median beat."""
     import pandas as pd
 
     from ..motion import segmentation_view
@@ -412,12 +399,8 @@ def speed_figure(results: dict[tuple[str, str], Any], *, mode: str = "beats") ->
 def beats_figure(
     pair: DancePair, own_beats: Any, result: Any, new_beats: Any, *, seconds: float = 12.0
 ) -> Any:
-    """Motion beats against music beats, before (own song) and after re-synchronisation.
-
-    Top: the dancer's kinematic beats and their own song's beats over the first
-    ``seconds`` of the dance (audio time). Bottom: the re-synchronised dancer's
-    kinematic beats and the new song's beats over its first ``seconds``.
-    """
+    """Motion beats against music beats over the first ``seconds``: the dancer with their
+    own song (audio time), then re-synchronised to the new song."""
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 1, figsize=(10, 3.6), sharex=False)

@@ -61,17 +61,15 @@ MARGIN = 1.05
 @dataclass(frozen=True)
 class CountPlan:
     """The placed events of a whole dance: indices (into the events given) of those
-    pinned, their half-beat ``grid_index`` and music ``targets`` [s], the ``beats`` each
-    step spans (halves allowed), the numbers of merges and half-beat landings, the
-    path's cost, and the share of phrase starts on bar lines (None without meters)."""
+    pinned, their music ``targets`` [s], the ``beats`` each step spans (halves allowed),
+    the numbers of merges and half-beat landings, and the share of phrase starts on bar
+    lines (None without meters)."""
 
     event_index: np.ndarray
-    grid_index: np.ndarray
     targets: np.ndarray
     beats: np.ndarray
     n_merged: int
     n_half: int
-    cost: float
     phrases_on_bars: float | None = None
 
 
@@ -85,10 +83,10 @@ def plan_counts(
     events: np.ndarray,
     beats: np.ndarray,
     *,
+    phrase_index: np.ndarray,
     end: str = "last_beat",
     dance: int | None = None,
     bar: int | None = None,
-    phrase_index: np.ndarray | None = None,
     band: tuple[float, float] = DEFAULT_SCALE_BOUND,
     max_speed: np.ndarray | None = None,
 ) -> CountPlan:
@@ -96,7 +94,7 @@ def plan_counts(
     first event lands on) for the whole dance at once; ``end`` as in the module docstring.
 
     ``dance`` motion beats make a dance bar and ``bar`` music beats a bar; each event's
-    ``phrase_index`` (its index in the clip, for a looped timeline; default ``arange``)
+    ``phrase_index`` (its index in the clip, for a looped timeline)
     marks phrase starts (``% dance == 0``). ``max_speed`` per interval, the fastest
     playback keeping its joints within the dancer's own peak, lowers the band's top.
     """
@@ -109,8 +107,6 @@ def plan_counts(
     grid, _ = music_grid(beats, np.zeros(beats.size - 1), 2)
     k_max = grid.size - 1
     cmax = MAX_HALF_BEATS
-    if phrase_index is None:
-        phrase_index = np.arange(p + 1)
     phrase = np.zeros(p + 1, dtype=bool)
     if dance is not None and bar is not None:
         phrase = (np.asarray(phrase_index) % dance) == 0
@@ -123,17 +119,16 @@ def plan_counts(
     span = np.full((k_max + 1, cmax + 1), np.nan)
     for c in range(1, cmax + 1):
         span[: k_max + 1 - c, c] = grid[c:] - grid[:-c] if c <= k_max else np.nan
-    inf = np.inf
     # D[i]: cost over states (k, c, m), stored sparsely per event index
     shape = (k_max + 1, cmax + 1, 2)
     cost: dict[int, np.ndarray] = {}
     back: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}
-    start = np.full(shape, inf)
+    start = np.full(shape, np.inf)
     start[0, 0, 0] = 0.0 if (bar is None or not phrase[0] or bar_ok[0]) else W_BAR
     cost[0] = start
-    best_end = (inf, -1, -1, -1, -1)
+    best_end = (np.inf, -1, -1, -1, -1)
     at_last: dict[int, np.ndarray] = {}  # event -> costs of (c, m) on the last beat
-    furthest = (-1, 0, inf, 0, 0)  # (k, -event, cost, c, m): the latest grid point reached
+    furthest = (-1, 0, np.inf, 0, 0)  # (k, -event, cost, c, m): the latest grid point reached
     for i in range(p):
         cur = cost.pop(i, None)
         if cur is None or not np.isfinite(cur).any():
@@ -143,7 +138,7 @@ def plan_counts(
             lo_k, hi_k = int(raw[0]), int(raw[-1]) + 1
             back[i] = (lo_k, *(a[lo_k:hi_k].copy() for a in back[i][1:]))
         floor = np.min(cur)
-        cur = np.where(cur <= floor + BEAM, cur, inf)
+        cur = np.where(cur <= floor + BEAM, cur, np.inf)
         ks = np.nonzero(np.isfinite(cur).any(axis=(1, 2)))[0]
         if ks.size == 0:
             continue
@@ -170,7 +165,7 @@ def plan_counts(
             j = i + 1 + merged
             nxt = cost.get(j)
             if nxt is None:
-                nxt = np.full(shape, inf)
+                nxt = np.full(shape, np.inf)
                 back[j] = (
                     0,  # offset of the first grid point stored
                     np.full(shape, -1, dtype=np.int32),
@@ -194,7 +189,7 @@ def plan_counts(
             tot = (sub[:, None] + change).reshape(kidx.size, cmax, -1)  # (nk, C, prev)
             arg = np.argmin(tot, axis=2)
             val = np.take_along_axis(tot, arg[:, :, None], axis=2)[:, :, 0] + step
-            val = np.where(ok, val, inf)
+            val = np.where(ok, val, np.inf)
             cc = np.broadcast_to(cs1, tk.shape)
             better = val < nxt[tk, cc, merged]
             if better.any():
@@ -231,7 +226,7 @@ def plan_counts(
         # too few events to reach the song's end: stop at the latest grid point reached
         kf, mj, val, c_, m_ = furthest
         best_end = (val, -mj, kf, c_, m_)
-    total, j, k, c, m = best_end
+    _, j, k, c, m = best_end
     ev, gk = [j], [k]
     while j > 0:
         off, bk, bc, bm = back[j]
@@ -244,12 +239,10 @@ def plan_counts(
     gk_a = np.array(gk[::-1], dtype=np.int64)
     return CountPlan(
         event_index=ev_a,
-        grid_index=gk_a,
         targets=grid[gk_a],
         beats=np.diff(gk_a) / 2.0,
         n_merged=int(np.count_nonzero(np.diff(ev_a) == 2)),
         n_half=int(np.count_nonzero(gk_a % 2 == 1)),
-        cost=total,
         phrases_on_bars=(
             float(np.mean(bar_ok[gk_a[phrase[ev_a]]])) if bar and phrase[ev_a].any() else None
         ),

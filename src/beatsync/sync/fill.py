@@ -46,6 +46,7 @@ from ..errors import ParameterError
 from ..graph.distance import aligned_distance_matrix, ground_axes, point_clouds
 from ..motion_beats import motion_positions
 from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
+from .positions import interp_frames
 
 __all__ = ["LoopedClip", "choose_loop", "joint_positions", "loop_events", "with_center"]
 
@@ -123,10 +124,10 @@ class LoopedClip:
         """Positions ``(frames, points, 3)`` (z up) at looped times ``t``: interpolated
         linearly, each pass moved by ``M^r``, blended at the joins."""
         a, b, w, ra, rb = self.locate(t)
-        out = _move(_interp(pos, fps, a), *self._moves(ra))
+        out = _move(interp_frames(pos, fps, a), *self._moves(ra))
         blend = w > 0
         if blend.any():
-            vb = _move(_interp(pos, fps, b[blend]), *(x[blend] for x in self._moves(rb)))
+            vb = _move(interp_frames(pos, fps, b[blend]), *(x[blend] for x in self._moves(rb)))
             wb = w[blend, None, None]
             out[blend] = (1.0 - wb) * out[blend] + wb * vb
         return out
@@ -157,12 +158,14 @@ class LoopedClip:
             c, s = np.cos(ang), np.sin(ang)
             values[:, cols[0]] = c * zx[:, 0] - s * zx[:, 1]
             values[:, cols[1]] = s * zx[:, 0] + c * zx[:, 1]
-            triple = _root_rotation(motion)
-            if triple is not None:
-                idx, order = triple
-                euler = values[:, idx]
-                turned = Rotation.from_euler("y", ang[:, None]) * euler_to_rotation(euler, order)
-                values[:, idx] = rotation_to_euler(turned, order, reference=euler)
+            root = motion.skeleton.joints[0].name
+            for joint, idx, order in motion.rotation_triples():
+                if joint == root:  # its rotation channels, turned about the vertical too
+                    euler = values[:, list(idx)]
+                    spin = Rotation.from_euler("y", ang[:, None])
+                    turned = spin * euler_to_rotation(euler, order)
+                    values[:, list(idx)] = rotation_to_euler(turned, order, reference=euler)
+                    break
         values[:, cols] += off
         return values
 
@@ -173,14 +176,6 @@ def join_weight(u: np.ndarray) -> np.ndarray:
     where the blend then adds no velocity and the landed speed minimum stays put."""
     c = 0.25 * np.cos(2.0 * np.pi * u)
     return np.where(u < 0.5, 0.25 - c, 0.75 + c)
-
-
-def _interp(pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
-    f = np.clip(np.asarray(t) * fps, 0.0, pos.shape[0] - 1)
-    i0 = np.floor(f).astype(np.int64)
-    i1 = np.minimum(i0 + 1, pos.shape[0] - 1)
-    w = (f - i0)[:, None, None]
-    return (1.0 - w) * pos[i0] + w * pos[i1]
 
 
 def _move(p: np.ndarray, ang: np.ndarray, off: np.ndarray) -> np.ndarray:
@@ -208,15 +203,6 @@ def _root_floor_columns(motion: object) -> np.ndarray | None:
     return np.array([motion.channels.index(n) for n in names])
 
 
-def _root_rotation(motion: object) -> tuple[list[int], str] | None:
-    """The skeleton root's rotation channels and their Euler order, or None."""
-    root = motion.skeleton.joints[0].name
-    for joint, idx, order in motion.rotation_triples():
-        if joint == root:
-            return list(idx), order
-    return None
-
-
 def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
     """Joint positions and the index of their vertical axis, or None (angle tables)."""
     if motion.is_positional:
@@ -232,13 +218,9 @@ def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
 def choose_loop(
     motion: object, events: np.ndarray, *, join: float = LOOP_BLEND_S, dance: int | None = None
 ) -> tuple[int, int, float, np.ndarray | None, float, float]:
-    """Where to loop a clip: ``(a, b, angle, shift, distance, join)``.
-
-    ``a < b`` index ``events``; ``angle`` [rad] and ``shift`` (floor translation,
-    position unit; None without positions) carry the pose at ``e_a`` onto the pose at
-    ``e_b``; ``distance`` is their motion-graph distance; ``join`` the blend width [s]
-    (shortened only when the clip leaves no room for it). See the module docstring.
-    """
+    """Where to loop a clip (see the module docstring): ``(a, b, angle, shift, distance,
+    join)``, ``a < b`` indexing ``events``, the rest as in :class:`LoopedClip` (``join``
+    shortened only when the clip leaves no room for it)."""
     p = events.size - 1
     duration = (motion.n_frames - 1) / motion.fps
     got = joint_positions(motion)
@@ -328,7 +310,7 @@ def with_center(out: Any, motion: Any, src_times: np.ndarray, looped: LoopedClip
         return out
     center = np.asarray(info.center, dtype=np.float64)[:, None, :]
     if looped is None:
-        c = _interp(center, motion.fps, src_times)
+        c = interp_frames(center, motion.fps, src_times)
     else:
         c = looped.sample_positions(center, motion.fps, src_times)
     return replace(out, position_info=replace(info, center=c[:, 0, :]), _cache={})

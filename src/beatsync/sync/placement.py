@@ -1,10 +1,6 @@
 """Beats mode for a whole dance: loop the clip where it loops best, then place every
-motion beat on the song's (half) beats at once (:mod:`.fill`, :mod:`.counts`).
-
-The looped timeline is made long enough that speeds up to ``LOOP_REACH`` can cover the
-song; the counts (:func:`.counts.plan_counts`) then choose how much of it is played.
-Each interval's headroom (:func:`peak_headroom`) keeps the intervals that hold the
-dancer's fastest moments from being played faster than the dancer's own peak.
+motion beat on the song's (half) beats at once (:mod:`.fill`, :mod:`.counts`), each
+interval no faster than keeps its joints within the dancer's own peak (:func:`peak_headroom`).
 """
 
 from __future__ import annotations

@@ -26,14 +26,7 @@ from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion_beats import motion_positions
 
-__all__ = [
-    "instantaneous_speed",
-    "joint_kinematics",
-    "speed_figures",
-    "join_figures",
-    "fitting_tempo",
-    "report_entries",
-]
+__all__ = ["instantaneous_speed", "joint_kinematics", "speed_figures", "join_figures"]
 
 
 def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict[str, float]:
@@ -66,12 +59,12 @@ def speed_figures(
     """Instantaneous and per-interval playback speed (see the module docstring)."""
     inst = instantaneous_speed(src_times, out_fps, covered)
     per = np.diff(used) / np.diff(targets)
-    t = np.arange(src_times.size) / out_fps
+    lead_in = np.count_nonzero(np.arange(src_times.size) / out_fps < covered[0])
     return {
         "band": list(band),
         "instantaneous": _stats(inst, np.ones_like(inst), band) if inst.size else None,
         "per_interval": _stats(per, np.diff(targets), band),
-        "held_lead_in_s": float(np.count_nonzero(t < covered[0]) / out_fps),
+        "held_lead_in_s": float(lead_in / out_fps),
     }
 
 

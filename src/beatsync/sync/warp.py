@@ -111,12 +111,8 @@ def time_warp(
     """Integrate the blended, boundary-corrected rate into a time warp that lands every
     boundary [s] on its target [s] (to rounding), covering ``start`` / ``end`` [s]
     before the first / after the last boundary at the rate there; ``delta`` [s] is eq.
-    9's width (default the mean period).
-
-    Raises
-    ------
-    ParameterError
-        Mismatched lengths, fewer than two boundaries, unsorted times, bad ``delta``.
+    9's width (default the mean period). ParameterError on mismatched lengths, fewer
+    than two boundaries, unsorted times or a bad ``delta``.
 
     Examples
     --------
