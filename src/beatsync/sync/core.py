@@ -255,8 +255,8 @@ def synchronize(
     ``PERIOD_BEATS`` of the music's beats in ``"periods"``, ``AUTO_PERIOD_RANGE`` in
     ``"auto"``).
 
-    - ``mode``: paper A's periods on groups of beats; ``"beats"``, the dancer's own
-      kinematic beats, counts chosen for the whole dance (figures that vary); ``"auto"``,
+    - ``mode``: ``"periods"``, paper A's periods on groups of beats; ``"beats"``, the
+      dancer's own kinematic beats, counts chosen for the whole dance; ``"auto"``,
       periods when the motion is periodic, else beats with a warning and
       ``report["mode_note"]``.
     - ``land="accents"``: synchronise, measure the mean lag of the kinematic beats behind
