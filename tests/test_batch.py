@@ -100,9 +100,9 @@ def test_grid_tempo_range_reaches_every_song(inputs, tmp_path):
 
 def test_grid_bad_arguments(inputs, tmp_path):
     _, clips, songs = inputs
-    with pytest.raises(ParameterError, match="none.bvh"):
+    with pytest.raises(ParameterError, match="does not exist"):
         sync_grid([tmp_path / "none.bvh"], songs, tmp_path)
-    with pytest.raises(ParameterError, match="missing"):
+    with pytest.raises(ParameterError, match="output folder"):
         sync_grid(clips, songs, tmp_path / "missing")
     with pytest.raises(ParameterError, match="at least one"):
         sync_grid([], songs, tmp_path)
@@ -320,7 +320,7 @@ def test_batch_refuses_a_positions_output_that_is_an_input(inputs, tmp_path, cli
                 "--out-dir", str(tmp_path), "--fps", "25", "--mode", "beats"]  # fmt: skip
         assert main(argv) == 3
     else:
-        with pytest.raises(ParameterError, match=clips[1].name):
+        with pytest.raises(ParameterError, match="would overwrite an input"):
             sync_grid(clips, songs[:1], tmp_path, processes=False, n_workers=1, fps=25.0)
     assert clips[1].read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(c.name for c in clips)
