@@ -172,7 +172,7 @@ def test_phase_offset_shifts_targets():
     res = synchronize(m, bounds, beats, phase_offset=-0.1)
     assert np.allclose(res.report["target_beats_s"], beats[: 2 * 5 + 1 : 2] - 0.1)
     assert res.report["max_abs_residual_frames"] <= 0.5 + 1e-6
-    with pytest.raises(ParameterError, match="before the music starts"):
+    with pytest.raises(ParameterError, match="phase_offset=-0.300"):
         synchronize(m, bounds, beats, phase_offset=-0.3)
 
 
@@ -266,9 +266,9 @@ def test_bad_inputs_raise(bounds, beats, kwargs, match):
 
 
 def test_time_warp_bad_inputs():
-    with pytest.raises(ParameterError, match="one music time per boundary"):
+    with pytest.raises(ParameterError, match=r"targets has shape \(2,\)"):
         time_warp([0.0, 1.0, 2.0], [0.0, 1.0])
-    with pytest.raises(ParameterError, match="at least 2"):
+    with pytest.raises(ParameterError, match="got 1"):
         time_warp([0.0], [0.0])
 
 
@@ -540,7 +540,7 @@ def test_mode_periods_does_not_suggest_motion_beats_for_a_dancer_standing_still(
     # no motion at all is not a free dance: motion beats would not sync it either
     still = waltz_dancer.with_values(np.repeat(waltz_dancer.values[:1], 300, axis=0))
     for mode in ("periods", "auto"):
-        with pytest.raises(ParameterError, match="does not move") as err:
+        with pytest.raises(ParameterError, match="over the 300 frames") as err:
             synchronize(still, None, np.arange(0.5, 30.0, 0.5), mode=mode)
         assert "mode='beats'" not in str(err.value)
 

@@ -15,21 +15,14 @@ dancer:
 (c) a random-offset control (:func:`beatsync.evaluate.alignment.offset_control`: the
     motion beats shifted by one random offset within a beat period), for (a) and (b);
 (d) the dance's period and motion-beat interval against the song's beat period;
-(e) whether the re-synchronised dancer still moves like the dancer
-    (:func:`motion_table`): the playback speed (instantaneous and per interval, share
-    of the output within 0.8-1.25), p99 joint speed and acceleration against the
-    dancer's own, the peak joint speed at the loop joins and overall, next to the
-    alignment scores of (a)-(c); and the same figures for the code before the
-    whole-dance beat counts and seamless loops (:func:`before_table`, read from the
-    record of ``benchmarks/bench_resync.py --label before``).
+(e) whether the re-synchronised dancer still moves like the dancer (:func:`motion_table`:
+    playback speed, joint speed and acceleration against the dancer's own, the joins),
+    and the same before the whole-dance counts and seamless loops (:func:`before_table`).
 
-What the data can and cannot show: the dataset says which part of each song was
-danced (25 fps frame ranges), not that the steps sit on its beats; its own
-alignment of dance and music is approximate, and the songs' beats here are tracked,
-not annotated. So (a) is a measurement of this data, not of the dancers' skill, and
-four 24 s excerpts are four examples, not a benchmark. The songs are short (28 s), so
-the re-synchronised dancer covers at most that; the scores count only beats inside
-the span both the dance and the song play.
+The dataset says which part of each song was danced, not that the steps sit on its
+(here tracked, not annotated) beats: (a) measures this data, not the dancers' skill, and
+four excerpts are four examples, not a benchmark. The scores count only beats inside the
+span both the dance and the song (28 s) play.
 
 Notebook: ``notebooks/paper_a_ext_real_dancers.ipynb``.
 """
@@ -46,6 +39,8 @@ import numpy as np
 from ..datasets import DANCE_PAIRS, DancePair, load_dance_pair
 from ..errors import BeatsyncWarning, ParameterError
 from ..evaluate.alignment import DEFAULT_SIGMA, alignment_scores, offset_control
+from ..motion_beats import kinematic_beats
+from ..sync.quality import instantaneous_speed
 from .artifacts import write_artifacts
 
 __all__ = [
@@ -54,7 +49,6 @@ __all__ = [
     "track_songs",
     "song_table",
     "own_song_scores",
-    "resynchronise",
     "resync_scores",
     "dancer_table",
     "period_table",
@@ -77,28 +71,14 @@ OTHER_SONG = {
 }
 
 
-def _kinematic_beats(motion: Any) -> np.ndarray:
-    from ..motion_beats import kinematic_beats
-
-    return kinematic_beats(motion)
-
-
 def load_pairs(names: list[str] | tuple[str, ...] = DANCE_PAIRS) -> dict[str, DancePair]:
     """The bundled dancer + song excerpts, checksum-verified, by name."""
-    unknown = [n for n in names if n not in DANCE_PAIRS]
-    if unknown:
-        raise ParameterError(f"unknown dance pair(s) {unknown}; choose from {DANCE_PAIRS}")
     return {n: load_dance_pair(n) for n in names}
 
 
 def track_songs(pairs: dict[str, DancePair]) -> dict[str, dict[str, Any]]:
-    """Beats of every song (tracked; times in the excerpt's audio [s]) and its meter.
-
-    Returns
-    -------
-    dict
-        name -> ``{"beats", "tempo_bpm", "beats_per_bar", "warning"}``.
-    """
+    """Beats of every song (tracked; times in the excerpt's audio [s]) and its meter:
+    name -> ``{"beats", "tempo_bpm", "beats_per_bar", "warning"}``."""
     from ..beats import track_beats
 
     songs = {}
@@ -136,9 +116,8 @@ def song_table(pairs: dict[str, DancePair], songs: dict[str, dict[str, Any]]) ->
     )
 
 
-def _scores(mb: np.ndarray, yb: np.ndarray, span: tuple[float, float], **kw: Any) -> dict:
+def _scores(mb: np.ndarray, yb: np.ndarray, span: tuple[float, float], *, sigma, n_control, seed):
     """Both scores and their random-offset control, on the beats inside ``span``."""
-    sigma, n_control, seed = kw["sigma"], kw["n_control"], kw["seed"]
     sc = alignment_scores(mb, yb, sigma=sigma, span=span)
     inside = (mb >= span[0]) & (mb <= span[1])
     ctrl = offset_control(
@@ -168,43 +147,10 @@ def own_song_scores(
     Motion beats are moved to the excerpt's audio time (``+ pair.audio_offset``) and
     compared with the song's beats while the dance plays.
     """
-    mb = _kinematic_beats(pair.motion) + pair.audio_offset
+    mb = kinematic_beats(pair.motion) + pair.audio_offset
     yb = np.asarray(beats, dtype=np.float64)
     span = (pair.audio_offset, pair.audio_offset + float(pair.motion.duration))
     return _scores(mb, yb, span, sigma=sigma, n_control=n_control, seed=seed)
-
-
-def resynchronise(
-    pair: DancePair,
-    beats: Any,
-    *,
-    mode: str = "beats",
-    land: str = "boundaries",
-    period_range: tuple[float, float] = (0.8, 5.0),
-    beats_per_bar: int | None = None,
-) -> Any:
-    """(b): :func:`beatsync.sync.synchronize` the dancer to a song, covering it (loop).
-
-    Returns the :class:`~beatsync.sync.SyncResult`; frame ``k`` of its motion plays at
-    time ``k / fps`` of the song's audio. Warnings (e.g. ``mode="auto"`` falling back)
-    are kept in ``report["warnings"]``.
-    """
-    from ..sync import synchronize
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", BeatsyncWarning)
-        res = synchronize(
-            pair.motion,
-            None,
-            np.asarray(beats, dtype=np.float64),
-            mode=mode,
-            land=land,
-            fill="loop",
-            period_range=period_range,
-            beats_per_bar=beats_per_bar,
-        )
-    res.report["warnings"] = [str(w.message) for w in caught]
-    return res
 
 
 def resync_scores(
@@ -213,7 +159,7 @@ def resync_scores(
     """(b) and (c): scores of the re-synchronised dancer on the song's beats it covers."""
     yb = np.asarray(beats, dtype=np.float64)
     span = (float(yb[0]), min(float(yb[-1]), float(result.motion.duration)))
-    mb = _kinematic_beats(result.motion)
+    mb = kinematic_beats(result.motion)
     return _scores(mb, yb, span, sigma=sigma, n_control=n_control, seed=seed)
 
 
@@ -232,15 +178,13 @@ def dancer_table(
     Columns ``own_*`` are the dancer with their own song, ``after_*`` re-synchronised
     to :data:`OTHER_SONG`, ``*_control_*`` the random-offset control of each; ``_motion``
     averages over motion beats (Li et al. 2021), ``_music`` over music beats (Siyao et
-    al. 2022); ``sigma`` in seconds.
-
-    Returns
-    -------
-    table : pandas.DataFrame
-    results : dict
-        ``(dancer, mode) -> SyncResult``.
+    al. 2022); ``sigma`` in seconds. Returns the table and ``(dancer, mode) -> SyncResult``
+    (:func:`beatsync.sync.synchronize` with ``fill="loop"``; its warnings, e.g. ``"auto"``
+    falling back, in ``report["warnings"]``).
     """
     import pandas as pd
+
+    from ..sync import synchronize
 
     rows, results = [], {}
     kw = {"sigma": sigma, "n_control": n_control, "seed": seed}
@@ -250,13 +194,18 @@ def dancer_table(
             raise ParameterError(f"{name} is re-synchronised to {other}'s song: load {other} too")
         own = own_song_scores(pair, songs[name]["beats"], **kw)
         for mode in modes:
-            res = resynchronise(
-                pair,
-                songs[other]["beats"],
-                mode=mode,
-                period_range=period_range,
-                beats_per_bar=songs[other]["beats_per_bar"],
-            )
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", BeatsyncWarning)
+                res = synchronize(
+                    pair.motion,
+                    None,
+                    songs[other]["beats"],
+                    mode=mode,
+                    fill="loop",
+                    period_range=period_range,
+                    beats_per_bar=songs[other]["beats_per_bar"],
+                )
+            res.report["warnings"] = [str(w.message) for w in caught]
             results[(name, mode)] = res
             after = resync_scores(res, songs[other]["beats"], **kw)
             rep = res.report
@@ -269,14 +218,12 @@ def dancer_table(
                     "mode used": rep["mode"],
                     "beats per unit": rep["beats_per_period"],
                     "repetitions": rep["repetitions"],
-                    "own_motion": own["motion"],
-                    "own_control_motion": own["control_motion"],
-                    "after_motion": after["motion"],
-                    "after_control_motion": after["control_motion"],
-                    "own_music": own["music"],
-                    "own_control_music": own["control_music"],
-                    "after_music": after["music"],
-                    "after_control_music": after["control_music"],
+                    **{
+                        f"{w}_{c}{s}": sc[f"{c}{s}"]
+                        for s in ("motion", "music")
+                        for w, sc in (("own", own), ("after", after))
+                        for c in ("", "control_")
+                    },
                     "sigma_s": sigma,
                     "note": "; ".join(rep["warnings"])[:160],
                 }
@@ -290,13 +237,8 @@ def period_table(
     *,
     period_range: tuple[float, float] = (0.8, 5.0),
 ) -> Any:
-    """(d) The dance's period and motion-beat interval against its song's beat period.
-
-    The period comes from paper A's segmentation of the dancer's joint angles (angles
-    between inferred bones, :func:`beatsync.motion.segmentation_view`) searched in
-    ``period_range``; the motion-beat interval is the median interval of its
-    kinematic beats; the song's beat period is the median interval of its tracked beats.
-    """
+    """(d) The dance's period (paper A's segmentation of its joint angles over
+    ``period_range``) and median motion-beat interval against its song's median beat."""
     import pandas as pd
 
     from ..motion import segmentation_view
@@ -305,7 +247,7 @@ def period_table(
     rows = []
     for name, pair in pairs.items():
         seg = segment(segmentation_view(pair.motion), period_range=period_range)
-        mb = _kinematic_beats(pair.motion)
+        mb = kinematic_beats(pair.motion)
         beat = 60.0 / songs[name]["tempo_bpm"]
         period = float(np.mean(np.diff(seg.boundaries)))
         interval = float(np.median(np.diff(mb)))
@@ -337,12 +279,9 @@ def summary_table(table: Any, *, mode: str = "beats") -> Any:
     return t[cols + ["beats_motion_target", "beats_music_target"]].reset_index(drop=True)
 
 
-def _playback_speed(result: Any) -> np.ndarray:
-    """Source seconds per output second between output frames, where the warp is live."""
-    fps = result.motion.fps
-    t = np.arange(result.warp_src_times.size) / fps
-    live = (t[1:] > result.warp.tgt[0]) & (t[1:] <= result.warp.tgt[-1] + 1e-9)
-    return np.diff(result.warp_src_times)[live] * fps
+def _playback_speed(res: Any) -> np.ndarray:
+    covered = (res.warp.tgt[0], res.warp.tgt[-1])
+    return instantaneous_speed(res.warp_src_times, res.motion.fps, covered)
 
 
 def motion_table(
@@ -355,11 +294,8 @@ def motion_table(
 ) -> Any:
     """(e) Per dancer re-synchronised to :data:`OTHER_SONG` (one sync ``mode``): playback
     speed, joint kinematics against the dancer's own, the joins, and the alignment
-    scores of :func:`dancer_table` (after, random-offset control, own song).
-
-    Speeds and kinematics are computed here from the output frames, with the sync
-    report's own functions (:func:`beatsync.sync.quality.joint_kinematics`), not read
-    from the report; finite differences over all joints and frames.
+    scores of :func:`dancer_table` (after, random-offset control, own song); speeds and
+    kinematics computed from the output frames (:mod:`beatsync.sync.quality`).
     """
     import pandas as pd
 
@@ -390,12 +326,11 @@ def motion_table(
                 "peak / own peak": ratio["peak_joint_speed"],
                 "joins": len(joins),
                 "join peak / own peak": float(np.max(joins) / own_peak) if joins else np.nan,
-                "after_motion": t.loc[name, "after_motion"],
-                "control_motion": t.loc[name, "after_control_motion"],
-                "own_motion": t.loc[name, "own_motion"],
-                "after_music": t.loc[name, "after_music"],
-                "control_music": t.loc[name, "after_control_music"],
-                "own_music": t.loc[name, "own_music"],
+                **{
+                    f"{w}_{s}": t.loc[name, f"{col}_{s}"]
+                    for s in ("motion", "music")
+                    for w, col in (("after", "after"), ("control", "after_control"), ("own", "own"))
+                },
             }
         )
     return pd.DataFrame(rows)
@@ -430,12 +365,11 @@ def before_table(path: str | Path, pairs: dict[str, DancePair] | None = None) ->
                 "p99 speed / own": r["p99_speed_ratio"],
                 "p99 accel / own": r["p99_accel_ratio"],
                 "peak / own peak": r["peak_ratio"],
-                "after_motion": r["after"]["motion"],
-                "control_motion": r["control"]["motion"],
-                "own_motion": r["own"]["motion"],
-                "after_music": r["after"]["music"],
-                "control_music": r["control"]["music"],
-                "own_music": r["own"]["music"],
+                **{
+                    f"{w}_{s}": r[w][s]
+                    for s in ("motion", "music")
+                    for w in ("after", "control", "own")
+                },
             }
         )
     return pd.DataFrame(rows)
@@ -463,27 +397,18 @@ def speed_figure(results: dict[tuple[str, str], Any], *, mode: str = "beats") ->
 
 
 def beats_figure(
-    pair: DancePair,
-    own_beats: Any,
-    result: Any,
-    new_beats: Any,
-    *,
-    seconds: float = 12.0,
+    pair: DancePair, own_beats: Any, result: Any, new_beats: Any, *, seconds: float = 12.0
 ) -> Any:
-    """Motion beats against music beats, before (own song) and after re-synchronisation.
-
-    Top: the dancer's kinematic beats and their own song's beats over the first
-    ``seconds`` of the dance (audio time). Bottom: the re-synchronised dancer's
-    kinematic beats and the new song's beats over its first ``seconds``.
-    """
+    """Motion beats against music beats over the first ``seconds``: the dancer with their
+    own song (audio time), then re-synchronised to the new song."""
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 1, figsize=(10, 3.6), sharex=False)
-    before = _kinematic_beats(pair.motion) + pair.audio_offset
+    before = kinematic_beats(pair.motion) + pair.audio_offset
     lo = pair.audio_offset
     panels = [
         (axes[0], before, np.asarray(own_beats), lo, f"{pair.name} with its own song"),
-        (axes[1], _kinematic_beats(result.motion), np.asarray(new_beats), 0.0,
+        (axes[1], kinematic_beats(result.motion), np.asarray(new_beats), 0.0,
          f"{pair.name} re-synchronised ({result.report['mode']} mode) to another song"),
     ]  # fmt: skip
     for ax, mb, yb, t0, title in panels:

@@ -46,11 +46,8 @@ Beyond the paper (real dances)
     - ``fill="loop"`` repeats a span chosen where the poses at its ends are most alike
       (:mod:`.fill`), turned and moved to go on from the previous pass, blended over
       0.6 s; ``fill="stop"`` (paper A) ends with the last period that fits.
-    - The report (:mod:`.quality`) gives what the warp did to the dance: playback
-      speed, joint speed and acceleration against the input's, each join's peak, a
-      warning naming a tempo that would fit; each boundary's residual on the realised
-      warp and at its nearest output frame. The JSON layout's ``center`` is resampled
-      with the joints.
+    - The report (:class:`SyncResult`, :mod:`.quality`) says what the warp did to the
+      dance. The JSON layout's ``center`` is resampled with the joints.
 
 Modules: :mod:`.warp` (eq. 9), :mod:`.mapping` (beats per period, meters, accent lag),
 :mod:`.counts` (whole-dance counts), :mod:`.fill` (loops), :mod:`.placement` (beats

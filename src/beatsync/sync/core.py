@@ -8,19 +8,26 @@ from typing import Any
 import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
+from ..motion import segmentation_view
+from ..motion_beats import kinematic_beats, motion_positions
+from ..rotations import sample_motion
+from ..segment.checks import check_alpha, check_period_range
+from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_count
 from ..validation import (
+    as_float,
     as_int,
     check_interval,
     check_motion_fps,
+    check_positive,
     check_times,
     frames_to_time,
     time_to_frames,
 )
 from .fill import LoopedClip, choose_loop, loop_events, with_center
-from .mapping import BeatCount, beats_per_unit, choose_count, lag_of
+from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
-from .quality import report_entries
+from .quality import fitting_tempo, report_entries
 from .warp import TimeWarp, integrate_warp
 
 __all__ = [
@@ -123,27 +130,12 @@ def _events(
     return np.asarray(seg.boundaries, dtype=np.float64), "periods", ""
 
 
-#: The periodicity refusal's advice to a caller of :func:`motion_periods`, which segments
-#: the channels :func:`beatsync.motion.segmentation_view` chooses.
-PERIODS_ADVICE = "Try another period_range (--period-range), or a clip with repeated movement"
-
-
 def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: float = 0.1) -> Any:
     """Paper A's segmentation of a dance into its periods (:func:`beatsync.segment.segment`
-    on :func:`beatsync.motion.segmentation_view`).
-
-    Raises
-    ------
-    NotPeriodicError
-        Not shown periodic, too short to tell, or no joint angles to search while its
-        joints move: its own motion beats may still sync it.
-    ParameterError
-        Bad ``alpha`` or ``period_range``, or a dancer whose joints do not move.
+    on :func:`beatsync.motion.segmentation_view`). NotPeriodicError when not shown periodic,
+    too short to tell, or without joint angles while its joints move (its own motion beats
+    may still sync it); ParameterError for bad settings or a dancer who does not move.
     """
-    from ..motion import segmentation_view
-    from ..segment.checks import check_alpha, check_period_range
-    from ..segment.core import PeriodicityRefused, _segment_motion
-
     alpha = check_alpha(alpha)  # the caller's settings: never a reason to fall back
     period_range = check_period_range(period_range)
     try:
@@ -151,14 +143,19 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
                               period_range=period_range, method="energy")  # fmt: skip
     except PeriodicityRefused as exc:
         # the channels are segmentation_view's here (sync and batch have no --channels)
-        raise NotPeriodicError(exc.advised(PERIODS_ADVICE)) from None
+        advice = "Try another period_range (--period-range), or a clip with repeated movement"
+        raise NotPeriodicError(exc.advised(advice)) from None
     except NotPeriodicError:  # too short to tell: its own message
         raise
     except ParameterError as exc:  # no angles to test, or angles that never change
-        moves = _joints_move(motion)
-        if moves is None:  # no joint positions either: the segmentation's own message
-            raise
-        if not moves:
+        try:
+            pos = motion_positions(motion)
+        except ParameterError:  # no joint positions either: the segmentation's own message
+            raise exc from None
+        with np.errstate(invalid="ignore"):
+            span = float(np.nanmax(np.abs(pos - pos[:1]))) if pos.size else 0.0
+            scale = float(np.nanmax(np.abs(pos))) if pos.size else 0.0
+        if not (np.isfinite(span) and span > 1e-9 * max(scale, 1e-300)):
             raise ParameterError(
                 f"the dancer does not move: every joint keeps its position over the "
                 f"{motion.n_frames} frames, so there is nothing to synchronise"
@@ -169,23 +166,7 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     return seg
 
 
-def _joints_move(motion: Any) -> bool | None:
-    """Whether any joint position changes over the motion (None: no joint positions)."""
-    from ..motion_beats import motion_positions
-
-    try:
-        pos = motion_positions(motion)
-    except ParameterError:
-        return None
-    with np.errstate(invalid="ignore"):
-        span = float(np.nanmax(np.abs(pos - pos[:1]))) if pos.size else 0.0
-        scale = float(np.nanmax(np.abs(pos))) if pos.size else 0.0
-    return bool(np.isfinite(span) and span > 1e-9 * max(scale, 1e-300))
-
-
 def _motion_beats(motion: Any, what: str) -> np.ndarray:
-    from ..motion_beats import kinematic_beats
-
     try:
         mb = kinematic_beats(motion)
     except ParameterError as exc:
@@ -203,13 +184,10 @@ def _motion_beats(motion: Any, what: str) -> np.ndarray:
 def motion_beat_count(motion: Any, events: np.ndarray) -> int | None:
     """Motion beats per period, counted from the kinematic beats (informative only).
 
-    The count that holds in at least :data:`METER_AGREEMENT` of the periods, else None
-    (also None without joint positions). Speed minima do not mark every step of a
-    real dance (a real waltz bar shows 2 of its 3 steps), so this count is reported,
+    The count that holds in at least :data:`METER_AGREEMENT` of the periods, else None.
+    Speed minima miss steps of a real dance (a real waltz bar shows 2 of its 3), so it is
     never used to choose the beats per period: give the dance's meter instead.
     """
-    from ..motion_beats import kinematic_beats
-
     try:
         with silenced():  # no beats: no count, no news
             mb = kinematic_beats(motion)
@@ -229,17 +207,11 @@ def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict 
     """The dance's own phrase in motion beats ``mb`` [s], for ``dance_beats_per_period``
     when the user gives none: ``(count or None, what was found)``.
 
-    Paper A's period ``T`` (:func:`beatsync.segment.core.estimate_period_count`, the
-    spectral peak: cheap on a long dance) over 1.5-8.5 median motion-beat intervals
-    ``b``; the phrase is ``N = round(T / b)`` motion beats. It is used only when every
-    ``N`` consecutive motion beats span ``T`` to within half an interval: the phrase
-    starts are every ``N``-th motion beat (:mod:`.counts`), so a single phrase of
-    another count would put every later one off its bar. None when that is not clear,
-    or without joint angles or positions to search.
+    Paper A's period ``T`` (the spectral peak of
+    :func:`beatsync.segment.core.estimate_period_count`) over ``PHRASE_BEATS`` median
+    motion-beat intervals ``b``; ``N = round(T / b)``, used only when every ``N``
+    consecutive motion beats span ``T`` to within ``b / 2`` (why: ``docs/tuning.md``).
     """
-    from ..motion import segmentation_view
-    from ..segment.core import estimate_period_count
-
     iv = np.diff(mb)
     step = float(np.median(iv))
     try:
@@ -277,54 +249,28 @@ def synchronize(
     """Resample a dance so that its periods (or its own motion beats) land on music beats
     (paper A, section 5; see :mod:`beatsync.sync`). The output's time 0 is the music's.
 
-    Parameters
-    ----------
-    motion : beatsync.motion.Motion
-        BVH joint angles, marker positions or joint positions, ``fps`` [Hz].
-    boundaries : np.ndarray [shape=(p+1,), p >= 1] [s] or None
-        Period boundaries in the source's time; None: segment here with ``period_range``.
-    beats : np.ndarray [shape=(n,), n >= 2] [s]
-        Music beat times.
-    mode : {"periods", "beats", "auto"}
-        Paper A's periods on groups of beats; the dancer's own kinematic beats on the
-        music's beats, counts chosen for the whole dance (for dances whose figures
-        vary); or periods when the motion is periodic, else beats with a
-        :class:`~beatsync.errors.BeatsyncWarning` and ``report["mode_note"]``.
-    land : {"boundaries", "accents"}
-        Land the boundaries, or the dancer's accents (synchronise, measure the mean lag
-        of the kinematic beats behind the beats, synchronise again without it).
-    fill : {"stop", "loop"}
-        End with the clip's last period that fits (paper A), or repeat a span with
-        blended joins until the dance covers the song to its last beat.
-    beats_per_period : int >= 1, optional
-        Beats one period (or motion beat) spans; default :func:`beats_per_period`'s
-        rule (periods) or the whole-dance counts (beats).
-    beats_per_bar : int >= 1, optional
-        The music's meter.
-    dance_beats_per_period : int >= 1, optional
-        The dance's meter (3 for a waltz step). Periods: the count is a multiple of it
-        (or it halved), with a warning when ``beats_per_bar`` cannot also be kept.
-        Beats: every such group of motion beats starts on a bar line where the speed
-        band allows and a loop holds whole groups; without it, the dance's own phrase
-        is used when it is clear (:func:`estimate_dance_meter`).
-    first_beat : int >= 0
-        Index of the beat the first boundary lands on.
-    out_fps : float > 0, optional [Hz]
-        Output frame rate; default ``motion.fps``.
-    delta : float > 0, optional [s]
-        Gaussian width of eq. 9; default the mean motion period (or beat interval).
-    phase_offset : float [s]
-        Land the boundaries this long after their beats (negative: before).
-    period_range : (float, float) [s], optional
-        Periods searched when segmenting here: default one to eight of the music's
-        beats (``PERIOD_BEATS``: real dance cycles) in ``"periods"``, paper A's
-        0.25-1.25 s (``AUTO_PERIOD_RANGE``) in ``"auto"``, so ballroom figures go to
-        ``"beats"``, which aligned the real dancers with a new song clearly better
-        (:mod:`beatsync.study.paper_a_dancers`).
+    ``motion`` (BVH joint angles, markers or joint positions) lands on the music's
+    ``beats`` [s] (at least 2); ``boundaries`` [s] are its period boundaries in the
+    source's time (None: segmented here over ``period_range`` [s], by default
+    ``PERIOD_BEATS`` of the music's beats in ``"periods"``, ``AUTO_PERIOD_RANGE`` in
+    ``"auto"``).
 
-    Returns
-    -------
-    SyncResult
+    - ``mode``: ``"periods"``, paper A's periods on groups of beats; ``"beats"``, the
+      dancer's own kinematic beats, counts chosen for the whole dance; ``"auto"``,
+      periods when the motion is periodic, else beats with a warning and
+      ``report["mode_note"]``.
+    - ``land="accents"``: synchronise, measure the mean lag of the kinematic beats behind
+      the beats, synchronise again without it.
+    - ``fill``: end with the clip's last period that fits (``"stop"``, paper A), or
+      repeat a span with blended joins up to the song's last beat (``"loop"``).
+    - ``beats_per_period`` (beats one period or motion beat spans) overrides
+      :func:`beats_per_period`'s rule or the whole-dance counts; ``beats_per_bar`` and
+      ``dance_beats_per_period`` (3 for a waltz step) are the meters; in beats mode
+      without the dance's, its own phrase when clear (:func:`estimate_dance_meter`).
+    - ``first_beat``: index of the beat the first boundary lands on; ``phase_offset``
+      [s]: land the boundaries this long after their beats (negative: before).
+    - ``out_fps`` [Hz], default ``motion.fps``; ``delta`` [s], eq. 9's Gaussian width,
+      default the mean motion period (or beat interval).
 
     Raises
     ------
@@ -336,12 +282,6 @@ def synchronize(
     NotPeriodicError
         ``mode="periods"`` without ``boundaries`` on a motion segmentation does not
         show periodic (:func:`motion_periods`); ``"beats"`` or ``"auto"`` can sync it.
-
-    Examples
-    --------
-    >>> res = synchronize(dancer, None, track.beats, mode="auto", fill="loop")  # doctest: +SKIP
-    >>> res.report["mode"], res.report["repetitions"]  # doctest: +SKIP
-    ('beats', 3)
     """
     mode = _choice(mode, MODES, "mode")
     land = _choice(land, LANDINGS, "land")
@@ -362,30 +302,15 @@ def synchronize(
         raise ParameterError(
             f"first_beat={first_beat} but the music has only {beats.size} beats (indices from 0)"
         )
-    override = (
-        None
-        if beats_per_period is None
-        else as_int(beats_per_period, name="beats_per_period", minimum=1)
-    )
-    bar = None if beats_per_bar is None else as_int(beats_per_bar, name="beats_per_bar", minimum=1)
-    dance = (
-        None
-        if dance_beats_per_period is None
-        else as_int(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
-    )
-    try:
-        phase_offset = float(phase_offset)
-    except (TypeError, ValueError):
-        raise ParameterError(f"phase_offset={phase_offset!r} must be a time in seconds") from None
-    if not np.isfinite(phase_offset):
-        raise ParameterError(f"phase_offset={phase_offset!r} must be finite [s]")
+    override = count_or_none(beats_per_period, "beats_per_period")
+    bar = count_or_none(beats_per_bar, "beats_per_bar")
+    dance = count_or_none(dance_beats_per_period, "dance_beats_per_period")
+    phase_offset = as_float(phase_offset, name="phase_offset", unit="s")
     if land == "accents" and phase_offset != 0.0:
         raise ParameterError(
             "land='accents' measures the phase offset itself; do not also give phase_offset"
         )
     if delta is not None:
-        from ..validation import check_positive
-
         delta = check_positive(delta, name="delta", unit="s")
     beat_period = float(np.median(np.diff(beats)))
     if abs(phase_offset) >= beat_period:
@@ -413,15 +338,13 @@ def synchronize(
     if whole_dance and dance is None:
         dance, meter_found = estimate_dance_meter(motion, events)
         meter_rule = "estimated" if dance else None
+    ideal = unit / beat_period
     if override is not None:
-        count = BeatCount(override, "override", unit / beat_period)
+        count = BeatCount(override, "override", ideal)
     elif whole_dance:
-        count = BeatCount(
-            max(1, int(np.rint(unit / beat_period))), "whole dance (dynamic programming)",
-            unit / beat_period,
-        )  # fmt: skip
+        count = BeatCount(max(1, int(np.rint(ideal))), "whole dance (dynamic programming)", ideal)
     else:
-        count = choose_count(unit / beat_period, dance=dance, bar=bar)
+        count = choose_count(ideal, dance=dance, bar=bar)
     if count.meter_fit is False:
         warn(count.note, stacklevel=2)
     counts = (
@@ -446,8 +369,6 @@ def synchronize(
     lag = 0.0
     res = _resample(plan, phase_offset)
     if land == "accents":
-        from ..motion_beats import kinematic_beats
-
         try:
             mb = kinematic_beats(res.motion)
         except ParameterError as exc:
@@ -458,7 +379,7 @@ def synchronize(
         if beats[first_beat] - lag < 0:
             plan["first_beat"] = first_beat = first_beat + 1
         res = _resample(plan, -lag)
-    ratio = unit / beat_period / count.m
+    ratio = ideal / count.m
     if not whole_dance and (ratio > 2.0 or ratio < 0.5):
         warn(
             f"motion {'beats' if used_mode == 'beats' else 'periods'} ({unit:.3f} s) become "
@@ -501,8 +422,6 @@ BAND_SHARE = 0.95
 def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
     """Warn when the song cannot be followed within the speed band, naming a tempo
     that would fit."""
-    from .quality import fitting_tempo
-
     sp = report["playback_speed"]
     share = (sp["instantaneous"] or sp["per_interval"])["in_band"]
     report["speed_warning"] = ""
@@ -551,13 +470,12 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
                 f"{int(counts[0])} beat(s) ({float(events[1] - events[0]):.2f} s of motion); use "
                 "a longer song, an earlier first_beat or fewer beats_per_period"
             )
-        p = min(n_avail if looped is None else events.size - 1, n_fit)
+        p = min(events.size - 1, n_fit)
         targets = beats[first_beat + cum[: p + 1]] + phase_offset
         check_start(targets, phase_offset)
         used = events[: p + 1]
-        end = None
-        if p == events.size - 1 and duration > used[-1]:
-            end = duration  # the clip's tail after its last boundary
+        tail = p == events.size - 1 and duration > used[-1]  # the clip's tail after it
+        end = duration if tail else None
         warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
         if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
             # cover the beats after the last whole interval with part of the next one: the
@@ -566,36 +484,28 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
             warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
         placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
-    tau_end = float(warp.tgt[-1])
-    if tau_end <= 0:
-        raise ParameterError(
-            f"the warped motion ends at music time {tau_end:.3f} s <= 0: first_beat={first_beat} "
-            "is too early for the motion before the first boundary"
-        )
+    tau_end = float(warp.tgt[-1])  # > 0: targets increase from check_start's >= 0
     # the last frame is the first one at or after the last warped time, so the frame
     # nearest to the last boundary exists (the source is clipped there)
     n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
     out_times = frames_to_time(np.arange(n_out), fps=out_fps)
     src_times = warp.to_source(out_times)
-    if looped is None:
-        from ..rotations import sample_motion
-
-        values = sample_motion(motion, src_times)
-    else:
-        values = looped.sample(motion, src_times)
+    values = (
+        sample_motion(motion, src_times) if looped is None else looped.sample(motion, src_times)
+    )
     bones = position_bones(motion)
     if bones is not None:  # position-only: linear resampling, then bone lengths restored
-        a, b, w = (src_times, None, None) if looped is None else looped.source_times(src_times)
+        a, b, w = (src_times, None, None) if looped is None else looped.locate(src_times)[:3]
         pos = restore_bone_lengths(
             values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
         )
         values = pos.reshape(n_out, -1)
     out_motion = with_center(motion.with_values(values, fps=out_fps), motion, src_times, looped)
 
-    # residuals: realised warp (interpolated between output frames) and nearest frame
+    # residuals on the realised warp: output frames joined by straight lines, plus the
+    # warp's ends (a boundary may sit exactly where a held lead-in or the clipped tail
+    # starts); and at the nearest frame
     live = (out_times > warp.tgt[0]) & (out_times < warp.tgt[-1])
-    # the realised warp: output frames joined by straight lines, plus the warp's ends
-    # (a boundary may sit exactly where a held lead-in or the clipped tail starts)
     xs = np.concatenate([warp.src[:1], src_times[live], warp.src[-1:]])
     ys = np.concatenate([warp.tgt[:1], out_times[live], warp.tgt[-1:]])
     realised = np.interp(used, xs, ys)
@@ -642,9 +552,8 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             float(targets[0]),
             float(min(tau_end, frames_to_time(n_out - 1, fps=out_fps))),
         ],
+        "first_boundary_frame": int(time_to_frames(targets[0], fps=out_fps)),  # for trimming
     }
-    # the first boundary frame index in the output, for users who trim
-    report["first_boundary_frame"] = int(time_to_frames(targets[0], fps=out_fps))
     report.update(
         report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed)
     )

@@ -20,9 +20,10 @@ step's count so that its speed change can be charged. Cost of a path:
 - with the dance's meter ``N`` and the music's bar, ``W_BAR`` per phrase start (every
   ``N``-th motion beat) off a bar line.
 
-``fill="loop"`` ends on the song's last beat after any number of intervals;
-``fill="stop"`` with the clip's last interval (or on the last beat if the song ends
-first). Times in seconds; counts in half beats inside, in beats in the result.
+``end="last_beat"`` (``fill="loop"``) ends on the song's last beat after any number of
+intervals; ``"last_event"`` (``fill="stop"``) with the clip's last interval (or on the
+last beat if the song ends first). Times in seconds; counts in half beats inside, in
+beats in the result.
 """
 
 from __future__ import annotations
@@ -60,24 +61,20 @@ MARGIN = 1.05
 @dataclass(frozen=True)
 class CountPlan:
     """The placed events of a whole dance: indices (into the events given) of those
-    pinned, their half-beat ``grid_index`` and music ``targets`` [s], the ``beats`` each
-    step spans (halves allowed), the numbers of merges and half-beat landings, the
-    path's cost, and the share of phrase starts on bar lines (None without meters)."""
+    pinned, their music ``targets`` [s], the ``beats`` each step spans (halves allowed),
+    the numbers of merges and half-beat landings, and the share of phrase starts on bar
+    lines (None without meters)."""
 
     event_index: np.ndarray
-    grid_index: np.ndarray
     targets: np.ndarray
     beats: np.ndarray
     n_merged: int
     n_half: int
-    cost: float
     phrases_on_bars: float | None = None
 
 
 def _speed_cost(ls: np.ndarray, dur: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """Cost of steps at log speed ``ls`` lasting ``dur`` [s], aimed band ``lo .. hi``:
-    ``(log s)^2`` per second inside; outside, ``W_OUT`` per second plus ``W_EXCESS``
-    per second times the squared log distance to the band."""
+    """Speed cost (module docstring) of steps at log speed ``ls`` lasting ``dur`` [s]."""
     excess = np.maximum(0.0, np.maximum(ls - hi, lo - ls))
     return dur * (ls * ls + W_OUT * (excess > 0) + W_EXCESS * excess * excess)
 
@@ -86,40 +83,20 @@ def plan_counts(
     events: np.ndarray,
     beats: np.ndarray,
     *,
+    phrase_index: np.ndarray,
     end: str = "last_beat",
     dance: int | None = None,
     bar: int | None = None,
-    phrase_index: np.ndarray | None = None,
     band: tuple[float, float] = DEFAULT_SCALE_BOUND,
     max_speed: np.ndarray | None = None,
 ) -> CountPlan:
-    """Place motion events on a song's (half) beats for the whole dance at once.
+    """Place motion ``events`` [s] on the song's (half) ``beats`` [s] (from the one the
+    first event lands on) for the whole dance at once; ``end`` as in the module docstring.
 
-    Parameters
-    ----------
-    events : np.ndarray [shape=(P+1,)] [s]
-        Motion events (increasing), e.g. a looped timeline's motion beats.
-    beats : np.ndarray [shape=(n,), n >= 2] [s]
-        Music beats from the one the first event lands on.
-    end : {"last_beat", "last_event"}
-        Cover the song to its last beat (``fill="loop"``), or place the events up to
-        the last one (``fill="stop"``; the last beat if the song ends first).
-    dance : int >= 1, optional
-        Motion beats per dance bar: phrase starts prefer the music's bar lines.
-    bar : int >= 1, optional
-        Music beats per bar.
-    phrase_index : np.ndarray [int], optional
-        Each event's index within its dance (its index in the clip, for a looped
-        timeline); phrase starts are those ``% dance == 0``. Default ``arange``.
-    band : (float, float)
-        Playback speeds outside which steps are heavily charged (narrowed by ``MARGIN``).
-    max_speed : np.ndarray [shape=(P,)], optional
-        Each interval's fastest playback that keeps its joints within the dancer's own
-        peak: it lowers the band's top for the intervals with the fastest moments.
-
-    Returns
-    -------
-    CountPlan
+    ``dance`` motion beats make a dance bar and ``bar`` music beats a bar; each event's
+    ``phrase_index`` (its index in the clip, for a looped timeline)
+    marks phrase starts (``% dance == 0``). ``max_speed`` per interval, the fastest
+    playback keeping its joints within the dancer's own peak, lowers the band's top.
     """
     d = np.diff(events)
     p = d.size
@@ -130,8 +107,6 @@ def plan_counts(
     grid, _ = music_grid(beats, np.zeros(beats.size - 1), 2)
     k_max = grid.size - 1
     cmax = MAX_HALF_BEATS
-    if phrase_index is None:
-        phrase_index = np.arange(p + 1)
     phrase = np.zeros(p + 1, dtype=bool)
     if dance is not None and bar is not None:
         phrase = (np.asarray(phrase_index) % dance) == 0
@@ -144,17 +119,16 @@ def plan_counts(
     span = np.full((k_max + 1, cmax + 1), np.nan)
     for c in range(1, cmax + 1):
         span[: k_max + 1 - c, c] = grid[c:] - grid[:-c] if c <= k_max else np.nan
-    inf = np.inf
     # D[i]: cost over states (k, c, m), stored sparsely per event index
     shape = (k_max + 1, cmax + 1, 2)
     cost: dict[int, np.ndarray] = {}
     back: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}
-    start = np.full(shape, inf)
+    start = np.full(shape, np.inf)
     start[0, 0, 0] = 0.0 if (bar is None or not phrase[0] or bar_ok[0]) else W_BAR
     cost[0] = start
-    best_end = (inf, -1, -1, -1, -1)
+    best_end = (np.inf, -1, -1, -1, -1)
     at_last: dict[int, np.ndarray] = {}  # event -> costs of (c, m) on the last beat
-    furthest = (-1, 0, inf, 0, 0)  # (k, -event, cost, c, m): the latest grid point reached
+    furthest = (-1, 0, np.inf, 0, 0)  # (k, -event, cost, c, m): the latest grid point reached
     for i in range(p):
         cur = cost.pop(i, None)
         if cur is None or not np.isfinite(cur).any():
@@ -164,7 +138,7 @@ def plan_counts(
             lo_k, hi_k = int(raw[0]), int(raw[-1]) + 1
             back[i] = (lo_k, *(a[lo_k:hi_k].copy() for a in back[i][1:]))
         floor = np.min(cur)
-        cur = np.where(cur <= floor + BEAM, cur, inf)
+        cur = np.where(cur <= floor + BEAM, cur, np.inf)
         ks = np.nonzero(np.isfinite(cur).any(axis=(1, 2)))[0]
         if ks.size == 0:
             continue
@@ -191,7 +165,7 @@ def plan_counts(
             j = i + 1 + merged
             nxt = cost.get(j)
             if nxt is None:
-                nxt = np.full(shape, inf)
+                nxt = np.full(shape, np.inf)
                 back[j] = (
                     0,  # offset of the first grid point stored
                     np.full(shape, -1, dtype=np.int32),
@@ -215,7 +189,7 @@ def plan_counts(
             tot = (sub[:, None] + change).reshape(kidx.size, cmax, -1)  # (nk, C, prev)
             arg = np.argmin(tot, axis=2)
             val = np.take_along_axis(tot, arg[:, :, None], axis=2)[:, :, 0] + step
-            val = np.where(ok, val, inf)
+            val = np.where(ok, val, np.inf)
             cc = np.broadcast_to(cs1, tk.shape)
             better = val < nxt[tk, cc, merged]
             if better.any():
@@ -231,18 +205,15 @@ def plan_counts(
                 kf = int(reached[-1])
                 c_, m_ = np.unravel_index(np.argmin(nxt[kf]), nxt[kf].shape)
                 furthest = (kf, -j, float(nxt[kf, c_, m_]), int(c_), int(m_))
-            if end == "last_beat" or j == p:
-                cand = nxt[k_max] if end == "last_beat" else None
-                if end == "last_beat":
-                    c_, m_ = np.unravel_index(np.argmin(cand), cand.shape)
-                    if cand[c_, m_] < best_end[0]:
-                        best_end = (float(cand[c_, m_]), j, k_max, int(c_), int(m_))
-                else:
-                    flat = nxt.reshape(-1)
-                    a = int(np.argmin(flat))
-                    if flat[a] < best_end[0]:
-                        k_, c_, m_ = np.unravel_index(a, shape)
-                        best_end = (float(flat[a]), j, int(k_), int(c_), int(m_))
+            if end == "last_beat":
+                c_, m_ = np.unravel_index(np.argmin(nxt[k_max]), nxt[k_max].shape)
+                if nxt[k_max, c_, m_] < best_end[0]:
+                    best_end = (float(nxt[k_max, c_, m_]), j, k_max, int(c_), int(m_))
+            elif j == p:
+                a = int(np.argmin(nxt))
+                if nxt.flat[a] < best_end[0]:
+                    k_, c_, m_ = np.unravel_index(a, shape)
+                    best_end = (float(nxt.flat[a]), j, int(k_), int(c_), int(m_))
     if end == "last_event" and not np.isfinite(best_end[0]):
         # the song ends first: the furthest event that reached the last beat
         for j in sorted(at_last, reverse=True):
@@ -255,7 +226,7 @@ def plan_counts(
         # too few events to reach the song's end: stop at the latest grid point reached
         kf, mj, val, c_, m_ = furthest
         best_end = (val, -mj, kf, c_, m_)
-    total, j, k, c, m = best_end
+    _, j, k, c, m = best_end
     ev, gk = [j], [k]
     while j > 0:
         off, bk, bc, bm = back[j]
@@ -268,12 +239,10 @@ def plan_counts(
     gk_a = np.array(gk[::-1], dtype=np.int64)
     return CountPlan(
         event_index=ev_a,
-        grid_index=gk_a,
         targets=grid[gk_a],
         beats=np.diff(gk_a) / 2.0,
         n_merged=int(np.count_nonzero(np.diff(ev_a) == 2)),
         n_half=int(np.count_nonzero(gk_a % 2 == 1)),
-        cost=total,
         phrases_on_bars=(
             float(np.mean(bar_ok[gk_a[phrase[ev_a]]])) if bar and phrase[ev_a].any() else None
         ),

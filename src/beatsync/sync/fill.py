@@ -25,14 +25,9 @@ Aligned and blended joins
     previous one ended, so a dancer who travels or turns goes on instead of jumping
     back. Within ``join / 2`` of a join the pose blends the ending pass's continuation
     (clip time ``e_b + d``, moved by ``M^(r-1)``) into the starting pass's lead
-    (``e_a + d``, moved by ``M^r``) with a weight of two raised-cosine half-ramps
-    (:func:`join_weight`), whose derivative vanishes at both ends of the window and at
-    the join: both motions carry their own velocity, so the velocity is continuous,
-    the blend adds only ``w'`` times the (small) remaining pose difference, and
-    nothing at the join itself (a motion beat, whose speed minimum stays put). A
-    skeleton's root is turned (its rotation channels and its floor position) and moved;
-    joint positions are rotated and translated. Rotation channels are blended by slerp,
-    positions linearly.
+    (``e_a + d``, moved by ``M^r``) with :func:`join_weight`. A skeleton's root is
+    turned and moved (rotation channels and floor position), joint positions rotated
+    and translated; rotations are blended by slerp, positions linearly.
 
 Data contract: times in seconds of the clip (``e``) or of the looped timeline
 (``t``); positions ``(frames, joints, 3)`` with z up (position-only motion) or the
@@ -47,9 +42,13 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..errors import ParameterError
+from ..graph.distance import aligned_distance_matrix, ground_axes, point_clouds
+from ..motion_beats import motion_positions
 from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
+from .positions import interp_frames
 
-__all__ = ["LOOP_BLEND_S", "MIN_SPAN", "LoopedClip", "choose_loop", "loop_events", "with_center"]
+__all__ = ["LoopedClip", "choose_loop", "joint_positions", "loop_events", "with_center"]
 
 #: width of the blended window at each join [s]
 LOOP_BLEND_S = 0.6
@@ -83,15 +82,9 @@ class LoopedClip:
         """Looped times of the joins [s]."""
         return self.last + np.arange(self.repetitions - 1) * self.length
 
-    def source_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Clip times for looped times ``t``: ``(a, b, w)``, pose = blend(a, b, w).
-
-        ``w`` is 0 away from joins (pose at clip time ``a``).
-        """
-        return self._locate(t)[:3]
-
-    def _locate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(a, b, w, ra, rb)``: clip times, blend weight and repetitions at ``t``."""
+    def locate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(a, b, w, ra, rb)`` at looped times ``t``: the pose blends clip times ``a`` and
+        ``b`` with weight ``w`` (0 away from joins) of repetitions ``ra`` and ``rb``."""
         t = np.asarray(t, dtype=np.float64)
         r = np.floor((t - self.last) / self.length) + 1.0  # repetition index (0: the clip)
         r = np.clip(r, 0.0, self.repetitions - 1.0)
@@ -130,11 +123,11 @@ class LoopedClip:
     def sample_positions(self, pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
         """Positions ``(frames, points, 3)`` (z up) at looped times ``t``: interpolated
         linearly, each pass moved by ``M^r``, blended at the joins."""
-        a, b, w, ra, rb = self._locate(t)
-        out = _move(_interp(pos, fps, a), *self._moves(ra))
+        a, b, w, ra, rb = self.locate(t)
+        out = _move(interp_frames(pos, fps, a), *self._moves(ra))
         blend = w > 0
         if blend.any():
-            vb = _move(_interp(pos, fps, b[blend]), *(x[blend] for x in self._moves(rb)))
+            vb = _move(interp_frames(pos, fps, b[blend]), *(x[blend] for x in self._moves(rb)))
             wb = w[blend, None, None]
             out[blend] = (1.0 - wb) * out[blend] + wb * vb
         return out
@@ -145,7 +138,7 @@ class LoopedClip:
         if motion.is_positional:
             pos = motion.values.reshape(motion.n_frames, -1, 3)
             return self.sample_positions(pos, motion.fps, t).reshape(len(t), -1)
-        a, b, w, ra, rb = self._locate(t)
+        a, b, w, ra, rb = self.locate(t)
         values = self._move_root(motion, sample_motion(motion, a), ra)
         blend = w > 0
         if blend.any():
@@ -165,12 +158,14 @@ class LoopedClip:
             c, s = np.cos(ang), np.sin(ang)
             values[:, cols[0]] = c * zx[:, 0] - s * zx[:, 1]
             values[:, cols[1]] = s * zx[:, 0] + c * zx[:, 1]
-            triple = _root_rotation(motion)
-            if triple is not None:
-                idx, order = triple
-                euler = values[:, idx]
-                turned = Rotation.from_euler("y", ang[:, None]) * euler_to_rotation(euler, order)
-                values[:, idx] = rotation_to_euler(turned, order, reference=euler)
+            root = motion.skeleton.joints[0].name
+            for joint, idx, order in motion.rotation_triples():
+                if joint == root:  # its rotation channels, turned about the vertical too
+                    euler = values[:, list(idx)]
+                    spin = Rotation.from_euler("y", ang[:, None])
+                    turned = spin * euler_to_rotation(euler, order)
+                    values[:, list(idx)] = rotation_to_euler(turned, order, reference=euler)
+                    break
         values[:, cols] += off
         return values
 
@@ -181,14 +176,6 @@ def join_weight(u: np.ndarray) -> np.ndarray:
     where the blend then adds no velocity and the landed speed minimum stays put."""
     c = 0.25 * np.cos(2.0 * np.pi * u)
     return np.where(u < 0.5, 0.25 - c, 0.75 + c)
-
-
-def _interp(pos: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
-    f = np.clip(np.asarray(t) * fps, 0.0, pos.shape[0] - 1)
-    i0 = np.floor(f).astype(np.int64)
-    i1 = np.minimum(i0 + 1, pos.shape[0] - 1)
-    w = (f - i0)[:, None, None]
-    return (1.0 - w) * pos[i0] + w * pos[i1]
 
 
 def _move(p: np.ndarray, ang: np.ndarray, off: np.ndarray) -> np.ndarray:
@@ -216,20 +203,8 @@ def _root_floor_columns(motion: object) -> np.ndarray | None:
     return np.array([motion.channels.index(n) for n in names])
 
 
-def _root_rotation(motion: object) -> tuple[list[int], str] | None:
-    """The skeleton root's rotation channels and their Euler order, or None."""
-    root = motion.skeleton.joints[0].name
-    for joint, idx, order in motion.rotation_triples():
-        if joint == root:
-            return list(idx), order
-    return None
-
-
-def _positions(motion: object) -> tuple[np.ndarray, int] | None:
+def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
     """Joint positions and the index of their vertical axis, or None (angle tables)."""
-    from ..errors import ParameterError
-    from ..motion_beats import motion_positions
-
     if motion.is_positional:
         return motion.values.reshape(motion.n_frames, -1, 3), 2
     if _root_floor_columns(motion) is None:
@@ -243,22 +218,21 @@ def _positions(motion: object) -> tuple[np.ndarray, int] | None:
 def choose_loop(
     motion: object, events: np.ndarray, *, join: float = LOOP_BLEND_S, dance: int | None = None
 ) -> tuple[int, int, float, np.ndarray | None, float, float]:
-    """Where to loop a clip: ``(a, b, angle, shift, distance, join)``.
-
-    ``a < b`` index ``events``; ``angle`` [rad] and ``shift`` (floor translation,
-    position unit; None without positions) carry the pose at ``e_a`` onto the pose at
-    ``e_b``; ``distance`` is their motion-graph distance; ``join`` the blend width [s]
-    (shortened only when the clip leaves no room for it). See the module docstring.
-    """
-    from ..graph.distance import aligned_distance_matrix, ground_axes, point_clouds
-
+    """Where to loop a clip (see the module docstring): ``(a, b, angle, shift, distance,
+    join)``, ``a < b`` indexing ``events``, the rest as in :class:`LoopedClip` (``join``
+    shortened only when the clip leaves no room for it)."""
     p = events.size - 1
     duration = (motion.n_frames - 1) / motion.fps
-    got = _positions(motion)
+    got = joint_positions(motion)
     half_t = 0.5 * join
     room = (events - half_t >= 0) & (events + half_t <= duration)
     idx = np.nonzero(room)[0]
-    if got is None or idx.size < 2:
+    ii, jj = np.meshgrid(idx, idx, indexing="ij")
+    ok = jj - ii >= max(1, int(np.ceil(MIN_SPAN * p)))
+    if dance is not None:
+        ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
+    ok &= events[jj] - events[ii] > 2.0 * join
+    if got is None or not ok.any():
         # nothing to compare or no room: the whole span, blended over what fits
         fit = float(min(join, 0.5 * np.min(np.diff(events))))
         return 0, p, 0.0, None, float("nan"), fit
@@ -268,14 +242,6 @@ def choose_loop(
     half = max(1, int(round(half_t * fps / 2)))
     clouds = point_clouds(pos, frames, half)
     dist = aligned_distance_matrix(clouds, clouds, up=up)
-    ii, jj = np.meshgrid(idx, idx, indexing="ij")
-    ok = jj - ii >= max(1, int(np.ceil(MIN_SPAN * p)))
-    if dance is not None:
-        ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
-    ok &= events[jj] - events[ii] > 2.0 * join
-    if not ok.any():
-        fit = float(min(join, 0.5 * np.min(np.diff(events))))
-        return 0, p, 0.0, None, float("nan"), fit
     score = np.where(ok, dist, np.inf)
     # the most alike pair; among equals the longest span
     best = np.flatnonzero(score == score.min())
@@ -305,15 +271,15 @@ def loop_events(
     n_needed: int,
     *,
     join: float,
-    span: tuple[int, int] | None = None,
+    span: tuple[int, int],
     angle: float = 0.0,
     shift: np.ndarray | None = None,
     distance: float = float("nan"),
 ) -> LoopedClip:
-    """Repeat the span ``events[a] .. events[b]`` (``span``, default the whole clip) until
+    """Repeat the span ``events[a] .. events[b]`` (``span``) until
     the looped timeline holds ``n_needed`` intervals; ``join`` [s] is the blend width,
     ``angle``, ``shift`` and ``distance`` the floor transform of :func:`choose_loop`."""
-    a, b = (0, events.size - 1) if span is None else span
+    a, b = span
     head = events[: b + 1]
     per = b - a
     reps = 1 + max(0, -(-(int(n_needed) - b) // per))  # the clip, then enough passes
@@ -344,7 +310,7 @@ def with_center(out: Any, motion: Any, src_times: np.ndarray, looped: LoopedClip
         return out
     center = np.asarray(info.center, dtype=np.float64)[:, None, :]
     if looped is None:
-        c = _interp(center, motion.fps, src_times)
+        c = interp_frames(center, motion.fps, src_times)
     else:
         c = looped.sample_positions(center, motion.fps, src_times)
     return replace(out, position_info=replace(info, center=c[:, 0, :]), _cache={})

@@ -29,6 +29,7 @@ __all__ = [
     "beats_per_period",
     "beats_per_unit",
     "choose_count",
+    "count_or_none",
     "lag_of",
 ]
 
@@ -49,20 +50,22 @@ class BeatCount:
     note: str = ""
 
 
+def count_or_none(value: Any, name: str) -> int | None:
+    """A count given by the user (an int >= 1; ParameterError naming it), or None."""
+    return None if value is None else as_int(value, name=name, minimum=1)
+
+
 def _candidates(dance: int | None, bar: int | None, limit: int) -> list[int]:
     """Counts respecting the dance's meter (multiples of it, or it halved by 2s) and
     the bar (dividing it, or whole bars), up to ``limit``."""
     out = []
     for m in range(1, limit + 1):
-        dance_ok = dance is None or m % dance == 0 or (dance % m == 0 and _power_of_two(dance // m))
+        halved = dance is not None and dance % m == 0 and (dance // m) & (dance // m - 1) == 0
+        dance_ok = dance is None or m % dance == 0 or halved
         bar_ok = bar is None or m % bar == 0 or bar % m == 0
         if dance_ok and bar_ok:
             out.append(m)
     return out
-
-
-def _power_of_two(k: int) -> bool:
-    return k >= 1 and (k & (k - 1)) == 0
 
 
 def _nearest(cands: list[int], ideal: float) -> int:
@@ -128,21 +131,15 @@ def beats_per_period(
             "the music may be silent or have no detectable beats (give --bpm or a beats file)"
         )
     mean_period = check_positive(mean_period, name="mean_period", unit="s")
-    dance = None
-    if dance_beats_per_period is not None:
-        dance = as_int(dance_beats_per_period, name="dance_beats_per_period", minimum=1)
-    bar = None if beats_per_bar is None else as_int(beats_per_bar, name="beats_per_bar", minimum=1)
+    dance = count_or_none(dance_beats_per_period, "dance_beats_per_period")
+    bar = count_or_none(beats_per_bar, "beats_per_bar")
     beat_period = float(np.median(np.diff(beats)))
     return choose_count(mean_period / beat_period, dance=dance, bar=bar).m
 
 
 def beats_per_unit(intervals: np.ndarray, m: int) -> np.ndarray:
-    """Whole music beats for each interval between motion events (checked inputs).
-
-    The median interval spans ``m`` beats; every interval spans
-    ``max(1, round(m * interval / median))``, so an interval where a motion beat was
-    missed (twice as long) spans twice the beats and the dance keeps its tempo.
-    """
+    """Whole music beats for each interval between motion events (checked inputs):
+    ``max(1, round(m * interval / median))`` (see the module docstring)."""
     med = float(np.median(intervals))
     return np.maximum(1, np.rint(m * intervals / med)).astype(np.int64)
 

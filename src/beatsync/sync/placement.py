@@ -1,10 +1,6 @@
 """Beats mode for a whole dance: loop the clip where it loops best, then place every
-motion beat on the song's (half) beats at once (:mod:`.fill`, :mod:`.counts`).
-
-The looped timeline is made long enough that speeds up to ``LOOP_REACH`` can cover the
-song; the counts (:func:`.counts.plan_counts`) then choose how much of it is played.
-Each interval's headroom (:func:`peak_headroom`) keeps the intervals that hold the
-dancer's fastest moments from being played faster than the dancer's own peak.
+motion beat on the song's (half) beats at once (:mod:`.fill`, :mod:`.counts`), each
+interval no faster than keeps its joints within the dancer's own peak (:func:`peak_headroom`).
 """
 
 from __future__ import annotations
@@ -15,7 +11,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .counts import plan_counts
-from .fill import _positions, choose_loop, loop_events
+from .fill import choose_loop, joint_positions, loop_events
 
 __all__ = ["LOOP_REACH", "check_start", "peak_headroom", "place_whole_dance"]
 
@@ -87,7 +83,7 @@ def peak_headroom(motion: Any, events: np.ndarray) -> np.ndarray | None:
     """Per interval of ``events``: the dancer's peak joint speed over the interval's
     peak, the fastest playback that keeps its joints within the dancer's own peak
     (None without joint positions)."""
-    got = _positions(motion)
+    got = joint_positions(motion)
     if got is None:
         return None
     v = np.linalg.norm(np.diff(got[0], axis=0), axis=-1).max(axis=1)  # per frame step

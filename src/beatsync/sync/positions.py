@@ -1,14 +1,11 @@
 """Keeping bone lengths when position-only motion is resampled.
 
-Joint positions are resampled linearly (there are no rotations to slerp). A straight
-line between two poses of a turning limb cuts the arc, so the limb gets shorter
-between frames (by ``1 - cos(theta / 2)`` for a turn of ``theta`` per source frame:
-1 % at 16 deg per frame, common for a forearm at 25 fps), and a blended loop join
-between two different poses shortens it more. After the linear resampling each bone
-is set back to its length in the source, interpolated the same way as the positions,
-keeping its direction: bones are walked outwards from a root joint along a spanning
-tree of the bone graph, and each child joint is placed at its parent's corrected
-position plus the bone's interpolated direction times its interpolated length.
+Joint positions are resampled linearly (no rotations to slerp), which shortens a turning
+limb between frames (by ``1 - cos(theta / 2)`` for a turn of ``theta`` per source frame)
+and more at a blended loop join. So each bone is then set back to its source length,
+interpolated like the positions, keeping its direction: walking a spanning tree of the
+bone graph outwards, each child joint goes to its parent's corrected position plus the
+bone's direction times that length.
 
 Data contract: positions ``(n_frames, n_joints, 3)``; bones ``(n_bones, 2)`` joint
 index pairs; source times in seconds of the source motion's timeline.
@@ -20,7 +17,16 @@ from collections import deque
 
 import numpy as np
 
-__all__ = ["bone_tree", "restore_bone_lengths"]
+__all__ = ["bone_tree", "interp_frames", "restore_bone_lengths"]
+
+
+def interp_frames(values: np.ndarray, fps: float, t: np.ndarray) -> np.ndarray:
+    """``values`` (frames first, at ``fps``) at times ``t`` [s], linear between frames."""
+    f = np.clip(np.asarray(t) * fps, 0.0, values.shape[0] - 1)
+    i0 = np.floor(f).astype(np.int64)
+    i1 = np.minimum(i0 + 1, values.shape[0] - 1)
+    w = (f - i0).reshape(-1, *[1] * (values.ndim - 1))
+    return (1.0 - w) * values[i0] + w * values[i1]
 
 
 def bone_tree(bones: np.ndarray, n_joints: int) -> list[tuple[int, int]]:
@@ -50,12 +56,6 @@ def bone_tree(bones: np.ndarray, n_joints: int) -> list[tuple[int, int]]:
     return order
 
 
-def _lengths(pos: np.ndarray, tree: list[tuple[int, int]]) -> np.ndarray:
-    par = np.array([p for p, _ in tree], dtype=np.int64)
-    chi = np.array([c for _, c in tree], dtype=np.int64)
-    return np.linalg.norm(pos[:, chi] - pos[:, par], axis=-1)
-
-
 def restore_bone_lengths(
     out_pos: np.ndarray,
     src_pos: np.ndarray,
@@ -72,19 +72,11 @@ def restore_bone_lengths(
     tree = bone_tree(bones, src_pos.shape[1])
     if not tree:
         return out_pos
-    lengths = _lengths(src_pos, tree)  # (n, n_tree)
-    frames = np.arange(src_pos.shape[0], dtype=np.float64)
-
-    def at(t: np.ndarray) -> np.ndarray:
-        f = np.clip(np.asarray(t) * fps, 0.0, frames[-1])
-        i0 = np.floor(f).astype(np.int64)
-        i1 = np.minimum(i0 + 1, frames.size - 1)
-        u = (f - i0)[:, None]
-        return lengths[i0] * (1.0 - u) + lengths[i1] * u
-
-    target = at(src_a)
+    par, chi = np.array(tree, dtype=np.int64).T
+    lengths = np.linalg.norm(src_pos[:, chi] - src_pos[:, par], axis=-1)  # (n, n_tree)
+    target = interp_frames(lengths, fps, src_a)
     if src_b is not None and w is not None and np.any(w > 0):
-        target = target * (1.0 - w[:, None]) + at(src_b) * w[:, None]
+        target = target * (1.0 - w[:, None]) + interp_frames(lengths, fps, src_b) * w[:, None]
     fixed = out_pos.copy()
     for k, (p, c) in enumerate(tree):
         d = out_pos[:, c] - out_pos[:, p]

@@ -24,8 +24,9 @@ import numpy as np
 
 from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
+from ..motion_beats import motion_positions
 
-__all__ = ["joint_kinematics", "speed_figures", "join_figures", "fitting_tempo", "report_entries"]
+__all__ = ["instantaneous_speed", "joint_kinematics", "speed_figures", "join_figures"]
 
 
 def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict[str, float]:
@@ -38,6 +39,15 @@ def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict
     }
 
 
+def instantaneous_speed(
+    src_times: np.ndarray, out_fps: float, covered: tuple[float, float]
+) -> np.ndarray:
+    """Source seconds per output second between output frames within ``covered`` [s]."""
+    t = np.arange(1, src_times.size) / out_fps
+    live = (t > covered[0]) & (t <= covered[1] + 1e-9)
+    return np.diff(src_times)[live] * out_fps
+
+
 def speed_figures(
     src_times: np.ndarray,
     out_fps: float,
@@ -47,15 +57,14 @@ def speed_figures(
     band: tuple[float, float] = DEFAULT_SCALE_BOUND,
 ) -> dict[str, Any]:
     """Instantaneous and per-interval playback speed (see the module docstring)."""
-    t = np.arange(src_times.size) / out_fps
-    live = (t[1:] > covered[0]) & (t[1:] <= covered[1] + 1e-9)
-    inst = np.diff(src_times)[live] * out_fps
+    inst = instantaneous_speed(src_times, out_fps, covered)
     per = np.diff(used) / np.diff(targets)
+    lead_in = np.count_nonzero(np.arange(src_times.size) / out_fps < covered[0])
     return {
         "band": list(band),
         "instantaneous": _stats(inst, np.ones_like(inst), band) if inst.size else None,
         "per_interval": _stats(per, np.diff(targets), band),
-        "held_lead_in_s": float(np.count_nonzero(t < covered[0]) / out_fps),
+        "held_lead_in_s": float(lead_in / out_fps),
     }
 
 
@@ -112,8 +121,6 @@ def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND
 
 def report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed) -> dict:
     """Report entries computed from the output frames (see the module docstring)."""
-    from ..motion_beats import motion_positions
-
     out_fps = float(out_motion.fps)
     counts, n = np.unique(np.asarray(placed["beats"], dtype=np.float64), return_counts=True)
     rep: dict[str, Any] = {

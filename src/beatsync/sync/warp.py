@@ -28,21 +28,14 @@ BLEND_REACH = 8.0
 _CHUNK = 4096
 
 
-def correction_bump(u: np.ndarray, taper: float | None = None) -> np.ndarray:
+def correction_bump(u: np.ndarray) -> np.ndarray:
     """Correction shape on the period phase ``u`` in [0, 1]: 0 at both ends, 1 in the
-    middle, with raised-cosine ramps over ``taper`` of the period at each end."""
-    taper = TAPER if taper is None else taper
-    ramp = np.minimum(u, 1.0 - u) / taper
+    middle, with raised-cosine ramps over ``TAPER`` of the period at each end."""
+    ramp = np.minimum(u, 1.0 - u) / TAPER
     return np.where(ramp >= 1.0, 1.0, np.sin(0.5 * np.pi * np.clip(ramp, 0.0, 1.0)) ** 2)
 
 
-def blended_rate(
-    t: Any,
-    centres: Any,
-    rates: Any,
-    *,
-    delta: float,
-) -> np.ndarray:
+def blended_rate(t: Any, centres: Any, rates: Any, *, delta: float) -> np.ndarray:
     """Gaussian-blended rate (paper A, eq. 9, our reading) at source times ``t`` [s]:
     ``r(t) = sum_i w_i(t) r_i / sum_i w_i(t)``, ``w_i(t) = exp(-(t - c_i)^2 / (2 delta^2))``
     with ``c_i`` the period centres [s], ``r_i`` the per-period rates (target / source)
@@ -118,12 +111,8 @@ def time_warp(
     """Integrate the blended, boundary-corrected rate into a time warp that lands every
     boundary [s] on its target [s] (to rounding), covering ``start`` / ``end`` [s]
     before the first / after the last boundary at the rate there; ``delta`` [s] is eq.
-    9's width (default the mean period).
-
-    Raises
-    ------
-    ParameterError
-        Mismatched lengths, fewer than two boundaries, unsorted times, bad ``delta``.
+    9's width (default the mean period). ParameterError on mismatched lengths, fewer
+    than two boundaries, unsorted times or a bad ``delta``.
 
     Examples
     --------
