@@ -336,15 +336,11 @@ def build_graph(
 ) -> WeightedMotionGraph:
     """Build the weighted motion graph of a motion library (paper B, section 3.2).
 
-    ``th``: TH of eq. 1 (paper: 3.0); ``weight_rule``: eq. 2 as written (``"paper"``) or
-    the plain ``rd``; ``beats``: beat times [s] per clip, each put on its nearest frame
-    (after a clip's last frame: refused; two on one frame: merged with a warning), by
-    default kinematic beats (``beat_method``, ``smooth``, ``min_interval``:
-    :func:`beatsync.motion_beats.kinematic_beats`); ``joints``: for beats, intensities and
-    distances (default all); ``window`` [s]: the frames compared by eq. 1; ``rd_unit``
-    [s]: the time unit of ``rd``; ``up_axis``: the vertical axis (BVH: y);
-    ``require_transitions``: refuse a graph without transitions (naming the smallest
-    ``rd``).
+    ``beats``: beat times [s] per clip, each put on its nearest frame (two on one frame
+    are merged with a warning), by default kinematic beats (``beat_method``, ``smooth``,
+    ``min_interval``: :func:`beatsync.motion_beats.kinematic_beats`); ``joints``: for
+    beats, intensities and distances; ``window``, ``rd_unit`` [s]: as in eq. 1 (module
+    docstring); ``require_transitions``: refuse a graph without transitions.
     """
     t0 = time.perf_counter()
     clips = check_library(clips)

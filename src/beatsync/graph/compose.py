@@ -82,17 +82,16 @@ class Composition:
             "transition_times_s": self.synthesis.transition_times,
             "graph": self.synthesis.info.get("graph_summary", {}),
             "tempo": self.tempo.report() if self.tempo is not None else None,
-            "multiplicity_used": _counts(np.diff(self.search.boundaries), self.tempo),
+            "multiplicity_used": self._multiplicity_used(),
             "plausibility": self.plausibility,
             "warnings": list(self.warnings),
         }
 
-
-def _counts(steps: np.ndarray, plan: TempoPlan | None) -> dict[str, int]:
-    """How many intervals covered each number of music beats."""
-    sub = plan.subdivision if plan is not None else 1
-    vals, counts = np.unique(steps, return_counts=True)
-    return {f"{v / sub:g}": int(c) for v, c in zip(vals, counts, strict=True)}
+    def _multiplicity_used(self) -> dict[str, int]:
+        """How many intervals covered each number of music beats."""
+        sub = self.tempo.subdivision if self.tempo is not None else 1
+        vals, counts = np.unique(np.diff(self.search.boundaries), return_counts=True)
+        return {f"{v / sub:g}": int(c) for v, c in zip(vals, counts, strict=True)}
 
 
 def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
@@ -126,16 +125,11 @@ def compose(
     """Compose a dance for the given music beats [s] and levels [dB] (one per beat interval).
 
     ``method``: ``"dp"`` (proposed), ``"conventional"`` (baseline) or ``"random"``
-    (control, seeded by ``seed``); ``lam``: factor on transition weights; ``fps``,
-    ``blend``, ``end_time``, ``warp``: of the output
-    (:func:`beatsync.graph.synthesis.synthesize`). ``scale_bound``: bound on every
-    interval's time-scale factor, ``None`` unbounded (paper B as written);
-    ``multiplicity``: music beats one motion interval may cover (``"auto"``: from the
-    tempo ratio, one beat when unbounded); ``tempo_select``: only the clips of the tempo
-    sub-group(s) that suit the song. ``search_kwargs``: ``tempo_weight``, ``start`` (DP),
-    ``segment_beats``, ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
-    (conventional). A result whose 99th-percentile root or joint rotation speed exceeds
-    the library's fastest clip's by more than 25 % warns (:mod:`.plausibility`).
+    (control, seeded by ``seed``); ``fps``, ``blend``, ``end_time``, ``warp``: as in
+    :func:`beatsync.graph.synthesis.synthesize`; ``scale_bound`` (``None``: unbounded,
+    paper B as written), ``multiplicity`` and ``tempo_select``: :mod:`.timescale`;
+    ``search_kwargs``: the options of :func:`.dp_search` or :func:`.conventional_search`.
+    A result much faster than its library warns (:mod:`.plausibility`).
     """
     beats = check_music_beats(music_beats)
     level = check_finite(music_level, name="music level")

@@ -110,10 +110,7 @@ def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", sub
             j = k - s
             if j < 0:
                 continue
-            if md is None and bound is None:
-                ok = graph.is_interval if mask is None else graph.is_interval & mask
-            else:
-                ok, scale = span_feasible(dm, t, j, s, bound, mask)
+            ok, scale = span_feasible(dm, t, j, s, bound, mask)
             c = s * zm * zm - 2.0 * zm * (cs1[k] - cs1[j]) + (cs2[k] - cs2[j])
             if tw:
                 c = c + tw * np.log(scale) ** 2

@@ -80,24 +80,6 @@ def beat_warp(
     return k, s
 
 
-def _root_layout(template: Motion) -> tuple[list[int], tuple[int, int, int], str]:
-    skel = template.skeleton
-    root = skel.joints[0].name
-    pos_cols = []
-    for ax in "XYZ":
-        name = f"{root}_{ax}position"
-        if name not in template.channels:
-            raise ParameterError(
-                f"the root joint {root!r} has no {ax}position channel: cannot place the "
-                "dancer on the floor"
-            )
-        pos_cols.append(template.channel_index(name))
-    for joint, idx, order in template.rotation_triples():
-        if joint == root:
-            return pos_cols, idx, order
-    raise ParameterError(f"the root joint {root!r} has no rotation triple")
-
-
 def _heading(rot: Rotation, up: int) -> np.ndarray:
     """Heading angle [rad] about the up axis of the root's local forward axis."""
     g0, g1 = ground_axes(up)
@@ -159,8 +141,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     template = graph.clips[0]
     up = "xyz".index(graph.params.get("up_axis", "y"))
     g0, g1 = ground_axes(up)
-    pos_cols, rot_cols, order = _root_layout(template)
-    rot_cols = list(rot_cols)
+    root = template.skeleton.joints[0].name
+    pos_cols = []
+    for ax in "XYZ":
+        if f"{root}_{ax}position" not in template.channels:
+            raise ParameterError(
+                f"the root joint {root!r} has no {ax}position channel: cannot place the "
+                "dancer on the floor"
+            )
+        pos_cols.append(template.channel_index(f"{root}_{ax}position"))
+    triples = [(list(idx), order) for j, idx, order in template.rotation_triples() if j == root]
+    if not triples:
+        raise ParameterError(f"the root joint {root!r} has no rotation triple")
+    rot_cols, order = triples[0]
 
     k_n = path.size
     node_t = graph.node_time()  # [s] in each node's clip (one frame rate per library)

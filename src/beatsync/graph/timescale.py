@@ -311,9 +311,8 @@ def no_path_error(
     beat_s = float(np.median(np.diff(grid_times))) * subdivision
     song_bpm = 60.0 / beat_s
     tempi = clip_tempi(graph)
-    used = np.ones(len(graph.clips), dtype=bool)
-    if node_mask is not None:
-        used = np.array([node_mask[graph.node_clip == c].any() for c in range(len(tempi))])
+    mask = np.ones(graph.n_nodes) if node_mask is None else node_mask
+    used = np.bincount(graph.node_clip, weights=mask, minlength=len(tempi)) > 0
     lib = tempi[used & np.isfinite(tempi)]
     lib_txt = (
         f"{np.median(lib):.0f} BPM (clips {np.min(lib):.0f}-{np.max(lib):.0f})"
