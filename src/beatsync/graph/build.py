@@ -414,8 +414,7 @@ def build_graph(
         rd = d / (speed * float(rd_unit))
         rows = np.arange(s, min(n, s + chunk))
         rd[rows - s, rows] = np.inf
-        if rd.size:
-            min_rd = min(min_rd, float(rd.min()))
+        min_rd = min(min_rd, float(rd.min()))
         ii, jj = np.nonzero(rd < th)
         src_l.append(ii + s)
         dst_l.append(jj)
@@ -423,15 +422,11 @@ def build_graph(
     trans_src = np.concatenate(src_l).astype(np.int64)
     trans_dst = np.concatenate(dst_l).astype(np.int64)
     trans_rd = np.concatenate(rd_l)
-    if require_transitions and trans_src.size == 0:
-        hint = (
-            f"the smallest rd between two beat frames is {min_rd:.3f}: try --th "
-            f"{max(min_rd * 1.5, min_rd + 0.5):.2f} or more"
-            if np.isfinite(min_rd)
-            else "the library has a single beat frame"
-        )
+    if require_transitions and trans_src.size == 0:  # (two beat frames at least: min_rd < inf)
         raise ParameterError(
-            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; " + hint
+            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; the "
+            f"smallest rd between two beat frames is {min_rd:.3f}: try --th "
+            f"{max(min_rd * 1.5, min_rd + 0.5):.2f} or more"
         )
     params = {
         "th": th,

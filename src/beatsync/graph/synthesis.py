@@ -110,7 +110,7 @@ def synthesize(
     beats = check_times(music_beats, name="music beats")
     path = np.asarray(path, dtype=np.int64)
     if beats.size < 2:
-        raise ParameterError("the music has fewer than two beats: nothing to compose")
+        raise ParameterError(f"the music has {beats.size} beat(s): nothing to compose")
     if path.shape != (beats.size - 1,):
         raise ParameterError(
             f"path has {path.size} nodes for {beats.size - 1} music intervals "

@@ -26,10 +26,8 @@ CONSTANT_REL_STD = 1e-3
 """A channel with std <= this times the largest selected std is excluded as constant."""
 
 
-# Joint-name keywords (lower case, side prefixes and CC_Base_ removed) of the main
-# limb and spine joints, for CMU (hip abdomen chest neck rShldr rForeArm rThigh rShin
-# rFoot ...), iClone CC_Base (Spine01, Waist, L_Upperarm, L_Forearm, L_Thigh, L_Calf,
-# L_Foot ...) and Mixamo-like (Spine, LeftArm, LeftUpLeg, LeftLeg ...) rigs.
+# Joint-name keywords (lower case, side prefixes removed) of the main limb and spine
+# joints of CMU, iClone CC_Base and Mixamo-like rigs (see select_channels).
 _LIMB_SPINE = (
     "abdomen", "chest", "neck", "spine", "waist", "pelvis",
     "shldr", "shoulder", "upperarm", "arm", "forearm", "elbow",
