@@ -257,12 +257,11 @@ def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.nd
     bf = np.asarray(beat_frames)
     if bf.ndim != 1:
         raise ParameterError(f"beat_frames must be 1-D, got shape {bf.shape}")
-    if bf.size and not np.issubdtype(bf.dtype, np.integer):
-        if not np.all(np.equal(np.mod(bf, 1), 0)):
-            raise ParameterError(
-                "beat_frames must be integer frame indices; convert seconds with "
-                "beatsync.validation.time_to_frames"
-            )
+    if not np.issubdtype(bf.dtype, np.integer) and not np.all(np.equal(np.mod(bf, 1), 0)):
+        raise ParameterError(
+            "beat_frames must be integer frame indices; convert seconds with "
+            "beatsync.validation.time_to_frames"
+        )
     bf = bf.astype(np.int64)
     if bf.size < 2:
         return np.empty(0)

@@ -20,13 +20,13 @@ import numpy as np
 from ..errors import ParameterError, silenced, warn
 from ..motion import Motion
 from ..motion_beats import zscore
-from ..validation import check_finite, check_fps, check_times
+from ..validation import check_finite, check_times
 from .baselines import check_conventional_options, conventional_core, random_core
 from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
 from .plausibility import plausibility
 from .search import METHODS, dp_core
-from .synthesis import SynthesisResult, check_blend_warp, synthesize_core
+from .synthesis import SynthesisResult, check_output, synthesize_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
     TempoPlan,
@@ -144,11 +144,7 @@ def compose(
     mult = check_multiplicity(multiplicity)
     if bound is None and mult == "auto":
         mult = (1.0,)
-    fps = check_fps(graph.clips[0].fps if fps is None else fps)
-    blend = check_blend_warp(blend, warp)
-    end_time = float(beats[-1]) if end_time is None else float(end_time)
-    if not end_time > 0:
-        raise ParameterError(f"end_time={end_time!r} must be > 0 [s]")
+    fps, blend, end_time = check_output(graph, beats, fps, blend, warp, 0.0, end_time)
     plan = plan_tempo(
         graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
     )

@@ -42,7 +42,7 @@ __all__ = [
     "SynthesisResult",
     "synthesize",
     "synthesize_core",
-    "check_blend_warp",
+    "check_output",
     "beat_warp",
 ]
 
@@ -118,22 +118,21 @@ def synthesize(
         )
     if np.any(path < 0) or np.any(path >= graph.n_nodes) or not graph.is_interval[path].all():
         raise ParameterError("path contains nodes that do not start an interval")
-    fps = check_fps(graph.clips[0].fps if fps is None else fps)
-    blend = check_blend_warp(blend, warp)
-    end_time = float(beats[-1]) if end_time is None else float(end_time)
-    if not end_time > start_time >= 0:
-        raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    fps, blend, end_time = check_output(graph, beats, fps, blend, warp, start_time, end_time)
     return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
 
 
-def check_blend_warp(blend: Any, warp: Any) -> float:
-    """The blend length [s] as a float in [0, 5], and ``warp`` one of "pchip", "linear"."""
+def check_output(graph, beats, fps, blend, warp, start_time, end_time):
+    """``(fps, blend, end_time)`` of the output motion (defaults: the library's, last beat)."""
     blend = float(blend)
     if not np.isfinite(blend) or blend < 0 or blend > 5:
         raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
     if warp not in ("pchip", "linear"):
         raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
-    return blend
+    end_time = float(beats[-1]) if end_time is None else float(end_time)
+    if not end_time > start_time >= 0:
+        raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    return check_fps(graph.clips[0].fps if fps is None else fps), blend, end_time
 
 
 def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):

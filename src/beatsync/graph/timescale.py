@@ -240,10 +240,7 @@ def music_grid(beats: np.ndarray, level: np.ndarray, subdivision: int):
     """Grid times and the level per grid interval (half beats repeat their beat's level)."""
     if subdivision == 1:
         return beats, level
-    mid = (beats[:-1] + beats[1:]) / 2
-    grid = np.empty(beats.size + mid.size)
-    grid[0::2] = beats
-    grid[1::2] = mid
+    grid = np.insert(beats, np.arange(1, beats.size), (beats[:-1] + beats[1:]) / 2)
     return grid, np.repeat(level, 2)
 
 

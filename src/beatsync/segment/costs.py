@@ -204,6 +204,4 @@ def edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) -> 
 def segmentation_energy(x: np.ndarray, frames: np.ndarray) -> float:
     """Energy E (eq. 2) of given boundary frames on standardised channels ``(C, n)``."""
     frames = np.asarray(frames, dtype=np.int64)
-    if frames.size < 3:
-        return 0.0
     return float(pair_costs(x, frames[:-2], frames[1:-1], frames[2:]).sum())
