@@ -192,8 +192,6 @@ def _search(graph, z, md, method, lam, seed, plan, kwargs):
         tw = kwargs.pop("tempo_weight", 0.0)
         if kwargs:
             raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
-        if start not in ("any", "clip_start"):
-            raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, z, lam, tw, md, plan.bound, plan.steps, plan.node_mask
     )

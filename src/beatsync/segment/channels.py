@@ -111,8 +111,7 @@ def select_channels(
 def nonconstant_channels(values: np.ndarray) -> np.ndarray:
     """Boolean mask of channels kept by the documented near-constant rule."""
     std = values.std(axis=0)
-    top = std.max() if std.size else 0.0
-    return (std > CONSTANT_REL_STD * top) & (std > 1e-9)
+    return (std > CONSTANT_REL_STD * std.max(initial=0.0)) & (std > 1e-9)
 
 
 def standardise(values: np.ndarray) -> np.ndarray:
@@ -125,8 +124,6 @@ def standardise(values: np.ndarray) -> np.ndarray:
 def unwrap_rotations(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
     """Unwrap rotation channels [deg] across the +-180 wrap (analysis only)."""
     rot = [i for i, nm in enumerate(names) if nm.lower().endswith("rotation")]
-    if not rot:
-        return values
     out = values.copy()
     out[:, rot] = np.unwrap(values[:, rot], axis=0, period=360.0)
     return out

@@ -315,11 +315,9 @@ def segment_values(
     lo_s, hi_s = check_period_range(period_range)
     method = check_period_method(period_method, p)
     vals = check_values(values)
-    names = (
-        tuple(str(c) for c in channel_names)
-        if channel_names is not None
-        else tuple(f"ch{i}" for i in range(vals.shape[1]))
-    )
+    if channel_names is None:
+        channel_names = [f"ch{i}" for i in range(vals.shape[1])]
+    names = tuple(str(c) for c in channel_names)
     if len(names) != vals.shape[1]:
         raise ParameterError(
             f"{len(names)} channel names for {vals.shape[1]} value columns; is the array "
