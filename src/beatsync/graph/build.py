@@ -359,11 +359,9 @@ def build_graph(
             "times [s] per clip"
         )
 
-    positions = []
+    positions = [motion_positions(c, joints=joints) for c in clips]
     frames_list = []
-    for i, c in enumerate(clips):
-        pos = motion_positions(c, joints=joints)
-        positions.append(pos)
+    for i, (c, pos) in enumerate(zip(clips, positions, strict=True)):
         if beats is None:
             with silenced():
                 fr = kinematic_beat_frames(
@@ -378,15 +376,13 @@ def build_graph(
     node_clip = np.repeat(np.arange(len(clips), dtype=np.int64), [f.size for f in frames_list])
     node_frame = np.concatenate(frames_list)
     n = node_frame.size
-    next_node = np.full(n, -1, dtype=np.int64)
+    last = np.diff(node_clip, append=-1) != 0  # the last beat node of each clip
+    next_node = np.where(last, -1, np.arange(1, n + 1))
     intensity = np.full(n, np.nan)
-    start = 0
-    for i, fr in enumerate(frames_list):
-        if fr.size >= 2:
-            idx = np.arange(start, start + fr.size - 1)
-            next_node[idx] = idx + 1
-            intensity[idx] = interval_intensity(positions[i], fr, fps=clips[i].fps)
-        start += fr.size
+    per_clip = zip(positions, frames_list, clips, strict=True)
+    intensity[~last] = np.concatenate(
+        [interval_intensity(p, f, fps=c.fps) if f.size > 1 else () for p, f, c in per_clip]
+    )
     ok = next_node >= 0
     if not ok.any():
         raise ParameterError(

@@ -256,9 +256,7 @@ def search_decimation(
     n: int, lo: int, hi: int, n_ch: int, count: int | None, budget: float = SEARCH_MEMORY_BUDGET
 ) -> int | None:
     """Smallest time decimation factor whose search fits ``budget`` bytes (None: none does)."""
-    if search_bytes(n, lo, hi, n_ch, count) <= budget:
-        return 1
-    factor = 2
+    factor = 1
     while True:
         lo_c, hi_c = coarse_band(lo, hi, factor)
         if lo_c < 2:
