@@ -177,11 +177,10 @@ def compose(
 
 def _search(graph, z, md, method, lam, seed, plan, kwargs):
     """Run one search on the song's grid under the tempo plan (inputs validated here)."""
-    kwargs = dict(kwargs)
     sub = plan.subdivision
     tw = 0.0
     if method == "conventional":
-        opts = check_conventional_options(kwargs.pop("segment_beats", 8), **kwargs)
+        opts = check_conventional_options(**kwargs)
         opts["seg"] = opts["seg"] * sub
     elif method == "random":
         if kwargs:

@@ -220,28 +220,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
 
     values = transformed(run_of, clip_of[k_of], s_of)
 
-    # blends after every transition (windows never overlap: one per music interval)
+    # blends after every transition, within its music interval: the frames of interval k
+    # within blend of its start, with the old run continued past its beat frame a
     trans_times = beats[:-1][trans]
-    idx, runs, clips, s_old, weights = [], [], [], [], []
-    for k in np.flatnonzero(trans):
-        length = min(blend, beats[k + 1] - beats[k])
-        if length <= 0:
-            continue
-        sel = np.flatnonzero((t >= beats[k]) & (t < beats[k] + length))
-        if not sel.size:
-            continue
+    length = np.minimum(blend, np.diff(beats))
+    sel = np.flatnonzero(trans[k_of] & (t >= beats[k_of]) & (t < beats[k_of] + length[k_of]))
+    if sel.size:
+        k = k_of[sel]
         a = graph.next_node[path[k - 1]]
         rate = (src_end[k] - src_start[k]) / (beats[k + 1] - beats[k])
-        idx.append(sel)
-        runs.append(np.full(sel.size, run_id[k] - 1))
-        clips.append(np.full(sel.size, graph.node_clip[a]))
-        s_old.append(node_t[a] + (t[sel] - beats[k]) * rate)
-        x = np.clip((t[sel] - beats[k]) / length, 0.0, 1.0)
-        weights.append(x * x * (3.0 - 2.0 * x))  # smooth step: zero slope at both ends
-    if idx:
-        sel = np.concatenate(idx)
-        old = transformed(np.concatenate(runs), np.concatenate(clips), np.concatenate(s_old))
-        values[sel] = blend_values(template, old, values[sel], np.concatenate(weights))
+        old = transformed(run_id[k] - 1, graph.node_clip[a], node_t[a] + (t[sel] - beats[k]) * rate)
+        x = np.clip((t[sel] - beats[k]) / length[k], 0.0, 1.0)
+        # smooth step: zero slope at both ends
+        values[sel] = blend_values(template, old, values[sel], x * x * (3.0 - 2.0 * x))
 
     # continuous Euler curves in the output file: the root's triples were re-derived
     # after the yaw alignment, so choose each frame's triple closest to the previous one
