@@ -52,8 +52,6 @@ __all__ = [
     "motion_tempo",
 ]
 
-_METHODS = ("speed", "pca")
-
 
 def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     """World joint positions of a motion, ``(n_frames, n_joints, 3)`` [position unit].
@@ -192,8 +190,8 @@ def kinematic_beat_frames(
     ``rel_prominence``: minimum prominence of an extremum, relative to the median
     absolute value (speed) or the median absolute deviation (pca) of the curve.
     """
-    if method not in _METHODS:
-        raise ParameterError(f"method={method!r} is not one of {_METHODS}")
+    if method not in ("speed", "pca"):
+        raise ParameterError(f"method={method!r} is not one of ('speed', 'pca')")
     pos, fps = _check_positions(positions, fps)
     min_interval = _check_seconds(min_interval, name="min_interval")
     rel_prominence = check_positive(

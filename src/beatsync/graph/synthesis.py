@@ -169,8 +169,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     t = frames_to_time(np.arange(j0, j1 + 1), fps=fps)
     k_of, s_of = beat_warp(beats, src_start, src_end, t)
     run_of = run_id[k_of]
-    if warp == "pchip":
-        s_of = _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_of)
+    if warp == "pchip":  # a monotone cubic through the beat correspondences of each run
+        from scipy.interpolate import PchipInterpolator
+
+        for r in np.unique(run_id):
+            ks = np.flatnonzero(run_id == r)
+            if ks.size < 2:
+                continue
+            x = beats[ks[0] : ks[-1] + 2]
+            y = np.concatenate([src_start[ks], src_end[ks[-1:]]])
+            # times before the first beat / after the last beat of the run keep the
+            # linear warp's extrapolation (lead-in and tail of the dance)
+            inside = (run_of == r) & (t >= x[0]) & (t <= x[-1])
+            s_of[inside] = PchipInterpolator(x, y)(t[inside])
 
     # rigid floor transforms per run: yaw angle and ground translation
     n_runs = int(run_id[-1]) + 1
@@ -257,21 +268,3 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         beat_source_times=beat_src,
         info={"n_runs": n_runs, "start_frame": j0, "blend_s": blend},
     )
-
-
-def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
-    """Monotone cubic warp through the beat correspondences of each run."""
-    from scipy.interpolate import PchipInterpolator
-
-    s = s_lin.copy()
-    for r in np.unique(run_id):
-        ks = np.flatnonzero(run_id == r)
-        if ks.size < 2:
-            continue
-        x = beats[ks[0] : ks[-1] + 2]
-        y = np.concatenate([src_start[ks], src_end[ks[-1:]]])
-        # times before the first beat / after the last beat of the run keep the
-        # linear warp's extrapolation (lead-in and tail of the dance)
-        inside = (run_id[k_of] == r) & (t >= x[0]) & (t <= x[-1])
-        s[inside] = PchipInterpolator(x, y)(t[inside])
-    return s
