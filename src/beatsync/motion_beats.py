@@ -33,6 +33,7 @@ from .validation import (
     check_finite,
     check_fps,
     check_positive,
+    check_range,
     check_times,
     frames_to_time,
     time_to_frames,
@@ -51,8 +52,6 @@ __all__ = [
     "motion_tempo",
 ]
 
-_METHODS = ("speed", "pca")
-
 
 def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     """World joint positions of a motion, ``(n_frames, n_joints, 3)`` [position unit].
@@ -63,17 +62,13 @@ def motion_positions(motion: Any, *, joints: Any = None) -> np.ndarray:
     pos = np.asarray(motion.positions(), dtype=np.float64)
     names = motion.joint_names
     if joints is not None:
-        idx = []
-        for j in joints:
-            if isinstance(j, (int, np.integer)):
-                if not 0 <= int(j) < pos.shape[1]:
-                    raise ParameterError(f"joint index {j} out of range 0..{pos.shape[1] - 1}")
-            elif j not in names:
+        idx = [names.index(j) if j in names else j for j in joints]
+        for j in idx:
+            if not isinstance(j, (int, np.integer)) or not 0 <= j < pos.shape[1]:
                 raise ParameterError(
-                    f"joint {j!r} not in the motion; known joints: {', '.join(names[:12])}"
-                    + (" ..." if len(names) > 12 else "")
+                    f"joint {j!r} not in the motion (indices 0..{pos.shape[1] - 1}); known "
+                    f"joints: {', '.join(names[:12])}" + (" ..." if len(names) > 12 else "")
                 )
-            idx.append(int(j) if isinstance(j, (int, np.integer)) else names.index(j))
         if not idx:
             raise ParameterError("joints is empty: give at least one joint name or None for all")
         pos = pos[:, idx, :]
@@ -195,8 +190,8 @@ def kinematic_beat_frames(
     ``rel_prominence``: minimum prominence of an extremum, relative to the median
     absolute value (speed) or the median absolute deviation (pca) of the curve.
     """
-    if method not in _METHODS:
-        raise ParameterError(f"method={method!r} is not one of {_METHODS}")
+    if method not in ("speed", "pca"):
+        raise ParameterError(f"method={method!r} is not one of ('speed', 'pca')")
     pos, fps = _check_positions(positions, fps)
     min_interval = _check_seconds(min_interval, name="min_interval")
     rel_prominence = check_positive(
@@ -206,16 +201,20 @@ def kinematic_beat_frames(
     if method == "speed":
         curve = speed_curve(pos, fps=fps, smooth=smooth)
         scale = float(np.median(np.abs(curve)))
-        prom = rel_prominence * scale if scale > 0 else None
-        frames, _ = find_peaks(-curve, distance=distance, prominence=prom)
     else:
         curve = pca_curve(pos, fps=fps, window=window, smooth=smooth)
         scale = float(np.median(np.abs(curve - np.median(curve))))
-        prom = rel_prominence * scale if scale > 0 else None
+    prom = rel_prominence * scale if scale > 0 else None
+    if method == "speed":
+        frames, _ = find_peaks(-curve, distance=distance, prominence=prom)
+    else:
         lo, _ = find_peaks(-curve, prominence=prom)
         hi, _ = find_peaks(curve, prominence=prom)
-        frames = np.sort(np.concatenate([lo, hi]))
-        frames = _thin(frames, distance)
+        kept: list[int] = []  # drop extrema closer than distance to the previously kept one
+        for f in np.sort(np.concatenate([lo, hi])):
+            if not kept or f - kept[-1] >= distance:
+                kept.append(int(f))
+        frames = kept
     frames = np.asarray(frames, dtype=np.int64)
     if frames.size == 0:
         warn(
@@ -224,17 +223,6 @@ def kinematic_beat_frames(
             stacklevel=2,
         )
     return frames
-
-
-def _thin(frames: np.ndarray, distance: int) -> np.ndarray:
-    """Drop extrema closer than ``distance`` frames to the previously kept one."""
-    if frames.size == 0 or distance <= 1:
-        return frames
-    kept = [int(frames[0])]
-    for f in frames[1:]:
-        if f - kept[-1] >= distance:
-            kept.append(int(f))
-    return np.asarray(kept, dtype=np.int64)
 
 
 def kinematic_beats(
@@ -267,12 +255,11 @@ def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.nd
     bf = np.asarray(beat_frames)
     if bf.ndim != 1:
         raise ParameterError(f"beat_frames must be 1-D, got shape {bf.shape}")
-    if bf.size and not np.issubdtype(bf.dtype, np.integer):
-        if not np.all(np.equal(np.mod(bf, 1), 0)):
-            raise ParameterError(
-                "beat_frames must be integer frame indices; convert seconds with "
-                "beatsync.validation.time_to_frames"
-            )
+    if not np.issubdtype(bf.dtype, np.integer) and not np.all(np.equal(np.mod(bf, 1), 0)):
+        raise ParameterError(
+            "beat_frames must be integer frame indices; convert seconds with "
+            "beatsync.validation.time_to_frames"
+        )
     bf = bf.astype(np.int64)
     if bf.size < 2:
         return np.empty(0)
@@ -292,8 +279,7 @@ def interval_intensity(positions: Any, beat_frames: Any, *, fps: float) -> np.nd
 def beat_interval_intensity(motion: Any, beat_times: Any, *, joints: Any = None) -> np.ndarray:
     """Motion intensity of each interval between successive motion beats [s] of a clip."""
     fps = check_fps(motion.fps)
-    n = int(motion.values.shape[0]) if hasattr(motion, "values") else None
-    duration = float(frames_to_time(n - 1, fps=fps)) if n else None
+    duration = float(frames_to_time(motion.n_frames - 1, fps=fps))
     beats = check_times(beat_times, name="beat_times", duration=duration)
     pos = motion_positions(motion, joints=joints)
     frames = time_to_frames(beats, fps=fps)
@@ -323,8 +309,6 @@ def motion_tempo(
     >>> motion_tempo([0.0, 0.5, 1.0, 2.0, 2.5])  # one missed beat
     120.0
     """
-    from .validation import check_range
-
     lo, hi = check_range(min_bpm, max_bpm, name="(min_bpm, max_bpm)", unit="BPM")
     tol = float(tolerance)
     if not np.isfinite(tol) or not 0 < tol < 1:

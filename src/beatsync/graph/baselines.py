@@ -14,13 +14,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..validation import as_float, as_int, check_positive
 from .build import WeightedMotionGraph
-from .objective import (
-    SearchResult,
-    grid_times,
-    interval_scales,
-    make_result,
-    prepare_search,
-)
+from .objective import SearchResult, grid_times, make_result, prepare_search
 from .timescale import completion_table, no_path_error, span_feasible
 
 __all__ = [
@@ -30,10 +24,6 @@ __all__ = [
     "random_walk",
     "random_core",
 ]
-
-
-def _rhythm_score(dm: np.ndarray, ds: np.ndarray, sigma: float) -> np.ndarray:
-    return np.exp(-(np.log(dm / ds) ** 2) / (2.0 * sigma * sigma))
 
 
 def conventional_search(
@@ -182,7 +172,10 @@ class _Ctx:
             best[better] = s
             dev[better] = dv[better]
         kk = np.minimum(k + np.maximum(best, 1), self.g_n)
-        r = _rhythm_score(self.dm[nodes], self.t[kk] - self.t[k], self.sigma)
+        r = np.exp(
+            -(np.log(self.dm[nodes] / (self.t[kk] - self.t[k])) ** 2)
+            / (2.0 * self.sigma * self.sigma)
+        )
         return best, np.where(best > 0, r, 0.0)
 
     def icost(self, nodes: np.ndarray, k: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -311,21 +304,7 @@ def random_core(graph, k_n, seed, md, bound, steps, mask, *, subdivision=1):
             break
         nxt = succ[indptr[v] : indptr[v + 1]]
         cand = nxt[alive[k][nxt]]
-    path_a = np.asarray(path, dtype=np.int64)
-    bnd_a = np.asarray(bnd, dtype=np.int64)
-    trans = np.zeros(path_a.size, dtype=bool)
-    trans[1:] = graph.next_node[path_a[:-1]] != path_a[1:]
-    nan = float("nan")
-    return SearchResult(
-        path=path_a,
-        boundaries=bnd_a,
-        transitions=trans,
-        scales=interval_scales(graph, path_a, bnd_a, md, k_n),
-        cost=nan,
-        intensity_cost=nan,
-        transition_cost=nan,
-        tempo_cost=0.0,
-        method="random",
-        search_time=time.perf_counter() - t0,
-        info={"seed": seed},
+    elapsed = time.perf_counter() - t0
+    return make_result(
+        graph, path, bnd, np.zeros(k_n), 0.0, 0.0, md, bound, "random", elapsed, {"seed": seed}
     )

@@ -336,15 +336,11 @@ def build_graph(
 ) -> WeightedMotionGraph:
     """Build the weighted motion graph of a motion library (paper B, section 3.2).
 
-    ``th``: TH of eq. 1 (paper: 3.0); ``weight_rule``: eq. 2 as written (``"paper"``) or
-    the plain ``rd``; ``beats``: beat times [s] per clip, each put on its nearest frame
-    (after a clip's last frame: refused; two on one frame: merged with a warning), by
-    default kinematic beats (``beat_method``, ``smooth``, ``min_interval``:
-    :func:`beatsync.motion_beats.kinematic_beats`); ``joints``: for beats, intensities and
-    distances (default all); ``window`` [s]: the frames compared by eq. 1; ``rd_unit``
-    [s]: the time unit of ``rd``; ``up_axis``: the vertical axis (BVH: y);
-    ``require_transitions``: refuse a graph without transitions (naming the smallest
-    ``rd``).
+    ``beats``: beat times [s] per clip, each put on its nearest frame (two on one frame
+    are merged with a warning), by default kinematic beats (``beat_method``, ``smooth``,
+    ``min_interval``: :func:`beatsync.motion_beats.kinematic_beats`); ``joints``: for
+    beats, intensities and distances; ``window``, ``rd_unit`` [s]: as in eq. 1 (module
+    docstring); ``require_transitions``: refuse a graph without transitions.
     """
     t0 = time.perf_counter()
     clips = check_library(clips)
@@ -363,11 +359,9 @@ def build_graph(
             "times [s] per clip"
         )
 
-    positions = []
+    positions = [motion_positions(c, joints=joints) for c in clips]
     frames_list = []
-    for i, c in enumerate(clips):
-        pos = motion_positions(c, joints=joints)
-        positions.append(pos)
+    for i, (c, pos) in enumerate(zip(clips, positions, strict=True)):
         if beats is None:
             with silenced():
                 fr = kinematic_beat_frames(
@@ -382,15 +376,13 @@ def build_graph(
     node_clip = np.repeat(np.arange(len(clips), dtype=np.int64), [f.size for f in frames_list])
     node_frame = np.concatenate(frames_list)
     n = node_frame.size
-    next_node = np.full(n, -1, dtype=np.int64)
+    last = np.diff(node_clip, append=-1) != 0  # the last beat node of each clip
+    next_node = np.where(last, -1, np.arange(1, n + 1))
     intensity = np.full(n, np.nan)
-    start = 0
-    for i, fr in enumerate(frames_list):
-        if fr.size >= 2:
-            idx = np.arange(start, start + fr.size - 1)
-            next_node[idx] = idx + 1
-            intensity[idx] = interval_intensity(positions[i], fr, fps=clips[i].fps)
-        start += fr.size
+    per_clip = zip(positions, frames_list, clips, strict=True)
+    intensity[~last] = np.concatenate(
+        [interval_intensity(p, f, fps=c.fps) if f.size > 1 else () for p, f, c in per_clip]
+    )
     ok = next_node >= 0
     if not ok.any():
         raise ParameterError(
@@ -418,8 +410,7 @@ def build_graph(
         rd = d / (speed * float(rd_unit))
         rows = np.arange(s, min(n, s + chunk))
         rd[rows - s, rows] = np.inf
-        if rd.size:
-            min_rd = min(min_rd, float(rd.min()))
+        min_rd = min(min_rd, float(rd.min()))
         ii, jj = np.nonzero(rd < th)
         src_l.append(ii + s)
         dst_l.append(jj)
@@ -427,15 +418,11 @@ def build_graph(
     trans_src = np.concatenate(src_l).astype(np.int64)
     trans_dst = np.concatenate(dst_l).astype(np.int64)
     trans_rd = np.concatenate(rd_l)
-    if require_transitions and trans_src.size == 0:
-        hint = (
-            f"the smallest rd between two beat frames is {min_rd:.3f}: try --th "
-            f"{max(min_rd * 1.5, min_rd + 0.5):.2f} or more"
-            if np.isfinite(min_rd)
-            else "the library has a single beat frame"
-        )
+    if require_transitions and trans_src.size == 0:  # (two beat frames at least: min_rd < inf)
         raise ParameterError(
-            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; " + hint
+            f"no transition edges at TH={th}: no two beat frames are closer than rd < TH; the "
+            f"smallest rd between two beat frames is {min_rd:.3f}: try --th "
+            f"{max(min_rd * 1.5, min_rd + 0.5):.2f} or more"
         )
     params = {
         "th": th,

@@ -20,13 +20,13 @@ import numpy as np
 from ..errors import ParameterError, silenced, warn
 from ..motion import Motion
 from ..motion_beats import zscore
-from ..validation import check_finite, check_fps, check_times
+from ..validation import check_finite, check_times
 from .baselines import check_conventional_options, conventional_core, random_core
 from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
 from .plausibility import plausibility
 from .search import METHODS, dp_core
-from .synthesis import SynthesisResult, check_blend_warp, synthesize_core
+from .synthesis import SynthesisResult, check_output, synthesize_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
     TempoPlan,
@@ -82,17 +82,16 @@ class Composition:
             "transition_times_s": self.synthesis.transition_times,
             "graph": self.synthesis.info.get("graph_summary", {}),
             "tempo": self.tempo.report() if self.tempo is not None else None,
-            "multiplicity_used": _counts(np.diff(self.search.boundaries), self.tempo),
+            "multiplicity_used": self._multiplicity_used(),
             "plausibility": self.plausibility,
             "warnings": list(self.warnings),
         }
 
-
-def _counts(steps: np.ndarray, plan: TempoPlan | None) -> dict[str, int]:
-    """How many intervals covered each number of music beats."""
-    sub = plan.subdivision if plan is not None else 1
-    vals, counts = np.unique(steps, return_counts=True)
-    return {f"{v / sub:g}": int(c) for v, c in zip(vals, counts, strict=True)}
+    def _multiplicity_used(self) -> dict[str, int]:
+        """How many intervals covered each number of music beats."""
+        sub = self.tempo.subdivision if self.tempo is not None else 1
+        vals, counts = np.unique(np.diff(self.search.boundaries), return_counts=True)
+        return {f"{v / sub:g}": int(c) for v, c in zip(vals, counts, strict=True)}
 
 
 def check_music_beats(beats: Any, *, duration: float | None = None) -> np.ndarray:
@@ -126,16 +125,11 @@ def compose(
     """Compose a dance for the given music beats [s] and levels [dB] (one per beat interval).
 
     ``method``: ``"dp"`` (proposed), ``"conventional"`` (baseline) or ``"random"``
-    (control, seeded by ``seed``); ``lam``: factor on transition weights; ``fps``,
-    ``blend``, ``end_time``, ``warp``: of the output
-    (:func:`beatsync.graph.synthesis.synthesize`). ``scale_bound``: bound on every
-    interval's time-scale factor, ``None`` unbounded (paper B as written);
-    ``multiplicity``: music beats one motion interval may cover (``"auto"``: from the
-    tempo ratio, one beat when unbounded); ``tempo_select``: only the clips of the tempo
-    sub-group(s) that suit the song. ``search_kwargs``: ``tempo_weight``, ``start`` (DP),
-    ``segment_beats``, ``rhythm_sigma``, ``rhythm_threshold``, ``max_candidates``
-    (conventional). A result whose 99th-percentile root or joint rotation speed exceeds
-    the library's fastest clip's by more than 25 % warns (:mod:`.plausibility`).
+    (control, seeded by ``seed``); ``fps``, ``blend``, ``end_time``, ``warp``: as in
+    :func:`beatsync.graph.synthesis.synthesize`; ``scale_bound`` (``None``: unbounded,
+    paper B as written), ``multiplicity`` and ``tempo_select``: :mod:`.timescale`;
+    ``search_kwargs``: the options of :func:`.dp_search` or :func:`.conventional_search`.
+    A result much faster than its library warns (:mod:`.plausibility`).
     """
     beats = check_music_beats(music_beats)
     level = check_finite(music_level, name="music level")
@@ -150,11 +144,7 @@ def compose(
     mult = check_multiplicity(multiplicity)
     if bound is None and mult == "auto":
         mult = (1.0,)
-    fps = check_fps(graph.clips[0].fps if fps is None else fps)
-    blend = check_blend_warp(blend, warp)
-    end_time = float(beats[-1]) if end_time is None else float(end_time)
-    if not end_time > 0:
-        raise ParameterError(f"end_time={end_time!r} must be > 0 [s]")
+    fps, blend, end_time = check_output(graph, beats, fps, blend, warp, 0.0, end_time)
     plan = plan_tempo(
         graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
     )
@@ -187,11 +177,10 @@ def compose(
 
 def _search(graph, z, md, method, lam, seed, plan, kwargs):
     """Run one search on the song's grid under the tempo plan (inputs validated here)."""
-    kwargs = dict(kwargs)
     sub = plan.subdivision
     tw = 0.0
     if method == "conventional":
-        opts = check_conventional_options(kwargs.pop("segment_beats", 8), **kwargs)
+        opts = check_conventional_options(**kwargs)
         opts["seg"] = opts["seg"] * sub
     elif method == "random":
         if kwargs:
@@ -202,8 +191,6 @@ def _search(graph, z, md, method, lam, seed, plan, kwargs):
         tw = kwargs.pop("tempo_weight", 0.0)
         if kwargs:
             raise ParameterError(f"unknown DP option(s) {sorted(kwargs)}: use tempo_weight, start")
-        if start not in ("any", "clip_start"):
-            raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, z, lam, tw, md, plan.bound, plan.steps, plan.node_mask
     )

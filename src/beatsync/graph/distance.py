@@ -58,25 +58,6 @@ def ground_axes(up: int) -> tuple[int, int]:
 CANCELLATION_RATIO = 1e-4
 
 
-def _closed_form(a: np.ndarray, b: np.ndarray, up: int, pairwise: bool):
-    """Summed squares, optimal floor rotation terms and vertical products of centred clouds."""
-    g0, g1 = ground_axes(up)
-    sa = np.sum(a * a, axis=(1, 2))
-    sb = np.sum(b * b, axis=(1, 2))
-    if pairwise:
-        dot = np.sum(a[:, :, g0] * b[:, :, g0] + a[:, :, g1] * b[:, :, g1], axis=1)
-        crs = np.sum(a[:, :, g0] * b[:, :, g1] - a[:, :, g1] * b[:, :, g0], axis=1)
-        yy = np.sum(a[:, :, up] * b[:, :, up], axis=1)
-        ss = sa + sb
-    else:
-        dot = a[:, :, g0] @ b[:, :, g0].T + a[:, :, g1] @ b[:, :, g1].T
-        crs = a[:, :, g0] @ b[:, :, g1].T - a[:, :, g1] @ b[:, :, g0].T
-        yy = a[:, :, up] @ b[:, :, up].T
-        ss = sa[:, None] + sb[None, :]
-    d2 = ss - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * yy
-    return d2, ss, np.arctan2(-crs, dot)
-
-
 def _direct_d2(a: np.ndarray, b: np.ndarray, theta: np.ndarray, up: int) -> np.ndarray:
     """``sum |a - R(theta) b|^2`` over points, row-wise (``a[k]`` vs ``b[k]``): no cancellation."""
     g0, g1 = ground_axes(up)
@@ -99,22 +80,27 @@ def aligned_distance_matrix(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.
     """
     a = center_on_floor(a, up)
     b = center_on_floor(b, up)
-    m = a.shape[1]
-    d2, ss, theta = _closed_form(a, b, up, pairwise=False)
+    g0, g1 = ground_axes(up)
+    dot = a[:, :, g0] @ b[:, :, g0].T + a[:, :, g1] @ b[:, :, g1].T
+    crs = a[:, :, g0] @ b[:, :, g1].T - a[:, :, g1] @ b[:, :, g0].T
+    ss = np.sum(a * a, axis=(1, 2))[:, None] + np.sum(b * b, axis=(1, 2))[None, :]
+    d2 = ss - 2.0 * np.sqrt(dot * dot + crs * crs) - 2.0 * (a[:, :, up] @ b[:, :, up].T)
+    theta = np.arctan2(-crs, dot)
     ii, jj = np.nonzero(d2 < CANCELLATION_RATIO * ss)
     for s in range(0, ii.size, 256):
         i, j = ii[s : s + 256], jj[s : s + 256]
         d2[i, j] = _direct_d2(a[i], b[j], theta[i, j], up)
-    return np.sqrt(np.maximum(d2, 0.0) / m)
+    return np.sqrt(np.maximum(d2, 0.0) / a.shape[1])
 
 
 def aligned_pair_distance(a: np.ndarray, b: np.ndarray, *, up: int = 1) -> np.ndarray:
     """Row-wise :func:`aligned_distance_matrix` (``a[k]`` vs ``b[k]``), from direct differences."""
     a = center_on_floor(a, up)
     b = center_on_floor(b, up)
-    m = a.shape[1]
-    _, _, theta = _closed_form(a, b, up, pairwise=True)
-    return np.sqrt(_direct_d2(a, b, theta, up) / m)
+    g0, g1 = ground_axes(up)
+    dot = np.sum(a[:, :, g0] * b[:, :, g0] + a[:, :, g1] * b[:, :, g1], axis=1)
+    crs = np.sum(a[:, :, g0] * b[:, :, g1] - a[:, :, g1] * b[:, :, g0], axis=1)
+    return np.sqrt(_direct_d2(a, b, np.arctan2(-crs, dot), up) / a.shape[1])
 
 
 def typical_speed(

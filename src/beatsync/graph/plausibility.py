@@ -34,9 +34,6 @@ PERCENTILES = (50, 95, 99)
 #: A result may exceed the library's largest clip 99th percentile by this factor.
 TOLERANCE = 1.25
 
-# multiplying a unit quaternion by this gives its inverse (the conjugate)
-_CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
-
 
 def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
     """Root speed [unit / s] ``(n - 1,)`` and joint rotation speeds [deg / s] ``(n - 1, J)``."""
@@ -52,7 +49,8 @@ def motion_speeds(motion: Any) -> dict[str, np.ndarray]:
         cols = [list(triples[i][1]) for i in members]
         ang = np.stack([motion.values[:, c] for c in cols], axis=1)  # (n, J, 3)
         q = quat_from_euler(ang.reshape(-1, 3), order).reshape(n, len(members), 4)
-        rel = quat_multiply(q[:-1] * _CONJUGATE, q[1:])  # frame-to-frame rotation
+        conj = q[:-1] * np.array([-1.0, -1.0, -1.0, 1.0])  # inverse of a unit quaternion
+        rel = quat_multiply(conj, q[1:])  # frame-to-frame rotation
         # its angle, as Rotation.magnitude computes it (precise for small angles)
         step = 2.0 * np.arctan2(np.linalg.norm(rel[..., :3], axis=-1), np.abs(rel[..., 3]))
         rot[:, members] = np.degrees(step) * motion.fps

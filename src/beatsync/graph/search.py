@@ -76,13 +76,13 @@ def dp_search(
     music_z, lam, tw, md, bound, steps, mask = prepare_search(
         graph, music_z, lam, tempo_weight, music_durations, scale_bound, steps, node_mask
     )
-    if start not in ("any", "clip_start"):
-        raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     return dp_core(graph, music_z, lam, tw, md, bound, steps, mask, start=start)
 
 
 def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", subdivision=1):
-    """:func:`dp_search` on validated inputs (the compose path calls this directly)."""
+    """:func:`dp_search` on validated inputs but ``start`` (the compose path calls this)."""
+    if start not in ("any", "clip_start"):
+        raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
     t0 = time.perf_counter()
     pred, weight, _ = graph.predecessor_table()
     lw = weight * lam if lam > 0 else np.where(np.isinf(weight), np.inf, 0.0)
@@ -110,10 +110,7 @@ def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", sub
             j = k - s
             if j < 0:
                 continue
-            if md is None and bound is None:
-                ok = graph.is_interval if mask is None else graph.is_interval & mask
-            else:
-                ok, scale = span_feasible(dm, t, j, s, bound, mask)
+            ok, scale = span_feasible(dm, t, j, s, bound, mask)
             c = s * zm * zm - 2.0 * zm * (cs1[k] - cs1[j]) + (cs2[k] - cs2[j])
             if tw:
                 c = c + tw * np.log(scale) ** 2

@@ -42,7 +42,7 @@ __all__ = [
     "SynthesisResult",
     "synthesize",
     "synthesize_core",
-    "check_blend_warp",
+    "check_output",
     "beat_warp",
 ]
 
@@ -80,24 +80,6 @@ def beat_warp(
     return k, s
 
 
-def _root_layout(template: Motion) -> tuple[list[int], tuple[int, int, int], str]:
-    skel = template.skeleton
-    root = skel.joints[0].name
-    pos_cols = []
-    for ax in "XYZ":
-        name = f"{root}_{ax}position"
-        if name not in template.channels:
-            raise ParameterError(
-                f"the root joint {root!r} has no {ax}position channel: cannot place the "
-                "dancer on the floor"
-            )
-        pos_cols.append(template.channel_index(name))
-    for joint, idx, order in template.rotation_triples():
-        if joint == root:
-            return pos_cols, idx, order
-    raise ParameterError(f"the root joint {root!r} has no rotation triple")
-
-
 def _heading(rot: Rotation, up: int) -> np.ndarray:
     """Heading angle [rad] about the up axis of the root's local forward axis."""
     g0, g1 = ground_axes(up)
@@ -128,7 +110,7 @@ def synthesize(
     beats = check_times(music_beats, name="music beats")
     path = np.asarray(path, dtype=np.int64)
     if beats.size < 2:
-        raise ParameterError("the music has fewer than two beats: nothing to compose")
+        raise ParameterError(f"the music has {beats.size} beat(s): nothing to compose")
     if path.shape != (beats.size - 1,):
         raise ParameterError(
             f"path has {path.size} nodes for {beats.size - 1} music intervals "
@@ -136,22 +118,21 @@ def synthesize(
         )
     if np.any(path < 0) or np.any(path >= graph.n_nodes) or not graph.is_interval[path].all():
         raise ParameterError("path contains nodes that do not start an interval")
-    fps = check_fps(graph.clips[0].fps if fps is None else fps)
-    blend = check_blend_warp(blend, warp)
-    end_time = float(beats[-1]) if end_time is None else float(end_time)
-    if not end_time > start_time >= 0:
-        raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    fps, blend, end_time = check_output(graph, beats, fps, blend, warp, start_time, end_time)
     return synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp)
 
 
-def check_blend_warp(blend: Any, warp: Any) -> float:
-    """The blend length [s] as a float in [0, 5], and ``warp`` one of "pchip", "linear"."""
+def check_output(graph, beats, fps, blend, warp, start_time, end_time):
+    """``(fps, blend, end_time)`` of the output motion (defaults: the library's, last beat)."""
     blend = float(blend)
     if not np.isfinite(blend) or blend < 0 or blend > 5:
         raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
     if warp not in ("pchip", "linear"):
         raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
-    return blend
+    end_time = float(beats[-1]) if end_time is None else float(end_time)
+    if not end_time > start_time >= 0:
+        raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")
+    return check_fps(graph.clips[0].fps if fps is None else fps), blend, end_time
 
 
 def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
@@ -159,8 +140,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     template = graph.clips[0]
     up = "xyz".index(graph.params.get("up_axis", "y"))
     g0, g1 = ground_axes(up)
-    pos_cols, rot_cols, order = _root_layout(template)
-    rot_cols = list(rot_cols)
+    root = template.skeleton.joints[0].name
+    pos_cols = []
+    for ax in "XYZ":
+        if f"{root}_{ax}position" not in template.channels:
+            raise ParameterError(
+                f"the root joint {root!r} has no {ax}position channel: cannot place the "
+                "dancer on the floor"
+            )
+        pos_cols.append(template.channel_index(f"{root}_{ax}position"))
+    triples = [(list(idx), order) for j, idx, order in template.rotation_triples() if j == root]
+    if not triples:
+        raise ParameterError(f"the root joint {root!r} has no rotation triple")
+    rot_cols, order = triples[0]
 
     k_n = path.size
     node_t = graph.node_time()  # [s] in each node's clip (one frame rate per library)
@@ -177,8 +169,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
     t = frames_to_time(np.arange(j0, j1 + 1), fps=fps)
     k_of, s_of = beat_warp(beats, src_start, src_end, t)
     run_of = run_id[k_of]
-    if warp == "pchip":
-        s_of = _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_of)
+    if warp == "pchip":  # a monotone cubic through the beat correspondences of each run
+        from scipy.interpolate import PchipInterpolator
+
+        for r in np.unique(run_id):
+            ks = np.flatnonzero(run_id == r)
+            if ks.size < 2:
+                continue
+            x = beats[ks[0] : ks[-1] + 2]
+            y = np.concatenate([src_start[ks], src_end[ks[-1:]]])
+            # times before the first beat / after the last beat of the run keep the
+            # linear warp's extrapolation (lead-in and tail of the dance)
+            inside = (run_of == r) & (t >= x[0]) & (t <= x[-1])
+            s_of[inside] = PchipInterpolator(x, y)(t[inside])
 
     # rigid floor transforms per run: yaw angle and ground translation
     n_runs = int(run_id[-1]) + 1
@@ -228,28 +231,19 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
 
     values = transformed(run_of, clip_of[k_of], s_of)
 
-    # blends after every transition (windows never overlap: one per music interval)
+    # blends after every transition, within its music interval: the frames of interval k
+    # within blend of its start, with the old run continued past its beat frame a
     trans_times = beats[:-1][trans]
-    idx, runs, clips, s_old, weights = [], [], [], [], []
-    for k in np.flatnonzero(trans):
-        length = min(blend, beats[k + 1] - beats[k])
-        if length <= 0:
-            continue
-        sel = np.flatnonzero((t >= beats[k]) & (t < beats[k] + length))
-        if not sel.size:
-            continue
+    length = np.minimum(blend, np.diff(beats))
+    sel = np.flatnonzero(trans[k_of] & (t >= beats[k_of]) & (t < beats[k_of] + length[k_of]))
+    if sel.size:
+        k = k_of[sel]
         a = graph.next_node[path[k - 1]]
         rate = (src_end[k] - src_start[k]) / (beats[k + 1] - beats[k])
-        idx.append(sel)
-        runs.append(np.full(sel.size, run_id[k] - 1))
-        clips.append(np.full(sel.size, graph.node_clip[a]))
-        s_old.append(node_t[a] + (t[sel] - beats[k]) * rate)
-        x = np.clip((t[sel] - beats[k]) / length, 0.0, 1.0)
-        weights.append(x * x * (3.0 - 2.0 * x))  # smooth step: zero slope at both ends
-    if idx:
-        sel = np.concatenate(idx)
-        old = transformed(np.concatenate(runs), np.concatenate(clips), np.concatenate(s_old))
-        values[sel] = blend_values(template, old, values[sel], np.concatenate(weights))
+        old = transformed(run_id[k] - 1, graph.node_clip[a], node_t[a] + (t[sel] - beats[k]) * rate)
+        x = np.clip((t[sel] - beats[k]) / length[k], 0.0, 1.0)
+        # smooth step: zero slope at both ends
+        values[sel] = blend_values(template, old, values[sel], x * x * (3.0 - 2.0 * x))
 
     # continuous Euler curves in the output file: the root's triples were re-derived
     # after the yaw alignment, so choose each frame's triple closest to the previous one
@@ -274,21 +268,3 @@ def synthesize_core(graph, path, beats, fps, blend, start_time, end_time, warp):
         beat_source_times=beat_src,
         info={"n_runs": n_runs, "start_frame": j0, "blend_s": blend},
     )
-
-
-def _pchip_runs(beats, src_start, src_end, run_id, t, k_of, s_lin):
-    """Monotone cubic warp through the beat correspondences of each run."""
-    from scipy.interpolate import PchipInterpolator
-
-    s = s_lin.copy()
-    for r in np.unique(run_id):
-        ks = np.flatnonzero(run_id == r)
-        if ks.size < 2:
-            continue
-        x = beats[ks[0] : ks[-1] + 2]
-        y = np.concatenate([src_start[ks], src_end[ks[-1:]]])
-        # times before the first beat / after the last beat of the run keep the
-        # linear warp's extrapolation (lead-in and tail of the dance)
-        inside = (run_id[k_of] == r) & (t >= x[0]) & (t <= x[-1])
-        s[inside] = PchipInterpolator(x, y)(t[inside])
-    return s

@@ -240,10 +240,7 @@ def music_grid(beats: np.ndarray, level: np.ndarray, subdivision: int):
     """Grid times and the level per grid interval (half beats repeat their beat's level)."""
     if subdivision == 1:
         return beats, level
-    mid = (beats[:-1] + beats[1:]) / 2
-    grid = np.empty(beats.size + mid.size)
-    grid[0::2] = beats
-    grid[1::2] = mid
+    grid = np.insert(beats, np.arange(1, beats.size), (beats[:-1] + beats[1:]) / 2)
     return grid, np.repeat(level, 2)
 
 
@@ -311,9 +308,8 @@ def no_path_error(
     beat_s = float(np.median(np.diff(grid_times))) * subdivision
     song_bpm = 60.0 / beat_s
     tempi = clip_tempi(graph)
-    used = np.ones(len(graph.clips), dtype=bool)
-    if node_mask is not None:
-        used = np.array([node_mask[graph.node_clip == c].any() for c in range(len(tempi))])
+    mask = np.ones(graph.n_nodes) if node_mask is None else node_mask
+    used = np.bincount(graph.node_clip, weights=mask, minlength=len(tempi)) > 0
     lib = tempi[used & np.isfinite(tempi)]
     lib_txt = (
         f"{np.median(lib):.0f} BPM (clips {np.min(lib):.0f}-{np.max(lib):.0f})"

@@ -33,20 +33,10 @@ count given the DP carries it in its state (``argmin E``, as in the paper); with
 count estimated the optimum minimises ``E / (p - 1)`` (Dinkelbach iteration), since
 ``E`` itself would favour one period fewer.
 
-Documented rules (choices the paper leaves open; calibration in ``docs/tuning.md``)
------------------------------------------------------------------------------------
-- Near-constant channels are dropped (``CONSTANT_REL_STD``); a flat period costs ~1.
-- Period range: the paper's by default (``DEFAULT_PERIOD_RANGE``), wider for dance
-  figures (``DANCE_PERIOD_RANGE``, :func:`period_range_from_beat`); a range wider than
-  a factor 5 is searched in tiers, shortest first: the first periodic tier wins.
-- Clip length: at least ``MIN_CLIP_PERIODS`` of the range's shortest period; shorter
-  than that of its own period needs ``SHORT_CLIP_MAX_ENERGY``.
-- Not periodic: ``E / (C (p - 1))`` at least ``MAX_NORMALISED_ENERGY``, or
-  :func:`periodicity_contrast` below ``MIN_PERIODICITY_CONTRAST``.
-- Free ends: ``t_0`` in the lead-in (``t_0 < lo``, the shortest allowed period) and
-  ``t_p`` in the tail (``t_p >= n - lo``); an exact tiling gives ``0`` and ``n - 1``.
-- Above :data:`SEARCH_MEMORY_BUDGET` the search runs decimated in time, then every
-  boundary is refined at full rate (:attr:`Segmentation.search_decimation`).
+Choices the paper leaves open are the constants below, each documented where it is
+defined (calibration in ``docs/tuning.md``). Free ends: ``t_0`` in the lead-in
+(``t_0 < lo``, the shortest allowed period) and ``t_p`` in the tail (``t_p >= n - lo``);
+a period range wider than a factor 5 is searched in tiers, shortest first.
 """
 
 from .channels import CONSTANT_REL_STD, select_channels

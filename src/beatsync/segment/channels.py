@@ -26,10 +26,8 @@ CONSTANT_REL_STD = 1e-3
 """A channel with std <= this times the largest selected std is excluded as constant."""
 
 
-# Joint-name keywords (lower case, side prefixes and CC_Base_ removed) of the main
-# limb and spine joints, for CMU (hip abdomen chest neck rShldr rForeArm rThigh rShin
-# rFoot ...), iClone CC_Base (Spine01, Waist, L_Upperarm, L_Forearm, L_Thigh, L_Calf,
-# L_Foot ...) and Mixamo-like (Spine, LeftArm, LeftUpLeg, LeftLeg ...) rigs.
+# Joint-name keywords (lower case, side prefixes removed) of the main limb and spine
+# joints of CMU, iClone CC_Base and Mixamo-like rigs (see select_channels).
 _LIMB_SPINE = (
     "abdomen", "chest", "neck", "spine", "waist", "pelvis",
     "shldr", "shoulder", "upperarm", "arm", "forearm", "elbow",
@@ -113,8 +111,7 @@ def select_channels(
 def nonconstant_channels(values: np.ndarray) -> np.ndarray:
     """Boolean mask of channels kept by the documented near-constant rule."""
     std = values.std(axis=0)
-    top = std.max() if std.size else 0.0
-    return (std > CONSTANT_REL_STD * top) & (std > 1e-9)
+    return (std > CONSTANT_REL_STD * std.max(initial=0.0)) & (std > 1e-9)
 
 
 def standardise(values: np.ndarray) -> np.ndarray:
@@ -127,8 +124,6 @@ def standardise(values: np.ndarray) -> np.ndarray:
 def unwrap_rotations(values: np.ndarray, names: Sequence[str]) -> np.ndarray:
     """Unwrap rotation channels [deg] across the +-180 wrap (analysis only)."""
     rot = [i for i, nm in enumerate(names) if nm.lower().endswith("rotation")]
-    if not rot:
-        return values
     out = values.copy()
     out[:, rot] = np.unwrap(values[:, rot], axis=0, period=360.0)
     return out

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..validation import as_float, as_float_array, as_int, check_finite, check_interval
+from ..validation import as_float, as_int, check_finite, check_interval
 from .period import PERIOD_METHODS
 
 __all__ = [
@@ -25,14 +25,13 @@ __all__ = [
 
 def check_values(values: Any) -> np.ndarray:
     """Values as a finite float64 ``(n_frames, n_channels)`` array (1-D: one channel)."""
-    arr = as_float_array(values, name="motion values")
-    if arr.ndim == 1:
-        arr = arr[:, None]
+    arr = check_finite(values, name="motion values")
+    arr = arr[:, None] if arr.ndim == 1 else arr
     if arr.ndim != 2:
         raise ParameterError(f"values must be 2-D (n_frames, n_channels), got shape {arr.shape}")
     if arr.shape[0] < 3:
         raise ParameterError(f"values have {arr.shape[0]} frame(s); a segmentation needs more")
-    return check_finite(arr, name="motion values")
+    return arr
 
 
 def check_alpha(alpha: Any) -> float:

@@ -178,27 +178,23 @@ def _segment(
         return _search(x, used, fps=fps, alpha=alpha, nominal=(n - 1) / n_periods,
                        count=n_periods, period_range=period_range)  # fmt: skip
     tiers = period_tiers(*period_range)
-    bands = [_frame_band(n, fps, tiers[0])]  # the clip's length first (cheap)
+    _frame_band(n, fps, tiers[0])  # the clip's length first (cheap)
     x, used = _motion_channels(vals, names)
-    refusal = None
-    for i, tier in enumerate(tiers):
-        if i:
-            lo_p, hi_p = time_to_frames(tier, fps=fps, round_to_int=False)
-            lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
-            if hi_f < lo_f:  # the clip cannot show two periods of this tier
-                break
-            bands.append((lo_f, hi_f))
-        nominal = estimate_period(x, *bands[i], method)
+    refusal, tried = None, []
+    for tier in tiers:
+        lo_p, hi_p = time_to_frames(tier, fps=fps, round_to_int=False)
+        lo_f, hi_f = estimation_band(n, float(lo_p), float(hi_p))
+        if hi_f < lo_f:  # the clip cannot show two periods of this tier
+            break
+        tried.append(f"{tier[0]:g}-{tier[1]:g} s")
+        nominal = estimate_period(x, lo_f, hi_f, method)
         try:
             return _search(x, used, fps=fps, alpha=alpha, nominal=nominal, count=None,
                            period_range=tier, method=method)  # fmt: skip
         except PeriodicityRefused as exc:
             refusal = exc
-    searched = ""
-    if len(bands) > 1:
-        tried = ", ".join(f"{a:g}-{b:g} s" for a, b in tiers[: len(bands)])
-        searched = f" (period tiers searched, shortest first: {tried})"
-    raise PeriodicityRefused(refusal.finding, refusal.hint, searched)
+    searched = f" (period tiers searched, shortest first: {', '.join(tried)})"
+    raise PeriodicityRefused(refusal.finding, refusal.hint, searched if len(tried) > 1 else "")
 
 
 def _search(
@@ -267,11 +263,10 @@ def _search(
         raise PeriodicityRefused(
             f"the motion is not periodic: the best segmentation into {n_found} periods of "
             f"~{float(frames_to_time((frames[-1] - frames[0]) / n_found, fps=fps)):.3f} s has "
-            f"mean Pearson distance "
-            f"{e_norm:.3f} between consecutive periods, and uniform segmentations at this "
-            f"period beat those at wrong periods by only {contrast:.3f} (periodic needs "
-            f"< {MAX_NORMALISED_ENERGY} and a "
-            f"contrast >= {MIN_PERIODICITY_CONTRAST}); no boundaries are reported. ",
+            f"mean Pearson distance {e_norm:.3f} between consecutive periods, and uniform "
+            f"segmentations at this period beat those at wrong periods by only {contrast:.3f} "
+            f"(periodic needs < {MAX_NORMALISED_ENERGY} and a contrast >= "
+            f"{MIN_PERIODICITY_CONTRAST}); no boundaries are reported. ",
             hint,
         )
     times = frames_to_time(frames, fps=fps)
@@ -299,15 +294,12 @@ def segment_values(
 ) -> Segmentation:
     """Globally optimal segmentation of a periodic multi-channel signal (paper A, sec. 3).
 
-    ``values`` ``(n_frames, n_channels)``: joint angles, any unit (channels are z-scored,
-    which leaves r unchanged), already unwrapped (:func:`segment` does it for BVH
-    rotations); ``alpha``: allowed relative deviation of every period from the nominal
-    one (eq. 3); ``n_periods``: the count if known (overrides ``period_method``);
-    ``period_range`` [s]: shortest and longest period when the count is estimated
-    (``period_method``, see :func:`estimate_period_count`), in tiers of a factor 5,
-    shortest first. A clip that is not periodic, or too short to tell, raises
-    :class:`NotPeriodicError` (its own motion beats can still sync it:
-    :func:`beatsync.sync.synchronize`, ``mode="beats"``).
+    ``values`` ``(n_frames, n_channels)``: joint angles, any unit, already unwrapped;
+    ``alpha``: allowed relative deviation of every period from the nominal one (eq. 3);
+    ``n_periods``: the count if known; else it is estimated (``period_method``, see
+    :func:`estimate_period_count`) in ``period_range`` [s]. A clip that is not periodic,
+    or too short to tell, raises :class:`NotPeriodicError` (its own motion beats can
+    still sync it: :func:`beatsync.sync.synchronize`, ``mode="beats"``).
 
     Examples
     --------
@@ -323,11 +315,9 @@ def segment_values(
     lo_s, hi_s = check_period_range(period_range)
     method = check_period_method(period_method, p)
     vals = check_values(values)
-    names = (
-        tuple(str(c) for c in channel_names)
-        if channel_names is not None
-        else tuple(f"ch{i}" for i in range(vals.shape[1]))
-    )
+    if channel_names is None:
+        channel_names = [f"ch{i}" for i in range(vals.shape[1])]
+    names = tuple(str(c) for c in channel_names)
     if len(names) != vals.shape[1]:
         raise ParameterError(
             f"{len(names)} channel names for {vals.shape[1]} value columns; is the array "
@@ -348,8 +338,7 @@ def segment(
 ) -> Segmentation:
     """Split a periodic motion into its periods, globally optimally (paper A, sec. 3).
 
-    ``motion``: joint angles (BVH rotations [deg]) or marker-derived ``*_angle`` channels;
-    ``channels`` as in :func:`~beatsync.segment.select_channels`; the rest as in
+    ``channels`` as in :func:`~beatsync.segment.select_channels`, the rest as in
     :func:`segment_values`.
 
     >>> from beatsync.synth.motion import periodic_motion
@@ -396,9 +385,8 @@ def estimate_period_count(
     """Number of whole periods ``p`` in a clip, by FFT peak or uniform-segmentation energy.
 
     The whole ``period_range`` [s] is searched at once (no tiers); ``method`` as in
-    :func:`beatsync.segment.period.estimate_period` (``"energy"``: the paper's ``E/s`` is
-    replaced by ``E(U) / (s - 1)``, which does not favour fewer, longer periods on short
-    clips). Returns ``floor((n_frames - 1) / (T * fps))``, at least 2.
+    :func:`beatsync.segment.period.estimate_period`. Returns
+    ``max(2, floor((n_frames - 1) / (T * fps)))``.
     """
     fps = check_fps(fps)
     lo_s, hi_s = check_period_range(period_range)

@@ -67,18 +67,13 @@ def pair_costs(x: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np
             pos = b[s][:, None] + j
             A = x[:, a[s][:, None] + k[None, :]]  # (C, T, d0+1)
             B = x[:, pos] * (1 - w) + x[:, pos + 1] * w
-            out[s] = n_ch - _pearson(A, B).sum(axis=0)
+            A = A - A.mean(axis=-1, keepdims=True)  # Pearson r with the flat-period floor
+            B = B - B.mean(axis=-1, keepdims=True)
+            floor = FLAT_REL_VAR * (d0 + 1)
+            num = np.sum(A * B, axis=-1)
+            ss = (np.sum(A * A, axis=-1) + floor) * (np.sum(B * B, axis=-1) + floor)
+            out[s] = n_ch - (num / np.sqrt(ss)).sum(axis=0)
     return out
-
-
-def _pearson(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """Pearson r along the last axis with the flat-period floor."""
-    m = A.shape[-1]
-    A = A - A.mean(axis=-1, keepdims=True)
-    B = B - B.mean(axis=-1, keepdims=True)
-    floor = FLAT_REL_VAR * m
-    num = np.sum(A * B, axis=-1)
-    return num / np.sqrt((np.sum(A * A, axis=-1) + floor) * (np.sum(B * B, axis=-1) + floor))
 
 
 @lru_cache(maxsize=32)
@@ -209,6 +204,4 @@ def edge_costs(x: np.ndarray, lo: int, hi: int, *, dtype: type = np.float64) -> 
 def segmentation_energy(x: np.ndarray, frames: np.ndarray) -> float:
     """Energy E (eq. 2) of given boundary frames on standardised channels ``(C, n)``."""
     frames = np.asarray(frames, dtype=np.int64)
-    if frames.size < 3:
-        return 0.0
     return float(pair_costs(x, frames[:-2], frames[1:-1], frames[2:]).sum())

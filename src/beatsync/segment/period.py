@@ -73,20 +73,14 @@ def uniform_frames(n: int, period: float) -> np.ndarray:
 def uniform_energy(x: np.ndarray, periods: np.ndarray) -> np.ndarray:
     """Mean Pearson distance per channel and pair of uniform segmentations (NaN if < 2)."""
     n_ch, n = x.shape
-    a_l, b_l, c_l, owner = [], [], [], []
-    for i, per in enumerate(periods):
-        f = uniform_frames(n, float(per))
-        if f.size < 3 or np.any(np.diff(f) < 1):
-            continue
-        a_l.append(f[:-2])
-        b_l.append(f[1:-1])
-        c_l.append(f[2:])
-        owner.append(np.full(f.size - 2, i))
+    fs = [uniform_frames(n, float(per)) for per in periods]
+    use = [i for i, f in enumerate(fs) if f.size >= 3 and np.all(np.diff(f) >= 1)]
     out = np.full(len(periods), np.nan)
-    if not a_l:
+    if not use:
         return out
-    own = np.concatenate(owner)
-    costs = pair_costs(x, np.concatenate(a_l), np.concatenate(b_l), np.concatenate(c_l))
+    own = np.concatenate([np.full(fs[i].size - 2, i) for i in use])
+    a, b, c = (np.concatenate([fs[i][k : fs[i].size - 2 + k] for i in use]) for k in range(3))
+    costs = pair_costs(x, a, b, c)
     tot = np.bincount(own, weights=costs, minlength=len(periods))
     cnt = np.bincount(own, minlength=len(periods))
     ok = cnt > 0
@@ -119,10 +113,7 @@ def estimate_period(x: np.ndarray, lo_f: float, hi_f: float, method: str) -> flo
         cands = np.geomspace(lo_f, hi_f, _MAX_COUNT_CANDIDATES)
     else:
         cands = lo_f + step * np.arange(count)
-    e = uniform_energy(x, cands)
-    if np.all(np.isnan(e)):
-        raise RuntimeError(f"no uniform segmentation of {lo_f:.1f}-{hi_f:.1f} frames fits {n}")
-    e = np.where(np.isnan(e), np.inf, e)
+    e = np.nan_to_num(uniform_energy(x, cands), nan=np.inf)  # two periods fit: one is finite
     best = int(np.argmin(e))
     edge = max(1, cands.size // 50)
     if best < edge:
@@ -145,8 +136,7 @@ def periodicity_contrast(x: np.ndarray, frames: np.ndarray) -> float:
     Noise scores about 0 or below, a periodic motion clearly above; NaN if no
     off-period segmentation fits.
     """
-    n_found = frames.size - 1
-    period = (frames[-1] - frames[0]) / n_found
+    period = (frames[-1] - frames[0]) / (frames.size - 1)
     xs = x[:, frames[0] :]
     e = uniform_energy(xs, period * np.array((1.0,) + OFF_PERIOD_FACTORS))
     if np.isnan(e[0]) or np.all(np.isnan(e[1:])):

@@ -94,8 +94,6 @@ def shortest_path(
             break
         b, i = b_prev, i_prev
     frames = np.array(frames[::-1], dtype=np.int64)
-    if frames[0] >= lo or frames.size < 3:
-        raise RuntimeError("the optimal path does not start in the lead-in")
     return frames, value + reward * (frames.size - 2)
 
 
@@ -208,15 +206,6 @@ def search_bytes(n: int, lo: int, hi: int, n_ch: int, count: int | None) -> floa
     return kernels + blocks + costs + dp
 
 
-def _decimate(x: np.ndarray, factor: int) -> np.ndarray:
-    """Box-filtered, every ``factor``-th frame (coarse frame ``k`` is frame ``k * factor``)."""
-    from scipy.ndimage import uniform_filter1d
-
-    xs = uniform_filter1d(x, size=factor, axis=1, mode="nearest")[:, ::factor]
-    xs = xs - xs.mean(axis=1, keepdims=True)
-    return xs / np.maximum(xs.std(axis=1, keepdims=True), 1e-12)
-
-
 def _refine(
     x: np.ndarray, guess: np.ndarray, lo: int, hi: int, radius: int
 ) -> tuple[np.ndarray, float]:
@@ -267,9 +256,7 @@ def search_decimation(
     n: int, lo: int, hi: int, n_ch: int, count: int | None, budget: float = SEARCH_MEMORY_BUDGET
 ) -> int | None:
     """Smallest time decimation factor whose search fits ``budget`` bytes (None: none does)."""
-    if search_bytes(n, lo, hi, n_ch, count) <= budget:
-        return 1
-    factor = 2
+    factor = 1
     while True:
         lo_c, hi_c = coarse_band(lo, hi, factor)
         if lo_c < 2:
@@ -300,7 +287,12 @@ def optimum(
     if factor == 1:
         return search(x, lo, hi)
     lo_c, hi_c = coarse_band(lo, hi, factor)
-    frames_c, _ = search(_decimate(x, factor), lo_c, hi_c)
+    from scipy.ndimage import uniform_filter1d
+
+    # box-filtered, every factor-th frame (coarse frame k is frame k * factor), z-scored
+    xs = uniform_filter1d(x, size=factor, axis=1, mode="nearest")[:, ::factor]
+    xs = xs - xs.mean(axis=1, keepdims=True)
+    frames_c, _ = search(xs / np.maximum(xs.std(axis=1, keepdims=True), 1e-12), lo_c, hi_c)
     frames, energy = _refine(x, frames_c * factor, lo, hi, radius=factor)
     for _ in range(_MAX_REFINE_PASSES):  # re-centre the window until it no longer moves
         f_new, e_new = _refine(x, frames, lo, hi, radius=factor)
