@@ -396,7 +396,7 @@ def _counts_text(used: dict[str, int]) -> str:
 
 
 def _speed_lines(r: dict[str, Any]) -> list[str]:
-    """Playback speed, joint kinematics and the loop joins, as measured on the output."""
+    """Playback speed, joint kinematics and the loop joins, computed from the output."""
     sp = r["playback_speed"]
     lo, hi = sp["band"]
     lines = []
