@@ -61,6 +61,15 @@ def test_kinematic_beats_on_marker_motion_returns_seconds():
     np.testing.assert_allclose(beats, np.arange(0.25, 4.0, 0.5), atol=1.5 / FPS)
 
 
+def test_upper_case_marker_axes_are_positions_too():
+    pos = oscillator()
+    n, j, _ = pos.shape
+    ch = tuple(f"m{i}_{a}" for i in range(j) for a in "XYZ")
+    upper = Motion(pos.reshape(n, -1), FPS, ch, None, "markers")
+    assert upper.is_positional and upper.joint_names == ["m0", "m1", "m2"]
+    np.testing.assert_array_equal(kinematic_beats(upper), kinematic_beats(as_markers(pos)))
+
+
 def test_intensity_scales_with_amplitude_squared():
     slow = interval_intensity(oscillator(amp=0.1), [15, 45, 75], fps=FPS)
     fast = interval_intensity(oscillator(amp=0.3), [15, 45, 75], fps=FPS)

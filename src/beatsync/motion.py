@@ -184,16 +184,17 @@ class Motion:
 
     @property
     def is_positional(self) -> bool:
-        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples."""
+        """True for position-only motion: no skeleton, channels ``<joint>_x/_y/_z`` triples
+        (the axis letters in either case)."""
         if "positional" not in self._cache:
-            ch = self.channels
-            stems = [c.rpartition("_")[0] for c in ch[::3]]
+            parts = [c.rpartition("_") for c in self.channels]
+            stems = [p[0] for p in parts[::3]]
             self._cache["positional"] = (
                 self.skeleton is None
-                and len(ch) % 3 == 0
+                and len(parts) % 3 == 0
                 and "" not in stems
-                and len(ch) >= 3
-                and ch == tuple(f"{s}_{a}" for s in stems for a in "xyz")
+                and len(parts) >= 3
+                and [(p[0], p[2].lower()) for p in parts] == [(s, a) for s in stems for a in "xyz"]
             )
         return self._cache["positional"]
 
