@@ -317,3 +317,11 @@ def test_cli_bad_bounds_write_nothing(slow_lib, capsys, extra, message):
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
     assert not (slow_lib / "dance.bvh").exists()
+
+
+@pytest.mark.parametrize("multiplicity", ["bogus", "Auto", [5.0]])
+def test_plan_tempo_refuses_a_bad_multiplicity(two_tempo_graph, multiplicity):
+    from beatsync.graph.timescale import plan_tempo
+
+    with pytest.raises(ParameterError, match="multiplicity"):
+        plan_tempo(two_tempo_graph, np.arange(0.0, 10.0, 0.5), multiplicity=multiplicity)

@@ -148,6 +148,7 @@ def plan_tempo(
     tempo_select: bool = True,
 ) -> TempoPlan:
     """Eligible clips and multiplicities for a song (``tempo_select=False``: every clip)."""
+    multiplicity = check_multiplicity(multiplicity)
     song_bpm = float(60.0 / np.median(np.diff(music_beats)))
     tempi = clip_tempi(graph)
     width = scale_bound[1] / scale_bound[0] if scale_bound is not None else np.inf
