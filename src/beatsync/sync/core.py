@@ -217,7 +217,12 @@ def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict 
     try:
         view = segmentation_view(motion)
         reach = (PHRASE_BEATS[0] * step, PHRASE_BEATS[1] * step)
-        n = estimate_period_count(view.values, fps=view.fps, period_range=reach, method="fft")
+        # a phrase lasts seconds: about 15 frames a second resolve it (a long dance at a
+        # high frame rate would otherwise cost most of the sync in this one FFT)
+        q = max(1, int(view.fps // 15))
+        n = estimate_period_count(
+            view.values[::q], fps=view.fps / q, period_range=reach, method="fft"
+        )
     except ParameterError:  # too short for the range, or nothing to search
         return None, None
     period = float(motion.duration) / n  # >= the spectral peak's: a whole number fits
@@ -225,7 +230,7 @@ def estimate_dance_meter(motion: Any, mb: np.ndarray) -> tuple[int | None, dict 
     k = int(np.rint(period / step))
     if period > reach[1] or k < 2 or iv.size < 3 * k:  # no period in range, or too few
         return None, found
-    spans = np.convolve(iv, np.ones(k), mode="valid")
+    spans = mb[k:] - mb[:-k]
     return (k if np.all(np.abs(spans - period) <= 0.5 * step) else None), found
 
 
