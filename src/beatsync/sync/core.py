@@ -35,6 +35,7 @@ __all__ = [
     "LANDINGS",
     "FILLS",
     "SyncResult",
+    "estimate_dance_meter",
     "motion_beat_count",
     "motion_periods",
     "position_bones",

@@ -48,7 +48,14 @@ from ..motion_beats import motion_positions
 from ..rotations import blend_values, euler_to_rotation, rotation_to_euler, sample_motion
 from .positions import interp_frames
 
-__all__ = ["LoopedClip", "choose_loop", "joint_positions", "loop_events", "with_center"]
+__all__ = [
+    "LoopedClip",
+    "choose_loop",
+    "join_weight",
+    "joint_positions",
+    "loop_events",
+    "with_center",
+]
 
 #: width of the blended window at each join [s]
 LOOP_BLEND_S = 0.6
