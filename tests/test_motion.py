@@ -158,6 +158,9 @@ def test_fill_joint_gaps_short_filled_long_refused():
     long[50:70, 3, 1] = np.nan  # 20 frames = 0.8 s
     with pytest.raises(ParameterError, match=r"'j3' .*20 frames"):
         fill_joint_gaps(long, 25.0, max_gap=0.25, joint_names=["j0", "j1", "j2", "j3", "j4"])
+    names = np.array(["j0", "j1", "j2", "j3", "j4"])  # names as an array too
+    with pytest.raises(ParameterError, match=r"'j3' "):
+        fill_joint_gaps(long, 25.0, max_gap=0.25, joint_names=names)
 
 
 def test_segmentation_view_of_keypoints_is_bone_angles():

@@ -105,7 +105,11 @@ def fill_joint_gaps(
     missing = ~np.all(np.isfinite(pos), axis=2)
     if not missing.any():
         return pos
-    names = list(joint_names or [f"joint {j}" for j in range(pos.shape[1])])
+    names = (
+        [str(n) for n in joint_names]
+        if joint_names is not None and len(joint_names)
+        else [f"joint {j}" for j in range(pos.shape[1])]
+    )
     t = np.arange(pos.shape[0])
     limit = int(np.floor(max_gap * rate + 1e-9))
     for j in np.flatnonzero(missing.any(axis=0)):
