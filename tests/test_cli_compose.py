@@ -193,6 +193,8 @@ def _odd_clip(path):
         ("not_bvh_out", "dance.csv"),
         ("range_with_beats", "--min-bpm"),
         ("range_reversed", "--min-bpm 150"),
+        ("song_folder", "is not a file"),
+        ("empty_beats", "is empty"),
     ],
 )
 def test_bad_inputs_write_nothing(workdir, capsys, case, message):
@@ -224,6 +226,12 @@ def test_bad_inputs_write_nothing(workdir, capsys, case, message):
         extra += ["--min-bpm", "60"]
     elif case == "range_reversed":
         extra = ["--min-bpm", "150", "--max-bpm", "100"]
+    elif case == "song_folder":
+        (workdir / "a_song").mkdir()
+        song = str(workdir / "a_song")
+    elif case == "empty_beats":
+        (workdir / "empty.beats").write_text("")
+        extra = ["--beats", str(workdir / "empty.beats")]
     before = _outputs(workdir)
     out = workdir / ("dance.csv" if case == "not_bvh_out" else "dance.bvh")
     argv = [

@@ -154,7 +154,7 @@ def _library_files(entries: list[str]) -> list[Path]:
 
 def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Outputs]:
     from ..graph.build import check_th
-    from ..io import AUDIO_SUFFIXES
+    from ..io import AUDIO_SUFFIXES, check_input_file
 
     entries = list(args.library or [])
     audio = args.audio
@@ -168,10 +168,9 @@ def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Out
             raise ParameterError("give the music file (AUDIO), e.g. beatsync compose song.wav ...")
     th = check_th(args.th, name="--th")
     tempo_options(args)  # a bad tempo or range, or --beats with --bpm: before any work
-    if not Path(audio).is_file():
-        raise ParameterError(f"audio file {audio!r} does not exist")
-    if args.beats is not None and not Path(args.beats).is_file():
-        raise ParameterError(f"beats file {args.beats!r} does not exist")
+    check_input_file(audio, "audio")
+    if args.beats is not None:
+        check_input_file(args.beats, "beats")
     files = _library_files(entries)
     if Path(args.output).suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
