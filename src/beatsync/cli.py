@@ -40,7 +40,7 @@ from typing import NoReturn
 from . import __version__
 from .commands import COMMAND_HELP, COMMAND_MODULES
 
-EXIT_USAGE = 2  # as beatsync.commands._common.EXIT_USAGE (not imported: --help stays light)
+EXIT_USAGE = 2  # argparse's own exit status for a usage error
 
 __all__ = ["build_parser", "main", "UsageError"]
 

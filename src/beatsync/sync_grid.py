@@ -83,6 +83,7 @@ def prepare_song(
     track = track_beats(y, sr, bpm=bpm, **{k: v for k, v in told.items() if v is not None})
     bar = int(getattr(track, "beats_per_bar", 0) or 0)
     return {
+        "song": Path(path).stem,
         "beats": track.beats,
         "tempo_bpm": track.tempo,
         "beats_per_bar": bar if bar > 0 else None,
@@ -106,6 +107,7 @@ def prepare_clip(
 
     motion = io.read_motion(path, fps=fps, variable=variable)
     clip = {
+        "clip": Path(path).stem,
         "motion": motion,
         "boundaries": None,
         "mean_period_s": float("nan"),

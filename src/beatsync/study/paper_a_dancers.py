@@ -73,6 +73,9 @@ OTHER_SONG = {
 
 def load_pairs(names: list[str] | tuple[str, ...] = DANCE_PAIRS) -> dict[str, DancePair]:
     """The bundled dancer + song excerpts, checksum-verified, by name."""
+    unknown = [n for n in names if n not in DANCE_PAIRS]
+    if unknown:
+        raise ParameterError(f"unknown dance pair(s) {unknown}; choose from {DANCE_PAIRS}")
     return {n: load_dance_pair(n) for n in names}
 
 
