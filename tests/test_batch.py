@@ -44,6 +44,7 @@ def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
     for _, row in ok.iterrows():
         back = io.read_bvh(row["output"])
         assert back.n_frames == row["output_frames"]
+        assert (back.n_frames - 1) / 60.0 >= 14.0 - 1e-9  # danced to the song's end
         assert row["max_abs_residual_ms"] <= 1000.0 / 60.0
     bad = table[table["clip"] == "pirouette"]
     assert (bad["status"] == "error").all()

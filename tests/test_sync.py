@@ -485,6 +485,30 @@ def test_fill_loop_of_a_clip_longer_than_the_song_is_stop_to_the_last_beat():
     assert res.report["output_duration_s"] >= beats[-1] - 1.0 / FPS
 
 
+@pytest.mark.parametrize("mode", ["periods", "beats"])
+def test_fill_loop_dances_on_to_the_songs_end(mode):
+    # the song plays 1.6 s after its last beat: the dancer goes on at the final speed
+    # instead of standing still (the video holds the last frame)
+    m = _periodic_motion(period=1.0, duration=6.0)
+    bounds = None if mode == "beats" else np.arange(0.0, 5.5, 1.0)
+    beats = np.arange(0.3, 20.0, 0.5)  # last beat 19.8 s
+    if mode == "beats":
+        m = _arm_positions(fps=FPS, seconds=6.0)
+    res = synchronize(m, bounds, beats, mode=mode, fill="loop", song_end=21.4)
+    r = res.report
+    assert r["output_duration_s"] >= 21.4 - 1e-9 and r["covered_s"][1] == pytest.approx(21.4)
+    tail = res.warp_src_times[res.motion.times > beats[-1] + 0.1]
+    assert np.diff(tail).min() > 0  # moving, not held
+    stop = synchronize(m, bounds, beats, mode=mode, fill="loop")
+    assert stop.report["covered_s"][1] == pytest.approx(beats[-1])
+
+
+def test_song_end_before_the_last_beat_is_refused():
+    m = _periodic_motion(period=1.0, duration=6.0)
+    with pytest.raises(ParameterError, match=r"song_end=9 s is before the music's last beat"):
+        synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0.3, 20.0, 0.5), song_end=9)
+
+
 # ---------------------------------------------------------------- modes
 
 

@@ -87,6 +87,7 @@ def prepare_song(
         "beats": track.beats,
         "tempo_bpm": track.tempo,
         "beats_per_bar": bar if bar > 0 else None,
+        "duration_s": y.size / sr,
     }
 
 
@@ -146,8 +147,12 @@ def sync_pair(
             row.update(status="error", error=f"{what}: {value}")
             return row
     assert isinstance(clip, dict) and isinstance(song, dict)
-    # as `beatsync sync` with its defaults: looped to the song's last beat, its meter kept
-    kw = {"fill": "loop", "beats_per_bar": song.get("beats_per_bar")}
+    # as `beatsync sync` with its defaults: looped to the song's end, its meter kept
+    kw = {
+        "fill": "loop",
+        "beats_per_bar": song.get("beats_per_bar"),
+        "song_end": song.get("duration_s"),
+    }
     try:
         if clip["boundaries"] is None:  # mode "beats", or "auto" on a clip that is not periodic
             res = synchronize(clip["motion"], None, song["beats"], mode="beats", **kw)

@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="sync every motion clip with every song, in parallel on Dask",
         description="Track each song's beats once, segment each clip once, then sync every "
         "(clip, song) pair on a Dask cluster (local by default), as `beatsync sync` does with its "
-        "defaults (--mode auto, the dance looped to the song's last beat). Clips or songs "
+        "defaults (--mode auto, the dance looped to the song's end). Clips or songs "
         "whose file names repeat (one folder per take) are named by their folder. Writes "
         "OUT_DIR/<clip>__<song> in the clip's own kind of file (.bvh with a skeleton; joint "
         "positions in the input's layout: .json, .npy, .npz, .c3d; else .csv) and a "

@@ -106,7 +106,8 @@ def register(subparsers: Any) -> None:
         choices=("loop", "stop"),
         default="loop",
         help="'loop' (default): repeat whole periods, with blended joins, until the dance "
-        "covers the song to its last beat; 'stop': end with the clip's last period",
+        "covers the song to its end (dancing on after the last beat); 'stop': end with the "
+        "clip's last period",
     )
     p.add_argument(
         "--beats-per-bar",
@@ -294,6 +295,7 @@ def _pipeline(
             out_fps=args.out_fps,
             phase_offset=args.phase_offset,
             period_range=None if args.period_range is None else tuple(args.period_range),
+            song_end=music_s,
         )
         timings["sync_s"] = time.perf_counter() - t0
 

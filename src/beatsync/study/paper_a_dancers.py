@@ -81,7 +81,7 @@ def load_pairs(names: list[str] | tuple[str, ...] = DANCE_PAIRS) -> dict[str, Da
 
 def track_songs(pairs: dict[str, DancePair]) -> dict[str, dict[str, Any]]:
     """Beats of every song (tracked; times in the excerpt's audio [s]) and its meter:
-    name -> ``{"beats", "tempo_bpm", "beats_per_bar", "warning"}``."""
+    name -> ``{"beats", "tempo_bpm", "beats_per_bar", "duration_s", "warning"}``."""
     from ..beats import track_beats
 
     songs = {}
@@ -94,6 +94,7 @@ def track_songs(pairs: dict[str, DancePair]) -> dict[str, dict[str, Any]]:
             "beats": beats,
             "tempo_bpm": 60.0 / float(np.median(np.diff(beats))),
             "beats_per_bar": getattr(track, "beats_per_bar", None),
+            "duration_s": len(pair.y) / pair.sr,
             "warning": "; ".join(str(w.message) for w in caught),
         }
     return songs
@@ -207,6 +208,7 @@ def dancer_table(
                     fill="loop",
                     period_range=period_range,
                     beats_per_bar=songs[other]["beats_per_bar"],
+                    song_end=songs[other]["duration_s"],
                 )
             res.report["warnings"] = [str(w.message) for w in caught]
             results[(name, mode)] = res

@@ -45,7 +45,8 @@ Beyond the paper (real dances)
       ballroom figures go to ``"beats"``, which aligned the real dancers far better.
     - ``fill="loop"`` repeats a span chosen where the poses at its ends are most alike
       (:mod:`.fill`), turned and moved to go on from the previous pass, blended over
-      0.6 s; ``fill="stop"`` (paper A) ends with the last period that fits.
+      0.6 s, up to the last beat or on to ``song_end``; ``fill="stop"`` (paper A) ends
+      with the last period that fits.
     - The report (:class:`SyncResult`, :mod:`.quality`) says what the warp did to the
       dance. The JSON layout's ``center`` is resampled with the joints.
 

@@ -251,6 +251,7 @@ def synchronize(
     delta: float | None = None,
     phase_offset: float = 0.0,
     period_range: tuple[float, float] | None = None,
+    song_end: float | None = None,
 ) -> SyncResult:
     """Resample a dance so that its periods (or its own motion beats) land on music beats
     (paper A, section 5; see :mod:`beatsync.sync`). The output's time 0 is the music's.
@@ -268,7 +269,9 @@ def synchronize(
     - ``land="accents"``: synchronise, measure the mean lag of the kinematic beats behind
       the beats, synchronise again without it.
     - ``fill``: end with the clip's last period that fits (``"stop"``, paper A), or
-      repeat a span with blended joins up to the song's last beat (``"loop"``).
+      repeat a span with blended joins up to the song's last beat (``"loop"``) and on
+      to ``song_end`` [s] (the song's end, if given) at the final speed, so the dancer
+      does not stand still while the song plays out.
     - ``beats_per_period`` (beats one period or motion beat spans) overrides
       :func:`beats_per_period`'s rule or the whole-dance counts; ``beats_per_bar`` and
       ``dance_beats_per_period`` (3 for a waltz step) are the meters; in beats mode
@@ -331,6 +334,13 @@ def synchronize(
         period_range = (PERIOD_BEATS[0] * beat_period, PERIOD_BEATS[1] * beat_period)
     else:
         period_range = check_interval(period_range, name="period_range", unit="s")
+    if song_end is not None:
+        song_end = as_float(song_end, name="song_end", unit="s")
+        if song_end < beats[-1]:
+            raise ParameterError(
+                f"song_end={song_end:g} s is before the music's last beat ({beats[-1]:.2f} s): "
+                "it is the song's duration in seconds"
+            )
     duration = float(frames_to_time(n_frames - 1, fps=fps))  # sample_motion clips here
 
     events, used_mode, note = _events(
@@ -371,6 +381,7 @@ def synchronize(
         "out_fps": out_fps,
         "delta": delta,
         "duration": duration,
+        "song_end": song_end if fill == "loop" else None,
     }
     lag = 0.0
     res = _resample(plan, phase_offset)
@@ -443,6 +454,16 @@ def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
         warn(note, stacklevel=3)
 
 
+def _go_on(warp: TimeWarp, plan: dict[str, Any], stop: float, last: float) -> TimeWarp:
+    """``warp`` going on after its last boundary at its end rate up to music time ``stop``
+    [s], or as far as the source reaches (``last`` [s])."""
+    used, targets = warp.boundaries, warp.targets
+    end = float(min(used[-1] + (stop - targets[-1]) / warp.rate[-1], last))
+    if end <= used[-1]:
+        return warp
+    return integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+
+
 def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     """Warp and resample (inputs checked by :func:`synchronize`)."""
     motion, events, counts, beats = plan["motion"], plan["events"], plan["counts"], plan["beats"]
@@ -455,13 +476,20 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
         warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
         p = used.size - 1
+        if end is None and plan["song_end"] is not None:
+            last = float(looped.events[-1]) if looped is not None else duration
+            warp = _go_on(warp, plan, plan["song_end"] + phase_offset, last)
     else:
         cum = np.concatenate([[0], np.cumsum(counts)])
-        if plan["fill"] == "loop" and cum[-1] < last_beat - first_beat:
-            # enough repetitions that whole intervals reach the last beat, plus one for the tail
+        # beats to cover: up to the last one, and the song's end in beats after it
+        reach = last_beat - first_beat
+        if plan["song_end"] is not None:
+            reach += int(np.ceil((plan["song_end"] - beats[-1]) / np.median(np.diff(beats))))
+        if plan["fill"] == "loop" and cum[-1] < reach:
+            # enough repetitions that whole intervals reach it, plus one for the tail
             a, b, angle, shift, dist, join = choose_loop(motion, events)
             per_rep = max(int(cum[b] - cum[a]), 1)
-            need = b + 1 + -(-max(0, last_beat - first_beat - int(cum[b])) // per_rep) * (b - a)
+            need = b + 1 + -(-max(0, reach - int(cum[b])) // per_rep) * (b - a)
             looped = loop_events(
                 events, need, join=join, span=(a, b), angle=angle, shift=shift, distance=dist
             )
@@ -483,12 +511,11 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         tail = p == events.size - 1 and duration > used[-1]  # the clip's tail after it
         end = duration if tail else None
         warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
-        if plan["fill"] == "loop" and p < events.size - 1 and int(cum[p]) < last_beat - first_beat:
-            # cover the beats after the last whole interval with part of the next one: the
-            # warp goes on at its end rate up to the last beat (within that interval)
-            need = beats[last_beat] + phase_offset - targets[-1]
-            end = float(min(used[-1] + need / warp.rate[-1], events[p + 1]))
-            warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        if plan["fill"] == "loop" and p < events.size - 1:
+            # cover the beats after the last whole interval (and the song's end) with part
+            # of the next one, at the warp's end rate
+            stop = beats[last_beat] if plan["song_end"] is None else plan["song_end"]
+            warp = _go_on(warp, plan, stop + phase_offset, float(events[-1]))
         placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
     tau_end = float(warp.tgt[-1])  # > 0: targets increase from check_start's >= 0
     # the last frame is the first one at or after the last warped time, so the frame
