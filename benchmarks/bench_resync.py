@@ -4,8 +4,8 @@ Every ordered pair of the four bundled Dance-with-Melody dancers (a cha-cha, a r
 two waltzes: 23 joint positions at 25 fps, 24 s excerpts, each with its 28 s song):
 the dancer of one pair is synchronised to the song of another with ``beatsync sync``'s
 defaults (``synchronize(motion, None, beats, mode="auto", fill="loop",
-beats_per_bar=<the tracker's meter>, song_end=<the song's length>)``), 12 runs. Measured on the output, by this
-script (not read from the sync report):
+beats_per_bar=<the tracker's meter>, song_end=<the song's length>)``), 12 runs.
+Measured on the output, by this script (not read from the sync report):
 
 - local playback speed: source seconds per output second between consecutive output
   frames, over the output time the warp covers (the held lead-in excluded, its length
@@ -311,7 +311,8 @@ def markdown(labels: dict[str, dict]) -> list[str]:
         "Command: `.venv/bin/python benchmarks/bench_resync.py --label <before|after>` "
         "(`before`: the code before the whole-dance beat counts and seamless loops; "
         "`after`: with them). Each run: `synchronize(dancer, None, song beats, mode='auto', "
-        "fill='loop', beats_per_bar=meter, song_end=song length)`, what `beatsync sync dancer.json song.ogg` does. "
+        "fill='loop', beats_per_bar=meter, song_end=song length)`, what `beatsync sync "
+        "dancer.json song.ogg` does. "
         "Speeds are measured on the output frames by the script. Targets: speed in "
         "0.8-1.25 for >= 95 % of the covered output time; p99 joint speed <= x1.15 and p99 "
         "acceleration <= x1.30 the dancer's own; peak joint speed (joins included) <= x1.10; "

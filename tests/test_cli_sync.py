@@ -56,16 +56,8 @@ def test_sync_end_to_end_with_beats_file(inputs, tmp_path, capsys):
     rep = tmp_path / "report.json"
     code, stdout, err = _run(
         [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--report",
-            str(rep),
-            "--json",
+            "sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out),
+            "--beats", str(d / "song.beats"), "--report", str(rep), "--json",
         ],
         capsys,
     )
@@ -88,16 +80,8 @@ def test_sync_default_loops_over_the_whole_song(inputs, tmp_path, capsys):
     d, _, beats = inputs  # a 12 s dance on a 20 s song
     out = tmp_path / "out.bvh"
     code, stdout, err = _run(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--json",
-        ],
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json"],
         capsys,
     )
     assert code == 0, err
@@ -109,18 +93,8 @@ def test_sync_default_loops_over_the_whole_song(inputs, tmp_path, capsys):
     assert r["max_abs_residual_frames"] <= 1.0
     # --fill stop: the paper's behaviour, the dance ends with its last period
     code, stdout, err = _run(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--json",
-            "--fill",
-            "stop",
-        ],
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json", "--fill", "stop"],
         capsys,
     )
     r = json.loads(stdout)["report"]
@@ -131,18 +105,8 @@ def test_sync_mode_beats_and_auto_fallback(inputs, tmp_path, capsys):
     d, _, beats = inputs
     out = tmp_path / "out.bvh"
     code, stdout, err = _run(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--mode",
-            "beats",
-            "--json",
-        ],
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--mode", "beats", "--json"],
         capsys,
     )
     assert code == 0, err
@@ -150,16 +114,8 @@ def test_sync_mode_beats_and_auto_fallback(inputs, tmp_path, capsys):
     assert r["mode"] == "beats" and r["max_abs_residual_frames"] <= 1.0
     # not periodic: auto falls back to motion beats and says so
     code, stdout, err = _run(
-        [
-            "sync",
-            str(d / "noise.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--json",
-        ],
+        ["sync", str(d / "noise.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--json"],
         capsys,
     )
     assert code == 0, err
@@ -173,17 +129,8 @@ def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.bvh"
     code, stdout, err = _run(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--bpm",
-            "115",
-            "--out-fps",
-            "30",
-        ],
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--bpm", "115",
+         "--out-fps", "30"],
         capsys,
     )
     assert code == 0, err
@@ -213,17 +160,8 @@ def test_sync_align_accents(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.bvh"
     code, stdout, err = _run(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--align-accents",
-            "--json",
-        ],
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--align-accents", "--json"],
         capsys,
     )
     assert code == 0, err
@@ -236,17 +174,8 @@ def test_sync_table_to_csv(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.csv"
     code, _, err = _run(
-        [
-            "sync",
-            str(d / "angles.csv"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--fps",
-            "60",
-            "--beats",
-            str(d / "song.beats"),
-        ],
+        ["sync", str(d / "angles.csv"), str(d / "song.wav"), "-o", str(out), "--fps", "60",
+         "--beats", str(d / "song.beats")],
         capsys,
     )
     assert code == 0, err
@@ -261,19 +190,8 @@ def test_sync_video(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out, vid = tmp_path / "out.bvh", tmp_path / "out.mp4"
     code, _, err = _run(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(out),
-            "--beats",
-            str(d / "song.beats"),
-            "--video",
-            str(vid),
-            "--video-fps",
-            "8",
-        ],
+        ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(out), "--beats",
+         str(d / "song.beats"), "--video", str(vid), "--video-fps", "8"],
         capsys,
     )
     assert code == 0, err
@@ -281,183 +199,58 @@ def test_sync_video(inputs, tmp_path, capsys):
 
 
 BAD = [
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song.beats",
-            "--bpm",
-            "120",
-        ],
-        "conflict",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--bpm", "120"], "conflict"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{d}/salsa.bvh"], "same"),
     # a tempo range is checked before any work, named as the options, and conflicts with a
     # fixed tempo or given beats
-    (
-        ["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--bpm", "115", "--max-bpm", "80"],
-        "--max-bpm.*--bpm",
-    ),
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song.beats",
-            "--min-bpm",
-            "60",
-            "--max-bpm",
-            "80",
-        ],
-        "--min-bpm and --max-bpm bound.*--beats",
-    ),
-    (
-        ["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--min-bpm", "300"],
-        "--min-bpm 300.*--max-bpm 240.*default",
-    ),
-    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--max-bpm", "1"], "--max-bpm=1.0"),
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--align-accents",
-            "--phase-offset",
-            "0.1",
-        ],
-        "phase",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--bpm", "115", "--max-bpm", "80"],
+     "--max-bpm.*--bpm"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--min-bpm", "60", "--max-bpm", "80"], "--min-bpm and --max-bpm bound.*--beats"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--min-bpm", "300"],
+     "--min-bpm 300.*--max-bpm 240.*default"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--max-bpm", "1"],
+     "--max-bpm=1.0"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--align-accents", "--phase-offset",
+      "0.1"], "phase"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/missing/x.bvh"], "does not exist"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.mp3"], ".bvh or .csv"),
     (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "60"], "skeleton"),
-    (
-        [
-            "{d}/noise.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song.beats",
-            "--mode",
-            "periods",
-        ],
-        "periodic.*--mode beats",
-    ),
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song.beats",
-            "--beats-per-bar",
-            "0",
-        ],
-        "beats-per-bar",
-    ),
-    (
-        ["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--period-range", "2", "1"],
-        "period-range",
-    ),
+    (["{d}/noise.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--mode", "periods"], "periodic.*--mode beats"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--beats-per-bar", "0"], "beats-per-bar"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--period-range", "2", "1"],
+     "period-range"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--dance-beats", "-3"], "dance-beats"),
     (["{d}/dancer.json", "{d}/song.wav", "-o", "{o}/x.bvh", "--fps", "25"], "json.*npy"),
-    (
-        ["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.json", "--beats", "{d}/song.beats"],
-        "not joint positions",
-    ),
-    (
-        [
-            "{d}/angles.csv",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.csv",
-            "--fps",
-            "60",
-            "--beats",
-            "{d}/song.beats",
-            "--mode",
-            "beats",
-        ],
-        "positions",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.json", "--beats", "{d}/song.beats"],
+     "not joint positions"),
+    (["{d}/angles.csv", "{d}/song.wav", "-o", "{o}/x.csv", "--fps", "60", "--beats",
+      "{d}/song.beats", "--mode", "beats"], "positions"),
     (["{d}/salsa.bvh", "{d}/silence.wav", "-o", "{o}/x.bvh"], "silen"),
     (["{d}/salsa.bvh", "{d}/short.wav", "-o", "{o}/x.bvh"], "shorter"),
     (["{d}/salsa.bvh", "{d}/tone.wav", "-o", "{o}/x.bvh"], "no detectable beats"),
-    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--video", "{d}/song.wav"], "same|mp4"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--video", "{d}/song.wav"],
+     "same|mp4"),
     # beat times in milliseconds: refused (the dance would run for hours, --fill stop and
     # --out-fps 1 only keep the old behaviour's output small)
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song_ms.beats",
-            "--fill",
-            "stop",
-            "--out-fps",
-            "1",
-        ],
-        "milliseconds",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song_ms.beats",
+      "--fill", "stop", "--out-fps", "1"], "milliseconds"),
     # a beats file with one beat: the file is named, not the music blamed
-    (
-        ["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/one.beats"],
-        "one.beats' holds 1 beat time",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/one.beats"],
+     "one.beats' holds 1 beat time"),
     # song first, dance second: the message says the arguments look swapped
     (["{d}/song.wav", "{d}/salsa.bvh", "-o", "{o}/x.bvh"], "swapped"),
     # a bad video frame rate is refused before the motion is synced (named as the option)
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song.beats",
-            "--video",
-            "{o}/v.mp4",
-            "--video-fps",
-            "0",
-        ],
-        "--video-fps=0",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--video", "{o}/v.mp4", "--video-fps", "0"], "--video-fps=0"),
     # an absurd output or video frame rate: refused before the memory fills
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--beats",
-            "{d}/song.beats",
-            "--out-fps",
-            "100000",
-        ],
-        "out_fps=100000",
-    ),
-    (
-        [
-            "{d}/salsa.bvh",
-            "{d}/song.wav",
-            "-o",
-            "{o}/x.bvh",
-            "--first-beat",
-            "500",
-            "--beats",
-            "{d}/song.beats",
-        ],
-        "first_beat",
-    ),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
+      "--out-fps", "100000"], "out_fps=100000"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--first-beat", "500",
+      "--beats", "{d}/song.beats"], "first_beat"),
 ]
 
 
@@ -480,17 +273,8 @@ def test_sync_bad_inputs(inputs, tmp_path, capsys, argv, match):
 @pytest.mark.parametrize("option, value", [("--mode", "bars"), ("--fill", "repeat")])
 def test_sync_unknown_choice_is_a_usage_error(inputs, tmp_path, capsys, option, value):
     d, _, _ = inputs
-    code = main(
-        [
-            "sync",
-            str(d / "salsa.bvh"),
-            str(d / "song.wav"),
-            "-o",
-            str(tmp_path / "x.bvh"),
-            option,
-            value,
-        ]
-    )
+    code = main(["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(tmp_path / "x.bvh"),
+                 option, value])
     assert code == 2
     assert "invalid choice" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
@@ -499,20 +283,8 @@ def test_sync_unknown_choice_is_a_usage_error(inputs, tmp_path, capsys, option, 
 def test_sync_real_dancer_positions_end_to_end(inputs, tmp_path, capsys):
     d, _, beats = inputs  # 12 s of a real waltz dancer on a 20 s song
     out = tmp_path / "out.json"
-    argv = [
-        "sync",
-        str(d / "dancer.json"),
-        str(d / "song.wav"),
-        "-o",
-        str(out),
-        "--fps",
-        "25",
-        "--beats",
-        str(d / "song.beats"),
-        "--json",
-        "--beats-per-bar",
-        "3",
-    ]
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(out), "--fps", "25",
+            "--beats", str(d / "song.beats"), "--json", "--beats-per-bar", "3"]
     code, stdout, err = _run(argv, capsys)
     assert code == 0, err
     result = json.loads(stdout)

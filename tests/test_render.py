@@ -23,12 +23,8 @@ FPS = 20.0
 def _motion(n: int = 30) -> Motion:
     skel = Skeleton(
         (
-            Joint(
-                "hip",
-                -1,
-                np.zeros(3),
-                ("Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation"),
-            ),
+            Joint("hip", -1, np.zeros(3), ("Xposition", "Yposition", "Zposition",
+                                           "Zrotation", "Xrotation", "Yrotation")),
             Joint("spine", 0, np.array([0.0, 0.5, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
             Joint("head", 1, np.array([0.0, 0.3, 0.0]), (), True),
             Joint("leg", 0, np.array([0.1, -0.5, 0.0]), ("Zrotation", "Xrotation", "Yrotation")),
@@ -65,27 +61,24 @@ def test_plot_frames_marks_beats():
 
 
 def test_plot_beat_timeline(tmp_path):
-    fig = render.plot_beat_timeline(
-        _motion(), beats=[0.5, 1.0], motion_beats=[0.25], boundaries=[0.0, 1.0]
-    )
+    fig = render.plot_beat_timeline(_motion(), beats=[0.5, 1.0], motion_beats=[0.25],
+                                    boundaries=[0.0, 1.0])
     out = render.save_figure(fig, tmp_path / "t.png")
     assert out.stat().st_size > 1000
 
 
 def _streams(path) -> str:
     exe = render.find_ffmpeg()
-    return subprocess.run(
-        [exe, "-hide_banner", "-i", str(path)], capture_output=True, text=True
-    ).stderr
+    return subprocess.run([exe, "-hide_banner", "-i", str(path)], capture_output=True,
+                          text=True).stderr
 
 
 @pytest.mark.skipif(render.find_ffmpeg() is None, reason="no ffmpeg")
 def test_write_video_mp4_with_sound(tmp_path):
     sr = 8000
     y = 0.1 * np.sin(2 * np.pi * 440 * np.arange(2 * sr) / sr).astype(np.float32)
-    out = render.write_video(
-        _motion(), tmp_path / "v.mp4", audio=(y, sr), beats=[0.5, 1.0], size=(96, 64)
-    )
+    out = render.write_video(_motion(), tmp_path / "v.mp4", audio=(y, sr), beats=[0.5, 1.0],
+                             size=(96, 64))
     assert out == tmp_path / "v.mp4" and out.stat().st_size > 0
     info = _streams(out)
     assert "Video: h264" in info and "Audio: aac" in info
@@ -96,9 +89,8 @@ def test_write_video_fallback_gif_and_wav(tmp_path):
     sr = 8000
     y = np.zeros(sr, dtype=np.float32)
     with pytest.warns(BeatsyncWarning, match="no ffmpeg"):
-        out = render.write_video(
-            _motion(10), tmp_path / "v.mp4", audio=(y, sr), ffmpeg=False, size=(64, 64)
-        )
+        out = render.write_video(_motion(10), tmp_path / "v.mp4", audio=(y, sr), ffmpeg=False,
+                                 size=(64, 64))
     assert out.suffix == ".gif" and out.is_file()
     assert (tmp_path / "v.wav").is_file()
     assert not (tmp_path / "v.mp4").exists()
@@ -149,11 +141,11 @@ def test_write_video_lasts_as_long_as_asked_holding_the_last_pose(tmp_path):
     y = 0.1 * np.sin(2 * np.pi * 440 * np.arange(4 * sr) / sr).astype(np.float32)
     m = _motion(30)  # 1.5 s of motion, 4 s of song
     short = render.write_video(m, tmp_path / "a.mp4", audio=(y, sr), fps=10, size=(64, 64))
-    full = render.write_video(
-        m, tmp_path / "b.mp4", audio=(y, sr), fps=10, size=(64, 64), duration=4.0
-    )
+    full = render.write_video(m, tmp_path / "b.mp4", audio=(y, sr), fps=10, size=(64, 64),
+                              duration=4.0)
     assert _duration_s(short) < 2.0
     assert abs(_duration_s(full) - 4.0) < 0.15
+
 
 
 def test_position_only_motion_is_drawn_with_bones():
@@ -193,9 +185,8 @@ def test_write_video_progress_callable_and_interruption_leaves_no_ffmpeg(tmp_pat
     assert list(tmp_path.iterdir()) == []  # no temporary folder, no partial video
     # the same callable, not interrupted, counts every frame
     done = []
-    render.write_video(
-        _motion(), tmp_path / "v.mp4", size=(64, 64), progress=lambda d, t: done.append((d, t))
-    )
+    render.write_video(_motion(), tmp_path / "v.mp4", size=(64, 64),
+                       progress=lambda d, t: done.append((d, t)))
     assert done[-1] == (done[-1][1], done[-1][1]) and len(done) == done[-1][1]
 
 
