@@ -56,6 +56,18 @@ def test_alignment_scores_dict_and_span():
     assert d["n_music_beats"] == 10 and d["sigma_s"] == 0.05
 
 
+def test_a_beat_on_the_span_edge_matches_one_just_outside():
+    # the song's last beat at 5.0 s is danced one 25 fps frame later, just after the span
+    # ends there: it is danced (it counted 0 when the other side was cut at the span too)
+    motion = MUSIC[:10] + 0.04
+    d = alignment_scores(motion, MUSIC, span=(0.5, 5.0))
+    assert d["n_music_beats"] == 10 and d["n_motion_beats"] == 9
+    assert d["alignment_music"] == pytest.approx(np.exp(-0.04**2 / (2 * 0.05**2)))
+    # a beat far outside still does not count
+    d = alignment_scores(MUSIC[:9], MUSIC, span=(0.5, 5.0))
+    assert d["alignment_music"] == pytest.approx(0.9)
+
+
 def test_nearest_distance():
     d = nearest_distance([0.1, 0.74, 3.0], [0.0, 0.5, 1.0])
     assert np.allclose(d, [0.1, 0.24, 2.0])

@@ -44,6 +44,8 @@ __all__ = [
 
 #: Gaussian width of both published scores: 3 frames at 60 fps [s]
 DEFAULT_SIGMA = 0.05
+#: sigmas beyond a span's ends that a nearest beat may lie (its weight is below 1.2 %)
+SPAN_REACH = 3.0
 
 
 def _checked(motion_beats: Any, music_beats: Any, sigma: Any):
@@ -127,19 +129,25 @@ def alignment_scores(
     span: tuple[float, float] | None = None,
 ) -> dict[str, float]:
     """Both beat alignment scores (``alignment_motion``, ``alignment_music``), the beat counts
-    they were computed on and ``sigma_s``. Given a ``span`` [s], only beats inside it count
-    (e.g. the time both the dance and the music play).
+    they were computed on and ``sigma_s``. Given a ``span`` [s], only beats inside it are
+    averaged (e.g. the time both the dance and the music play); the nearest beat of the
+    other kind may lie up to ``SPAN_REACH`` sigmas outside it, so a beat on the span's
+    edge danced a frame later still counts.
     """
     mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
+    mb_near, yb_near = mb, yb
     if span is not None:
         lo, hi = float(span[0]), float(span[1])
         if not hi > lo:
             raise ParameterError(f"span={span!r} must be (start, end) with end > start [s]")
+        r = SPAN_REACH * sigma
+        mb_near = mb[(mb >= lo - r) & (mb <= hi + r)]
+        yb_near = yb[(yb >= lo - r) & (yb <= hi + r)]
         mb = mb[(mb >= lo) & (mb <= hi)]
         yb = yb[(yb >= lo) & (yb <= hi)]
     return {
-        "alignment_motion": _score(mb, yb, sigma, "motion beats"),
-        "alignment_music": _score(yb, mb, sigma, "music beats"),
+        "alignment_motion": _score(mb, yb_near, sigma, "motion beats"),
+        "alignment_music": _score(yb, mb_near, sigma, "music beats"),
         "n_motion_beats": int(mb.size),
         "n_music_beats": int(yb.size),
         "sigma_s": sigma,
