@@ -77,6 +77,23 @@ def test_time_warp_lands_boundaries_exactly():
     assert np.allclose(w.to_source(b), s, atol=1e-9)
 
 
+def test_warp_holds_its_rate_around_every_boundary():
+    from beatsync.sync.warp import integrate_warp
+
+    rng = np.random.default_rng(2)
+    s = np.cumsum(np.r_[0.2, rng.uniform(0.7, 1.3, 12)])
+    b = 0.1 + np.cumsum(np.r_[0.0, rng.uniform(0.6, 1.4, 12)])
+    w = integrate_warp(s, b, hold=0.1)
+    assert np.allclose(w.to_target(s), b, atol=1e-9)  # still lands every boundary
+    for x in s[1:-1]:  # constant within 0.1 s on both sides of each inner boundary
+        near = np.abs(w.src - x) <= 0.1 - 1e-9
+        assert near.sum() >= 20 and np.ptp(w.rate[near]) < 1e-9
+    # without a hold the rate changes there
+    free = integrate_warp(s, b)
+    near = np.abs(free.src - s[5]) <= 0.1
+    assert np.ptp(free.rate[near]) > 1e-3
+
+
 def test_time_warp_identity_when_tempi_match():
     s = np.arange(0.0, 5.01, 1.0)
     w = time_warp(s, s + 0.25)
@@ -667,6 +684,18 @@ def test_real_dancer_plays_within_the_speed_band(rumba_on_a_waltz):
     assert np.mean((speed >= 0.8) & (speed <= 1.25)) >= 0.95
     # every motion beat placed lands on a beat or half beat, within half an output frame
     assert res.report["max_abs_residual_frames"] <= 0.5 + 1e-6
+
+
+def test_real_dancer_shows_its_landed_motion_beats_on_the_beat(rumba_on_a_waltz):
+    # the playback speed is held around every landing, so the speed minimum there is
+    # found again in the output within one output frame (86 % of them without the hold)
+    from beatsync.evaluate.alignment import nearest_distance
+    from beatsync.motion_beats import kinematic_beats
+
+    _, _, res = rumba_on_a_waltz
+    landed = np.asarray(res.report["target_beats_s"])[1:-1]  # the ends: no minimum
+    d = nearest_distance(landed, kinematic_beats(res.motion))
+    assert np.mean(d <= 1.0 / res.motion.fps + 1e-9) >= 0.95
 
 
 def test_real_dancer_loop_join_is_seamless(rumba_on_a_waltz):

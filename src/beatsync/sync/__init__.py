@@ -37,7 +37,9 @@ Beyond the paper (real dances)
       0.8-1.25 where the song allows (paper B's bound) and never faster than keeps the
       joints within the dancer's own peak, smooth, dance bars on the music's bar lines
       (``dance_beats_per_period``, else the dance's own phrase when clear), merging an
-      interval or landing on a half beat where no whole count fits.
+      interval or landing on a half beat where no whole count fits. The rate is held
+      for ``LANDING_HOLD`` on both sides of every landed motion beat (a speed minimum),
+      so the stop stays on its beat.
       ``mode="auto"`` uses periods when the periodicity test accepts the motion, else
       beats with a warning.
     - ``boundaries=None`` segments here: in ``"periods"`` over one to eight of the

@@ -51,6 +51,10 @@ PERIOD_BEATS = (0.9, 8.5)
 AUTO_PERIOD_RANGE = (0.25, 1.25)
 #: share of periods that must hold the same number of motion beats to call it a meter
 METER_AGREEMENT = 0.6
+#: beats mode holds the playback speed this long [s] on both sides of every landed motion
+#: beat: the motion-beat detector's smoothing width (``kinematic_beats``' ``smooth``), so
+#: the speed minimum a viewer sees stays on its beat
+LANDING_HOLD = 0.1
 
 
 @dataclass(frozen=True)
@@ -461,7 +465,8 @@ def _go_on(warp: TimeWarp, plan: dict[str, Any], stop: float, last: float) -> Ti
     end = float(min(used[-1] + (stop - targets[-1]) / warp.rate[-1], last))
     if end <= used[-1]:
         return warp
-    return integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+    hold = plan.get("hold", 0.0)
+    return integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"], hold=hold)
 
 
 def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
@@ -474,7 +479,10 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     looped: LoopedClip | None = None
     if counts is None:  # beats mode: the whole dance's counts at once
         looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
-        warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        plan["hold"] = LANDING_HOLD
+        warp = integrate_warp(
+            used, targets, start=0.0, end=end, delta=plan["delta"], hold=LANDING_HOLD
+        )
         p = used.size - 1
         if end is None and plan["song_end"] is not None:
             last = float(looped.events[-1]) if looped is not None else duration

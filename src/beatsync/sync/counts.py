@@ -53,9 +53,10 @@ W_BAR = 3.0
 #: states costlier than the best by more than this are dropped (beam)
 BEAM = 60.0
 #: the counts aim inside the speed band narrowed by this factor at each end: the
-#: smooth warp (eq. 9's blend, then the bump that lands every event on its
-#: beat) overshoots an interval's mean speed by a few percent where neighbours differ
-MARGIN = 1.05
+#: smooth warp (eq. 9's blend, then the bump that lands every event on its beat,
+#: between the held landings) overshoots an interval's mean speed by a few percent
+#: where neighbours differ
+MARGIN = 1.06
 
 
 @dataclass(frozen=True)

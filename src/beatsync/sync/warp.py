@@ -25,6 +25,8 @@ TAPER = 0.25
 MIN_BUMP = -0.9
 #: Gaussian weights are summed over centres within this many widths of a time
 BLEND_REACH = 8.0
+#: a held stretch covers at most this share of a period at each end
+MAX_HOLD = 0.2
 _CHUNK = 4096
 
 
@@ -143,8 +145,14 @@ def integrate_warp(
     start: float | None = None,
     end: float | None = None,
     delta: float | None = None,
+    hold: float = 0.0,
 ) -> TimeWarp:
-    """:func:`time_warp` on inputs already checked (float64, increasing, same length >= 2)."""
+    """:func:`time_warp` on inputs already checked (float64, increasing, same length >= 2).
+
+    ``hold`` [s]: the rate stays at its boundary value this long on both sides of every
+    boundary (at most ``MAX_HOLD`` of a period), so that a speed minimum of the motion
+    there is neither moved nor erased by a change of rate; the bump corrects in between.
+    """
     src_len = np.diff(s)
     tgt_len = np.diff(b)
     if delta is None:
@@ -158,14 +166,21 @@ def integrate_warp(
     centres = 0.5 * (s[:-1] + s[1:])
     r = blended_rate(grid.ravel(), centres, rates, delta=delta).reshape(p, k + 1)
     # exact landing: r~ = r (1 + a_i h), h vanishes at both ends
-    h = correction_bump(u)
+    v = u[None, :]
+    if hold > 0:  # the bump's phase runs over the period between the held ends
+        q = np.minimum(hold / src_len, MAX_HOLD)[:, None]
+        v = np.clip((v - q) / (1.0 - 2.0 * q), 0.0, 1.0)
+        ease = v * v * (3.0 - 2.0 * v)  # flat at 0 and 1: the held boundary rates
+        base = r[:, :1] + (r[:, -1:] - r[:, :1]) * ease
+        r = base + (r - base) * correction_bump(v)
+    h = np.broadcast_to(correction_bump(v), r.shape)
     dt = src_len[:, None] * np.diff(u)[None, :]
     integ = ((r[:, :-1] + r[:, 1:]) * 0.5 * dt).sum(axis=1)
-    rh = r * h[None, :]
+    rh = r * h
     integ_h = ((rh[:, :-1] + rh[:, 1:]) * 0.5 * dt).sum(axis=1)
     a = (tgt_len - integ) / integ_h
     scaled = a <= MIN_BUMP
-    rc = r * (1.0 + a[:, None] * h[None, :])
+    rc = r * (1.0 + a[:, None] * h)
     if scaled.any():
         rc[scaled] = r[scaled] * (tgt_len[scaled] / integ[scaled])[:, None]
     seg = (rc[:, :-1] + rc[:, 1:]) * 0.5 * dt  # (p, k)
