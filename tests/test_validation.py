@@ -13,6 +13,7 @@ from beatsync.validation import (
     as_int,
     check_audio,
     check_bpm,
+    check_choice,
     check_finite,
     check_fps,
     check_motion_fps,
@@ -329,3 +330,13 @@ def test_check_interval_accepts_arrays_and_lists():
 
     assert check_interval(np.array([0.5, 2.0]), name="r", unit="s") == (0.5, 2.0)
     assert check_interval([1, 3], name="r", unit="s") == (1.0, 3.0)
+
+
+def test_check_choice_names_the_value_and_the_options():
+    assert check_choice("loop", ("stop", "loop"), name="fill") == "loop"
+    with pytest.raises(ParameterError, match=r"fill='Loop' must be one of 'stop', 'loop'"):
+        check_choice("Loop", ("stop", "loop"), name="fill")
+    # not text (an array, a number): refused the same way, not numpy's truth-value error
+    for bad in (np.array(["loop"]), 1, None):
+        with pytest.raises(ParameterError, match=r"fill=.* must be one of"):
+            check_choice(bad, ("stop", "loop"), name="fill")

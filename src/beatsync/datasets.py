@@ -11,13 +11,13 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from . import io
 from .errors import ParameterError
 from .motion import Motion
+from .validation import check_choice
 
 __all__ = [
     "CHECKSUMS",
@@ -132,14 +132,9 @@ def verify_all() -> dict[str, bool]:
     return out
 
 
-def _known(name: str, known: Any, what: str) -> None:
-    if name not in known:
-        raise ParameterError(f"unknown {what} {name!r}; choose from {list(known)}")
-
-
 def load_salsa(take: str = "60_01") -> Motion:
     """A CMU salsa clip (``"60_01"``, ``"61_01"``, ``"60_04"``, ``"61_04"``) at 60 fps."""
-    _known(take, SALSA_CLIPS, "salsa take")
+    check_choice(take, SALSA_CLIPS, name="take")
     m = io.read_bvh(path(f"motion/cmu_salsa/{take}_scaled.bvh"), fps=CMU_FPS)
     return m.rename(f"salsa_{take}")
 
@@ -147,14 +142,14 @@ def load_salsa(take: str = "60_01") -> Motion:
 def load_walk(clip: str = "007_01") -> Motion:
     """A CMU subject 7 walk (``"007_01"``, ``"007_02"``, ``"007_12"``) or the 5 pirouette
     (``"005_02"``, not periodic) at 60 fps."""
-    _known(clip, WALK_CLIPS, "clip")
+    check_choice(clip, WALK_CLIPS, name="clip")
     m = io.read_bvh(path(f"motion/cmu_walk_modern/{clip}.bvh"), fps=CMU_FPS)
     return m.rename(f"cmu_{clip}")
 
 
 def load_mocap_toolbox(variable: str = "dance2") -> Motion:
     """MoCap Toolbox demo markers (``"dance1"``, ``"dance2"``, ``"walk1"``, ``"walk2"``), 60 Hz, metres."""
-    _known(variable, ("dance1", "dance2", "walk1", "walk2"), "MoCap Toolbox recording")
+    check_choice(variable, ("dance1", "dance2", "walk1", "walk2"), name="variable")
     return io.read_mocap_mat(path("motion/mocaptoolbox/mcdemodata.mat"), variable)
 
 
@@ -197,7 +192,7 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
 
     Frame ``i`` of the motion plays at time ``audio_offset + i / fps`` of ``y``.
     """
-    _known(name, DANCE_PAIRS, "Dance-with-Melody pair")
+    check_choice(name, DANCE_PAIRS, name="name")
     folder = f"motion/dance_with_melody/{name}"
     excerpt = json.loads(path(f"{folder}/excerpt.json").read_text(encoding="utf-8"))
     motion = io.read_motion(
@@ -211,7 +206,7 @@ def load_dance_pair(name: str = "DANCE_C_4") -> DancePair:
 def load_real_dev(name: str) -> tuple[np.ndarray, int, np.ndarray]:
     """``(y, sr, beats [s])`` of a real recording with human beat annotations: Hainsworth
     excerpt 001 (4/4, about 100 BPM) or ``"ballroom_waltz"`` (Media-105901, 3/4, 84 BPM)."""
-    _known(name, REAL_DEV_ITEMS, "development recording")
+    check_choice(name, REAL_DEV_ITEMS, name="name")
     audio, beats = REAL_DEV_ITEMS[name]
     y, sr = io.read_audio(path(f"audio/real_dev/{audio}"))
     return y, sr, io.read_beats(path(f"audio/real_dev/{beats}"))

@@ -30,6 +30,7 @@ from scipy.signal import find_peaks
 
 from .errors import ParameterError, warn
 from .validation import (
+    check_choice,
     check_finite,
     check_fps,
     check_positive,
@@ -190,8 +191,7 @@ def kinematic_beat_frames(
     ``rel_prominence``: minimum prominence of an extremum, relative to the median
     absolute value (speed) or the median absolute deviation (pca) of the curve.
     """
-    if method not in ("speed", "pca"):
-        raise ParameterError(f"method={method!r} is not one of ('speed', 'pca')")
+    check_choice(method, ("speed", "pca"), name="method")
     pos, fps = _check_positions(positions, fps)
     min_interval = _check_seconds(min_interval, name="min_interval")
     rel_prominence = check_positive(

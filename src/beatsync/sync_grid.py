@@ -239,11 +239,10 @@ def sync_grid(
     from .io import check_input_file
     from .segment.checks import check_alpha, check_period_range
     from .sync import MODES
-    from .validation import check_cluster_options, check_motion_fps
+    from .validation import check_choice, check_cluster_options, check_motion_fps
 
     check_cluster_options(scheduler, n_workers)
-    if mode not in MODES:
-        raise ParameterError(f"mode={mode!r} must be one of {', '.join(MODES)}")
+    check_choice(mode, MODES, name="mode")
     # settings shared by every clip: refused here, once, before any worker starts
     if fps is not None:
         fps = check_motion_fps(fps)

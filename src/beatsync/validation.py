@@ -97,6 +97,14 @@ def as_int(
     return i
 
 
+def check_choice(value: Any, options: Any, *, name: str) -> str:
+    """Return ``value`` if it is one of the strings ``options``, else refuse it naming them."""
+    options = tuple(options)
+    if not isinstance(value, str) or value not in options:
+        raise ParameterError(f"{name}={value!r} must be one of {', '.join(map(repr, options))}")
+    return value
+
+
 def check_fps(fps: Any, *, name: str = "fps") -> float:
     """Return ``fps`` [Hz] as a float: finite, > 0, not a period in seconds (< 1 Hz)."""
     value = as_float(fps, name=name, unit="Hz", allow_nonfinite=True, text=True)

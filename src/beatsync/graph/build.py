@@ -34,7 +34,14 @@ import numpy as np
 
 from ..errors import ParameterError, silenced, warn
 from ..motion_beats import interval_intensity, kinematic_beat_frames, motion_positions, zscore
-from ..validation import check_fps, check_positive, check_times, frames_to_time, time_to_frames
+from ..validation import (
+    check_choice,
+    check_fps,
+    check_positive,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 from .distance import aligned_distance_matrix, point_clouds, typical_speed
 
 __all__ = [
@@ -54,8 +61,7 @@ _ARRAYS = ("node_clip", "node_frame", "next_node", "intensity", "z_intensity",
 
 def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:
     """Eq. 2: ``w2 = rd if rd > 2 else 2`` (``"paper"``) or ``w2 = rd`` (``"rd"``)."""
-    if rule not in WEIGHT_RULES:
-        raise ParameterError(f"weight_rule={rule!r} is not one of {WEIGHT_RULES}")
+    check_choice(rule, WEIGHT_RULES, name="weight_rule")
     rd = np.asarray(rd, dtype=np.float64)
     if rule == "paper":
         return np.where(rd > 2.0, rd, 2.0)
@@ -345,8 +351,7 @@ def build_graph(
     t0 = time.perf_counter()
     clips = check_library(clips)
     th = check_th(th)
-    if weight_rule not in WEIGHT_RULES:
-        raise ParameterError(f"weight_rule={weight_rule!r} is not one of {WEIGHT_RULES}")
+    check_choice(weight_rule, WEIGHT_RULES, name="weight_rule")
     if up_axis not in ("y", "z"):
         raise ParameterError(f"up_axis={up_axis!r} must be 'y' (BVH) or 'z'")
     up = "xyz".index(up_axis)

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ParameterError, silenced, warn
 from ..motion import Motion
 from ..motion_beats import zscore
-from ..validation import check_finite, check_times
+from ..validation import check_choice, check_finite, check_times
 from .baselines import check_conventional_options, conventional_core, random_core
 from .build import WeightedMotionGraph
 from .objective import SearchResult, prepare_search
@@ -138,8 +138,7 @@ def compose(
             f"music_level has {level.size} values for {beats.size - 1} beat intervals "
             "(one per interval between successive beats)"
         )
-    if method not in METHODS:
-        raise ParameterError(f"method={method!r} is not one of {METHODS}")
+    check_choice(method, METHODS, name="method")
     bound = check_scale_bound(scale_bound)
     mult = check_multiplicity(multiplicity)
     if bound is None and mult == "auto":

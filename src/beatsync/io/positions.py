@@ -32,7 +32,7 @@ from ..motion import (
     PositionInfo,
     fill_joint_gaps,
 )
-from ..validation import check_fps, check_positive
+from ..validation import check_choice, check_fps, check_positive
 from ._files import atomic_write, check_input_file
 from .tables import need_fps, read_npz
 
@@ -45,11 +45,9 @@ _KEYPOINT_KEYS = ("keypoints3d", "keypoints3d_optim", "positions", "joints")
 
 def _options(up: Any, units: Any, bones: Any, max_gap: Any) -> dict[str, Any]:
     """The readers' common options, checked (``up``/``units`` ``None``: detect)."""
-    for name, value, choices in (("up", up, ("y", "z")), ("units", units, tuple(UNIT_METRES))):
-        if value is not None and value not in choices:
-            raise ParameterError(
-                f"{name}={value!r} must be one of {', '.join(repr(c) for c in choices)}"
-            )
+    for name, value, choices in (("up", up, ("y", "z")), ("units", units, UNIT_METRES)):
+        if value is not None:
+            check_choice(value, choices, name=name)
     max_gap = check_positive(max_gap, name="max_gap", unit="s", allow_zero=True)
     return {"up": up, "units": units, "bones": bones, "max_gap": max_gap}
 

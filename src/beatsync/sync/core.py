@@ -16,6 +16,7 @@ from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_
 from ..validation import (
     as_float,
     as_int,
+    check_choice,
     check_interval,
     check_motion_fps,
     check_positive,
@@ -95,12 +96,6 @@ def position_bones(motion: Any) -> np.ndarray | None:
         return None
     bones = np.asarray(motion.bones, dtype=np.int64).reshape(-1, 2)
     return bones if bones.size else None
-
-
-def _choice(value: Any, options: tuple[str, ...], name: str) -> str:
-    if not isinstance(value, str) or value not in options:
-        raise ParameterError(f"{name}={value!r} must be one of {', '.join(options)}")
-    return value
 
 
 def _events(
@@ -296,9 +291,9 @@ def synchronize(
         ``mode="periods"`` without ``boundaries`` on a motion segmentation does not
         show periodic (:func:`motion_periods`); ``"beats"`` or ``"auto"`` can sync it.
     """
-    mode = _choice(mode, MODES, "mode")
-    land = _choice(land, LANDINGS, "land")
-    fill = _choice(fill, FILLS, "fill")
+    mode = check_choice(mode, MODES, name="mode")
+    land = check_choice(land, LANDINGS, name="land")
+    fill = check_choice(fill, FILLS, name="fill")
     fps = check_motion_fps(motion.fps, name="motion.fps")
     out_fps = fps if out_fps is None else check_motion_fps(out_fps, name="out_fps")
     n_frames = int(motion.n_frames)
