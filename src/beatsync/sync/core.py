@@ -453,15 +453,14 @@ def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
         warn(note, stacklevel=3)
 
 
-def _go_on(warp: TimeWarp, plan: dict[str, Any], stop: float, last: float) -> TimeWarp:
+def _go_on(warp: TimeWarp, stop: float, last: float, hold: float = 0.0) -> TimeWarp:
     """``warp`` going on after its last boundary at its end rate up to music time ``stop``
     [s], or as far as the source reaches (``last`` [s])."""
     used, targets = warp.boundaries, warp.targets
     end = float(min(used[-1] + (stop - targets[-1]) / warp.rate[-1], last))
     if end <= used[-1]:
         return warp
-    hold = plan.get("hold", 0.0)
-    return integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"], hold=hold)
+    return integrate_warp(used, targets, start=0.0, end=end, delta=warp.delta, hold=hold)
 
 
 def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
@@ -474,14 +473,13 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     looped: LoopedClip | None = None
     if counts is None:  # beats mode: the whole dance's counts at once
         looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
-        plan["hold"] = LANDING_HOLD
         warp = integrate_warp(
             used, targets, start=0.0, end=end, delta=plan["delta"], hold=LANDING_HOLD
         )
         p = used.size - 1
         if end is None and plan["song_end"] is not None:
             last = float(looped.events[-1]) if looped is not None else duration
-            warp = _go_on(warp, plan, plan["song_end"] + phase_offset, last)
+            warp = _go_on(warp, plan["song_end"] + phase_offset, last, LANDING_HOLD)
     else:
         cum = np.concatenate([[0], np.cumsum(counts)])
         # beats to cover: up to the last one, and the song's end in beats after it
@@ -518,7 +516,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             # cover the beats after the last whole interval (and the song's end) with part
             # of the next one, at the warp's end rate
             stop = beats[last_beat] if plan["song_end"] is None else plan["song_end"]
-            warp = _go_on(warp, plan, stop + phase_offset, float(events[-1]))
+            warp = _go_on(warp, stop + phase_offset, float(events[-1]))
         placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
     tau_end = float(warp.tgt[-1])  # > 0: targets increase from check_start's >= 0
     # the last frame is the first one at or after the last warped time, so the frame
