@@ -520,10 +520,20 @@ def test_fill_loop_dances_on_to_the_songs_end(mode):
     assert stop.report["covered_s"][1] == pytest.approx(beats[-1])
 
 
-def test_song_end_before_the_last_beat_is_refused():
+def test_song_end_before_the_last_beat_or_in_milliseconds_is_refused():
     m = _periodic_motion(period=1.0, duration=6.0)
     with pytest.raises(ParameterError, match=r"song_end=9 s is before the music's last beat"):
         synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0.3, 20.0, 0.5), song_end=9)
+    with pytest.raises(ParameterError, match=r"song_end=21400 s .*milliseconds given"):
+        synchronize(m, np.arange(0.0, 5.5, 1.0), np.arange(0.3, 20.0, 0.5), song_end=21400)
+
+
+def test_beats_mode_dances_through_a_long_outro():
+    # 40 s of song after its last beat (a beatless outro): the loop reaches it too
+    m = _arm_positions(fps=FPS, seconds=6.0)
+    beats = np.arange(0.3, 20.0, 0.5)
+    res = synchronize(m, None, beats, mode="beats", fill="loop", song_end=60.0)
+    assert res.report["covered_s"][1] == pytest.approx(60.0)
 
 
 # ---------------------------------------------------------------- modes

@@ -41,7 +41,8 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
         )
     looped = None
     timeline, index = events, np.arange(events.size)
-    span_s = float(song[-1] - song[0])
+    # music to cover: to the last beat, or on to the song's end
+    span_s = float(max(song[-1], plan["song_end"] or 0.0) - song[0])
     if plan["fill"] == "loop" and events[-1] - events[0] < LOOP_REACH * span_s:
         a, b, angle, shift, dist, join = choose_loop(motion, events, dance=plan["dance"])
         length = events[b] - events[a]
