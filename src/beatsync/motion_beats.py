@@ -200,10 +200,10 @@ def kinematic_beat_frames(
     distance = max(1, int(time_to_frames(min_interval, fps=fps, mode="round")))
     if method == "speed":
         curve = speed_curve(pos, fps=fps, smooth=smooth)
-        scale = float(np.median(np.abs(curve)))
     else:
         curve = pca_curve(pos, fps=fps, window=window, smooth=smooth)
-        scale = float(np.median(np.abs(curve - np.median(curve))))
+    # the speed's median value, the projection's median absolute deviation
+    scale = float(np.median(np.abs(curve - (0.0 if method == "speed" else np.median(curve)))))
     prom = rel_prominence * scale if scale > 0 else None
     if method == "speed":
         frames, _ = find_peaks(-curve, distance=distance, prominence=prom)

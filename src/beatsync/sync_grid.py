@@ -2,8 +2,8 @@
 
 Each song's beats are tracked once, each clip is read and segmented once, and every
 (clip, song) pair is synchronised from those results as ``beatsync sync`` does with its
-defaults (:func:`beatsync.sync.synchronize`; ``mode="auto"``, looped to the song's last
-beat, the song's estimated meter respected). A pair that fails records its error in its
+defaults (:func:`beatsync.sync.synchronize`; ``mode="auto"``, looped to the song's end,
+the song's estimated meter respected). A pair that fails records its error in its
 row instead of stopping the study. Outputs are ``<clip>__<song>`` under ``out_dir`` in
 the clip's own kind of file (:func:`output_suffix`), items named by their file name
 without suffix, or by their folder where file names repeat (:func:`item_names`).

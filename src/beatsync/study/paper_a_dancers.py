@@ -300,19 +300,16 @@ def motion_table(
     """(e) Per dancer re-synchronised to :data:`OTHER_SONG` (one sync ``mode``): playback
     speed, joint kinematics against the dancer's own, the joins, and the alignment
     scores of :func:`dancer_table` (after, random-offset control, own song); speeds and
-    kinematics computed from the output frames (:mod:`beatsync.sync.quality`).
+    kinematics as the sync report computes them from the output frames
+    (:mod:`beatsync.sync.quality`).
     """
     import pandas as pd
 
-    from ..sync.quality import joint_kinematics
-
     rows = []
     t = table[table["mode"] == mode].set_index("dancer")
-    for name, pair in pairs.items():
+    for name in pairs:
         res = results[(name, mode)]
-        kin = joint_kinematics(
-            pair.motion.positions(), pair.motion.fps, res.motion.positions(), res.motion.fps
-        )
+        kin = res.report["kinematics"]
         ratio, own_peak = kin["ratio"], kin["input"]["peak_joint_speed"]
         speed = _playback_speed(res)
         joins = [j.get("peak_joint_speed", np.nan) for j in res.report.get("joins", [])]

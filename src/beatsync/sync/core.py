@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -152,10 +152,8 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
             pos = motion_positions(motion)
         except ParameterError:  # no joint positions either: the segmentation's own message
             raise exc from None
-        with np.errstate(invalid="ignore"):
-            span = float(np.nanmax(np.abs(pos - pos[:1]))) if pos.size else 0.0
-            scale = float(np.nanmax(np.abs(pos))) if pos.size else 0.0
-        if not (np.isfinite(span) and span > 1e-9 * max(scale, 1e-300)):
+        # positions are finite (motion_positions checks): still, or moving
+        if not np.abs(pos - pos[:1]).max(initial=0.0) > 1e-9 * np.abs(pos).max(initial=0.0):
             raise ParameterError(
                 f"the dancer does not move: every joint keeps its position over the "
                 f"{motion.n_frames} frames, so there is nothing to synchronise"
@@ -386,6 +384,7 @@ def synchronize(
         "delta": delta,
         "duration": duration,
         "song_end": song_end if fill == "loop" else None,
+        "beat_period": beat_period,
     }
     lag = 0.0
     res = _resample(plan, phase_offset)
@@ -458,14 +457,19 @@ def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
         warn(note, stacklevel=3)
 
 
-def _go_on(warp: TimeWarp, stop: float, last: float, hold: float = 0.0) -> TimeWarp:
-    """``warp`` going on after its last boundary at its end rate up to music time ``stop``
-    [s], or as far as the source reaches (``last`` [s])."""
-    used, targets = warp.boundaries, warp.targets
-    end = float(min(used[-1] + (stop - targets[-1]) / warp.rate[-1], last))
-    if end <= used[-1]:
+def _go_on(warp: TimeWarp, stop: float, last: float) -> TimeWarp:
+    """``warp`` (ending on its last boundary) going on at its end rate up to music time
+    ``stop`` [s], or as far as the source reaches (``last`` [s]): one more knot."""
+    rate = warp.rate[-1]
+    end = float(min(warp.src[-1] + (stop - warp.tgt[-1]) / rate, last))
+    if end <= warp.src[-1]:
         return warp
-    return integrate_warp(used, targets, start=0.0, end=end, delta=warp.delta, hold=hold)
+    return replace(
+        warp,
+        src=np.append(warp.src, end),
+        tgt=np.append(warp.tgt, warp.tgt[-1] + (end - warp.src[-1]) * rate),
+        rate=np.append(warp.rate, rate),
+    )
 
 
 def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
@@ -484,13 +488,13 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         p = used.size - 1
         if end is None and plan["song_end"] is not None:
             last = float(looped.events[-1]) if looped is not None else duration
-            warp = _go_on(warp, plan["song_end"] + phase_offset, last, LANDING_HOLD)
+            warp = _go_on(warp, plan["song_end"] + phase_offset, last)
     else:
         cum = np.concatenate([[0], np.cumsum(counts)])
         # beats to cover: up to the last one, and the song's end in beats after it
         reach = last_beat - first_beat
         if plan["song_end"] is not None:
-            reach += int(np.ceil((plan["song_end"] - beats[-1]) / np.median(np.diff(beats))))
+            reach += int(np.ceil((plan["song_end"] - beats[-1]) / plan["beat_period"]))
         if plan["fill"] == "loop" and cum[-1] < reach:
             # enough repetitions that whole intervals reach it, plus one for the tail
             a, b, angle, shift, dist, join = choose_loop(motion, events)

@@ -170,10 +170,11 @@ def integrate_warp(
     if hold > 0:  # the bump's phase runs over the period between the held ends
         q = np.minimum(hold / src_len, MAX_HOLD)[:, None]
         v = np.clip((v - q) / (1.0 - 2.0 * q), 0.0, 1.0)
+    h = np.broadcast_to(correction_bump(v), r.shape)
+    if hold > 0:
         ease = v * v * (3.0 - 2.0 * v)  # flat at 0 and 1: the held boundary rates
         base = r[:, :1] + (r[:, -1:] - r[:, :1]) * ease
-        r = base + (r - base) * correction_bump(v)
-    h = np.broadcast_to(correction_bump(v), r.shape)
+        r = base + (r - base) * h
     dt = src_len[:, None] * np.diff(u)[None, :]
     integ = ((r[:, :-1] + r[:, 1:]) * 0.5 * dt).sum(axis=1)
     rh = r * h
