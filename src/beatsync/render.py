@@ -31,6 +31,7 @@ import numpy as np
 from .errors import ParameterError, warn
 from .validation import (
     check_audio,
+    check_choice,
     check_fps,
     check_motion_fps,
     check_positive,
@@ -60,20 +61,15 @@ def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
     position-only motion, none for a table whose bones are unknown (drawn as dots)."""
     from .motion_beats import motion_positions
 
-    skel = getattr(motion, "skeleton", None)
-    if skel is not None:
-        bones = [(i, j.parent) for i, j in enumerate(skel.joints) if j.parent >= 0]
-    else:
-        bones = motion.bones if getattr(motion, "is_positional", False) else []
-    return motion_positions(motion), np.asarray(bones, dtype=np.int64).reshape(-1, 2)
+    has_bones = motion.skeleton is not None or motion.is_positional
+    bones = motion.bones if has_bones else np.zeros((0, 2), dtype=np.int64)
+    return motion_positions(motion), bones
 
 
 def _up_axis(motion: Any, up: str | None) -> int:
     if up is None:
         up = "y" if getattr(motion, "skeleton", None) is not None else "z"
-    if up not in ("x", "y", "z"):
-        raise ParameterError(f"up={up!r} must be 'x', 'y' or 'z' (the vertical axis of the data)")
-    return "xyz".index(up)
+    return "xyz".index(check_choice(up, ("x", "y", "z"), name="up"))
 
 
 def project(positions: Any, *, up: int = 1, azimuth: float = 0.0) -> np.ndarray:
@@ -90,9 +86,11 @@ def project(positions: Any, *, up: int = 1, azimuth: float = 0.0) -> np.ndarray:
 
 
 def _near_beat(times: np.ndarray, beats: np.ndarray | None, tol: float) -> np.ndarray:
+    from .evaluate.alignment import nearest_distance
+
     if beats is None or len(beats) == 0:
         return np.zeros(times.shape, dtype=bool)
-    return np.abs(times[:, None] - beats[None, :]).min(axis=1) <= tol
+    return nearest_distance(times, beats) <= tol
 
 
 def beat_strip_times(
@@ -199,10 +197,9 @@ def plot_beat_timeline(
 
     import matplotlib.pyplot as plt
 
-    from .motion_beats import speed_curve
+    from .motion_beats import motion_positions, speed_curve
 
-    pos, _ = pose_positions(motion)
-    speed = speed_curve(pos, fps=motion.fps, smooth=smooth)
+    speed = speed_curve(motion_positions(motion), fps=motion.fps, smooth=smooth)
     t = frames_to_time(np.arange(speed.size), fps=motion.fps)
     if ax is None:
         fig, ax = plt.subplots(figsize=(8, 2.4))
@@ -532,8 +529,7 @@ def write_video(
 
     if not 0.0 <= float(elevation) <= 80.0:
         raise ParameterError(f"elevation={elevation!r} must be in [0, 80] degrees")
-    if preset not in _PRESETS:
-        raise ParameterError(f"preset={preset!r} is not an x264 preset; one of {_PRESETS}")
+    check_choice(preset, _PRESETS, name="preset")
     exe = find_ffmpeg() if ffmpeg is None else (ffmpeg or None)
     t, src, on = _video_frames(motion, fps, beats_arr, duration)
     pos, bones = pose_positions(motion)

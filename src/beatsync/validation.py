@@ -24,6 +24,7 @@ __all__ = [
     "time_to_frames",
     "as_float",
     "as_int",
+    "check_choice",
     "check_fps",
     "check_times",
     "check_finite",
@@ -144,6 +145,7 @@ def time_to_frames(
     ``round_to_int=False`` gives fractional frames; ``mode`` "floor"/"ceil" give the
     frame at or before/after the time (1e-9 frames of tolerance for float error).
     """
+    check_choice(mode, ("round", "floor", "ceil"), name="mode")
     fps = check_fps(fps)
     frames = np.asarray(times, dtype=np.float64) * fps
     if not round_to_int:
@@ -152,9 +154,7 @@ def time_to_frames(
         return np.rint(frames).astype(np.int64)
     if mode == "floor":
         return np.floor(frames + 1e-9).astype(np.int64)
-    if mode == "ceil":
-        return np.ceil(frames - 1e-9).astype(np.int64)
-    raise ParameterError(f"mode={mode!r} must be 'round', 'floor' or 'ceil'")
+    return np.ceil(frames - 1e-9).astype(np.int64)
 
 
 _KIND_NAMES = {

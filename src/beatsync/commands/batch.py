@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from . import COMMAND_HELP
 from ._common import (
     add_mode,
     add_output_flags,
@@ -17,7 +18,7 @@ from ._common import (
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "batch",
-        help="sync every motion clip with every song, in parallel on Dask",
+        help=COMMAND_HELP["batch"],
         description="Track each song's beats once, segment each clip once, then sync every "
         "(clip, song) pair on a Dask cluster (local by default), as `beatsync sync` does with its "
         "defaults (--mode auto, the dance looped to the song's end). Clips or songs "

@@ -152,7 +152,11 @@ def _library_files(entries: list[str]) -> list[Path]:
     return files
 
 
-def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Outputs]:
+def _check_inputs(
+    args: argparse.Namespace,
+) -> tuple[str, list[Path], float, Outputs, tuple[Path, Path | None, Path | None]]:
+    """The audio, the library's files, ``--th``, and the outputs with their paths
+    (motion, video, report), all checked before any work."""
     from ..graph.build import check_th
     from ..io import AUDIO_SUFFIXES, check_input_file
 
@@ -175,12 +179,10 @@ def _check_inputs(args: argparse.Namespace) -> tuple[str, list[Path], float, Out
     if Path(args.output).suffix.lower() != ".bvh":
         raise ParameterError(f"output {args.output!r} must end in .bvh")
     outs = Outputs(inputs=(audio, args.beats, *files))
-    outs.add(args.output, option="-o/--output")
-    if args.video:
-        outs.add(args.video, option="--video", suffixes=[".mp4"])
-    if args.report:
-        outs.add(args.report, option="--report", suffixes=[".json"])
-    return audio, files, th, outs
+    out = outs.add(args.output, option="-o/--output")
+    video = outs.add(args.video, option="--video", suffixes=[".mp4"]) if args.video else None
+    report = outs.add(args.report, option="--report", suffixes=[".json"]) if args.report else None
+    return audio, files, th, outs, (out, video, report)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -191,7 +193,8 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--tempo-weight {args.tempo_weight!r} must be >= 0")
     if not (np.isfinite(args.blend) and 0 <= args.blend <= 5):
         raise ParameterError(f"--blend {args.blend!r} must be a duration in [0, 5] s")
-    audio, files, th, outs = _check_inputs(args)  # files after the options: cheapest first
+    # files after the options: cheapest first
+    audio, files, th, outs, (out, video_path, report) = _check_inputs(args)
     fb = feedback(args)
     from ..graph.timescale import check_multiplicity, check_scale_bound
 
@@ -245,9 +248,6 @@ def run(args: argparse.Namespace) -> int:
             **kw,
         )
     notes += composed
-    out = Path(args.output)
-    video_path = Path(args.video) if args.video else None
-    report = Path(args.report) if args.report else None
     result = {
         "output": str(out),
         "video": str(video_path) if video_path else None,

@@ -92,7 +92,8 @@ def _period_rates(answer: Any) -> str | None:
     """``period_rates(boundaries, targets)``: r_i of every period (paper A, sec. 5)."""
     from ..sync import time_warp
 
-    boundaries, beats = (a.copy() for a in (_case()[0].boundaries, _case()[1]))
+    syn, beats = _case()
+    boundaries, beats = syn.boundaries.copy(), beats.copy()
     targets = beats[: 2 * boundaries.size : 2][: boundaries.size]
     expected = time_warp(boundaries, targets).period_rates
     got = answer(boundaries, targets)
