@@ -18,6 +18,7 @@ from ..errors import ParameterError, warn
 from ..validation import check_audio as _units_check_audio
 from ..validation import (
     check_bpm,
+    check_choice,
     check_positive,
     check_range,
     check_times,
@@ -204,8 +205,7 @@ def track_beats(
                 f"front-end parameters {sorted(frontend_params)} only apply to method='psf'"
             )
         return _track_librosa(y, sr, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm)
-    if method != "psf":
-        raise ParameterError(f"method={method!r} is unknown; choose 'psf' or 'librosa'")
+    check_choice(method, ("psf", "librosa"), name="method")
     prior_period_s = check_positive(prior_period_s, name="prior_period_s", unit="s")
     prior_sigma = check_positive(prior_sigma, name="prior_sigma", unit="log-period")
     tempo_win_s = check_positive(tempo_win_s, name="tempo_win_s", unit="s")

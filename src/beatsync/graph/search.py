@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..validation import check_choice
 from .baselines import conventional_search, random_walk
 from .build import WeightedMotionGraph
 from .objective import SearchResult, grid_times, make_result, path_cost, prepare_search
@@ -81,8 +81,7 @@ def dp_search(
 
 def dp_core(graph, music_z, lam, tw, md, bound, steps, mask, *, start="any", subdivision=1):
     """:func:`dp_search` on validated inputs but ``start`` (the compose path calls this)."""
-    if start not in ("any", "clip_start"):
-        raise ParameterError(f"start={start!r} must be 'any' or 'clip_start'")
+    check_choice(start, ("any", "clip_start"), name="start")
     t0 = time.perf_counter()
     pred, weight, _ = graph.predecessor_table()
     lw = weight * lam if lam > 0 else np.where(np.isinf(weight), np.inf, 0.0)

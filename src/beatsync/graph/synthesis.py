@@ -34,7 +34,7 @@ from ..rotations import (
     rotation_to_euler,
     sample_motion,
 )
-from ..validation import check_fps, check_times, frames_to_time, time_to_frames
+from ..validation import check_choice, check_fps, check_times, frames_to_time, time_to_frames
 from .build import WeightedMotionGraph
 from .distance import ground_axes
 
@@ -127,8 +127,7 @@ def check_output(graph, beats, fps, blend, warp, start_time, end_time):
     blend = float(blend)
     if not np.isfinite(blend) or blend < 0 or blend > 5:
         raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
-    if warp not in ("pchip", "linear"):
-        raise ParameterError(f"warp={warp!r} must be 'pchip' or 'linear'")
+    check_choice(warp, ("pchip", "linear"), name="warp")
     end_time = float(beats[-1]) if end_time is None else float(end_time)
     if not end_time > start_time >= 0:
         raise ParameterError(f"end_time={end_time!r} must be > start_time={start_time!r} >= 0")

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..validation import as_float, as_int, check_finite, check_interval
+from ..validation import as_float, as_int, check_choice, check_finite, check_interval
 from .period import PERIOD_METHODS
 
 __all__ = [
@@ -57,8 +57,7 @@ def check_n_periods(n_periods: Any) -> int | None:
 
 def check_period_method(period_method: Any, n_periods: int | None) -> str:
     """The method actually used: ``"given"`` when a count is given, else the one asked."""
-    if period_method not in PERIOD_METHODS:
-        raise ParameterError(f"period_method={period_method!r}: choose one of {PERIOD_METHODS}")
+    check_choice(period_method, PERIOD_METHODS, name="period_method")
     if period_method == "given" and n_periods is None:
         raise ParameterError("period_method='given' needs n_periods (the period count)")
     return "given" if n_periods is not None else str(period_method)

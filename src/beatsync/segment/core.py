@@ -19,6 +19,7 @@ from ..validation import (
     MAX_BPM,
     MIN_BPM,
     as_float,
+    check_choice,
     check_finite,
     check_fps,
     check_interval,
@@ -390,8 +391,7 @@ def estimate_period_count(
     """
     fps = check_fps(fps)
     lo_s, hi_s = check_period_range(period_range)
-    if method not in ("energy", "fft"):
-        raise ParameterError(f"method={method!r}: choose 'energy' or 'fft'")
+    check_choice(method, ("energy", "fft"), name="method")
     vals = check_values(values)
     n = vals.shape[0]
     lo_f, hi_f = _frame_band(n, fps, (lo_s, hi_s))

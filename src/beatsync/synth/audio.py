@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..validation import (
     check_bpm,
+    check_choice,
     check_positive,
     check_times,
     frames_to_time,
@@ -201,8 +202,7 @@ def meter_pattern(
     """A drum pattern in ``meter`` (:data:`METERS`; ``beats`` the tactus), float32: a kick on
     the first beat of every bar, snares on the others, a hi-hat on every eighth.
     """
-    if meter not in METERS:
-        raise ParameterError(f"meter={meter!r} is unknown; choose from {sorted(METERS)}")
+    check_choice(meter, sorted(METERS), name="meter")
     beats, sr, duration = _check_common(beats, sr, duration)
     per_bar, eighths = METERS[meter]
     down = np.arange(beats.size) % per_bar == 0
@@ -263,8 +263,8 @@ def make_beat_test_set(
     if duration < 4.0:
         raise ParameterError(f"duration={duration!r} s is too short for a test item (>= 4 s)")
     for what, values, known in (("kind", kinds, KINDS), ("group", groups, GROUPS)):
-        for v in set(values) - set(known):
-            raise ParameterError(f"unknown {what} {v!r}; choose from {known}")
+        for v in values:  # the first unknown one, in the order given
+            check_choice(v, known, name=what)
     rng = np.random.default_rng(seed)
     items = []
     for kind in kinds:
