@@ -259,6 +259,9 @@ def test_conventional_and_random_are_feasible(graph):
     rw2 = random_walk(graph, k_n, seed=5)
     np.testing.assert_array_equal(rw1.path, rw2.path)
     path_cost(graph, rw1.path, music)  # raises if a step is not an edge
+    # the control optimises nothing: it reports no costs, but its transitions
+    assert np.isnan([rw1.cost, rw1.intensity_cost, rw1.transition_cost]).all()
+    assert rw1.transitions.shape == rw1.path.shape
 
 
 def test_search_bad_inputs(graph):

@@ -55,8 +55,17 @@ __all__ = [
 
 WEIGHT_RULES = ("paper", "rd")
 # the graph's arrays, as stored in the on-disk cache
-_ARRAYS = ("node_clip", "node_frame", "next_node", "intensity", "z_intensity",
-           "trans_src", "trans_dst", "trans_rd", "trans_weight")  # fmt: skip
+_ARRAYS = (
+    "node_clip",
+    "node_frame",
+    "next_node",
+    "intensity",
+    "z_intensity",
+    "trans_src",
+    "trans_dst",
+    "trans_rd",
+    "trans_weight",
+)
 
 
 def transition_weight(rd: Any, rule: str = "paper") -> np.ndarray:

@@ -194,8 +194,6 @@ def make_result(graph, path, bnd, music_z, lam, tw, md, bound, method, elapsed, 
     total, inten, tcost, tempo, trans = path_cost_core(
         graph, path, bnd, music_z, lam, tw, md, bound
     )
-    if method == "random":  # the control optimises nothing: no costs
-        total = inten = tcost = float("nan")
     return SearchResult(
         path=path,
         boundaries=bnd,

@@ -57,7 +57,10 @@ def check_scale_bound(bound: Any, *, name: str = "scale_bound") -> tuple[float, 
     """``None`` (unbounded) or ``(lo, hi)`` with ``0 < lo <= 1 <= hi``."""
     if bound is None:
         return None
-    lo, hi = check_interval(bound, name=name, unit="time-scale factor")
+    try:
+        lo, hi = check_interval(bound, name=name, unit="time-scale factor")
+    except ParameterError as exc:
+        raise ParameterError(f"{exc}; e.g. (0.8, 1.25), or None for unbounded") from None
     if not lo <= 1.0 <= hi:
         raise ParameterError(
             f"{name}=({lo:g}, {hi:g}) must contain 1 (an interval played at its own speed); "
