@@ -141,7 +141,7 @@ def resonator_saliences(
         seg = np.zeros((len(chunk), n_sets, n_bands, n_acf))
         for i, (a, b) in enumerate(chunk):
             x = bands[:, :, a:b]
-            seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * np.hanning(b - a)
+            seg[i, :, :, : b - a] = (x - x.mean(axis=2, keepdims=True)) * _hanning(b - a)
         spec = scipy.fft.rfft(seg, axis=3)
         acf = scipy.fft.irfft(spec.real**2 + spec.imag**2, n=n_acf, axis=3)[..., :length]
         acf = acf.reshape(-1, length).T  # (lag, window x set x band)
@@ -260,6 +260,14 @@ def ratio_weight(
     for ratio, w in enumerate(weights, start=1):
         out += w * np.exp(-0.5 * ((x - ratio) / model.ratio_sigma) ** 2)
     return out
+
+
+@functools.lru_cache(maxsize=8)
+def _hanning(n: int) -> np.ndarray:
+    """``np.hanning(n)``, cached (the tempo windows of a song share their length)."""
+    w = np.hanning(n)
+    w.flags.writeable = False
+    return w
 
 
 def _level_grid(lo: float, hi: float, step: float = 0.01) -> np.ndarray:
