@@ -30,7 +30,6 @@ from .synthesis import SynthesisResult, check_output, synthesize_core
 from .timescale import (
     DEFAULT_SCALE_BOUND,
     TempoPlan,
-    check_multiplicity,
     check_scale_bound,
     music_grid,
     plan_tempo,
@@ -140,12 +139,9 @@ def compose(
         )
     check_choice(method, METHODS, name="method")
     bound = check_scale_bound(scale_bound)
-    mult = check_multiplicity(multiplicity)
-    if bound is None and mult == "auto":
-        mult = (1.0,)
     fps, blend, end_time = check_output(graph, beats, fps, blend, warp, 0.0, end_time)
     plan = plan_tempo(
-        graph, beats, scale_bound=bound, multiplicity=mult, tempo_select=bool(tempo_select)
+        graph, beats, scale_bound=bound, multiplicity=multiplicity, tempo_select=bool(tempo_select)
     )
     grid, grid_level = music_grid(beats, level, plan.subdivision)
     with silenced():

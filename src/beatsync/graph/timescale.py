@@ -150,8 +150,11 @@ def plan_tempo(
     multiplicity: Any = "auto",
     tempo_select: bool = True,
 ) -> TempoPlan:
-    """Eligible clips and multiplicities for a song (``tempo_select=False``: every clip)."""
+    """Eligible clips and multiplicities for a song (``tempo_select=False``: every clip);
+    unbounded, ``"auto"`` is one beat per motion beat (paper B as written)."""
     multiplicity = check_multiplicity(multiplicity)
+    if scale_bound is None and multiplicity == "auto":
+        multiplicity = (1.0,)
     song_bpm = float(60.0 / np.median(np.diff(music_beats)))
     tempi = clip_tempi(graph)
     width = scale_bound[1] / scale_bound[0] if scale_bound is not None else np.inf
@@ -160,7 +163,7 @@ def plan_tempo(
     eligible_groups: set[int] = set()
     why: dict[int, str] = {}
     dev = {}
-    rungs = LADDER if isinstance(multiplicity, str) else tuple(float(m) for m in multiplicity)
+    rungs = LADDER if multiplicity == "auto" else multiplicity
     for g in range(n_groups):
         tg = float(np.exp(np.mean(np.log(tempi[groups == g]))))
         scales = np.array([m * tg / song_bpm for m in rungs])
@@ -206,10 +209,10 @@ def plan_tempo(
         )
     eligible = np.array([r["eligible"] for r in rows], dtype=bool)
     lib_bpm = float(np.median(tempi[eligible])) if eligible.any() else float("nan")
-    if isinstance(multiplicity, str):
+    if multiplicity == "auto":
         mult = choose_multiplicity(lib_bpm, song_bpm, scale_bound) if eligible.any() else (1.0,)
     else:
-        mult = tuple(sorted({float(m) for m in multiplicity}))
+        mult = multiplicity
     sub = 2 if 0.5 in mult else 1
     steps = tuple(int(round(m * sub)) for m in mult)
     return TempoPlan(

@@ -132,8 +132,7 @@ def _song_grid(graph: WeightedMotionGraph, beats: np.ndarray, level: np.ndarray,
     intervals' durations [s] and the search's options."""
     from ..graph.timescale import music_grid, plan_tempo
 
-    mult = "auto" if bound is not None else (1.0,)
-    plan = plan_tempo(graph, beats, scale_bound=bound, multiplicity=mult)
+    plan = plan_tempo(graph, beats, scale_bound=bound)
     grid, glevel = music_grid(beats, level, plan.subdivision)
     kw = {"scale_bound": plan.bound, "steps": plan.steps, "node_mask": plan.node_mask}
     return plan, _z(glevel), np.diff(grid), kw
