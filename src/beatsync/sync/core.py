@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..motion import segmentation_view
-from ..motion_beats import kinematic_beats, motion_positions
+from ..motion_beats import kinematic_beats, motion_positions, speed_curve
 from ..rotations import sample_motion
 from ..segment.checks import check_alpha, check_period_range
 from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_count
@@ -25,6 +25,7 @@ from ..validation import (
     time_to_frames,
 )
 from .fill import LoopedClip, choose_loop, loop_events, with_center
+from .landing import dip_floor, land_seen
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
@@ -482,13 +483,36 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     looped: LoopedClip | None = None
     if counts is None:  # beats mode: the whole dance's counts at once
         looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
-        warp = integrate_warp(
-            used, targets, start=0.0, end=end, delta=plan["delta"], hold=LANDING_HOLD
-        )
         p = used.size - 1
-        if end is None and plan["song_end"] is not None:
-            last = float(looped.events[-1]) if looped is not None else duration
-            warp = _go_on(warp, plan["song_end"] + phase_offset, last)
+        last = float(looped.events[-1]) if looped is not None else duration
+        pos = motion_positions(motion)
+        curve = speed_curve(pos, fps=fps)
+        frame_t = frames_to_time(np.arange(curve.size), fps=fps)
+
+        def speed_at(t: np.ndarray) -> np.ndarray:  # on the looped timeline
+            if looped is None:
+                return np.interp(t, frame_t, curve)
+            a, b, w = looped.locate(t)[:3]
+            return (1.0 - w) * np.interp(a, frame_t, curve) + w * np.interp(b, frame_t, curve)
+
+        def render(pins: np.ndarray):
+            warp = integrate_warp(
+                pins,
+                targets,
+                start=0.0,
+                end=end,
+                delta=plan["delta"],
+                hold=LANDING_HOLD,
+                floor=dip_floor(speed_at, pins, targets),
+            )
+            if end is None and plan["song_end"] is not None:
+                warp = _go_on(warp, plan["song_end"] + phase_offset, last)
+            return (warp, *_output(plan, warp, looped))
+
+        own_peak = float(np.linalg.norm(np.diff(pos, axis=0), axis=-1).max()) * fps
+        used, (warp, out_motion, out_times, src_times) = land_seen(
+            render, used, targets, placed["speed_band"], own_peak
+        )
     else:
         cum = np.concatenate([[0], np.cumsum(counts)])
         # beats to cover: up to the last one, and the song's end in beats after it
@@ -527,23 +551,10 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             stop = beats[last_beat] if plan["song_end"] is None else plan["song_end"]
             warp = _go_on(warp, stop + phase_offset, float(events[-1]))
         placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
-    tau_end = float(warp.tgt[-1])  # > 0: targets increase from check_start's >= 0
-    # the last frame is the first one at or after the last warped time, so the frame
-    # nearest to the last boundary exists (the source is clipped there)
-    n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
-    out_times = frames_to_time(np.arange(n_out), fps=out_fps)
-    src_times = warp.to_source(out_times)
-    values = (
-        sample_motion(motion, src_times) if looped is None else looped.sample(motion, src_times)
-    )
-    bones = position_bones(motion)
-    if bones is not None:  # position-only: linear resampling, then bone lengths restored
-        a, b, w = (src_times, None, None) if looped is None else looped.locate(src_times)[:3]
-        pos = restore_bone_lengths(
-            values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
-        )
-        values = pos.reshape(n_out, -1)
-    out_motion = with_center(motion.with_values(values, fps=out_fps), motion, src_times, looped)
+    if counts is not None:
+        out_motion, out_times, src_times = _output(plan, warp, looped)
+    n_out = out_times.size
+    tau_end = float(warp.tgt[-1])
 
     # residuals on the realised warp: output frames joined by straight lines, plus the
     # warp's ends (a boundary may sit exactly where a held lead-in or the clipped tail
@@ -601,3 +612,26 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed)
     )
     return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)
+
+
+def _output(plan: dict[str, Any], warp: TimeWarp, looped: LoopedClip | None):
+    """The output of ``warp``: ``(motion, output times [s], source times [s])``."""
+    motion, fps, out_fps = plan["motion"], plan["fps"], plan["out_fps"]
+    tau_end = float(warp.tgt[-1])  # > 0: targets increase from check_start's >= 0
+    # the last frame is the first one at or after the last warped time, so the frame
+    # nearest to the last boundary exists (the source is clipped there)
+    n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
+    out_times = frames_to_time(np.arange(n_out), fps=out_fps)
+    src_times = warp.to_source(out_times)
+    values = (
+        sample_motion(motion, src_times) if looped is None else looped.sample(motion, src_times)
+    )
+    bones = position_bones(motion)
+    if bones is not None:  # position-only: linear resampling, then bone lengths restored
+        a, b, w = (src_times, None, None) if looped is None else looped.locate(src_times)[:3]
+        pos = restore_bone_lengths(
+            values.reshape(n_out, -1, 3), motion.positions(), bones, fps, a, b, w
+        )
+        values = pos.reshape(n_out, -1)
+    out_motion = with_center(motion.with_values(values, fps=out_fps), motion, src_times, looped)
+    return out_motion, out_times, src_times

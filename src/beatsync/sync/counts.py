@@ -63,8 +63,10 @@ MARGIN = 1.06
 class CountPlan:
     """The placed events of a whole dance: indices (into the events given) of those
     pinned, their music ``targets`` [s], the ``beats`` each step spans (halves allowed),
-    the numbers of merges and half-beat landings, and the share of phrase starts on bar
-    lines (None without meters)."""
+    the numbers of merges and half-beat landings, the share of phrase starts on bar
+    lines (None without meters), and the playback speeds each step aimed within
+    (``speed_band``: lowest, highest per step; the band narrowed by ``MARGIN``, its top
+    lowered by the peak headroom)."""
 
     event_index: np.ndarray
     targets: np.ndarray
@@ -72,6 +74,7 @@ class CountPlan:
     n_merged: int
     n_half: int
     phrases_on_bars: float | None = None
+    speed_band: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def _speed_cost(ls: np.ndarray, dur: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -238,6 +241,7 @@ def plan_counts(
         gk.append(k)
     ev_a = np.array(ev[::-1], dtype=np.int64)
     gk_a = np.array(gk[::-1], dtype=np.int64)
+    step_top = np.array([top[a:b].min() for a, b in zip(ev_a[:-1], ev_a[1:], strict=True)])
     return CountPlan(
         event_index=ev_a,
         targets=grid[gk_a],
@@ -247,4 +251,5 @@ def plan_counts(
         phrases_on_bars=(
             float(np.mean(bar_ok[gk_a[phrase[ev_a]]])) if bar and phrase[ev_a].any() else None
         ),
+        speed_band=(np.full(step_top.size, np.exp(lo)), np.exp(step_top)),
     )

@@ -76,6 +76,7 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
         "n_merged": placed.n_merged,
         "n_half_beat": placed.n_half,
         "phrases_on_bars": placed.phrases_on_bars,
+        "speed_band": placed.speed_band,
     }
     return looped, used, targets, end, info
 

@@ -146,12 +146,14 @@ def integrate_warp(
     end: float | None = None,
     delta: float | None = None,
     hold: float = 0.0,
+    floor: np.ndarray | None = None,
 ) -> TimeWarp:
     """:func:`time_warp` on inputs already checked (float64, increasing, same length >= 2).
 
     ``hold`` [s]: the rate stays at its boundary value this long on both sides of every
     boundary (at most ``MAX_HOLD`` of a period), so that a speed minimum of the motion
     there is neither moved nor erased by a change of rate; the bump corrects in between.
+    ``floor`` (with ``hold``; one per boundary): the lowest rate held at each boundary.
     """
     src_len = np.diff(s)
     tgt_len = np.diff(b)
@@ -172,6 +174,9 @@ def integrate_warp(
         v = np.clip((v - q) / (1.0 - 2.0 * q), 0.0, 1.0)
     h = np.broadcast_to(correction_bump(v), r.shape)
     if hold > 0:
+        if floor is not None:
+            r[:, 0] = np.maximum(r[:, 0], floor[:-1])
+            r[:, -1] = np.maximum(r[:, -1], floor[1:])
         ease = v * v * (3.0 - 2.0 * v)  # flat at 0 and 1: the held boundary rates
         base = r[:, :1] + (r[:, -1:] - r[:, :1]) * ease
         r = base + (r - base) * h

@@ -1,0 +1,87 @@
+"""Tests of beatsync.sync.landing: the motion beats a viewer sees land on the beats."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from beatsync.errors import BeatsyncWarning
+from beatsync.sync import synchronize
+from beatsync.sync.landing import _within, dip_floor
+from beatsync.sync.warp import integrate_warp
+
+
+def test_dip_floor_keeps_half_of_each_dips_log_depth():
+    # a speed of 1 at the landings, peaks of 1.21 and 4 amid the two intervals: the
+    # held rate may not fall below m / sqrt(P) on either side, m the interval's rate
+    def speed_at(t):
+        t = np.asarray(t, dtype=np.float64)
+        bump = np.where(t < 1.0, 0.21, 3.0) * np.sin(np.pi * t) ** 2
+        return 1.0 + bump
+
+    used = np.array([0.0, 1.0, 2.0])
+    targets = np.array([0.0, 0.8, 2.0])  # rates 0.8 and 1.2
+    floor = dip_floor(speed_at, used, targets)
+    np.testing.assert_allclose(floor, [0.8 / 1.1, max(0.8 / 1.1, 1.2 / 2.0), 1.2 / 2.0], rtol=1e-3)
+
+
+def test_integrate_warp_holds_at_least_the_floor_at_every_boundary():
+    s = np.array([0.0, 1.0, 1.5, 2.5])
+    b = np.array([0.0, 1.2, 1.6, 2.5])
+    floor = np.array([0.0, 1.5, 0.0, 0.0])
+    w = integrate_warp(s, b, hold=0.1, floor=floor)
+    at = np.searchsorted(w.src, s[1])
+    assert w.rate[at] >= 1.5 - 1e-9
+    assert abs(w.rate[at] - 1.5) < 1e-6  # the blend alone holds less than that there
+    np.testing.assert_allclose(w.to_target(s), b, atol=1e-9)  # still lands every beat
+
+
+def test_within_shortens_a_move_that_leaves_the_band():
+    targets = np.array([0.0, 1.0, 2.0])
+    kept = np.array([0.0, 1.0, 2.0])
+    moved = np.array([0.0, 1.3, 2.0])  # speeds 1.3 and 0.7
+    lo, hi = np.full(2, 0.85), np.full(2, 1.18)
+    pins = _within(moved, kept, kept, targets, lo, hi)
+    speed = np.diff(pins) / np.diff(targets)
+    assert np.all((speed >= lo - 1e-12) & (speed <= hi + 1e-12))
+    assert 1.0 < pins[1] < 1.3  # moved as far as the band lets it
+
+
+@pytest.fixture(scope="module")
+def waltz_on_a_cha_cha():
+    """The real waltz dancer DANCE_W_10 (24 s) looped onto 40 s at a cha-cha's tempo
+    (125 BPM), beats a quarter frame off the output's 25 fps grid."""
+    from beatsync import datasets
+
+    dancer = datasets.load_dance_pair("DANCE_W_10").motion
+    beats = np.arange(0.31, 40.0, 60.0 / 125.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        res = synchronize(dancer, None, beats, mode="beats", fill="loop", beats_per_bar=4)
+    return dancer, res
+
+
+def test_real_waltz_shows_its_landings_within_half_a_frame(waltz_on_a_cha_cha):
+    # the output's own motion beats (as kinematic_beats finds them) on their beats: the
+    # nearest output frame; 50 % of them without landing what the output shows
+    from beatsync.evaluate.alignment import nearest_distance
+    from beatsync.motion_beats import kinematic_beats
+
+    _, res = waltz_on_a_cha_cha
+    landed = np.asarray(res.report["target_beats_s"])[1:-1]  # the ends: no minimum
+    d = nearest_distance(landed, kinematic_beats(res.motion))
+    assert np.mean(d <= 0.5 / res.motion.fps + 1e-9) >= 0.85
+
+
+def test_real_waltz_landings_keep_the_speed_band_and_the_dancers_peak(waltz_on_a_cha_cha):
+    dancer, res = waltz_on_a_cha_cha
+    fps = res.motion.fps
+    t = np.arange(res.warp_src_times.size) / fps
+    live = (t[1:] > res.warp.tgt[0]) & (t[1:] <= res.warp.tgt[-1])
+    speed = np.diff(res.warp_src_times)[live] * fps
+    assert np.mean((speed >= 0.8) & (speed <= 1.25)) >= 0.95
+    own = np.linalg.norm(np.diff(dancer.positions(), axis=0), axis=-1).max() * dancer.fps
+    out = np.linalg.norm(np.diff(res.motion.positions(), axis=0), axis=-1).max() * fps
+    assert out <= 1.10 * own
