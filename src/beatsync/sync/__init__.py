@@ -39,7 +39,8 @@ Beyond the paper (real dances)
       (``dance_beats_per_period``, else the dance's own phrase when clear), merging an
       interval or landing on a half beat where no whole count fits. The rate is held
       for ``LANDING_HOLD`` on both sides of every landed motion beat (a speed minimum),
-      so the stop stays on its beat.
+      never so fast that a shallow dip fills in, and each landing is moved to where the
+      output shows its minimum (:mod:`.landing`), so the stop stays on its beat.
       ``mode="auto"`` uses periods when the periodicity test accepts the motion, else
       beats with a warning.
     - ``boundaries=None`` segments here: in ``"periods"`` over one to eight of the
@@ -54,7 +55,7 @@ Beyond the paper (real dances)
 
 Modules: :mod:`.warp` (eq. 9), :mod:`.mapping` (beats per period, meters, accent lag),
 :mod:`.counts` (whole-dance counts), :mod:`.fill` (loops), :mod:`.placement` (beats
-mode), :mod:`.quality` (report), :mod:`.core` (:func:`synchronize`).
+mode), :mod:`.landing` (the landings a viewer sees), :mod:`.quality` (report), :mod:`.core` (:func:`synchronize`).
 
 Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb``,
 ``notebooks/paper_a_fig03_animation_frames.ipynb``.
