@@ -55,7 +55,8 @@ Beyond the paper (real dances)
 
 Modules: :mod:`.warp` (eq. 9), :mod:`.mapping` (beats per period, meters, accent lag),
 :mod:`.counts` (whole-dance counts), :mod:`.fill` (loops), :mod:`.placement` (beats
-mode), :mod:`.landing` (the landings a viewer sees), :mod:`.quality` (report), :mod:`.core` (:func:`synchronize`).
+mode), :mod:`.landing` (the landings a viewer sees), :mod:`.quality` (report),
+:mod:`.core` (:func:`synchronize`).
 
 Notebooks: ``notebooks/paper_a_tab01_frame_counts.ipynb``,
 ``notebooks/paper_a_fig03_animation_frames.ipynb``.

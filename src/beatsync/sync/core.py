@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..motion import segmentation_view
-from ..motion_beats import kinematic_beats, motion_positions, speed_curve
+from ..motion_beats import kinematic_beats, motion_positions
 from ..rotations import sample_motion
 from ..segment.checks import check_alpha, check_period_range
 from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_count
@@ -25,7 +25,7 @@ from ..validation import (
     time_to_frames,
 )
 from .fill import LoopedClip, choose_loop, loop_events, with_center
-from .landing import dip_floor, land_seen
+from .landing import dip_floor, land_seen, source_speed
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
@@ -78,7 +78,8 @@ class SyncResult:
       ``output_fps``, ``periods_available``, ``periods_used`` (over all repetitions),
       ``covered_s``, ``lead_in_hold_frames``, ``n_scaled_periods``, ``rate_range``
       (target/source), ``tempo_ratio_range`` (playback speed);
-    - landings: ``boundaries_s`` (source, looped timeline) and ``target_beats_s``,
+    - landings: ``boundaries_s`` (source, looped timeline; in beats mode the source
+      times the output shows at its motion beats, :mod:`.landing`) and ``target_beats_s``,
       ``residual_ms`` (realised warp) and ``residual_nearest_frame_ms``, their maxima;
     - from the output frames (:mod:`.quality`): ``beats_per_motion_beat_used``,
       ``n_merged_intervals``, ``n_half_beat_landings``, ``phrases_on_bars``,
@@ -486,14 +487,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         p = used.size - 1
         last = float(looped.events[-1]) if looped is not None else duration
         pos = motion_positions(motion)
-        curve = speed_curve(pos, fps=fps)
-        frame_t = frames_to_time(np.arange(curve.size), fps=fps)
-
-        def speed_at(t: np.ndarray) -> np.ndarray:  # on the looped timeline
-            if looped is None:
-                return np.interp(t, frame_t, curve)
-            a, b, w = looped.locate(t)[:3]
-            return (1.0 - w) * np.interp(a, frame_t, curve) + w * np.interp(b, frame_t, curve)
+        speed_at = source_speed(pos, fps, looped)
 
         def render(pins: np.ndarray):
             warp = integrate_warp(

@@ -29,7 +29,7 @@ from ..errors import silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion_beats import kinematic_beat_frames, motion_positions, speed_curve
 
-__all__ = ["SEEN_ROUNDS", "SEEN_REACH", "dip_floor", "seen_landings", "land_seen"]
+__all__ = ["SEEN_ROUNDS", "SEEN_REACH", "source_speed", "dip_floor", "seen_landings", "land_seen"]
 
 #: rounds of measuring the output's motion beats and moving the pins
 SEEN_ROUNDS = 2
@@ -37,6 +37,22 @@ SEEN_ROUNDS = 2
 SEEN_REACH = 0.1
 #: samples per interval when looking for its speed peak
 _PEAK_SAMPLES = 33
+
+
+def source_speed(pos: np.ndarray, fps: float, looped: Any) -> Callable:
+    """The source's smoothed mean joint speed (:func:`speed_curve` of joint positions
+    ``pos`` at ``fps``) as a function of (looped, :class:`.fill.LoopedClip` or None)
+    source times [s]."""
+    curve = speed_curve(pos, fps=fps)
+    frame_t = np.arange(curve.size) / fps
+
+    def speed_at(t: np.ndarray) -> np.ndarray:
+        if looped is None:
+            return np.interp(t, frame_t, curve)
+        a, b, w = looped.locate(t)[:3]
+        return (1.0 - w) * np.interp(a, frame_t, curve) + w * np.interp(b, frame_t, curve)
+
+    return speed_at
 
 
 def dip_floor(
@@ -71,9 +87,9 @@ def seen_landings(out_motion: Any, targets: np.ndarray, to_source) -> tuple[np.n
     bend = c0 - 2.0 * c1 + c2
     vertex = np.where(bend > 0, 0.5 * (c0 - c2) / np.where(bend > 0, bend, 1.0), 0.0)
     seen = (f + np.clip(vertex, -0.5, 0.5)) / fps
-    i = np.clip(np.searchsorted(seen, targets), 1, max(seen.size - 1, 1))
-    i = np.where(np.abs(seen[i - 1] - targets) <= np.abs(seen[i] - targets), i - 1, i)
-    near = seen[i]
+    i = np.searchsorted(seen, targets)
+    lo, hi = seen[np.clip(i - 1, 0, seen.size - 1)], seen[np.clip(i, 0, seen.size - 1)]
+    near = np.where(np.abs(lo - targets) <= np.abs(hi - targets), lo, hi)
     d = np.abs(near - targets)
     return np.where(d <= SEEN_REACH, d, np.inf), to_source(near)
 
