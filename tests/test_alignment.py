@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -66,6 +68,16 @@ def test_a_beat_on_the_span_edge_matches_one_just_outside():
     # a beat far outside still does not count
     d = alignment_scores(MUSIC[:9], MUSIC, span=(0.5, 5.0))
     assert d["alignment_music"] == pytest.approx(0.9)
+
+
+@pytest.mark.parametrize(
+    "span, named",
+    [(("a", 2.0), "span start='a'"), ((0.0, None), "span end=None"), (5.0, "span=5.0"),
+     ((1.0, 2.0, 3.0), "span=(1.0, 2.0, 3.0)"), ((0.0, float("nan")), "span end=nan")],
+)  # fmt: skip
+def test_a_bad_span_is_refused_by_name(span, named):
+    with pytest.raises(ParameterError, match=re.escape(named)):
+        alignment_scores(MUSIC[:10], MUSIC, span=span)
 
 
 def test_nearest_distance():

@@ -441,6 +441,10 @@ def test_compose_and_quality(graph):
         compose(graph, [0.5], [])
     with pytest.raises(ParameterError, match="music_level"):
         compose(graph, beats, level[:-1])
+    with pytest.raises(ParameterError, match="blend=None is not a number"):
+        compose(graph, beats, level, blend=None)
+    with pytest.raises(ParameterError, match=r"unknown option\(s\) \['segment_beat'\]"):
+        compose(graph, beats, level, method="conventional", segment_beat=4)
 
 
 def test_transition_jumps_and_foot_sliding_known():

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import ParameterError, warn
 from ..validation import (
+    as_float,
     beat_phase,
     check_fps,
     check_positive,
@@ -137,7 +138,12 @@ def alignment_scores(
     mb, yb, sigma = _checked(motion_beats, music_beats, sigma)
     mb_near, yb_near = mb, yb
     if span is not None:
-        lo, hi = float(span[0]), float(span[1])
+        try:
+            lo, hi = span
+        except (TypeError, ValueError):
+            raise ParameterError(f"span={span!r} must be (start, end) [s]") from None
+        lo = as_float(lo, name="span start", unit="s")
+        hi = as_float(hi, name="span end", unit="s")
         if not hi > lo:
             raise ParameterError(f"span={span!r} must be (start, end) with end > start [s]")
         r = SPAN_REACH * sigma

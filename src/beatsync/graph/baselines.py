@@ -74,8 +74,14 @@ def check_conventional_options(
     rhythm_sigma: Any = 0.3,
     rhythm_threshold: Any = 0.5,
     max_candidates: Any = 20000,
+    **unknown: Any,
 ) -> dict[str, Any]:
     """Validate the options of the multi-stage search (keys of :func:`conventional_core`)."""
+    if unknown:
+        raise ParameterError(
+            f"unknown option(s) {sorted(unknown)} of the multi-stage search: use "
+            "segment_beats, rhythm_sigma, rhythm_threshold, max_candidates"
+        )
     thr = as_float(rhythm_threshold, name="rhythm_threshold")
     if not 0 <= thr < 1:
         raise ParameterError(f"rhythm_threshold={rhythm_threshold!r} must lie in [0, 1)")

@@ -34,7 +34,14 @@ from ..rotations import (
     rotation_to_euler,
     sample_motion,
 )
-from ..validation import check_choice, check_fps, check_times, frames_to_time, time_to_frames
+from ..validation import (
+    as_float,
+    check_choice,
+    check_fps,
+    check_times,
+    frames_to_time,
+    time_to_frames,
+)
 from .build import WeightedMotionGraph
 from .distance import ground_axes
 
@@ -124,8 +131,8 @@ def synthesize(
 
 def check_output(graph, beats, fps, blend, warp, start_time, end_time):
     """``(fps, blend, end_time)`` of the output motion (defaults: the library's, last beat)."""
-    blend = float(blend)
-    if not np.isfinite(blend) or blend < 0 or blend > 5:
+    blend = as_float(blend, name="blend", unit="s")
+    if blend < 0 or blend > 5:
         raise ParameterError(f"blend={blend!r} must be a duration in [0, 5] [s]")
     check_choice(warp, ("pchip", "linear"), name="warp")
     end_time = float(beats[-1]) if end_time is None else float(end_time)
