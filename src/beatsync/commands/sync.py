@@ -217,21 +217,7 @@ def _pipeline(
         motion = io.read_motion(
             args.motion, fps=args.fps, variable=args.variable, **position_options(args)
         )
-        if out.suffix.lower() == ".bvh" and motion.skeleton is None:
-            alt = (
-                ".json, .npy or .c3d (joint positions, in the input's layout) or .csv"
-                if motion.is_positional
-                else ".csv"
-            )
-            raise ParameterError(
-                f"{args.motion!r} has no skeleton (joint positions, markers or a joint-angle "
-                f"table), so it cannot be written as BVH; give an output ending in {alt}"
-            )
-        if out.suffix.lower() in (".json", ".npz", ".c3d") and not motion.is_positional:
-            raise ParameterError(
-                f"{args.motion!r} is not joint positions, so it cannot be written as "
-                f"{out.suffix}; give an output ending in .bvh (with a skeleton) or .csv"
-            )
+        io.check_motion_output(motion, out.suffix.lower(), out)
         y, sr = io.read_audio(args.audio)
         timings["read_s"] = time.perf_counter() - t0
 

@@ -28,6 +28,29 @@ def check_input_file(path: str | os.PathLike[str], what: str) -> Path:
     return p
 
 
+def check_motion_output(
+    motion: Any, suffix: str, path: str | os.PathLike[str], *, as_positions: bool = False
+) -> None:
+    """Refuse to write ``motion`` to ``path`` as ``suffix`` when that format cannot hold
+    it: BVH stores the rotations of a skeleton; .json, .npz and .c3d (and any suffix
+    ``as_positions``) joint positions."""
+    if suffix == ".bvh" and motion.skeleton is None:
+        what, alt = "a table without a skeleton", ".csv (write_table)"
+        if motion.is_positional:
+            what = "joint positions without joint rotations"
+            alt = ".json, .npy or .c3d (positions, in the input's layout) or .csv"
+        raise ParameterError(
+            f"cannot write {str(path)!r} as BVH: motion {motion.name!r} is {what}, and BVH "
+            f"stores rotations of a skeleton; write {alt}"
+        )
+    if (as_positions or suffix in (".json", ".npz", ".c3d")) and not motion.is_positional:
+        raise ParameterError(
+            f"cannot write {str(path)!r}: motion {motion.name!r} is not joint positions "
+            f"(channels <joint>_x/_y/_z), so it cannot be written as {suffix} joint "
+            "positions; write .bvh (rotation data with a skeleton) or a .csv table"
+        )
+
+
 def _new_file_mode(dest: Path) -> int:
     """Permissions for a written file: the existing file's, else 0o666 less the umask."""
     if dest.exists():

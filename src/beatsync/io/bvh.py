@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..motion import Joint, Motion, Skeleton
 from ..validation import as_int, check_finite, check_fps
-from ._files import atomic_write, check_input_file
+from ._files import atomic_write, check_input_file, check_motion_output
 
 __all__ = ["read_bvh", "write_bvh", "BVH_CHANNELS"]
 
@@ -369,15 +369,7 @@ def _refuse_non_numeric(toks: list[str], lineno: int, path: Path) -> None:
 
 def write_bvh(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write ``motion`` as BVH (atomic), each value as its shortest exact decimal."""
-    if motion.skeleton is None:
-        what, alt = ("a table without a skeleton", "write .csv (write_table)")
-        if motion.is_positional:
-            what = "joint positions without joint rotations"
-            alt = "write .json, .npy or .c3d (positions, in the input's layout) or .csv"
-        raise ParameterError(
-            f"cannot write {str(path)!r} as BVH: motion {motion.name!r} is {what}, and BVH "
-            f"stores rotations of a skeleton; {alt}"
-        )
+    check_motion_output(motion, ".bvh", path)
     check_finite(motion.values, name="motion values")
     joints = motion.skeleton.joints
     for j in joints:

@@ -33,7 +33,7 @@ from ..motion import (
     fill_joint_gaps,
 )
 from ..validation import check_choice, check_fps, check_positive
-from ._files import atomic_write, check_input_file
+from ._files import atomic_write, check_input_file, check_motion_output
 from .tables import need_fps, read_npz
 
 POSITION_SUFFIXES = (".json", ".npy", ".npz", ".c3d")
@@ -256,7 +256,7 @@ def _ragged_check(data: Any, what: str, p: Path, ndim: int) -> np.ndarray:
 def write_positions_json(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write a position-only motion in the Dance-with-Melody JSON layout (atomic), in its
     file's units and axis; ``center``: its root track, else the joints' per-frame mean."""
-    info = _positional_info(motion, ".json")
+    info = _positional_info(motion, Path(path))
     pos = motion.positions()
     center = info.center
     if center is None or len(center) != motion.n_frames:
@@ -269,13 +269,8 @@ def write_positions_json(path: str | os.PathLike[str], motion: Motion) -> Path:
     return Path(path)
 
 
-def _positional_info(motion: Motion, suffix: str) -> PositionInfo:
-    if not motion.is_positional:
-        raise ParameterError(
-            f"motion {motion.name!r} is not joint positions (channels <joint>_x/_y/_z), so "
-            f"it cannot be written as {suffix} joint positions; write .bvh (rotation "
-            "data with a skeleton) or a .csv table"
-        )
+def _positional_info(motion: Motion, path: Path) -> PositionInfo:
+    check_motion_output(motion, path.suffix.lower(), path, as_positions=True)
     return motion.position_info or PositionInfo()
 
 
@@ -341,7 +336,7 @@ def write_positions_array(path: str | os.PathLike[str], motion: Motion) -> Path:
     """Write a position-only motion as ``(n_frames, n_joints, 3)`` (atomic), in its file's
     units and axis; ``.npz`` adds the scalar ``fps`` (array key default ``keypoints3d``)."""
     dest = Path(path)
-    info = _positional_info(motion, dest.suffix.lower())
+    info = _positional_info(motion, dest)
     arr = from_canonical(motion.positions(), units=info.units, up=info.up)
     with atomic_write(dest, mode="wb") as fh:
         if dest.suffix.lower() == ".npz":
@@ -416,7 +411,7 @@ def write_c3d(path: str | os.PathLike[str], motion: Motion) -> Path:
     axis (without one: mm, z up, the usual C3D convention)."""
     import c3d
 
-    info = _positional_info(motion, ".c3d")
+    info = _positional_info(motion, Path(path))
     units = info.units if motion.position_info is not None else "mm"
     pos = from_canonical(motion.positions(), units=units, up=info.up).astype(np.float32)
     writer = c3d.Writer(point_rate=float(motion.fps), point_units=f"{units:<4}")
