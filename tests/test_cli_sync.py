@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -137,6 +138,9 @@ def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     assert "residual" in stdout and "periods" in stdout
     assert "Traceback" not in err
     assert io.read_bvh(out).fps == 30.0
+    # the output line says where the dance's last landing falls, as the song goes on
+    line = next(t for t in stdout.splitlines() if t.startswith("output"))
+    assert re.search(r"\(\d+\.\d\d s, the last landing at \d+\.\d\d s\)", line)
 
 
 def test_sync_tempo_range_steers_the_metrical_level(inputs, tmp_path, capsys):

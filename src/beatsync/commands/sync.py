@@ -369,7 +369,7 @@ def _text(result: dict[str, Any]) -> str:
         ),
         *_speed_lines(r),
         f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
-        f"({r['output_duration_s']:.2f} s)",
+        f"({r['output_duration_s']:.2f} s, the last landing at {r['target_beats_s'][-1]:.2f} s)",
         f"residual warp max {res.max():.3f} ms; nearest frame max {near.max():.2f} ms "
         f"({r['max_abs_residual_frames']:.2f} frame)",
     ]
