@@ -49,6 +49,57 @@ def test_within_shortens_a_move_that_leaves_the_band():
     assert 1.0 < pins[1] < 1.3  # moved as far as the band lets it
 
 
+def test_within_falls_back_until_every_interval_is_in_its_band():
+    # shortening alone cannot mend these moves: every interval ends inside its band
+    targets = np.array([0.0, 0.597, 0.936, 1.389, 1.878, 2.229])
+    planned = np.array([0.0, 0.54, 0.86, 1.298, 1.747, 2.087])
+    moved = np.array([-0.03, 0.559, 0.999, 1.4, 1.77, 1.979])
+    lo, hi = np.full(5, 0.848), np.full(5, 1.18)
+    speed = np.diff(_within(moved, planned, planned, targets, lo, hi)) / np.diff(targets)
+    assert np.all((speed >= lo - 1e-12) & (speed <= hi + 1e-12))
+
+
+def _seen_score(res) -> float:
+    """The landings' music-side Gaussian (sigma 0.05 s) on the output's motion beats."""
+    from beatsync.evaluate.alignment import nearest_distance
+    from beatsync.motion_beats import kinematic_beats
+
+    d = nearest_distance(np.asarray(res.report["target_beats_s"]), kinematic_beats(res.motion))
+    return float(np.mean(np.exp(-(d * d) / (2 * 0.05**2))))
+
+
+def _off_band(res) -> int:
+    fps = res.motion.fps
+    t = np.arange(1, res.warp_src_times.size) / fps
+    live = (t > res.warp.tgt[0]) & (t <= res.warp.tgt[-1])
+    speed = np.diff(res.warp_src_times)[live] * fps
+    return int(np.count_nonzero((speed < 0.8) | (speed > 1.25)))
+
+
+@pytest.mark.parametrize(
+    "name, bpm, bar", [("DANCE_C_4", 84.0, 3), ("DANCE_W_10", 90.0, 3), ("salsa", 125.0, 4)]
+)
+def test_moved_landings_never_leave_the_plan_worse(name, bpm, bar, monkeypatch):
+    # against the plan's own landings (no rounds): the landings score at least as well
+    # and no more output plays outside 0.8-1.25 (a real dancer, a BVH dancer)
+    from beatsync import datasets
+    from beatsync.sync import landing
+
+    dancer = datasets.load_salsa() if name == "salsa" else datasets.load_dance_pair(name).motion
+    beats = np.arange(0.31, 30.0, 60.0 / bpm)
+    runs = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BeatsyncWarning)
+        for rounds in (0, landing.SEEN_ROUNDS):
+            monkeypatch.setattr(landing, "SEEN_ROUNDS", rounds)
+            runs[rounds] = synchronize(
+                dancer, None, beats, mode="beats", fill="loop", beats_per_bar=bar, out_fps=25.0
+            )
+    plan, moved = runs[0], runs[landing.SEEN_ROUNDS]
+    assert _seen_score(moved) >= _seen_score(plan) - 0.01  # view and output differ a little
+    assert _off_band(moved) <= _off_band(plan)
+
+
 @pytest.fixture(scope="module")
 def waltz_on_a_cha_cha():
     """The real waltz dancer DANCE_W_10 (24 s) looped onto 40 s at a cha-cha's tempo

@@ -43,6 +43,7 @@ from .validation import (
 __all__ = [
     "kinematic_beats",
     "kinematic_beat_frames",
+    "speed_minima",
     "beat_interval_intensity",
     "interval_intensity",
     "speed_curve",
@@ -176,6 +177,18 @@ def pca_curve(
     return proj
 
 
+def speed_minima(
+    curve: np.ndarray, fps: float, min_interval: float = 0.2, rel_prominence: float = 0.02
+) -> np.ndarray:
+    """Frames of the minima of a :func:`speed_curve` (checked inputs): at least
+    ``min_interval`` [s] apart and ``rel_prominence`` of its median value prominent;
+    never its first or last frame."""
+    distance = max(1, int(time_to_frames(min_interval, fps=fps, mode="round")))
+    scale = float(np.median(np.abs(curve)))
+    prom = rel_prominence * scale if scale > 0 else None
+    return find_peaks(-curve, distance=distance, prominence=prom)[0]
+
+
 def kinematic_beat_frames(
     positions: Any,
     *,
@@ -197,17 +210,16 @@ def kinematic_beat_frames(
     rel_prominence = check_positive(
         rel_prominence, name="rel_prominence", unit="fraction of the curve's scale", allow_zero=True
     )
-    distance = max(1, int(time_to_frames(min_interval, fps=fps, mode="round")))
     if method == "speed":
-        curve = speed_curve(pos, fps=fps, smooth=smooth)
+        frames = speed_minima(
+            speed_curve(pos, fps=fps, smooth=smooth), fps, min_interval, rel_prominence
+        )
     else:
+        distance = max(1, int(time_to_frames(min_interval, fps=fps, mode="round")))
         curve = pca_curve(pos, fps=fps, window=window, smooth=smooth)
-    # the speed's median value, the projection's median absolute deviation
-    scale = float(np.median(np.abs(curve - (0.0 if method == "speed" else np.median(curve)))))
-    prom = rel_prominence * scale if scale > 0 else None
-    if method == "speed":
-        frames, _ = find_peaks(-curve, distance=distance, prominence=prom)
-    else:
+        # the projection's median absolute deviation
+        scale = float(np.median(np.abs(curve - np.median(curve))))
+        prom = rel_prominence * scale if scale > 0 else None
         lo, _ = find_peaks(-curve, prominence=prom)
         hi, _ = find_peaks(curve, prominence=prom)
         kept: list[int] = []  # drop extrema closer than distance to the previously kept one

@@ -40,6 +40,7 @@ __all__ = [
     "MIN_BPM",
     "MAX_BPM",
     "beat_phase",
+    "nearest",
     "MAX_MOTION_FPS",
     "check_motion_fps",
     "default_workers",
@@ -365,6 +366,17 @@ def beat_phase(events: Any, beats: Any) -> np.ndarray:
     e = e[(e >= b[0]) & (e < b[-1])]
     i = np.searchsorted(b, e, side="right") - 1
     return (e - b[i]) / (b[i + 1] - b[i])
+
+
+def nearest(events: Any, reference: Any) -> np.ndarray:
+    """The nearest of the increasing ``reference`` times to each event [s] (inputs are
+    checked by the caller)."""
+    e = np.asarray(events, dtype=np.float64)
+    r = np.asarray(reference, dtype=np.float64)
+    idx = np.searchsorted(r, e)
+    lo = r[np.clip(idx - 1, 0, r.size - 1)]
+    hi = r[np.clip(idx, 0, r.size - 1)]
+    return np.where(np.abs(e - lo) <= np.abs(e - hi), lo, hi)
 
 
 def check_interval(pair: Any, *, name: str, unit: str) -> tuple[float, float]:

@@ -28,6 +28,7 @@ from ..validation import (
     check_positive,
     check_times,
     frames_to_time,
+    nearest,
     time_to_frames,
 )
 
@@ -70,11 +71,7 @@ def validate(motion_beats: Any, music_beats: Any) -> tuple[np.ndarray, np.ndarra
 def nearest_distance(events: Any, reference: Any) -> np.ndarray:
     """Distance [s] from each event to the nearest of the increasing ``reference`` times."""
     e = np.asarray(events, dtype=np.float64)
-    r = np.asarray(reference, dtype=np.float64)
-    idx = np.searchsorted(r, e)
-    lo = np.clip(idx - 1, 0, r.size - 1)
-    hi = np.clip(idx, 0, r.size - 1)
-    return np.minimum(np.abs(e - r[lo]), np.abs(e - r[hi]))
+    return np.abs(e - nearest(e, reference))
 
 
 def _score(averaged: np.ndarray, other: np.ndarray, sigma: float, what: str) -> float:

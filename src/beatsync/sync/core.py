@@ -24,8 +24,8 @@ from ..validation import (
     frames_to_time,
     time_to_frames,
 )
-from .fill import LoopedClip, choose_loop, loop_events, with_center
-from .landing import dip_floor, land_seen, source_speed
+from .fill import LoopedClip, choose_loop, joint_positions, loop_events, with_center
+from .landing import dip_floor, land_seen, position_view, source_speed
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
@@ -486,10 +486,13 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
         p = used.size - 1
         last = float(looped.events[-1]) if looped is not None else duration
-        pos = motion_positions(motion)
+        got = joint_positions(motion)
+        pos, up = got if got is not None else (motion_positions(motion), 1)
         speed_at = source_speed(pos, fps, looped)
+        pos_at = position_view(pos, up, fps, looped)
 
-        def render(pins: np.ndarray):
+        def warp_of(pins: np.ndarray) -> TimeWarp:
+            floor = dip_floor(speed_at, pins, targets)
             warp = integrate_warp(
                 pins,
                 targets,
@@ -497,16 +500,21 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
                 end=end,
                 delta=plan["delta"],
                 hold=LANDING_HOLD,
-                floor=dip_floor(speed_at, pins, targets),
+                floor=floor,
             )
             if end is None and plan["song_end"] is not None:
                 warp = _go_on(warp, plan["song_end"] + phase_offset, last)
-            return (warp, *_output(plan, warp, looped))
+            return warp
 
-        own_peak = float(np.linalg.norm(np.diff(pos, axis=0), axis=-1).max()) * fps
-        used, (warp, out_motion, out_times, src_times) = land_seen(
-            render, used, targets, placed["speed_band"], own_peak
-        )
+        def view(pins: np.ndarray):
+            warp = warp_of(pins)
+            out_t = _output_times(warp, out_fps)
+            src_t = warp.to_source(out_t)
+            return pos_at(src_t), out_t, src_t
+
+        used = land_seen(view, out_fps, used, targets, placed["speed_band"])
+        warp = warp_of(used)
+        out_motion, out_times, src_times = _output(plan, warp, looped)
     else:
         cum = np.concatenate([[0], np.cumsum(counts)])
         # beats to cover: up to the last one, and the song's end in beats after it
@@ -545,7 +553,6 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             stop = beats[last_beat] if plan["song_end"] is None else plan["song_end"]
             warp = _go_on(warp, stop + phase_offset, float(events[-1]))
         placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
-    if counts is not None:
         out_motion, out_times, src_times = _output(plan, warp, looped)
     n_out = out_times.size
     tau_end = float(warp.tgt[-1])
@@ -608,14 +615,19 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)
 
 
+def _output_times(warp: TimeWarp, out_fps: float) -> np.ndarray:
+    """Output frame times [s] up to the first frame at or after the warp's last time
+    (> 0: targets increase from check_start's >= 0), so the frame nearest to the last
+    boundary exists (the source is clipped there)."""
+    n_out = int(np.ceil(float(warp.tgt[-1]) * out_fps - 1e-6)) + 1
+    return frames_to_time(np.arange(n_out), fps=out_fps)
+
+
 def _output(plan: dict[str, Any], warp: TimeWarp, looped: LoopedClip | None):
     """The output of ``warp``: ``(motion, output times [s], source times [s])``."""
     motion, fps, out_fps = plan["motion"], plan["fps"], plan["out_fps"]
-    tau_end = float(warp.tgt[-1])  # > 0: targets increase from check_start's >= 0
-    # the last frame is the first one at or after the last warped time, so the frame
-    # nearest to the last boundary exists (the source is clipped there)
-    n_out = int(np.ceil(tau_end * out_fps - 1e-6)) + 1
-    out_times = frames_to_time(np.arange(n_out), fps=out_fps)
+    out_times = _output_times(warp, out_fps)
+    n_out = out_times.size
     src_times = warp.to_source(out_times)
     values = (
         sample_motion(motion, src_times) if looped is None else looped.sample(motion, src_times)

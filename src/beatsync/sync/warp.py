@@ -153,7 +153,8 @@ def integrate_warp(
     ``hold`` [s]: the rate stays at its boundary value this long on both sides of every
     boundary (at most ``MAX_HOLD`` of a period), so that a speed minimum of the motion
     there is neither moved nor erased by a change of rate; the bump corrects in between.
-    ``floor`` (with ``hold``; one per boundary): the lowest rate held at each boundary.
+    ``floor`` (one per boundary): the lowest rate held at each boundary (ignored
+    without ``hold``).
     """
     src_len = np.diff(s)
     tgt_len = np.diff(b)
