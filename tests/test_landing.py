@@ -77,23 +77,26 @@ def _off_band(res) -> int:
 
 
 @pytest.mark.parametrize(
-    "name, bpm, bar", [("DANCE_C_4", 84.0, 3), ("DANCE_W_10", 90.0, 3), ("salsa", 125.0, 4)]
-)
-def test_moved_landings_never_leave_the_plan_worse(name, bpm, bar, monkeypatch):
+    "name, bpm, bar, fill",
+    [("DANCE_C_4", 84.0, 3, "loop"), ("DANCE_W_10", 90.0, 3, "loop"), ("salsa", 125.0, 4, "loop"),
+     ("DANCE_R_3", 90.0, 3, "stop")],
+)  # fmt: skip
+def test_moved_landings_never_leave_the_plan_worse(name, bpm, bar, fill, monkeypatch):
     # against the plan's own landings (no rounds): the landings score at least as well
-    # and no more output plays outside 0.8-1.25 (a real dancer, a BVH dancer)
+    # and no more output plays outside 0.8-1.25, the run-on after the last landing
+    # included (a real dancer, a BVH dancer)
     from beatsync import datasets
     from beatsync.sync import landing
 
     dancer = datasets.load_salsa() if name == "salsa" else datasets.load_dance_pair(name).motion
-    beats = np.arange(0.31, 30.0, 60.0 / bpm)
+    beats = np.arange(0.31, 30.0 if fill == "loop" else 40.0, 60.0 / bpm)
     runs = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", BeatsyncWarning)
         for rounds in (0, landing.SEEN_ROUNDS):
             monkeypatch.setattr(landing, "SEEN_ROUNDS", rounds)
             runs[rounds] = synchronize(
-                dancer, None, beats, mode="beats", fill="loop", beats_per_bar=bar, out_fps=25.0
+                dancer, None, beats, mode="beats", fill=fill, beats_per_bar=bar, out_fps=25.0
             )
     plan, moved = runs[0], runs[landing.SEEN_ROUNDS]
     assert _seen_score(moved) >= _seen_score(plan) - 0.01  # view and output differ a little

@@ -510,7 +510,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             warp = warp_of(pins)
             out_t = _output_times(warp, out_fps)
             src_t = warp.to_source(out_t)
-            return pos_at(src_t), out_t, src_t
+            return pos_at(src_t), out_t, src_t, warp
 
         used = land_seen(view, out_fps, used, targets, placed["speed_band"])
         warp = warp_of(used)

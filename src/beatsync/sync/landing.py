@@ -14,14 +14,17 @@ per source time), so the warp can fill a minimum in or move it:
 - **The smoothing reaches past the held rate** (``LANDING_HOLD`` is one sigma), so
   the output's minimum can sit a frame or two off its beat. :func:`land_seen` finds
   the output's motion beats (to a sub-frame, the parabola through the minimum and its
-  neighbours) and pins the source time each one shows to its beat instead, over
-  ``SEEN_ROUNDS`` rounds; each landing keeps the best of its pins. A move is
-  shortened so that no interval's mean speed leaves the band the beat counts aimed at
-  (their peak headroom included), and a landing beside an interval that the move left
-  with more output outside 0.8-1.25 keeps its pin. Every round, and the landings' best
-  pins together, are measured; of those with no more output outside the band than the
-  plan, the one whose landings score best (the music-side alignment score's Gaussian,
-  summed) wins.
+  neighbours) and moves each landing's source pin so that its minimum falls on the
+  output frame nearest its beat (the frame a viewer can see it on; aimed at the beat
+  itself, a minimum a little off lands on the wrong frame), over ``SEEN_ROUNDS``
+  rounds; each landing keeps the best of its pins. A move is shortened so that no
+  interval's mean speed leaves the band the beat counts aimed at (their peak headroom
+  included), and a landing beside an interval that the move left with more output
+  outside 0.8-1.25 keeps its pin. Every round, and the landings' best pins together,
+  are measured; of those with no more output outside the band than the plan (counted
+  per interval, the lead-in and the run-on included), the one with the most minima
+  within half a frame of their frames, then the best music-side alignment Gaussian
+  (summed), wins.
 
 The rounds are judged on a cheap view of the output, the source's joint positions
 sampled linearly (:func:`position_view`); the output itself is made once, at the end.
@@ -110,18 +113,20 @@ def seen_landings(
     pos: np.ndarray, fps: float, targets: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """For every beat in ``targets`` [s]: how far [s] the nearest motion beat of the
-    output's joint positions ``pos`` (at ``fps``) lies (inf beyond ``SEEN_REACH``), and
-    its time [s]."""
+    output's joint positions ``pos`` (at ``fps``) lies from the output frame nearest
+    the beat, the frame a viewer can see it on (inf beyond ``SEEN_REACH``), and how far
+    it lies from the beat [s] (signed)."""
+    aim = np.rint(targets * fps) / fps
     curve = speed_curve(pos, fps=fps)
     f = speed_minima(curve, fps)  # kinematic_beats' defaults
     if f.size == 0:
-        return np.full(targets.size, np.inf), targets
+        return np.full(targets.size, np.inf), np.zeros(targets.size)
     c0, c1, c2 = curve[f - 1], curve[f], curve[f + 1]
     bend = c0 - 2.0 * c1 + c2
     vertex = np.where(bend > 0, 0.5 * (c0 - c2) / np.where(bend > 0, bend, 1.0), 0.0)
-    near = nearest(targets, (f + vertex) / fps)
-    d = np.abs(near - targets)
-    return np.where(d <= SEEN_REACH, d, np.inf), near
+    near = nearest(aim, (f + vertex) / fps)
+    d = np.abs(near - aim)
+    return np.where(d <= SEEN_REACH, d, np.inf), near - aim
 
 
 def _within(moved, kept, planned, targets, lo, hi):
@@ -154,14 +159,16 @@ def _within(moved, kept, planned, targets, lo, hi):
 
 
 def _off_band(view: tuple, fps: float, targets: np.ndarray) -> np.ndarray:
-    """Output frames per interval between ``targets`` played outside the speed band
-    (``view``: positions, output and source times)."""
-    _, out_times, src_times = view
-    speed = np.diff(src_times) * fps
+    """Output frames per interval between ``targets`` played outside the speed band,
+    wherever the warp plays (its lead-in in the first interval, its run-on in the last;
+    ``view``: positions, output and source times, the warp)."""
+    _, out_times, src_times, warp = view
+    t = out_times[1:]
+    live = (t > warp.tgt[0]) & (t <= warp.tgt[-1] + 1e-9)
+    speed = np.diff(src_times)[live] * fps
     off = (speed < DEFAULT_SCALE_BOUND[0]) | (speed > DEFAULT_SCALE_BOUND[1])
-    k = np.searchsorted(targets, out_times[1:]) - 1
-    inside = (k >= 0) & (k < targets.size - 1)
-    return np.bincount(k[inside], weights=off[inside], minlength=targets.size - 1)
+    k = np.clip(np.searchsorted(targets, t[live]) - 1, 0, targets.size - 2)
+    return np.bincount(k, weights=off, minlength=targets.size - 1)
 
 
 def land_seen(
@@ -173,19 +180,24 @@ def land_seen(
 ) -> np.ndarray:
     """The landings' source pins (from ``used`` [s]) whose output shows its motion beats
     on ``targets`` [s] (module docstring). ``view(pins)`` returns the output's joint
-    positions, output times and source times at ``fps``; ``band`` the lowest and
+    positions, output times and source times at ``fps``, and the warp; ``band`` the lowest and
     highest playback speed per interval the beat counts aimed at."""
     speed = np.diff(used) / np.diff(targets)
     lo, hi = np.minimum(band[0], speed), np.maximum(band[1], speed)
 
     def measure(pins):
-        """Landing errors, the source times shown, output frames outside the band."""
+        """Landing errors, the source times to pin (those that put the seen minima on
+        their frames), output frames outside the band."""
         look = view(pins)
-        err, seen = seen_landings(look[0], fps, targets)
-        return err, np.interp(seen, look[1], look[2]), _off_band(look, fps, targets)
+        err, off_aim = seen_landings(look[0], fps, targets)
+        shown = np.interp(targets + off_aim, look[1], look[2])
+        return err, shown, _off_band(look, fps, targets)
 
-    def score(err):  # the music-side alignment score's Gaussian, summed
-        return float(np.sum(np.exp(-(err * err) / (2.0 * SCORE_SIGMA**2))))
+    def score(err):
+        """Minima on their frames (within half a frame), then the music-side alignment
+        score's Gaussian, summed."""
+        hits = int(np.count_nonzero(err <= 0.5 / fps))
+        return hits, float(np.sum(np.exp(-(err * err) / (2.0 * SCORE_SIGMA**2))))
 
     planned, pins = used, used
     best, best_err = used, np.full(used.size, np.inf)  # per landing, its best pin
