@@ -37,6 +37,7 @@ from .validation import (
     check_positive,
     check_times,
     frames_to_time,
+    nearest,
     time_to_frames,
 )
 
@@ -58,12 +59,10 @@ _POSE_COLOR = "#333333"
 def pose_positions(motion: Any) -> tuple[np.ndarray, np.ndarray]:
     """Joint positions [shape=(n_frames, n_joints, 3)] and the bones to draw between them:
     pairs of joint indices, (child, parent) for a skeleton, the motion's bones for
-    position-only motion, none for a table whose bones are unknown (drawn as dots)."""
+    position-only motion."""
     from .motion_beats import motion_positions
 
-    has_bones = motion.skeleton is not None or motion.is_positional
-    bones = motion.bones if has_bones else np.zeros((0, 2), dtype=np.int64)
-    return motion_positions(motion), bones
+    return motion_positions(motion), motion.bones
 
 
 def _up_axis(motion: Any, up: str | None) -> int:
@@ -86,11 +85,9 @@ def project(positions: Any, *, up: int = 1, azimuth: float = 0.0) -> np.ndarray:
 
 
 def _near_beat(times: np.ndarray, beats: np.ndarray | None, tol: float) -> np.ndarray:
-    from .evaluate.alignment import nearest_distance
-
     if beats is None or len(beats) == 0:
         return np.zeros(times.shape, dtype=bool)
-    return nearest_distance(times, beats) <= tol
+    return np.abs(times - nearest(times, beats)) <= tol
 
 
 def beat_strip_times(

@@ -6,19 +6,8 @@ via :func:`beatsync.commands._common.emit`. ``beatsync --help`` lists the subcom
 from :data:`COMMAND_HELP` without importing any of them.
 """
 
-# Order shown in ``beatsync --help``.
-COMMAND_MODULES = (
-    "segment",
-    "beats",
-    "sync",
-    "compose",
-    "batch",
-    "evaluate",
-    "reproduce",
-    "data",
-)
-
-# One-line help of each subcommand, shown by ``beatsync --help`` (and by its ``register``).
+# One-line help of each subcommand, shown by ``beatsync --help`` (and by its
+# ``register``), in the order shown.
 COMMAND_HELP = {
     "segment": "find the period boundaries of a periodic motion (paper A, section 3)",
     "beats": "track the beats of a song and print their times in seconds",
@@ -29,3 +18,6 @@ COMMAND_HELP = {
     "reproduce": "run the study's notebooks with papermill from a parameter file",
     "data": "list the bundled data files and verify their SHA-256 checksums",
 }
+
+# The subcommands' modules, in the order shown in ``beatsync --help``.
+COMMAND_MODULES = tuple(COMMAND_HELP)

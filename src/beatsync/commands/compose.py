@@ -270,7 +270,7 @@ def run(args: argparse.Namespace) -> int:
         "fps": comp.motion.fps,
         "transition_times_s": comp.synthesis.transition_times,
         "tempo": comp.tempo.report(),
-        "multiplicity_used": comp.report()["multiplicity_used"],
+        "multiplicity_used": comp.multiplicity_used(),
         "plausibility": comp.plausibility,
         "warnings": notes,
     }
@@ -307,7 +307,7 @@ def _tempo_text(comp: Any) -> str:
     plan = comp.tempo
     p = comp.plausibility
     bound = "none" if plan.bound is None else f"{plan.bound[0]:g}-{plan.bound[1]:g}"
-    used = ", ".join(f"{k} beat(s) x{v}" for k, v in comp.report()["multiplicity_used"].items())
+    used = ", ".join(f"{k} beat(s) x{v}" for k, v in comp.multiplicity_used().items())
     lines = [
         f"tempo: song {plan.song_bpm:.0f} BPM, library {plan.library_bpm:.0f} BPM; "
         f"time-scale bound {bound}; intervals covering {used}"

@@ -58,7 +58,7 @@ METRICS = (
 TEMPO_RATIOS = {"correct": 1.0, "double": 2.0, "half": 0.5, "triple": 3.0, "third": 1 / 3}
 
 #: Values of :func:`octave_relation` that are octave errors.
-OCTAVE_ERRORS = ("double", "half", "triple", "third")
+OCTAVE_ERRORS = tuple(k for k in TEMPO_RATIOS if k != "correct")
 
 
 def diagnose_times(times: np.ndarray) -> str | None:

@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from ..validation import nearest
+
 __all__ = ["boundary_errors"]
 
 
@@ -23,11 +25,7 @@ def boundary_errors(estimated: Any, reference: Any, *, remove_offset: bool = Fal
     if est.size == 0 or ref.size == 0:
         return {"mean": np.nan, "max": np.nan, "n_matched": 0, "count_error": est.size - ref.size,
                 "offset": 0.0}  # fmt: skip
-    idx = np.clip(np.searchsorted(est, ref), 1, max(est.size - 1, 1))
-    left = est[idx - 1]
-    right = est[np.minimum(idx, est.size - 1)]
-    nearest = np.where(np.abs(ref - left) <= np.abs(ref - right), left, right)
-    signed = nearest - ref
+    signed = nearest(ref, est) - ref
     if remove_offset:
         offset = float(np.median(signed))
         return boundary_errors(est - offset, ref) | {"offset": offset}

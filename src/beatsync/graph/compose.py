@@ -81,12 +81,12 @@ class Composition:
             "transition_times_s": self.synthesis.transition_times,
             "graph": self.synthesis.info.get("graph_summary", {}),
             "tempo": self.tempo.report() if self.tempo is not None else None,
-            "multiplicity_used": self._multiplicity_used(),
+            "multiplicity_used": self.multiplicity_used(),
             "plausibility": self.plausibility,
             "warnings": list(self.warnings),
         }
 
-    def _multiplicity_used(self) -> dict[str, int]:
+    def multiplicity_used(self) -> dict[str, int]:
         """How many intervals covered each number of music beats."""
         sub = self.tempo.subdivision if self.tempo is not None else 1
         vals, counts = np.unique(np.diff(self.search.boundaries), return_counts=True)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..motion import segmentation_view
-from ..motion_beats import kinematic_beats, motion_positions
+from ..motion_beats import kinematic_beats, motion_positions, speed_curve
 from ..rotations import sample_motion
 from ..segment.checks import check_alpha, check_period_range
 from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_count
@@ -24,7 +24,7 @@ from ..validation import (
     frames_to_time,
     time_to_frames,
 )
-from .fill import LoopedClip, choose_loop, joint_positions, loop_events, with_center
+from .fill import LoopedClip, choose_loop, loop_events, with_center
 from .landing import dip_floor, land_seen, position_view, source_speed
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
@@ -387,7 +387,11 @@ def synchronize(
         "duration": duration,
         "song_end": song_end if fill == "loop" else None,
         "beat_period": beat_period,
+        # beats mode: the joint positions and their speed curve, once for both passes
+        "positions": motion_positions(motion) if whole_dance else None,
     }
+    if whole_dance:
+        plan["speed_curve"] = speed_curve(plan["positions"], fps=fps)
     lag = 0.0
     res = _resample(plan, phase_offset)
     if land == "accents":
@@ -486,10 +490,8 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         looped, used, targets, end, placed = place_whole_dance(plan, phase_offset)
         p = used.size - 1
         last = float(looped.events[-1]) if looped is not None else duration
-        got = joint_positions(motion)
-        pos, up = got if got is not None else (motion_positions(motion), 1)
-        speed_at = source_speed(pos, fps, looped)
-        pos_at = position_view(pos, up, fps, looped)
+        speed_at = source_speed(plan["speed_curve"], fps, looped)
+        pos_at = position_view(plan["positions"], 2 if motion.is_positional else 1, fps, looped)
 
         def warp_of(pins: np.ndarray) -> TimeWarp:
             floor = dip_floor(speed_at, pins, targets)
@@ -512,8 +514,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             src_t = warp.to_source(out_t)
             return pos_at(src_t), out_t, src_t, warp
 
-        used = land_seen(view, out_fps, used, targets, placed["speed_band"])
-        warp = warp_of(used)
+        used, warp = land_seen(view, out_fps, used, targets, placed["speed_band"])
         out_motion, out_times, src_times = _output(plan, warp, looped)
     else:
         cum = np.concatenate([[0], np.cumsum(counts)])

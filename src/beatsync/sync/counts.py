@@ -63,18 +63,18 @@ MARGIN = 1.06
 class CountPlan:
     """The placed events of a whole dance: indices (into the events given) of those
     pinned, their music ``targets`` [s], the ``beats`` each step spans (halves allowed),
-    the numbers of merges and half-beat landings, the share of phrase starts on bar
-    lines (None without meters), and the playback speeds each step aimed within
-    (``speed_band``: lowest, highest per step; the band narrowed by ``MARGIN``, its top
-    lowered by the peak headroom)."""
+    the numbers of merges and half-beat landings, the playback speeds each step aimed
+    within (``speed_band``: the lowest, the highest per step; the band narrowed by
+    ``MARGIN``, its top lowered by the peak headroom), and the share of phrase starts on
+    bar lines (None without meters)."""
 
     event_index: np.ndarray
     targets: np.ndarray
     beats: np.ndarray
     n_merged: int
     n_half: int
+    speed_band: tuple[float, np.ndarray]
     phrases_on_bars: float | None = None
-    speed_band: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def _speed_cost(ls: np.ndarray, dur: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -251,5 +251,5 @@ def plan_counts(
         phrases_on_bars=(
             float(np.mean(bar_ok[gk_a[phrase[ev_a]]])) if bar and phrase[ev_a].any() else None
         ),
-        speed_band=(np.full(step_top.size, np.exp(lo)), np.exp(step_top)),
+        speed_band=(float(np.exp(lo)), np.exp(step_top)),
     )

@@ -63,11 +63,9 @@ SCORE_SIGMA = 0.05
 _PEAK_SAMPLES = 33
 
 
-def source_speed(pos: np.ndarray, fps: float, looped: Any) -> Callable:
-    """The source's smoothed mean joint speed (:func:`speed_curve` of joint positions
-    ``pos`` at ``fps``) as a function of (looped, :class:`.fill.LoopedClip` or None)
-    source times [s]."""
-    curve = speed_curve(pos, fps=fps)
+def source_speed(curve: np.ndarray, fps: float, looped: Any) -> Callable:
+    """The source's smoothed mean joint speed (its :func:`speed_curve` at ``fps``) as a
+    function of (looped, :class:`.fill.LoopedClip` or None) source times [s]."""
 
     def speed_at(t: np.ndarray) -> np.ndarray:
         if looped is None:
@@ -176,22 +174,22 @@ def land_seen(
     fps: float,
     used: np.ndarray,
     targets: np.ndarray,
-    band: tuple[np.ndarray, np.ndarray],
-) -> np.ndarray:
+    band: tuple[float, np.ndarray],
+) -> tuple[np.ndarray, Any]:
     """The landings' source pins (from ``used`` [s]) whose output shows its motion beats
-    on ``targets`` [s] (module docstring). ``view(pins)`` returns the output's joint
-    positions, output times and source times at ``fps``, and the warp; ``band`` the lowest and
-    highest playback speed per interval the beat counts aimed at."""
+    on ``targets`` [s] (module docstring), and their warp. ``view(pins)`` returns the
+    output's joint positions, output times and source times at ``fps``, and the warp;
+    ``band`` the lowest and highest playback speed per interval the beat counts aimed at."""
     speed = np.diff(used) / np.diff(targets)
     lo, hi = np.minimum(band[0], speed), np.maximum(band[1], speed)
 
     def measure(pins):
         """Landing errors, the source times to pin (those that put the seen minima on
-        their frames), output frames outside the band."""
+        their frames), output frames outside the band, the warp."""
         look = view(pins)
         err, off_aim = seen_landings(look[0], fps, targets)
         shown = np.interp(targets + off_aim, look[1], look[2])
-        return err, shown, _off_band(look, fps, targets)
+        return err, shown, _off_band(look, fps, targets), look[3]
 
     def score(err):
         """Minima on their frames (within half a frame), then the music-side alignment
@@ -199,32 +197,27 @@ def land_seen(
         hits = int(np.count_nonzero(err <= 0.5 / fps))
         return hits, float(np.sum(np.exp(-(err * err) / (2.0 * SCORE_SIGMA**2))))
 
-    planned, pins = used, used
-    best, best_err = used, np.full(used.size, np.inf)  # per landing, its best pin
-    err, shown, off0 = measure(used)
-    rounds = [(score(err), used)]  # measured pins with no more output outside the band
-    for round_ in range(SEEN_ROUNDS + 1):
-        if round_:
-            err, shown, off = measure(pins)
-            if off.sum() <= off0.sum():
-                rounds.append((score(err), pins))
-            worse = off > off0  # a landing beside such an interval keeps its pin
-            better = (err < best_err) & ~np.concatenate([worse, [False]])
-            better &= ~np.concatenate([[False], worse])
-        else:
-            better = np.isfinite(err)
-        best = np.where(better, pins, best)
-        best_err = np.where(better, err, best_err)
-        if round_ == SEEN_ROUNDS:
-            break
-        moved = _within(np.where(better, shown, best), best, planned, targets, lo, hi)
+    err, shown, off0, warp = measure(used)
+    rounds = [(score(err), used, warp)]  # measured pins with no more output off the band
+    best, best_err, better, pins = used, err, np.isfinite(err), used  # per landing
+    for _ in range(SEEN_ROUNDS):
+        moved = _within(np.where(better, shown, best), best, used, targets, lo, hi)
         if np.array_equal(moved, pins) or not np.all(np.diff(moved) > 0):
             break
         pins = moved
-    # the landings' best pins together, measured too: pins act on their neighbours
-    mix = _within(best, planned, planned, targets, lo, hi)
-    if not any(np.array_equal(mix, r[1]) for r in rounds) and np.all(np.diff(mix) > 0):
-        err, _, off = measure(mix)
+        err, shown, off, warp = measure(pins)
         if off.sum() <= off0.sum():
-            rounds.append((score(err), mix))
-    return max(rounds, key=lambda r: r[0])[1]
+            rounds.append((score(err), pins, warp))
+        worse = off > off0  # a landing beside such an interval keeps its pin
+        better = (err < best_err) & ~np.concatenate([worse, [False]])
+        better &= ~np.concatenate([[False], worse])
+        best = np.where(better, pins, best)
+        best_err = np.where(better, err, best_err)
+    # the landings' best pins together, measured too: pins act on their neighbours
+    mix = _within(best, used, used, targets, lo, hi)
+    if not any(np.array_equal(mix, r[1]) for r in rounds) and np.all(np.diff(mix) > 0):
+        err, _, off, warp = measure(mix)
+        if off.sum() <= off0.sum():
+            rounds.append((score(err), mix, warp))
+    _, pins, warp = max(rounds, key=lambda r: r[0])
+    return pins, warp
