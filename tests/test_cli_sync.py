@@ -10,6 +10,7 @@ import pytest
 
 from beatsync import datasets, io
 from beatsync.cli import main
+from beatsync.motion_beats import kinematic_beats
 from beatsync.synth.audio import beat_times, click_track
 
 SR = 22050
@@ -333,6 +334,10 @@ def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, c
     assert sum(r["beats_per_motion_beat_used"].values()) == r["periods_used"]
     assert r["joins"] and all(j["peak_joint_speed"] > 0 for j in r["joins"])
     assert "beats    per motion beat used: " in stdout and "% of the output within" in stdout
+    # the text counts motion beats, as the report's landings do (not the gaps between them)
+    landed = re.search(r"mapping  (\d+) motion beats landed \((\d+) in the clip\)", stdout)
+    assert landed and int(landed[1]) == len(r["target_beats_s"])
+    assert int(landed[2]) == kinematic_beats(io.read_motion(d / "dancer.json", fps=25)).size
 
 
 def test_sync_reports_the_dance_phrase_it_steers_onto_bar_lines(inputs, tmp_path, capsys):

@@ -335,11 +335,17 @@ def _text(result: dict[str, Any]) -> str:
     meter = ""
     if r.get("meter_fit") is False:
         meter = " (meters do not fit)"
+    # the report counts intervals: periods, or the gaps between consecutive motion beats
+    beats_mode = r["mode"] == "beats"
+    n_avail, n_used = r["periods_available"] + beats_mode, r["periods_used"] + beats_mode
+    span = result["segmentation"]["mean_period_s"]
     lines = [
         f"motion   {result['motion']}: {r['input_frames']} frames at {r['input_fps']:g} fps, "
-        f"{result['segmentation']['n_periods']} {unit} of "
-        f"{result['segmentation']['mean_period_s']:.3f} s "
-        f"({'mean' if r['mode'] == 'periods' else 'median'})",
+        + (
+            f"{n_avail} motion beats, {span:.3f} s apart (median)"
+            if beats_mode
+            else f"{n_avail} periods of {span:.3f} s (mean)"
+        ),
         *([f"         {result['positions']}"] if result.get("positions") else []),
         f"music    {result['audio']}: {result['music_duration_s']:.2f} s, "
         f"{result['n_music_beats']} beats ({result['beats_source']}), "
@@ -348,7 +354,7 @@ def _text(result: dict[str, Any]) -> str:
         + (" (auto: not periodic, fell back to motion beats)" if r["mode_note"] else "")
         + (" (auto: periodic)" if r["mode_requested"] == "auto" and not r["mode_note"] else "")
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
-        f"mapping  {r['periods_used']} {unit} placed ({r['periods_available']} in the clip), "
+        f"mapping  {n_used} {unit} {'landed' if beats_mode else 'placed'} ({n_avail} in the clip), "
         f"first on beat {r['first_beat']}"
         + (f", {r['phase_offset_s'] * 1000:+.0f} ms after it" if r["phase_offset_s"] else ""),
         f"beats    per {unit[:-1]} used: {_counts_text(r['beats_per_motion_beat_used'])} "
