@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from beatsync import io
+from beatsync import datasets, io
 from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.motion import Joint, Motion, Skeleton
 from beatsync.sync import SyncResult, beats_per_period, blended_rate, synchronize, time_warp
@@ -493,6 +493,25 @@ def test_fill_loop_carries_the_travel_of_position_only_motion():
     assert np.allclose(out[:, :, 0].mean(axis=1).max(), pos[:, :, 0].mean(axis=1).max(), atol=0.05)
 
 
+def test_fill_loop_of_a_real_walk_too_short_for_its_blend_window_walks_on():
+    # CMU 007_01: two 1.08 s periods from 0.25 s to 2.42 s of a 2.6 s clip, so no loop
+    # has half a blend window of clip on both sides; each pass must still start where
+    # the previous one ended (it walked 2 m back at every join)
+    walk = datasets.load_walk("007_01")
+    beats = np.arange(0.3, 20.0, 0.6)
+    res = synchronize(walk, None, beats, mode="periods", fill="loop")
+    assert res.report["repetitions"] >= 5
+    root = res.motion.values[:, [0, 2]]  # the root on the floor (y up)
+    src = walk.values[:, [0, 2]]
+    step = np.linalg.norm(np.diff(root, axis=0), axis=1) * res.motion.fps
+    own = np.linalg.norm(np.diff(src, axis=0), axis=1) * walk.fps
+    assert step.max() <= own.max() * res.report["continuous_rate_range"][1]
+    assert np.linalg.norm(root[-1] - root[0]) > 5.0 * np.linalg.norm(src[-1] - src[0])
+    joins = res.report["joins"]
+    peak = res.report["kinematics"]["input"]["peak_joint_speed"]
+    assert joins and max(j["peak_joint_speed"] for j in joins) <= peak
+
+
 def test_fill_loop_of_a_clip_longer_than_the_song_is_stop_to_the_last_beat():
     m = _periodic_motion(period=1.0, duration=6.0)
     bounds = np.arange(0.0, 5.5, 1.0)
@@ -562,8 +581,6 @@ def test_mode_beats_lands_the_dancers_own_beats():
 @pytest.fixture(scope="module")
 def waltz_dancer() -> Motion:
     """12 s of a real waltz dancer (Dance-with-Melody, joint positions, 25 fps)."""
-    from beatsync import datasets
-
     return datasets.load_dance_pair("DANCE_W_5").motion.slice_frames(0, 300)
 
 
@@ -645,7 +662,6 @@ def test_mode_beats_needs_positions():
 
 def test_periodicity_refusal_in_sync_advises_only_what_sync_offers():
     # it said "Try other channels", and neither sync nor batch has a --channels option
-    from beatsync import datasets
     from beatsync.errors import NotPeriodicError
     from beatsync.motion import segmentation_view
     from beatsync.segment import segment
@@ -675,8 +691,6 @@ def _joint_speed(pos: np.ndarray, fps: float) -> np.ndarray:
 def rumba_on_a_waltz():
     """The real rumba dancer (24 s) re-synchronised to 40 s of a waltz's tempo (84 BPM):
     looped, at a tempo where one beat per motion beat plays the dance at x1.4-x2."""
-    from beatsync import datasets
-
     dancer = datasets.load_dance_pair("DANCE_R_3").motion
     beats = np.arange(0.3, 40.0, 60.0 / 84.0)
     with warnings.catch_warnings():
@@ -765,7 +779,6 @@ def test_join_weight_is_flat_at_the_join():
 def test_real_dancer_loop_join_keeps_its_motion_beat():
     # the real waltz dancer looped onto 40 s of 87 BPM: each join is one of its motion
     # beats (a speed minimum); the blend must not move it away from the join
-    from beatsync import datasets
     from beatsync.motion_beats import kinematic_beats
 
     dancer = datasets.load_dance_pair("DANCE_W_5").motion
@@ -789,8 +802,6 @@ def test_speed_warning_names_a_tempo_that_fits():
 
 def test_dance_meter_puts_the_dance_bars_on_bar_lines():
     # the real waltz dancer, told its meter (3 motion beats a bar), on a 3/4 song
-    from beatsync import datasets
-
     dancer = datasets.load_dance_pair("DANCE_W_10").motion
     beats = np.arange(0.3, 40.0, 60.0 / 87.0)
     with warnings.catch_warnings():
@@ -838,7 +849,6 @@ def test_dance_meter_without_a_period_in_range_is_none():
 def test_dance_meter_of_a_real_waltz_is_not_clear():
     # the waltz dancer's period is its bar (3 beats of its song, 2.14 s), but its speed
     # minima mark 1 to 3 of the bar's steps: no count of motion beats holds every bar
-    from beatsync import datasets
     from beatsync.motion_beats import kinematic_beats
     from beatsync.sync.core import estimate_dance_meter
 
@@ -852,7 +862,6 @@ def test_loop_of_a_turning_skeleton_carries_its_heading_on():
     # the loop starts facing where the previous one ended, without a turn back at a join
     from scipy.spatial.transform import Rotation
 
-    from beatsync import datasets
     from beatsync.motion_beats import motion_positions
     from beatsync.rotations import euler_to_rotation, rotation_to_euler
 

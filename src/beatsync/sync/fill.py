@@ -8,9 +8,10 @@ Where to loop (:func:`choose_loop`)
     al. 2002: the joints' point clouds over a window around both events compared after
     the best rotation about the vertical axis and translation on the floor), among the
     pairs whose span holds at least ``MIN_SPAN`` of the clip's events (so the loop keeps
-    most of the dance) and with half a blend window of clip on both sides. With a dance
-    meter of ``N`` motion beats, ``a`` and ``b - a`` are multiples of ``N`` (a loop
-    starts a dance bar and holds whole bars).
+    most of the dance) and with half a blend window of clip on both sides (with none,
+    the whole clip, blended over what fits). With a dance meter of ``N`` motion beats,
+    ``a`` and ``b - a`` are multiples of ``N`` (a loop starts a dance bar and holds
+    whole bars).
 
 The looped timeline
     ``t`` runs on from the clip: repetition ``r >= 1`` covers
@@ -239,10 +240,13 @@ def choose_loop(
     if dance is not None:
         ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
     ok &= events[jj] - events[ii] > 2.0 * join
-    if got is None or not ok.any():
-        # nothing to compare or no room: the whole span, blended over what fits
+    if got is None or not ok.any():  # the whole span, blended over what fits
         fit = float(min(join, 0.5 * np.min(np.diff(events))))
-        return 0, p, 0.0, None, float("nan"), fit
+        if got is None:  # nothing to compare or to move
+            return 0, p, 0.0, None, float("nan"), fit
+        # no pair with room: still each pass starts where the previous one ended
+        idx, ok, join = np.array([0, p]), np.array([[False, True], [False, False]]), fit
+        ii, jj = np.meshgrid(idx, idx, indexing="ij")
     pos, up = got
     fps = float(motion.fps)
     frames = np.rint(events[idx] * fps).astype(np.int64)
