@@ -512,6 +512,15 @@ def test_fill_loop_of_a_real_walk_too_short_for_its_blend_window_walks_on():
     assert joins and max(j["peak_joint_speed"] for j in joins) <= peak
 
 
+@pytest.mark.parametrize("mode", ["periods", "beats"])
+def test_loop_reports_the_passes_it_plays(mode):
+    # the looped timeline is built with room to spare; the report counts what is played
+    walk = datasets.load_walk("007_01")
+    beats = np.arange(0.3, 20.0, 0.6)
+    rep = synchronize(walk, None, beats, mode=mode, fill="loop", song_end=20.3).report
+    assert rep["repetitions"] == len(rep["joins"]) + 1 >= 5
+
+
 def test_fill_loop_of_a_clip_longer_than_the_song_is_stop_to_the_last_beat():
     m = _periodic_motion(period=1.0, duration=6.0)
     bounds = np.arange(0.0, 5.5, 1.0)

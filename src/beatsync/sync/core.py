@@ -67,8 +67,9 @@ class SyncResult:
     the ``warp`` itself (for plots); and the ``report``:
 
     - what was used and why: ``mode``, ``mode_requested``, ``mode_note``, ``land``,
-      ``fill``, ``repetitions``, ``beats_per_period`` (the count used most in beats
-      mode), ``beats_per_period_rule``, ``meter_fit``, ``meter_note``,
+      ``fill``, ``repetitions`` (passes of the clip the output plays),
+      ``beats_per_period`` (the count used most in beats mode), ``beats_per_period_rule``,
+      ``meter_fit``, ``meter_note``,
       ``dance_beats_per_period`` with ``dance_meter_rule`` (``"given"``,
       ``"estimated"`` or None) and ``dance_meter_found``,
       ``motion_beats_per_period_counted``, ``beats_per_bar``, ``period_range_s``,
@@ -583,7 +584,9 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         "input_duration_s": duration,
         "output_duration_s": float(frames_to_time(n_out - 1, fps=out_fps)),
         "fill": plan["fill"],
-        "repetitions": 1 if looped is None else looped.repetitions,
+        # passes the output plays: the clip, and one more after each join the warp reaches
+        "repetitions": 1
+        + (0 if looped is None else int(np.sum(looped.join_times <= warp.src[-1]))),
         "periods_available": int(n_avail),
         "periods_used": int(p),
         "first_beat": first_beat,
