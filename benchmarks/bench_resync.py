@@ -141,7 +141,8 @@ def speed_figures(res, out_fps: float) -> dict:
     """Playback speed between consecutive output frames, where the warp is live."""
     src = np.asarray(res.warp_src_times, dtype=np.float64)
     t = np.arange(src.size) / out_fps
-    live = (t[1:] > res.warp.tgt[0]) & (t[1:] <= res.warp.tgt[-1] + 1e-9)
+    # steps wholly within the warp: the step out of a held lead-in is half held
+    live = (t[:-1] >= res.warp.tgt[0] - 1e-9) & (t[1:] <= res.warp.tgt[-1] + 1e-9)
     s = np.diff(src)[live] * out_fps
     return {
         "in_band": float(np.mean((s >= BAND[0]) & (s <= BAND[1]))),

@@ -749,6 +749,16 @@ def test_real_dancer_loop_join_is_seamless(rumba_on_a_waltz):
         )
 
 
+def test_instantaneous_speed_leaves_out_the_step_out_of_a_held_start():
+    # the first pose waits for a beat 0.01 s after a frame: the step across it is
+    # mostly held, not a slow playback
+    m = _periodic_motion(period=1.0, duration=6.0)
+    beats = np.arange(1.01, 12.0, 0.5)  # 2 beats per 1 s period: the clip's own speed
+    sp = synchronize(m, np.arange(0.0, 5.5, 1.0), beats, fill="stop").report["playback_speed"]
+    assert sp["held_lead_in_s"] > 0.9
+    assert sp["instantaneous"]["min"] >= 0.9 * sp["per_interval"]["min"]
+
+
 def test_report_tells_the_counts_speeds_and_kinematics_used(rumba_on_a_waltz):
     dancer, _, res = rumba_on_a_waltz
     r = res.report

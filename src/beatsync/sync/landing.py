@@ -42,6 +42,7 @@ from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion_beats import speed_curve, speed_minima
 from ..validation import nearest
 from .positions import interp_frames
+from .quality import live_steps
 
 __all__ = [
     "SEEN_ROUNDS",
@@ -161,11 +162,10 @@ def _off_band(view: tuple, fps: float, targets: np.ndarray) -> np.ndarray:
     wherever the warp plays (its lead-in in the first interval, its run-on in the last;
     ``view``: positions, output and source times, the warp)."""
     _, out_times, src_times, warp = view
-    t = out_times[1:]
-    live = (t > warp.tgt[0]) & (t <= warp.tgt[-1] + 1e-9)
+    live = live_steps(src_times.size, fps, (warp.tgt[0], warp.tgt[-1]))
     speed = np.diff(src_times)[live] * fps
     off = (speed < DEFAULT_SCALE_BOUND[0]) | (speed > DEFAULT_SCALE_BOUND[1])
-    k = np.clip(np.searchsorted(targets, t[live]) - 1, 0, targets.size - 2)
+    k = np.clip(np.searchsorted(targets, out_times[1:][live]) - 1, 0, targets.size - 2)
     return np.bincount(k, weights=off, minlength=targets.size - 1)
 
 

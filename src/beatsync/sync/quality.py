@@ -26,7 +26,13 @@ from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion_beats import motion_positions
 
-__all__ = ["instantaneous_speed", "joint_kinematics", "speed_figures", "join_figures"]
+__all__ = [
+    "live_steps",
+    "instantaneous_speed",
+    "joint_kinematics",
+    "speed_figures",
+    "join_figures",
+]
 
 
 def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict[str, float]:
@@ -39,13 +45,18 @@ def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict
     }
 
 
+def live_steps(n: int, out_fps: float, covered: tuple[float, float]) -> np.ndarray:
+    """Which of the ``n - 1`` steps between consecutive output frames lie wholly within
+    ``covered`` [s], where the warp plays (a held lead-in, and the step out of it, left out)."""
+    t = np.arange(n) / out_fps
+    return (t[:-1] >= covered[0] - 1e-9) & (t[1:] <= covered[1] + 1e-9)
+
+
 def instantaneous_speed(
     src_times: np.ndarray, out_fps: float, covered: tuple[float, float]
 ) -> np.ndarray:
     """Source seconds per output second between output frames within ``covered`` [s]."""
-    t = np.arange(1, src_times.size) / out_fps
-    live = (t > covered[0]) & (t <= covered[1] + 1e-9)
-    return np.diff(src_times)[live] * out_fps
+    return np.diff(src_times)[live_steps(src_times.size, out_fps, covered)] * out_fps
 
 
 def speed_figures(
