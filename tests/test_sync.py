@@ -546,6 +546,9 @@ def test_fill_loop_dances_on_to_the_songs_end(mode):
     assert np.diff(tail).min() > 0  # moving, not held
     stop = synchronize(m, bounds, beats, mode=mode, fill="loop")
     assert stop.report["covered_s"][1] == pytest.approx(beats[-1])
+    # landed after their beats, the motion beats still end with the song, not after it
+    late = synchronize(m, bounds, beats, mode=mode, fill="loop", song_end=21.4, phase_offset=0.1)
+    assert late.report["output_duration_s"] <= 21.4 + 1.0 / FPS + 1e-9
 
 
 def test_song_end_before_the_last_beat_or_in_milliseconds_is_refused():

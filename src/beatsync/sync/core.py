@@ -506,7 +506,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
                 floor=floor,
             )
             if end is None and plan["song_end"] is not None:
-                warp = _go_on(warp, plan["song_end"] + phase_offset, last)
+                warp = _go_on(warp, plan["song_end"], last)  # the song's end: no offset
             return warp
 
         def view(pins: np.ndarray):
@@ -552,8 +552,8 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         if plan["fill"] == "loop" and p < events.size - 1:
             # cover the beats after the last whole interval (and the song's end) with part
             # of the next one, at the warp's end rate
-            stop = beats[last_beat] if plan["song_end"] is None else plan["song_end"]
-            warp = _go_on(warp, stop + phase_offset, float(events[-1]))
+            stop = beats[last_beat] + phase_offset if plan["song_end"] is None else plan["song_end"]
+            warp = _go_on(warp, stop, float(events[-1]))
         placed = {"beats": counts[:p].astype(np.float64), "n_merged": 0, "n_half_beat": 0}
         out_motion, out_times, src_times = _output(plan, warp, looped)
     n_out = out_times.size
