@@ -10,6 +10,7 @@ import pytest
 from beatsync import datasets, io
 from beatsync.errors import BeatsyncWarning, ParameterError
 from beatsync.motion import Joint, Motion, Skeleton
+from beatsync.motion_beats import kinematic_beats
 from beatsync.sync import SyncResult, beats_per_period, blended_rate, synchronize, time_warp
 
 FPS = 30.0
@@ -318,7 +319,6 @@ def _bounce(fps: float = 60.0, seconds: float = 12.0, period: float = 1.1) -> Mo
 
 
 def test_land_accents_puts_motion_beats_on_the_beats():
-    from beatsync.motion_beats import kinematic_beats
 
     m = _bounce()
     bounds = np.arange(0.0, 11.9, 1.1)
@@ -571,7 +571,6 @@ def test_beats_mode_dances_through_a_long_outro():
 
 
 def test_mode_beats_lands_the_dancers_own_beats():
-    from beatsync.motion_beats import kinematic_beats
 
     rng = np.random.default_rng(3)
     turns = np.cumsum(rng.uniform(0.45, 0.8, 30))  # an irregular dance: no period
@@ -726,7 +725,6 @@ def test_real_dancer_shows_its_landed_motion_beats_on_the_beat(rumba_on_a_waltz)
     # the playback speed is held around every landing, so the speed minimum there is
     # found again in the output within one output frame (86 % of them without the hold)
     from beatsync.evaluate.alignment import nearest_distance
-    from beatsync.motion_beats import kinematic_beats
 
     _, _, res = rumba_on_a_waltz
     landed = np.asarray(res.report["target_beats_s"])[1:-1]  # the ends: no minimum
@@ -760,6 +758,16 @@ def test_instantaneous_speed_leaves_out_the_step_out_of_a_held_start():
     sp = synchronize(m, np.arange(0.0, 5.5, 1.0), beats, fill="stop").report["playback_speed"]
     assert sp["held_lead_in_s"] > 0.9
     assert sp["instantaneous"]["min"] >= 0.9 * sp["per_interval"]["min"]
+
+
+@pytest.mark.parametrize("out_fps", [12.5, 50.0])
+def test_kinematics_compare_input_and_output_at_one_frame_rate(waltz_dancer, out_fps):
+    # the dancer played at its own timing: at another frame rate its joints move as before
+    own = kinematic_beats(waltz_dancer)
+    rep = synchronize(waltz_dancer, own, own, mode="periods", fill="stop", out_fps=out_fps).report
+    ratio = rep["kinematics"]["ratio"]
+    assert ratio["p99_joint_accel"] == pytest.approx(1.0, abs=0.05)
+    assert ratio["p99_joint_speed"] == pytest.approx(1.0, abs=0.05)
 
 
 def test_report_tells_the_counts_speeds_and_kinematics_used(rumba_on_a_waltz):
@@ -801,7 +809,6 @@ def test_join_weight_is_flat_at_the_join():
 def test_real_dancer_loop_join_keeps_its_motion_beat():
     # the real waltz dancer looped onto 40 s of 87 BPM: each join is one of its motion
     # beats (a speed minimum); the blend must not move it away from the join
-    from beatsync.motion_beats import kinematic_beats
 
     dancer = datasets.load_dance_pair("DANCE_W_5").motion
     beats = np.arange(0.3, 40.0, 60.0 / 87.0)
@@ -859,7 +866,6 @@ def test_dance_meter_is_estimated_when_clear_and_the_users_wins():
 def test_dance_meter_without_a_period_in_range_is_none():
     # the arm turns every 0.6 s and its bone angles repeat at every turn: no phrase of
     # 1.5-8.5 motion beats to find
-    from beatsync.motion_beats import kinematic_beats
     from beatsync.sync.core import estimate_dance_meter
 
     m = _arm_positions(seconds=12.0)
@@ -871,7 +877,6 @@ def test_dance_meter_without_a_period_in_range_is_none():
 def test_dance_meter_of_a_real_waltz_is_not_clear():
     # the waltz dancer's period is its bar (3 beats of its song, 2.14 s), but its speed
     # minima mark 1 to 3 of the bar's steps: no count of motion beats holds every bar
-    from beatsync.motion_beats import kinematic_beats
     from beatsync.sync.core import estimate_dance_meter
 
     dancer = datasets.load_dance_pair("DANCE_W_5").motion

@@ -10,7 +10,7 @@ Measured on the result, for the report of :func:`beatsync.sync.synchronize`:
   reported apart);
 - joint speed and acceleration (finite differences over all joints and frames, in
   the motion's position unit per second): p99 and peak of the output against the
-  input's;
+  input's, the input sampled (linearly) at the output's frame rate when they differ;
 - each loop join: its music time and the peak joint speed within its blend window.
 
 Data contract: times in seconds; positions ``(frames, joints, 3)``.
@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion_beats import motion_positions
+from .positions import interp_frames
 
 __all__ = [
     "live_steps",
@@ -148,9 +149,13 @@ def report_entries(motion, out_motion, src_times, warp, used, targets, looped, p
             pos_in, pos_out = motion_positions(motion), motion_positions(out_motion)
     except ParameterError:  # angle tables: no joint speeds to report
         pos_in = pos_out = None
-    rep["kinematics"] = (
-        None if pos_in is None else joint_kinematics(pos_in, motion.fps, pos_out, out_fps)
-    )
+    rep["kinematics"] = None
+    if pos_in is not None:
+        # finite differences depend on the frame rate: the input at the output's
+        if out_fps != motion.fps:
+            t = np.arange(0.0, (motion.n_frames - 1) / motion.fps + 1e-9, 1.0 / out_fps)
+            pos_in = interp_frames(pos_in, motion.fps, t)
+        rep["kinematics"] = joint_kinematics(pos_in, out_fps, pos_out, out_fps)
     rep["loop"] = None
     rep["joins"] = []
     if looped is not None:
