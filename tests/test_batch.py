@@ -4,6 +4,7 @@ import json
 import time
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from beatsync import datasets, io
@@ -26,16 +27,16 @@ def inputs(tmp_path_factory):
     io.write_bvh(d / "salsa.bvh", real.with_values(np.tile(step, (12, 1))).rename("salsa"))
     io.write_bvh(d / "pirouette.bvh", datasets.load_walk("005_02"))  # 9 s, not periodic
     songs = []
-    for bpm in (100, 125):
+    for bpm in (100, 125, 80):  # at 80 BPM the salsa's 1 s steps play x1.33: a warning
         beats = beat_times(bpm, duration=14.0, start=0.5)
         songs.append(
             io.write_audio(d / f"click{bpm}.wav", click_track(beats, sr=SR, duration=14.0), SR)
         )
-    return d, [d / "salsa.bvh", d / "pirouette.bvh"], songs
+    return d, [d / "salsa.bvh", d / "pirouette.bvh"], songs[:2], songs[2]
 
 
 def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     table = sync_grid(clips, songs, tmp_path, processes=False, n_workers=2, fps=60.0,
                       mode="periods")  # fmt: skip
     assert len(table) == 4
@@ -53,7 +54,7 @@ def test_grid_syncs_periodic_clip_and_records_errors(inputs, tmp_path):
 
 
 def test_grid_mode_auto_uses_the_motion_beats_of_a_clip_that_is_not_periodic(inputs, tmp_path):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     table = sync_grid(clips, songs[:1], tmp_path, processes=False, n_workers=2, fps=60.0,
                       mode="auto")  # fmt: skip
     assert (table["status"] == "ok").all()
@@ -71,7 +72,7 @@ def test_grid_mode_auto_uses_the_motion_beats_of_a_clip_that_is_not_periodic(inp
 def test_a_bad_setting_is_the_clips_error_not_a_free_dance(inputs, mode):
     # neither the hint that --mode beats syncs it nor mode auto's fallback to the motion
     # beats: those are for a dance that is not periodic
-    _, clips, _ = inputs
+    _, clips, _, _ = inputs
     with pytest.raises(ParameterError, match="alpha") as err:
         prepare_clip(str(clips[0]), fps=60.0, alpha=0.7, mode=mode)
     assert not isinstance(err.value, NotPeriodicError)
@@ -84,7 +85,7 @@ def test_a_bad_setting_is_the_clips_error_not_a_free_dance(inputs, mode):
      ({"fps": 44100.0}, "fps")],
 )  # fmt: skip
 def test_grid_refuses_a_bad_shared_setting_before_any_work(inputs, tmp_path, kwargs, match):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     with pytest.raises(ParameterError, match=match):
         sync_grid(clips, songs, tmp_path, processes=False, n_workers=1, mode="auto", **kwargs)
     assert list(tmp_path.iterdir()) == []
@@ -92,7 +93,7 @@ def test_grid_refuses_a_bad_shared_setting_before_any_work(inputs, tmp_path, kwa
 
 def test_grid_tempo_range_reaches_every_song(inputs, tmp_path):
     # click tracks at 100 and 125 BPM, searched at 40-70 BPM: every other click
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     table = sync_grid(clips[:1], songs, tmp_path, processes=False, n_workers=1, fps=60.0,
                       min_bpm=40, max_bpm=70)  # fmt: skip
     assert (table["status"] == "ok").all()
@@ -100,7 +101,7 @@ def test_grid_tempo_range_reaches_every_song(inputs, tmp_path):
 
 
 def test_grid_bad_arguments(inputs, tmp_path):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     with pytest.raises(ParameterError, match="none.bvh"):
         sync_grid([tmp_path / "none.bvh"], songs, tmp_path)
     with pytest.raises(ParameterError, match="missing"):
@@ -112,7 +113,7 @@ def test_grid_bad_arguments(inputs, tmp_path):
 
 
 def test_batch_cli_writes_summary(inputs, scheduler, tmp_path, capsys):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     code = main(
         [
             "batch",
@@ -135,7 +136,7 @@ def test_batch_cli_writes_summary(inputs, scheduler, tmp_path, capsys):
 
 
 def test_batch_refuses_to_overwrite_inputs(inputs, tmp_path):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     before = songs[0].read_bytes()
     code = main(
         [
@@ -155,7 +156,7 @@ def test_batch_refuses_to_overwrite_inputs(inputs, tmp_path):
 
 
 def test_batch_refuses_duplicate_song_names(inputs, tmp_path):
-    d, clips, songs = inputs
+    d, clips, songs, _ = inputs
     twins = [tmp_path / "a" / "take" / "song.wav", tmp_path / "b" / "take" / "song.wav"]
     for t in twins:  # the same file name in folders of the same name: nothing tells them apart
         t.parent.mkdir(parents=True)
@@ -215,7 +216,7 @@ def test_batch_cli_takes_one_folder_per_take(tmp_path, scheduler, capsys):
 
 
 def _batch_args(inputs, out, *extra):
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     return [
         "batch",
         "--clips",
@@ -282,7 +283,7 @@ def test_grid_writes_joint_positions_back_in_the_inputs_layout(inputs, tmp_path)
     # a real dancer (Dance-with-Melody JSON, cm, y up) and the same dancer as an
     # (n_frames, n_joints, 3) .npy: each pair is written as the clip came in, as
     # `beatsync sync` keeps it, not as a CSV table of metres, z up
-    _, _, songs = inputs
+    _, _, songs, _ = inputs
     src = datasets.path("motion/dance_with_melody/DANCE_W_5/skeletons.json")
     clips = tmp_path / "clips"
     clips.mkdir()
@@ -310,7 +311,7 @@ def test_grid_writes_joint_positions_back_in_the_inputs_layout(inputs, tmp_path)
 @pytest.mark.parametrize("cli", [True, False])
 def test_batch_refuses_a_positions_output_that_is_an_input(inputs, tmp_path, cli):
     # dancer x click100 would be written as dancer__click100.json: here an input clip
-    _, _, songs = inputs
+    _, _, songs, _ = inputs
     src = datasets.path("motion/dance_with_melody/DANCE_W_5/skeletons.json")
     clips = [tmp_path / "dancer.json", tmp_path / "dancer__click100.json"]
     for c in clips:
@@ -330,7 +331,7 @@ def test_batch_refuses_a_positions_output_that_is_an_input(inputs, tmp_path, cli
 def test_batch_text_gives_a_line_per_pair_and_its_note_or_error(inputs, scheduler, tmp_path,
                                                                  capsys):  # fmt: skip
     # as one table, the notes of real dancers made lines of several hundred characters
-    _, clips, songs = inputs
+    _, clips, songs, _ = inputs
     argv = ["batch", "--clips", *map(str, clips), "--songs", str(songs[0]), "--out-dir",
             str(tmp_path), "--fps", "60", "--scheduler", scheduler,
             "--mode", "periods"]  # fmt: skip
@@ -346,13 +347,36 @@ def test_batch_text_gives_a_line_per_pair_and_its_note_or_error(inputs, schedule
 
 def test_batch_refuses_a_summary_named_like_a_pairs_output(inputs, tmp_path, capsys):
     # it was written over the synchronised pair, and the command exited 0
-    _, clips, songs = inputs
-    pair = str(tmp_path / "salsa__click100.bvh")
+    _, clips, songs, _ = inputs
+    pair = str(tmp_path / "salsa__click100.csv")  # the name a table's pair would take
     argv = ["batch", "--clips", str(clips[0]), "--songs", str(songs[0]), "--out-dir",
             str(tmp_path), "--fps", "60", "--summary", pair]  # fmt: skip
     assert main(argv) == 3
     assert "give the summary another name" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_batch_refuses_a_summary_that_is_not_csv(inputs, tmp_path, capsys):
+    _, clips, songs, _ = inputs
+    argv = ["batch", "--clips", str(clips[0]), "--songs", str(songs[0]), "--out-dir",
+            str(tmp_path), "--fps", "60", "--summary", str(tmp_path / "sum.mp4")]  # fmt: skip
+    assert main(argv) == 3
+    assert "must end in .csv" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_batch_keeps_each_pairs_warnings_with_it(inputs, scheduler, tmp_path, capsys):
+    # they were printed raw by the worker (file, line and class) and lost from the summary
+    _, clips, _, slow = inputs
+    argv = ["batch", "--clips", str(clips[0]), "--songs", str(slow), "--out-dir",
+            str(tmp_path), "--fps", "60", "--scheduler", scheduler,
+            "--mode", "periods"]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "beatsync batch: warning: salsa x click80: the dance plays within x0.8-x1.25" in err
+    assert "BeatsyncWarning" not in err and ".py:" not in err
+    row = pd.read_csv(tmp_path / "summary.csv").iloc[0]
+    assert "a song at about 60 BPM" in row["warnings"] and row["mean_period_s"] > 0
 
 
 def test_outputs_adopt_never_takes_another_options_file(tmp_path):
@@ -370,7 +394,7 @@ def test_outputs_adopt_never_takes_another_options_file(tmp_path):
 
 def test_batch_variable_picks_the_recording_of_a_mat_file(inputs, tmp_path, capsys):
     # the toolbox's demo file holds several recordings: batch named --variable without having it
-    _, _, songs = inputs
+    _, _, songs, _ = inputs
     mat = datasets.path("motion/mocaptoolbox/mcdemodata.mat")
     argv = ["batch", "--clips", str(mat), "--songs", str(songs[0]), "--out-dir", str(tmp_path),
             "--variable", "dance2", "--mode", "beats", "--workers", "1", "--json"]  # fmt: skip

@@ -6,17 +6,19 @@ defaults (:func:`beatsync.sync.synchronize`; ``mode="auto"``, looped to the song
 the song's estimated meter respected). A pair that fails records its error in its
 row instead of stopping the study. Outputs are ``<clip>__<song>`` under ``out_dir`` in
 the clip's own kind of file (:func:`output_suffix`), items named by their file name
-without suffix, or by their folder where file names repeat (:func:`item_names`).
+without suffix, or by their folder where file names repeat (:func:`item_names`). The
+warnings of a pair's song, clip and synchronisation are kept in its row.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .errors import NotPeriodicError, ParameterError
+from .errors import NotPeriodicError, ParameterError, collect_warnings
 
 __all__ = [
     "item_names",
@@ -111,7 +113,6 @@ def prepare_clip(
         "clip": Path(path).stem,
         "motion": motion,
         "boundaries": None,
-        "mean_period_s": float("nan"),
         "note": "",
     }
     if mode == "beats":
@@ -126,7 +127,7 @@ def prepare_clip(
             ) from None
         clip["note"] = f"not periodic ({exc}): its motion beats were used"
         return clip
-    clip.update(boundaries=seg.boundaries, mean_period_s=seg.mean_period)
+    clip["boundaries"] = seg.boundaries
     return clip
 
 
@@ -141,7 +142,10 @@ def sync_pair(
     from . import io
     from .sync import synchronize
 
-    row: dict[str, Any] = {"clip": clip_name, "song": song_name}
+    row: dict[str, Any] = {"clip": clip_name, "song": song_name, "warnings": []}
+    for value in (song, clip):
+        if isinstance(value, dict):
+            row["warnings"] += value["warnings"]
     for what, value in (("clip", clip), ("song", song)):
         if isinstance(value, BaseException):
             row.update(status="error", error=f"{what}: {value}")
@@ -170,7 +174,7 @@ def sync_pair(
         mode=rep.get("mode"),
         note=clip["note"],
         tempo_bpm=float(song["tempo_bpm"]),
-        mean_period_s=float(clip["mean_period_s"]),
+        mean_period_s=float(rep["mean_motion_period_s"]),  # beats mode: the median interval
         input_frames=rep.get("input_frames"),
         output_frames=rep.get("output_frames"),
         beats_per_period=rep.get("beats_per_period"),
@@ -184,6 +188,22 @@ def sync_pair(
 def _error_text(exc: Exception) -> str:
     """A task's error as its rows record it: bad input by its message, else with its type."""
     return str(exc) if isinstance(exc, ParameterError) else f"{type(exc).__name__}: {exc}"
+
+
+def _noting(func: Any) -> Any:
+    """Wrap a task so the :class:`~beatsync.errors.BeatsyncWarning` messages it issues are
+    appended to its result's ``"warnings"`` (a worker would print them raw, apart from
+    their pair); other packages' warnings are dropped."""
+
+    def wrapped(*args: Any, **kwargs: Any) -> Any:
+        with collect_warnings() as caught, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = func(*args, **kwargs)
+        out["warnings"] = [*out.get("warnings", []), *caught]
+        return out
+
+    wrapped.__name__ = func.__name__
+    return wrapped
 
 
 def _guard(func: Any) -> Any:
@@ -230,7 +250,8 @@ def sync_grid(
 
     A row holds the status, output path, the mode used (and why, for a clip that
     ``"auto"`` found not periodic), tempo, frames, beats per period and largest boundary
-    residual [ms], or the error. Bad shared settings and inputs are refused with a
+    residual [ms], or the error, and the warnings of its song, clip and synchronisation
+    (joined by ``" | "``). Bad shared settings and inputs are refused with a
     ``ParameterError`` before any work.
     """
     import pandas as pd
@@ -274,13 +295,18 @@ def sync_grid(
     with dask_client(scheduler=scheduler, n_workers=n_workers, processes=processes) as client:
         song_f = {
             s: client.submit(
-                _guard(prepare_song), s, bpm=bpm, min_bpm=min_bpm, max_bpm=max_bpm, pure=False
+                _guard(_noting(prepare_song)),
+                s,
+                bpm=bpm,
+                min_bpm=min_bpm,
+                max_bpm=max_bpm,
+                pure=False,
             )
             for s in songs
         }
         clip_f = {
             c: client.submit(
-                _guard(prepare_clip),
+                _guard(_noting(prepare_clip)),
                 c,
                 fps=fps,
                 variable=variable,
@@ -293,7 +319,7 @@ def sync_grid(
         }
         pairs = [
             client.submit(
-                sync_pair,
+                _noting(sync_pair),
                 clip_f[c],
                 song_f[s],
                 str(out),
@@ -311,4 +337,6 @@ def sync_grid(
             for done, _ in enumerate(as_completed(pairs), 1):
                 progress(done)
         rows = client.gather(pairs)
+    for row in rows:
+        row["warnings"] = " | ".join(row["warnings"])
     return pd.DataFrame(rows)

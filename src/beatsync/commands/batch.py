@@ -70,7 +70,9 @@ def run(args: argparse.Namespace) -> int:
     # moved into place with the summary only when the whole grid has run
     with Outputs(inputs=inputs) as outs:
         out_dir = outs.add_folder(args.out_dir, option="--out-dir")
-        summary = outs.add(args.summary or out_dir / "summary.csv", option="--summary")
+        summary = outs.add(
+            args.summary or out_dir / "summary.csv", option="--summary", suffixes=[".csv"]
+        )
         clip_names = item_names(args.clips, "clip")
         song_names = item_names(args.songs, "song")
         for c, cn in zip(args.clips, clip_names, strict=True):
@@ -84,7 +86,8 @@ def run(args: argparse.Namespace) -> int:
                             f"{cn} x {sn} in --out-dir; give the "
                             "summary another name"
                         )
-        with feedback(args).step("batch") as progress:
+        fb = feedback(args)
+        with fb.step("batch") as progress:
             table = sync_grid(
                 args.clips,
                 args.songs,
@@ -101,6 +104,9 @@ def run(args: argparse.Namespace) -> int:
         for i in table.index[table["status"] == "ok"]:
             table.loc[i, "output"] = str(outs.adopt(table.loc[i, "output"], option="--out-dir"))
         io.write_csv(outs.path(summary), table)
+    for row in table.to_dict("records"):
+        for note in filter(None, row["warnings"].split(" | ")):
+            fb.warn(f"{row['clip']} x {row['song']}: {note}")
     n_ok = int((table["status"] == "ok").sum())
     text = _text(table, args.out_dir) + f"\n{n_ok}/{len(table)} pairs synchronised; {summary}"
     emit({"summary": str(summary), "rows": table.to_dict("records")}, text, args)
