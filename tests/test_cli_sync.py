@@ -337,7 +337,11 @@ def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, c
     # the text counts motion beats, as the report's landings do (not the gaps between them)
     landed = re.search(r"mapping  (\d+) motion beats landed \((\d+) in the clip\)", stdout)
     assert landed and int(landed[1]) == len(r["target_beats_s"])
-    assert int(landed[2]) == kinematic_beats(io.read_motion(d / "dancer.json", fps=25)).size
+    n_beats = kinematic_beats(io.read_motion(d / "dancer.json", fps=25)).size
+    assert int(landed[2]) == n_beats
+    seg = json.loads(rep.read_text())["segmentation"]  # named for what it holds
+    assert seg["mode"] == "beats" and seg["n_motion_beats"] == n_beats
+    assert seg["median_interval_s"] == pytest.approx(r["mean_motion_period_s"])
 
 
 def test_sync_reports_the_dance_phrase_it_steers_onto_bar_lines(inputs, tmp_path, capsys):

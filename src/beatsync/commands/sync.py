@@ -315,11 +315,20 @@ def _pipeline(
         "beats_per_bar": meter[0],
         "beats_per_bar_source": meter[1],
         "music_duration_s": music_s,
-        "segmentation": {
-            "mode": rep["mode"],
-            "n_periods": int(rep["periods_available"]),
-            "mean_period_s": float(rep["mean_motion_period_s"]),
-        },
+        # the events: paper A's periods, or the dancer's own motion beats
+        "segmentation": (
+            {
+                "mode": "beats",
+                "n_motion_beats": int(rep["periods_available"]) + 1,
+                "median_interval_s": float(rep["mean_motion_period_s"]),
+            }
+            if rep["mode"] == "beats"
+            else {
+                "mode": "periods",
+                "n_periods": int(rep["periods_available"]),
+                "mean_period_s": float(rep["mean_motion_period_s"]),
+            }
+        ),
         "report": rep,
         "outputs": written,
         "timings": timings,
@@ -338,7 +347,7 @@ def _text(result: dict[str, Any]) -> str:
     # the report counts intervals: periods, or the gaps between consecutive motion beats
     beats_mode = r["mode"] == "beats"
     n_avail, n_used = r["periods_available"] + beats_mode, r["periods_used"] + beats_mode
-    span = result["segmentation"]["mean_period_s"]
+    span = r["mean_motion_period_s"]
     lines = [
         f"motion   {result['motion']}: {r['input_frames']} frames at {r['input_fps']:g} fps, "
         + (

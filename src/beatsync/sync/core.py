@@ -456,7 +456,7 @@ def _speed_warning(report: dict[str, Any], beat_period: float) -> None:
         lo, hi = sp["band"]
         note = (
             f"the dance plays within x{lo:g}-x{hi:g} of its speed for only {share:.0%} of "
-            f"the song ({60.0 / beat_period:.0f} BPM); a song at about "
+            f"the output (song at {60.0 / beat_period:.0f} BPM); a song at about "
             f"{fitting_tempo(sp['per_interval']['median'], 60.0 / beat_period)} would fit "
             "with the same beat counts"
         )
