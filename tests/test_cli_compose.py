@@ -70,7 +70,7 @@ def test_compose_end_to_end_with_beats(workdir, capsys):
     assert report["search_time_s"] > 0 and report["graph_build_time_s"] > 0
     assert m.n_frames == int(np.floor(6.0 * m.fps)) + 1  # lasts as long as the song
     assert report["n_frames"] == m.n_frames
-    assert report["duration_s"] == pytest.approx(m.n_frames / m.fps)
+    assert report["duration_s"] == pytest.approx(6.0)  # frame j at j / fps: the song's end
     cache = list((workdir / "cache").glob("graph-*.npz"))
     assert len(cache) == 1
     # second run: the graph comes from the cache, the result is the same
@@ -101,6 +101,20 @@ def test_compose_end_to_end_with_beats(workdir, capsys):
     res3 = json.loads(capsys.readouterr().out)
     assert res3["tempo_bpm"] == pytest.approx(110, rel=0.05)
     assert out3.is_file()
+
+
+def test_compose_warns_when_the_beats_given_stop_long_before_the_song(workdir, capsys):
+    # the dance then holds its last pose: the beats of part of the song, or of another one
+    short = workdir / "short.beats"
+    io.write_beats(short, io.read_beats(workdir / "song.beats")[:4])
+    argv = ["compose", str(workdir / "song.wav"), "--library", str(workdir / "lib"),
+            "--beats", str(short), "-o", str(workdir / "d.bvh"), "--json"]  # fmt: skip
+    assert main(argv) == 0
+    out = capsys.readouterr()
+    assert "warning: the beats of" in out.err and "holds its last pose" in out.err
+    assert any("holds its last pose" in w for w in json.loads(out.out)["warnings"])
+    argv[argv.index(str(short))] = str(workdir / "song.beats")  # the whole song's: quiet
+    assert main(argv) == 0 and "warning" not in capsys.readouterr().err
 
 
 def test_cache_key_changes_with_content_and_params(workdir):

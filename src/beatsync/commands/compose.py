@@ -206,12 +206,20 @@ def run(args: argparse.Namespace) -> int:
     t_read = time.perf_counter()
     with fb.noted() as read_notes:  # e.g. the MP3 decoder's
         y, sr = io.read_audio(audio)
-    beats = None
+    beats, beat_notes = None, []
     if args.beats is not None:  # cheap checks first: the beats file before the clips
         try:
             beats = check_music_beats(io.read_beats(args.beats), duration=y.size / float(sr))
         except ParameterError as exc:
             raise ParameterError(f"beats file {args.beats!r}: {exc}") from None
+        rest = y.size / float(sr) - beats[-1]
+        if beats.size > 1 and rest > 4.0 * float(np.median(np.diff(beats))):  # over a bar
+            beat_notes.append(
+                f"the beats of {args.beats!r} end at {beats[-1]:.2f} s, {rest:.1f} s before "
+                "the music does: the dance holds its last pose from there (the annotation "
+                "of part of the song, or of another recording?)"
+            )
+            fb.warn(beat_notes[-1])
     with fb.step("reading the library", total=len(files)) as progress:
         clips = []
         for f in files:
@@ -223,7 +231,7 @@ def run(args: argparse.Namespace) -> int:
     from ..music import track_music_beats
 
     check_library(clips)
-    notes: list[str] = list(read_notes)
+    notes: list[str] = [*read_notes, *beat_notes]
     if beats is None:
         with fb.noted() as tracked, fb.step("tracking beats"):
             beats = track_music_beats(y, sr, **tempo_options(args))
@@ -265,7 +273,7 @@ def run(args: argparse.Namespace) -> int:
         "synthesis_time_s": comp.timings["synthesis_s"],
         "read_time_s": read_s,
         "cost": comp.search.cost,
-        "duration_s": comp.motion.n_frames / comp.motion.fps,
+        "duration_s": (comp.motion.n_frames - 1) / comp.motion.fps,  # the last frame
         "n_frames": comp.motion.n_frames,
         "fps": comp.motion.fps,
         "transition_times_s": comp.synthesis.transition_times,

@@ -76,7 +76,7 @@ class Composition:
             "transition_cost": self.search.transition_cost,
             "search_time_s": self.search.search_time,
             "synthesis_time_s": self.timings.get("synthesis_s"),
-            "duration_s": self.motion.n_frames / self.motion.fps,
+            "duration_s": (self.motion.n_frames - 1) / self.motion.fps,  # the last frame's time
             "fps": self.motion.fps,
             "transition_times_s": self.synthesis.transition_times,
             "graph": self.synthesis.info.get("graph_summary", {}),
