@@ -337,6 +337,8 @@ def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, c
     # the text counts motion beats, as the report's landings do (not the gaps between them)
     landed = re.search(r"mapping  (\d+) motion beats landed \((\d+) in the clip\)", stdout)
     assert landed and int(landed[1]) == len(r["target_beats_s"])
+    seen = r["landings_seen"]
+    assert f"seen     {seen['on_their_frame']} of {landed[1]} landings show" in stdout
     n_beats = kinematic_beats(io.read_motion(d / "dancer.json", fps=25)).size
     assert int(landed[2]) == n_beats
     seg = json.loads(rep.read_text())["segmentation"]  # named for what it holds

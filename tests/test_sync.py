@@ -794,6 +794,14 @@ def test_report_tells_the_counts_speeds_and_kinematics_used(rumba_on_a_waltz):
     assert k["ratio"]["p99_joint_speed"] == pytest.approx(
         np.percentile(out, 99) / k["input"]["p99_joint_speed"]
     )
+    # the landings the output shows, by the scorer's own detector
+    seen, targets = r["landings_seen"], np.asarray(r["target_beats_s"])
+    mb = kinematic_beats(res.motion)
+    near = mb[np.abs(mb[None, :] - targets[:, None]).argmin(axis=1)]
+    on_frame = np.isclose(near, np.rint(targets * fps) / fps)
+    assert seen["landings"] == targets.size and seen["on_their_frame"] == on_frame.sum() > 0
+    assert seen["not_found"] == np.sum(np.abs(near - targets) > 0.1)
+    assert seen["max_ms"] <= 100.0
 
 
 def test_join_weight_is_flat_at_the_join():

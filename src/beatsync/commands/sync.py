@@ -382,6 +382,7 @@ def _text(result: dict[str, Any]) -> str:
             if r.get("dance_meter_rule") and r["mode"] == "beats"
             else []
         ),
+        *_seen_lines(r.get("landings_seen")),
         *_speed_lines(r),
         f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
         f"({r['output_duration_s']:.2f} s, the last landing at {r['target_beats_s'][-1]:.2f} s)",
@@ -396,6 +397,18 @@ def _text(result: dict[str, Any]) -> str:
 def _counts_text(used: dict[str, int]) -> str:
     """``{"1": 6, "2": 8}`` as ``1 x6, 2 x8``."""
     return ", ".join(f"{k} x{v}" for k, v in sorted(used.items(), key=lambda kv: float(kv[0])))
+
+
+def _seen_lines(seen: dict[str, Any] | None) -> list[str]:
+    """How many landed motion beats the output shows on their beat's frame (beats mode)."""
+    if not seen:
+        return []
+    missing = f"; {seen['not_found']} not seen within 0.1 s" if seen["not_found"] else ""
+    return [
+        f"seen     {seen['on_their_frame']} of {seen['landings']} landings show their speed "
+        f"minimum on their beat's frame; {seen['median_ms']:.0f} ms from the beat (median), "
+        f"{seen['max_ms']:.0f} ms at most{missing}"
+    ]
 
 
 def _speed_lines(r: dict[str, Any]) -> list[str]:

@@ -84,7 +84,8 @@ class SyncResult:
       ``residual_ms`` (realised warp) and ``residual_nearest_frame_ms``, their maxima;
     - from the output frames (:mod:`.quality`): ``beats_per_motion_beat_used``,
       ``n_merged_intervals``, ``n_half_beat_landings``, ``phrases_on_bars``,
-      ``playback_speed``, ``kinematics``, ``loop``, ``joins``, ``speed_warning``.
+      ``playback_speed``, ``kinematics``, ``landings_seen`` (beats mode), ``loop``,
+      ``joins``, ``speed_warning``.
     """
 
     motion: Any
@@ -613,9 +614,8 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         ],
         "first_boundary_frame": int(time_to_frames(targets[0], fps=out_fps)),  # for trimming
     }
-    report.update(
-        report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed)
-    )
+    args = (motion, out_motion, src_times, warp, used, targets, looped, placed)
+    report.update(report_entries(*args, beats_mode=counts is None))
     return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)
 
 

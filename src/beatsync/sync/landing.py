@@ -39,25 +39,19 @@ import numpy as np
 
 from ..graph.distance import ground_axes
 from ..graph.timescale import DEFAULT_SCALE_BOUND
-from ..motion_beats import speed_curve, speed_minima
-from ..validation import nearest
 from .positions import interp_frames
-from .quality import live_steps
+from .quality import live_steps, seen_landings
 
 __all__ = [
     "SEEN_ROUNDS",
-    "SEEN_REACH",
     "source_speed",
     "position_view",
     "dip_floor",
-    "seen_landings",
     "land_seen",
 ]
 
 #: rounds of measuring the output's motion beats and moving the pins
 SEEN_ROUNDS = 2
-#: an output motion beat this close to a landing's beat [s] is that landing's
-SEEN_REACH = 0.1
 #: width of the landings' score [s]: the published alignment scores' (3 frames at 60 fps)
 SCORE_SIGMA = 0.05
 #: samples per interval when looking for its speed peak
@@ -106,26 +100,6 @@ def dip_floor(
     floor[:-1] = m / np.sqrt(np.maximum(peak / low[:-1], 1.0))  # the interval after
     floor[1:] = np.maximum(floor[1:], m / np.sqrt(np.maximum(peak / low[1:], 1.0)))
     return floor
-
-
-def seen_landings(
-    pos: np.ndarray, fps: float, targets: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """For every beat in ``targets`` [s]: how far [s] the nearest motion beat of the
-    output's joint positions ``pos`` (at ``fps``) lies from the output frame nearest
-    the beat, the frame a viewer can see it on (inf beyond ``SEEN_REACH``), and how far
-    it lies from the beat [s] (signed)."""
-    aim = np.rint(targets * fps) / fps
-    curve = speed_curve(pos, fps=fps)
-    f = speed_minima(curve, fps)  # kinematic_beats' defaults
-    if f.size == 0:
-        return np.full(targets.size, np.inf), np.zeros(targets.size)
-    c0, c1, c2 = curve[f - 1], curve[f], curve[f + 1]
-    bend = c0 - 2.0 * c1 + c2
-    vertex = np.where(bend > 0, 0.5 * (c0 - c2) / np.where(bend > 0, bend, 1.0), 0.0)
-    near = nearest(aim, (f + vertex) / fps)
-    d = np.abs(near - aim)
-    return np.where(d <= SEEN_REACH, d, np.inf), near - aim
 
 
 def _within(moved, kept, planned, targets, lo, hi):

@@ -11,7 +11,10 @@ Measured on the result, for the report of :func:`beatsync.sync.synchronize`:
 - joint speed and acceleration (finite differences over all joints and frames, in
   the motion's position unit per second): p99 and peak of the output against the
   input's, the input sampled (linearly) at the output's frame rate when they differ;
-- each loop join: its music time and the peak joint speed within its blend window.
+- each loop join: its music time and the peak joint speed within its blend window;
+- beats mode: the landed motion beats the output shows, found by the scorer's detector
+  (:func:`beatsync.motion_beats.kinematic_beats`): how many on their beat's frame (within
+  half a frame), how far from their beats, how many not within ``SEEN_REACH``.
 
 Data contract: times in seconds; positions ``(frames, joints, 3)``.
 """
@@ -24,16 +27,24 @@ import numpy as np
 
 from ..errors import ParameterError, silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
-from ..motion_beats import motion_positions
+from ..motion_beats import motion_positions, speed_curve, speed_minima
+from ..validation import nearest
 from .positions import interp_frames
 
 __all__ = [
+    "SEEN_REACH",
+    "seen_landings",
+    "landing_figures",
     "live_steps",
     "instantaneous_speed",
     "joint_kinematics",
     "speed_figures",
     "join_figures",
 ]
+
+
+#: an output motion beat this close to a landing's beat [s] is that landing's
+SEEN_REACH = 0.1
 
 
 def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict[str, float]:
@@ -51,6 +62,41 @@ def live_steps(n: int, out_fps: float, covered: tuple[float, float]) -> np.ndarr
     ``covered`` [s], where the warp plays (a held lead-in, and the step out of it, left out)."""
     t = np.arange(n) / out_fps
     return (t[:-1] >= covered[0] - 1e-9) & (t[1:] <= covered[1] + 1e-9)
+
+
+def seen_landings(
+    pos: np.ndarray, fps: float, targets: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """For every beat in ``targets`` [s]: how far [s] the nearest motion beat of the
+    output's joint positions ``pos`` (at ``fps``; a speed minimum found to a sub-frame,
+    the parabola through it and its neighbours) lies from the output frame nearest the
+    beat, the frame a viewer can see it on (inf beyond ``SEEN_REACH``), and the same
+    signed (the minimum's time minus the frame's)."""
+    aim = np.rint(targets * fps) / fps
+    curve = speed_curve(pos, fps=fps)
+    f = speed_minima(curve, fps)  # kinematic_beats' defaults
+    if f.size == 0:
+        return np.full(targets.size, np.inf), np.zeros(targets.size)
+    c0, c1, c2 = curve[f - 1], curve[f], curve[f + 1]
+    bend = c0 - 2.0 * c1 + c2
+    vertex = np.where(bend > 0, 0.5 * (c0 - c2) / np.where(bend > 0, bend, 1.0), 0.0)
+    near = nearest(aim, (f + vertex) / fps)
+    d = np.abs(near - aim)
+    return np.where(d <= SEEN_REACH, d, np.inf), near - aim
+
+
+def landing_figures(pos: np.ndarray, fps: float, targets: np.ndarray) -> dict[str, Any]:
+    """The landings the output's joint positions ``pos`` show (module docstring)."""
+    err, off = seen_landings(pos, fps, targets)
+    found = np.isfinite(err)
+    ms = 1e3 * np.abs(np.rint(targets * fps) / fps + off - targets)[found]  # from the beats
+    return {
+        "landings": int(targets.size),
+        "on_their_frame": int(np.count_nonzero(err <= 0.5 / fps)),
+        "not_found": int(np.count_nonzero(~found)),
+        "median_ms": float(np.median(ms)) if ms.size else float("nan"),
+        "max_ms": float(ms.max()) if ms.size else float("nan"),
+    }
 
 
 def instantaneous_speed(
@@ -131,7 +177,9 @@ def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND
     return f"{natural:.0f} BPM ({natural * band[0]:.0f}-{natural * band[1]:.0f} BPM)"
 
 
-def report_entries(motion, out_motion, src_times, warp, used, targets, looped, placed) -> dict:
+def report_entries(
+    motion, out_motion, src_times, warp, used, targets, looped, placed, *, beats_mode=False
+) -> dict:
     """Report entries computed from the output frames (see the module docstring)."""
     out_fps = float(out_motion.fps)
     counts, n = np.unique(np.asarray(placed["beats"], dtype=np.float64), return_counts=True)
@@ -156,6 +204,9 @@ def report_entries(motion, out_motion, src_times, warp, used, targets, looped, p
             t = np.arange(0.0, (motion.n_frames - 1) / motion.fps + 1e-9, 1.0 / out_fps)
             pos_in = interp_frames(pos_in, motion.fps, t)
         rep["kinematics"] = joint_kinematics(pos_in, out_fps, pos_out, out_fps)
+    rep["landings_seen"] = None
+    if beats_mode and pos_out is not None:
+        rep["landings_seen"] = landing_figures(pos_out, out_fps, targets)
     rep["loop"] = None
     rep["joins"] = []
     if looped is not None:
