@@ -616,6 +616,13 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     }
     args = (motion, out_motion, src_times, warp, used, targets, looped, placed)
     report.update(report_entries(*args, beats_mode=counts is None))
+    if report["repetitions"] > 1 and motion.skeleton is None and not motion.is_positional:
+        warn(
+            f"a table without a skeleton is looped as it is: {report['repetitions'] - 1} "
+            "join(s), at which a root position among its channels jumps back (give a BVH "
+            "or joint positions to carry the dance on)",
+            stacklevel=3,
+        )
     return SyncResult(motion=out_motion, warp_src_times=src_times, report=report, warp=warp)
 
 

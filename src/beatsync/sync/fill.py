@@ -9,9 +9,9 @@ Where to loop (:func:`choose_loop`)
     the best rotation about the vertical axis and translation on the floor), among the
     pairs whose span holds at least ``MIN_SPAN`` of the clip's events (so the loop keeps
     most of the dance) and with half a blend window of clip on both sides (with none,
-    the whole clip, blended over what fits). With a dance meter of ``N`` motion beats,
-    ``a`` and ``b - a`` are multiples of ``N`` (a loop starts a dance bar and holds
-    whole bars).
+    the pair with room for the widest blend, the blend shrunk to it). With a dance meter
+    of ``N`` motion beats, ``a`` and ``b - a`` are multiples of ``N`` (a loop starts a
+    dance bar and holds whole bars).
 
 The looped timeline
     ``t`` runs on from the clip: repetition ``r >= 1`` covers
@@ -240,17 +240,27 @@ def choose_loop(
     if dance is not None:
         ok &= (ii % dance == 0) & ((jj - ii) % dance == 0)
     ok &= events[jj] - events[ii] > 2.0 * join
-    if got is None or not ok.any():  # the whole span, blended over what fits
-        fit = float(min(join, 0.5 * np.min(np.diff(events))))
-        if got is None:  # nothing to compare or to move
-            return 0, p, 0.0, None, float("nan"), fit
-        # no pair with room: still each pass starts where the previous one ended
-        idx, ok, join = np.array([0, p]), np.array([[False, True], [False, False]]), fit
+    fit = float(min(join, 0.5 * np.min(np.diff(events))))
+    if got is None:  # nothing to compare or to move: the whole span, blended over what fits
+        return 0, p, 0.0, None, float("nan"), fit
+    if not ok.any():
+        # no pair with room for the whole blend: the pair with room for the widest, the
+        # blend shrunk to it, so that it never reaches outside the clip (a T-pose first
+        # frame, say); each pass still starts where the previous one ended
+        ii, jj = np.meshgrid(np.arange(p + 1), np.arange(p + 1), indexing="ij")
+        ok = jj - ii >= max(1, int(np.ceil(MIN_SPAN * p)))
+        width = np.minimum(np.minimum(2.0 * events[ii], 2.0 * (duration - events[jj])), fit)
+        width = np.where(ok, width, -np.inf)
+        best = np.flatnonzero(width == width.max())
+        pick = best[np.argmax((jj - ii).ravel()[best])]  # among equals the longest span
+        idx = np.array([ii.flat[pick], jj.flat[pick]])
+        join = max(float(width.flat[pick]), 0.0)
+        ok = np.array([[False, True], [False, False]])
         ii, jj = np.meshgrid(idx, idx, indexing="ij")
     pos, up = got
     fps = float(motion.fps)
     frames = np.rint(events[idx] * fps).astype(np.int64)
-    half = max(1, int(round(half_t * fps / 2)))
+    half = max(1, int(round(0.5 * join * fps / 2)))
     clouds = point_clouds(pos, frames, half)
     dist = aligned_distance_matrix(clouds, clouds, up=up)
     score = np.where(ok, dist, np.inf)
