@@ -127,6 +127,21 @@ def test_sync_mode_beats_and_auto_fallback(inputs, tmp_path, capsys):
     assert any("fell back" in w for w in result["warnings"]) and "fell back" in err
 
 
+def test_sync_warns_when_the_beats_given_stop_long_before_the_song(inputs, tmp_path, capsys):
+    d, _, beats = inputs
+    short = tmp_path / "short.beats"
+    io.write_beats(short, beats[:6])  # 20 s song, beats to 3 s
+    argv = ["sync", str(d / "salsa.bvh"), str(d / "song.wav"), "-o", str(tmp_path / "o.bvh"),
+            "--beats", str(short), "--json"]  # fmt: skip
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    assert "warning: the beats of" in err and "on no beat" in err
+    assert any("on no beat" in w for w in json.loads(stdout)["warnings"])
+    argv[argv.index(str(short))] = str(d / "song.beats")  # the whole song's: no such warning
+    code, _, err = _run(argv, capsys)
+    assert code == 0 and "the beats of" not in err
+
+
 def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     d, _, _ = inputs
     out = tmp_path / "out.bvh"

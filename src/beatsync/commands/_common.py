@@ -176,6 +176,20 @@ def tempo_options(args: argparse.Namespace) -> dict[str, float]:
     return {"min_bpm": lo, "max_bpm": hi}
 
 
+def beats_end_early(beats: Any, music_s: float, path: str, then: str) -> str:
+    """The warning for a beats file that ends more than a bar (4 beats) before the music
+    (``then``: what the dance does from there), or ``""``."""
+    import numpy as np
+
+    rest = music_s - float(beats[-1])
+    if len(beats) < 2 or rest <= 4.0 * float(np.median(np.diff(beats))):
+        return ""
+    return (
+        f"the beats of {path!r} end at {beats[-1]:.2f} s, {rest:.1f} s before the music does: "
+        f"{then} (the annotation of part of the song, or of another recording?)"
+    )
+
+
 def emit(result: dict[str, Any], text: str, args: argparse.Namespace) -> int:
     """Print ``result`` as JSON if ``--json`` was given, else ``text``; return exit code 0."""
     if getattr(args, "json", False):

@@ -19,6 +19,7 @@ from ._common import (
     Outputs,
     add_music_beat_options,
     add_output_flags,
+    beats_end_early,
     emit,
     feedback,
     tempo_options,
@@ -212,14 +213,11 @@ def run(args: argparse.Namespace) -> int:
             beats = check_music_beats(io.read_beats(args.beats), duration=y.size / float(sr))
         except ParameterError as exc:
             raise ParameterError(f"beats file {args.beats!r}: {exc}") from None
-        rest = y.size / float(sr) - beats[-1]
-        if beats.size > 1 and rest > 4.0 * float(np.median(np.diff(beats))):  # over a bar
-            beat_notes.append(
-                f"the beats of {args.beats!r} end at {beats[-1]:.2f} s, {rest:.1f} s before "
-                "the music does: the dance holds its last pose from there (the annotation "
-                "of part of the song, or of another recording?)"
-            )
-            fb.warn(beat_notes[-1])
+        then = "the dance holds its last pose from there"
+        early = beats_end_early(beats, y.size / float(sr), args.beats, then)
+        if early:
+            beat_notes.append(early)
+            fb.warn(early)
     with fb.step("reading the library", total=len(files)) as progress:
         clips = []
         for f in files:

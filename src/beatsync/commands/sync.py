@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, warn
 from . import COMMAND_HELP
 from ._common import (
     Feedback,
@@ -23,6 +23,7 @@ from ._common import (
     add_music_beat_options,
     add_output_flags,
     add_position_options,
+    beats_end_early,
     emit,
     feedback,
     position_options,
@@ -239,6 +240,10 @@ def _pipeline(
                     "two are needed to sync a dance"
                 )
             beat_source = f"file {args.beats}"
+            then = "the dance goes on from there at its last speed, on no beat"
+            early = beats_end_early(beats, music_s, args.beats, then)
+            if early:
+                warn(early)
         else:
             from ..beats import track_beats
 
