@@ -156,7 +156,8 @@ def test_sync_with_bpm_and_out_fps_text_report(inputs, tmp_path, capsys):
     assert io.read_bvh(out).fps == 30.0
     # the output line says where the dance's last landing falls, as the song goes on
     line = next(t for t in stdout.splitlines() if t.startswith("output"))
-    assert re.search(r"\(\d+\.\d\d s, the last landing at \d+\.\d\d s\)", line)
+    assert re.search(r"\(\d+\.\d\d s(, the first pose held for \S+ s)?, the last landing at "
+                     r"\d+\.\d\d s\)", line)  # fmt: skip
 
 
 def test_sync_tempo_range_steers_the_metrical_level(inputs, tmp_path, capsys):
@@ -361,6 +362,24 @@ def test_sync_keeps_the_input_center_track_and_reports_speed(inputs, tmp_path, c
     assert seg["median_interval_s"] == pytest.approx(r["mean_motion_period_s"])
 
 
+def test_sync_text_says_the_offset_the_held_start_and_what_is_seen(inputs, tmp_path, capsys):
+    # with counts given, beats mode lands interval by interval: what the output shows is
+    # still reported; an offset before the beat is said so; a long held start is said
+    d, _, _ = inputs
+    argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(tmp_path / "o.json"),
+            "--fps", "25", "--beats", str(d / "song.beats"), "--mode", "beats",
+            "--beats-per-period", "2", "--first-beat", "8", "--phase-offset", "-0.05",
+            "--report", str(tmp_path / "r.json")]  # fmt: skip
+    code, stdout, err = _run(argv, capsys)
+    assert code == 0, err
+    r = json.loads((tmp_path / "r.json").read_text())["report"]
+    assert r["landings_seen"]["landings"] == len(r["target_beats_s"])
+    assert "first on beat 8, 50 ms before it" in stdout
+    assert re.search(r"^seen     \d+ of \d+ landings show", stdout, re.M)
+    held = r["playback_speed"]["held_lead_in_s"]
+    assert held >= 3.5 and f"the first pose held for {held:.2f} s" in stdout
+
+
 def test_sync_reports_the_dance_phrase_it_steers_onto_bar_lines(inputs, tmp_path, capsys):
     d, _, _ = inputs  # the real waltz dancer: a phrase of 3 motion beats, given
     argv = ["sync", str(d / "dancer.json"), str(d / "song.wav"), "-o", str(tmp_path / "o.json"),
@@ -369,3 +388,9 @@ def test_sync_reports_the_dance_phrase_it_steers_onto_bar_lines(inputs, tmp_path
     code, stdout, err = _run(argv, capsys)
     assert code == 0, err
     assert "dance    phrases of 3 motion beats (given) start on bar lines" in stdout
+
+
+def test_sync_text_never_rounds_a_share_up_to_all():
+    from beatsync.commands.sync import _share
+
+    assert _share(0.996) == "99.6%" and _share(0.9999) == "99.9%" and _share(1.0) == "100%"

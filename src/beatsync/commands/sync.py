@@ -370,7 +370,7 @@ def _text(result: dict[str, Any]) -> str:
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
         f"mapping  {n_used} {unit} {'landed' if beats_mode else 'placed'} ({n_avail} in the clip), "
         f"first on beat {r['first_beat']}"
-        + (f", {r['phase_offset_s'] * 1000:+.0f} ms after it" if r["phase_offset_s"] else ""),
+        + _offset_text(r["phase_offset_s"]),
         f"beats    per {unit[:-1]} used: {_counts_text(r['beats_per_motion_beat_used'])} "
         f"({r['beats_per_period_rule']}){meter}"
         + (
@@ -390,7 +390,8 @@ def _text(result: dict[str, Any]) -> str:
         *_seen_lines(r.get("landings_seen")),
         *_speed_lines(r),
         f"output   {r['output_frames']} frames at {r['output_fps']:g} fps "
-        f"({r['output_duration_s']:.2f} s, the last landing at {r['target_beats_s'][-1]:.2f} s)",
+        f"({r['output_duration_s']:.2f} s{_held_text(r)}, "
+        f"the last landing at {r['target_beats_s'][-1]:.2f} s)",
         f"residual warp max {res.max():.3f} ms; nearest frame max {near.max():.2f} ms "
         f"({r['max_abs_residual_frames']:.2f} frame)",
     ]
@@ -404,6 +405,24 @@ def _counts_text(used: dict[str, int]) -> str:
     return ", ".join(f"{k} x{v}" for k, v in sorted(used.items(), key=lambda kv: float(kv[0])))
 
 
+def _share(x: float) -> str:
+    """A share as a percentage, never rounded up to 100 % (99.6 % is not all)."""
+    return "100%" if x >= 1.0 else f"{np.floor(x * 1000) / 10:.1f}%"
+
+
+def _held_text(r: dict[str, Any]) -> str:
+    """The first pose held before the first landing, when it is for more than a frame."""
+    held = r["playback_speed"]["held_lead_in_s"]
+    return f", the first pose held for {held:.2f} s" if held * r["output_fps"] > 1.5 else ""
+
+
+def _offset_text(offset: float) -> str:
+    """A phase offset [s] as the text report says it: after the beat, or before it."""
+    if not offset:
+        return ""
+    return f", {abs(offset) * 1000:.0f} ms {'after' if offset > 0 else 'before'} it"
+
+
 def _seen_lines(seen: dict[str, Any] | None) -> list[str]:
     """How many landed motion beats the output shows on their beat's frame (beats mode)."""
     if not seen:
@@ -411,7 +430,7 @@ def _seen_lines(seen: dict[str, Any] | None) -> list[str]:
     missing = f"; {seen['not_found']} not seen within 0.1 s" if seen["not_found"] else ""
     return [
         f"seen     {seen['on_their_frame']} of {seen['landings']} landings show their speed "
-        f"minimum on their beat's frame; {seen['median_ms']:.0f} ms from the beat (median), "
+        f"minimum on their frame; {seen['median_ms']:.0f} ms off (median), "
         f"{seen['max_ms']:.0f} ms at most{missing}"
     ]
 
@@ -426,7 +445,7 @@ def _speed_lines(r: dict[str, Any]) -> list[str]:
         if x is not None:
             lines.append(
                 f"speed    {what} x{x['min']:.2f} .. x{x['median']:.2f} (median) .. "
-                f"x{x['max']:.2f}; {x['in_band']:.0%} of the output within x{lo:g}-x{hi:g}"
+                f"x{x['max']:.2f}; {_share(x['in_band'])} of the output within x{lo:g}-x{hi:g}"
             )
     k = r.get("kinematics")
     if k is not None:

@@ -29,7 +29,7 @@ from .landing import dip_floor, land_seen, position_view, source_speed
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
-from .quality import fitting_tempo, report_entries
+from .quality import fitting_tempo, landing_figures, report_entries
 from .warp import TimeWarp, integrate_warp
 
 __all__ = [
@@ -378,6 +378,7 @@ def synchronize(
         "motion": motion,
         "events": events,
         "counts": None if whole_dance else counts,
+        "beats_mode": used_mode == "beats",
         "dance": dance if used_mode == "beats" else None,
         "bar": bar,
         "beats": beats,
@@ -407,6 +408,11 @@ def synchronize(
         if beats[first_beat] - lag < 0:
             plan["first_beat"] = first_beat = first_beat + 1
         res = _resample(plan, -lag)
+        if res.report["landings_seen"] is not None:  # the accents are aimed at the beats
+            aim = np.asarray(res.report["target_beats_s"]) + lag
+            res.report["landings_seen"] = landing_figures(
+                motion_positions(res.motion), res.motion.fps, aim
+            )
     ratio = ideal / count.m
     if not whole_dance and (ratio > 2.0 or ratio < 0.5):
         warn(
@@ -615,7 +621,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         "first_boundary_frame": int(time_to_frames(targets[0], fps=out_fps)),  # for trimming
     }
     args = (motion, out_motion, src_times, warp, used, targets, looped, placed)
-    report.update(report_entries(*args, beats_mode=counts is None))
+    report.update(report_entries(*args, beats_mode=plan["beats_mode"]))
     if report["repetitions"] > 1 and motion.skeleton is None and not motion.is_positional:
         warn(
             f"a table without a skeleton is looped as it is: {report['repetitions'] - 1} "

@@ -13,8 +13,9 @@ Measured on the result, for the report of :func:`beatsync.sync.synchronize`:
   input's, the input sampled (linearly) at the output's frame rate when they differ;
 - each loop join: its music time and the peak joint speed within its blend window;
 - beats mode: the landed motion beats the output shows, found by the scorer's detector
-  (:func:`beatsync.motion_beats.kinematic_beats`): how many on their beat's frame (within
-  half a frame), how far from their beats, how many not within ``SEEN_REACH``.
+  (:func:`beatsync.motion_beats.kinematic_beats`): how many on their landing's frame
+  (within half a frame), how far from their landing times (the beats, plus a phase
+  offset if one was asked for), how many not within ``SEEN_REACH``.
 
 Data contract: times in seconds; positions ``(frames, joints, 3)``.
 """
@@ -86,10 +87,11 @@ def seen_landings(
 
 
 def landing_figures(pos: np.ndarray, fps: float, targets: np.ndarray) -> dict[str, Any]:
-    """The landings the output's joint positions ``pos`` show (module docstring)."""
+    """The landings at ``targets`` [s] the output's joint positions ``pos`` show (module
+    docstring)."""
     err, off = seen_landings(pos, fps, targets)
     found = np.isfinite(err)
-    ms = 1e3 * np.abs(np.rint(targets * fps) / fps + off - targets)[found]  # from the beats
+    ms = 1e3 * np.abs(np.rint(targets * fps) / fps + off - targets)[found]  # from the aims
     return {
         "landings": int(targets.size),
         "on_their_frame": int(np.count_nonzero(err <= 0.5 / fps)),
