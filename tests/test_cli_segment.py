@@ -63,6 +63,17 @@ def test_segment_mat_markers_become_angles(capsys):
     assert res["mean_period_s"] == pytest.approx(0.51, abs=0.04)
 
 
+def test_mat_lists_only_its_marker_recordings(capsys):
+    # 'wiidata' has the fields of a marker struct but 3 columns for no marker: it was
+    # offered as a choice, then refused for its shape
+    mat = str(datasets.path("motion/mocaptoolbox/mcdemodata.mat"))
+    assert main(["segment", mat]) == 3
+    err = capsys.readouterr().err
+    assert "['dance1', 'dance2', 'walk1', 'walk2']" in err and "wiidata" not in err
+    assert main(["segment", mat, "--variable", "wiidata"]) == 3
+    assert "'wiidata' (is not marker data)" in capsys.readouterr().err
+
+
 def _bad_files(tmp_path):
     trunc = tmp_path / "trunc.bvh"
     trunc.write_text("HIERARCHY\nROOT hip\n{\n  OFFSET 0 0 0\n")

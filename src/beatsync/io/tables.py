@@ -31,10 +31,12 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
         mat = scipy.io.loadmat(p, squeeze_me=True, struct_as_record=False)
     except Exception as exc:  # scipy raises several types for bad files
         raise ParameterError(f"cannot read {str(p)!r} as a MATLAB .mat file: {exc}") from None
+    structs = {k: v for k, v in mat.items() if hasattr(v, "data") and hasattr(v, "markerName")}
+    # marker data: three columns per named marker (a struct of other data has the fields too)
     cands = [
         k
-        for k, v in mat.items()
-        if not k.startswith("__") and hasattr(v, "data") and hasattr(v, "markerName")
+        for k, v in structs.items()
+        if np.ndim(v.data) == 2 and np.shape(v.data)[1] == 3 * np.size(v.markerName) > 0
     ]
     if not cands:
         found = [k for k in mat if not k.startswith("__")]
@@ -50,8 +52,9 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
             )
         variable = cands[0]
     if variable not in cands:
+        what = "is not marker data" if variable in structs else "is not in it"
         raise ParameterError(
-            f"{str(p)!r} has no marker recording {variable!r}; choose from {cands}"
+            f"{str(p)!r} has no marker recording {variable!r} ({what}); choose from {cands}"
         )
     s = mat[variable]
     where = f"{str(p)!r} recording {variable!r}"
@@ -63,10 +66,6 @@ def read_mocap_mat(path: str | os.PathLike[str], variable: str | None = None) ->
     rate = check_fps(_scalar(s.freq), name=f"{where} freq")
     data = as_float_array(s.data, name=f"{where} data")
     names = [str(n) for n in np.atleast_1d(s.markerName)]
-    if data.ndim != 2 or data.shape[1] != 3 * len(names):
-        raise ParameterError(
-            f"{where} data has shape {data.shape}, expected (frames, 3 x {len(names)} markers)"
-        )
     if data.shape[0] < 2:
         raise ParameterError(f"{where} has {data.shape[0]} frame(s); need at least 2")
     channels = tuple(f"{m}_{a}" for m in names for a in "xyz")
