@@ -942,3 +942,14 @@ def test_loop_of_a_turning_skeleton_carries_its_heading_on():
     assert abs(heading[-1] - heading[0]) > 0.8 * 24.0 * res.motion.duration
     own = np.linalg.norm(np.diff(motion_positions(dancer), axis=0), axis=-1).max()
     assert np.linalg.norm(np.diff(pos, axis=0), axis=-1).max() <= 1.10 * own
+
+
+def test_mode_periods_searches_the_range_segment_bpm_searches():
+    # both said "one to eight beats"; sync searched 0.9-8.5 beats and segment --bpm 1-8,
+    # and on the real salsa at 99.6 BPM they found periods of 1.00 s and 2.94 s
+    from beatsync.segment import period_range_from_beat
+
+    m = _periodic_motion(period=1.0, duration=12.0)
+    rep = synchronize(m, None, np.arange(0.3, 12.0, 0.5), mode="periods").report
+    assert rep["period_range_s"] == pytest.approx(period_range_from_beat(0.5))
+    assert rep["mean_motion_period_s"] == pytest.approx(1.0, abs=0.05)

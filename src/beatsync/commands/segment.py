@@ -55,8 +55,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--bpm",
         type=float,
         help="tempo of the music the dance goes with [BPM]: search periods of 1 to 8 beats "
-        "(steps to figures such as a 6-beat waltz box), shortest first; instead of "
-        "--period-range",
+        "(0.9-8.5, as sync --mode periods; steps to figures such as a 6-beat waltz box), "
+        "shortest first; instead of --period-range",
     )
     p.add_argument(
         "--period-method",

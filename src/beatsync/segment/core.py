@@ -53,6 +53,7 @@ __all__ = [
     "MIN_CLIP_PERIODS",
     "SHORT_CLIP_MAX_ENERGY",
     "Segmentation",
+    "PERIOD_BEATS",
     "period_range_from_beat",
     "segment",
     "segment_values",
@@ -400,8 +401,13 @@ def estimate_period_count(
     return max(2, int(np.floor((n - 1) / per + 1e-9)))
 
 
+#: a dance cycle in music beats: one to eight, with room for one danced a little off the
+#: tempo (``beatsync segment --bpm`` and ``beatsync sync --mode periods``)
+PERIOD_BEATS = (0.9, 8.5)
+
+
 def period_range_from_beat(
-    beat_period: float, *, beats: tuple[float, float] = (1.0, 8.0)
+    beat_period: float, *, beats: tuple[float, float] = PERIOD_BEATS
 ) -> tuple[float, float]:
     """Period range [s] of a dance to music of this beat period [s]: ``beats`` beats.
 
@@ -409,7 +415,7 @@ def period_range_from_beat(
     few bars (a waltz box: 6 beats; a salsa basic: 8).
 
     >>> period_range_from_beat(0.5)
-    (0.5, 4.0)
+    (0.45, 4.25)
     """
     bp = as_float(beat_period, name="beat_period", unit="s", text=True)
     if not 60.0 / MAX_BPM <= bp <= 60.0 / MIN_BPM:

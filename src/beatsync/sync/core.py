@@ -12,7 +12,12 @@ from ..motion import segmentation_view
 from ..motion_beats import kinematic_beats, motion_positions, speed_curve
 from ..rotations import sample_motion
 from ..segment.checks import check_alpha, check_period_range
-from ..segment.core import PeriodicityRefused, _segment_motion, estimate_period_count
+from ..segment.core import (
+    PERIOD_BEATS,
+    PeriodicityRefused,
+    _segment_motion,
+    estimate_period_count,
+)
 from ..validation import (
     as_float,
     as_int,
@@ -47,8 +52,6 @@ __all__ = [
 MODES = ("periods", "beats", "auto")
 LANDINGS = ("boundaries", "accents")
 FILLS = ("stop", "loop")
-#: default period range when segmenting, in music beats: one to eight beats
-PERIOD_BEATS = (0.9, 8.5)
 #: period range of the periodicity test in mode="auto": paper A's (steps, not figures)
 AUTO_PERIOD_RANGE = (0.25, 1.25)
 #: share of periods that must hold the same number of motion beats to call it a meter
