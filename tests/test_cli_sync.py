@@ -269,9 +269,12 @@ BAD = [
       "--video", "{o}/v.mp4", "--video-fps", "0"], "--video-fps=0"),
     # an absurd output or video frame rate: refused before the memory fills
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats", "{d}/song.beats",
-      "--out-fps", "100000"], "out_fps=100000"),
+      "--out-fps", "100000"], "--out-fps=100000"),
+    # checked by the library, named as the option given for it
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--first-beat", "500",
-      "--beats", "{d}/song.beats"], "first_beat"),
+      "--beats", "{d}/song.beats"], "--first-beat=500 but the music has only"),
+    (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats-per-period", "0",
+      "--beats", "{d}/song.beats"], "--beats-per-period=0 must be an integer >= 1"),
 ]
 
 

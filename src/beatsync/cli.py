@@ -116,7 +116,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         except SystemExit:
             raise
         except BaseException as exc:  # noqa: BLE001 - every failure becomes a report
-            return error_report(exc, command, as_json=as_json)
+            return error_report(_as_options(exc, argv), command, as_json=as_json)
+
+
+def _as_options(exc: BaseException, argv: Sequence[str]) -> BaseException:
+    """Bad input checked by the library names its argument (``first_beat=-1``); said to
+    the command line, the option given for it (``--first-beat=-1``)."""
+    from .errors import ParameterError
+
+    if not isinstance(exc, ParameterError):
+        return exc
+    import re
+
+    msg = str(exc)
+    for opt in {a.split("=")[0] for a in argv if a.startswith("--")}:
+        name = re.escape(opt[2:].replace("-", "_"))
+        msg = re.sub(rf"(?<![\w-]){name}=", f"{opt}=", msg)
+    return exc if msg == str(exc) else ParameterError(msg)
 
 
 def _usage_error(exc: UsageError, command: str | None, as_json: bool) -> int:

@@ -124,7 +124,7 @@ def fill_joint_gaps(
             raise ParameterError(
                 f"{names[j]!r} is missing (NaN) for {b - a} frames ({(b - a) / rate:.2f} s, "
                 f"frames {a}-{b - 1}); gaps up to max_gap={max_gap:g} s are filled: fill "
-                "this one before reading, raise max_gap, or drop the joint"
+                "this one before reading, raise max_gap (--max-gap), or drop the joint"
             )
         for k in range(3):
             pos[miss, j, k] = np.interp(t[miss], t[~miss], pos[~miss, j, k])
