@@ -953,3 +953,19 @@ def test_mode_periods_searches_the_range_segment_bpm_searches():
     rep = synchronize(m, None, np.arange(0.3, 12.0, 0.5), mode="periods").report
     assert rep["period_range_s"] == pytest.approx(period_range_from_beat(0.5))
     assert rep["mean_motion_period_s"] == pytest.approx(1.0, abs=0.05)
+
+
+@pytest.mark.parametrize("clip, opening", [("walk", 1), ("salsa", 3)])
+def test_output_never_opens_on_the_clips_reference_pose(clip, opening):
+    # CMU's BVH files open on a T-pose that snaps to the first pose in 1-3 frames (joints
+    # at 10-30 m/s); a lead-in that reached back to the first frame showed it, then the snap
+    if clip == "walk":
+        m, mode, beats = datasets.load_walk("007_12"), "periods", np.arange(0.4, 20.0, 0.6)
+    else:  # a real song's beats
+        m, mode = datasets.load_salsa("60_01"), "auto"
+        beats = io.read_beats(datasets.path("audio/real_dev/hainsworth_001.beats"))
+    res = synchronize(m, None, beats[beats < 20.0], mode=mode, fill="loop")
+    own = np.linalg.norm(np.diff(m.positions(), axis=0), axis=-1).max(axis=1)
+    assert np.all(own[:opening] > own[opening:].max())  # the snap, faster than the dance
+    out = np.linalg.norm(np.diff(res.motion.positions(), axis=0), axis=-1).max(axis=1)
+    assert out.max() * res.motion.fps < own[:opening].min() * m.fps  # no snap shown

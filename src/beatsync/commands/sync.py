@@ -369,8 +369,7 @@ def _text(result: dict[str, Any]) -> str:
         + (" (auto: periodic)" if r["mode_requested"] == "auto" and not r["mode_note"] else "")
         + f"; fill {r['fill']}, {r['repetitions']} repetition(s) of the clip",
         f"mapping  {n_used} {unit} {'landed' if beats_mode else 'placed'} ({n_avail} in the clip), "
-        f"first on beat {r['first_beat']}"
-        + _offset_text(r["phase_offset_s"]),
+        f"first on beat {r['first_beat']}" + _offset_text(r["phase_offset_s"]),
         f"beats    per {unit[:-1]} used: {_counts_text(r['beats_per_motion_beat_used'])} "
         f"({r['beats_per_period_rule']}){meter}"
         + (

@@ -171,6 +171,29 @@ def motion_periods(motion: Any, *, period_range: tuple[float, float], alpha: flo
     return seg
 
 
+def _positions_or_none(motion: Any) -> np.ndarray | None:
+    """The motion's joint positions, or None for a table of angles without a skeleton."""
+    try:
+        with silenced():
+            return motion_positions(motion)
+    except ParameterError:
+        return None
+
+
+def _opening_snap(pos: np.ndarray | None) -> int:
+    """Frames a clip opens with that are not dance: each step faster than every later
+    one, as a converter's reference pose snaps to the first pose (CMU's BVH files open on a
+    T-pose); the output's lead-in never shows them."""
+    if pos is None or pos.shape[0] < 3:
+        return 0
+    step = np.linalg.norm(np.diff(pos, axis=0), axis=-1).max(axis=1)
+    later = np.maximum.accumulate(step[::-1])[::-1]  # the fastest step from each on
+    k = 0
+    while k < step.size - 1 and step[k] > later[k + 1]:
+        k += 1
+    return k
+
+
 def _motion_beats(motion: Any, what: str) -> np.ndarray:
     try:
         mb = kinematic_beats(motion)
@@ -393,9 +416,12 @@ def synchronize(
         "duration": duration,
         "song_end": song_end if fill == "loop" else None,
         "beat_period": beat_period,
-        # beats mode: the joint positions and their speed curve, once for both passes
-        "positions": motion_positions(motion) if whole_dance else None,
+        # the joint positions (None for angle tables) and, in beats mode, their speed
+        # curve: once for both passes
+        "positions": _positions_or_none(motion),
     }
+    # the output starts after a converter's reference pose, if the clip opens on one
+    plan["start"] = _opening_snap(plan["positions"]) / fps
     if whole_dance:
         plan["speed_curve"] = speed_curve(plan["positions"], fps=fps)
     lag = 0.0
@@ -509,7 +535,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             warp = integrate_warp(
                 pins,
                 targets,
-                start=0.0,
+                start=plan["start"],
                 end=end,
                 delta=plan["delta"],
                 hold=LANDING_HOLD,
@@ -558,7 +584,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         used = events[: p + 1]
         tail = p == events.size - 1 and duration > used[-1]  # the clip's tail after it
         end = duration if tail else None
-        warp = integrate_warp(used, targets, start=0.0, end=end, delta=plan["delta"])
+        warp = integrate_warp(used, targets, start=plan["start"], end=end, delta=plan["delta"])
         if plan["fill"] == "loop" and p < events.size - 1:
             # cover the beats after the last whole interval (and the song's end) with part
             # of the next one, at the warp's end rate
@@ -623,7 +649,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         ],
         "first_boundary_frame": int(time_to_frames(targets[0], fps=out_fps)),  # for trimming
     }
-    args = (motion, out_motion, src_times, warp, used, targets, looped, placed)
+    args = (motion, out_motion, src_times, warp, used, targets, looped, placed, plan["positions"])
     report.update(report_entries(*args, beats_mode=plan["beats_mode"]))
     if report["repetitions"] > 1 and motion.skeleton is None and not motion.is_positional:
         warn(

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, silenced
+from ..errors import silenced
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion_beats import motion_positions, speed_curve, speed_minima
 from ..validation import nearest
@@ -180,9 +180,10 @@ def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND
 
 
 def report_entries(
-    motion, out_motion, src_times, warp, used, targets, looped, placed, *, beats_mode=False
+    motion, out_motion, src_times, warp, used, targets, looped, placed, pos_in, *, beats_mode
 ) -> dict:
-    """Report entries computed from the output frames (see the module docstring)."""
+    """Report entries computed from the output frames (see the module docstring);
+    ``pos_in``: the input's joint positions (None for angle tables)."""
     out_fps = float(out_motion.fps)
     counts, n = np.unique(np.asarray(placed["beats"], dtype=np.float64), return_counts=True)
     rep: dict[str, Any] = {
@@ -194,11 +195,10 @@ def report_entries(
             src_times, out_fps, (float(warp.tgt[0]), float(warp.tgt[-1])), used, targets
         ),
     }
-    try:
+    pos_out = None
+    if pos_in is not None:  # angle tables have no joint speeds to report
         with silenced():
-            pos_in, pos_out = motion_positions(motion), motion_positions(out_motion)
-    except ParameterError:  # angle tables: no joint speeds to report
-        pos_in = pos_out = None
+            pos_out = motion_positions(out_motion)
     rep["kinematics"] = None
     if pos_in is not None:
         # finite differences depend on the frame rate: the input at the output's
