@@ -257,7 +257,7 @@ class _Stage:
     The camera looks from ``azimuth`` [deg] about the vertical axis and ``elevation``
     [deg] above the floor at the joints' horizontal centroid smoothed over a second, so
     steps move the figure over a floor grid fixed in the world; the dancer's height sets
-    the distance (the figure fills about two thirds of the frame whatever the units).
+    the distance (the figure fills a little over half the frame whatever the units).
     Bones are drawn far to near over their shadows; on a beat the figure turns red and a
     dot lights; a ruler at the bottom scrolls the beats within 2 s past a playhead. The
     geometry of all frames is planned at once (:meth:`_plan`).
@@ -288,8 +288,11 @@ class _Stage:
         self.floor = float(np.percentile(p[..., 2].min(axis=1), 1))
         height = float(np.percentile(np.ptp(p[..., 2], axis=1), 95)) or 1.0
         # the camera's target: the joints' centroid's horizontal track, smoothed over a
-        # second so that the view does not shake with the hips
-        track = gaussian_filter1d(p.mean(axis=1)[:, :2], sigma=fps, axis=0, mode="nearest")
+        # second so that the view does not shake with the hips; extended beyond both ends
+        # by point reflection, so that it keeps up with a dancer still travelling there
+        pad = min(4 * int(np.ceil(fps)), len(p) - 1)
+        ext = np.pad(p.mean(axis=1)[:, :2], ((pad, pad), (0, 0)), "reflect", reflect_type="odd")
+        track = gaussian_filter1d(ext, sigma=fps, axis=0, mode="nearest")[pad : pad + len(p)]
         a, e = np.deg2rad(azimuth), np.deg2rad(elevation)
         # at azimuth 0 the image's horizontal axis is h2, as in :func:`project`
         right = np.array([-np.sin(a), np.cos(a), 0.0])
@@ -297,8 +300,10 @@ class _Stage:
         fwd = -(np.cos(e) * back) - np.sin(e) * np.array([0.0, 0.0, 1.0])
         cam_up = np.cross(right, fwd)
         self.f = 0.5 * h / np.tan(np.deg2rad(20.0))  # 40 degrees vertical field of view
-        dist = self.f * height / (0.7 * h)
-        target = np.column_stack([track, np.full(len(track), self.floor + 0.5 * height)])
+        # the figure about 0.55 of the frame high, aimed a little below its middle: room
+        # for raised arms above, and for the shadows and the beat ruler below
+        dist = self.f * height / (0.55 * h)
+        target = np.column_stack([track, np.full(len(track), self.floor + 0.45 * height)])
         self.eye = target - dist * fwd
         self.basis = np.stack([right, cam_up, fwd])  # rows: camera x, y, depth
         self.centre = np.array([w / 2.0, h / 2.0])
