@@ -426,7 +426,9 @@ def _seen_lines(seen: dict[str, Any] | None) -> list[str]:
     """How many landed motion beats the output shows on their beat's frame (beats mode)."""
     if not seen:
         return []
-    missing = f"; {seen['not_found']} not seen within 0.1 s" if seen["not_found"] else ""
+    from ..sync.quality import SEEN_REACH
+
+    missing = f"; {seen['not_found']} not seen within {SEEN_REACH:g} s" if seen["not_found"] else ""
     return [
         f"seen     {seen['on_their_frame']} of {seen['landings']} landings show their speed "
         f"minimum on their frame; {seen['median_ms']:.0f} ms off (median), "

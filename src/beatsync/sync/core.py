@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
 from ..motion import segmentation_view
-from ..motion_beats import kinematic_beats, motion_positions, speed_curve
+from ..motion_beats import kinematic_beat_frames, kinematic_beats, motion_positions, speed_curve
 from ..rotations import sample_motion
 from ..segment.checks import check_alpha, check_period_range
 from ..segment.core import (
@@ -34,7 +34,7 @@ from .landing import dip_floor, land_seen, position_view, source_speed
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
-from .quality import fitting_tempo, landing_figures, report_entries
+from .quality import fitting_tempo, report_entries
 from .warp import TimeWarp, integrate_warp
 
 __all__ = [
@@ -106,9 +106,15 @@ def position_bones(motion: Any) -> np.ndarray | None:
 
 
 def _events(
-    motion: Any, boundaries: Any, mode: str, period_range: tuple[float, float], duration: float
+    motion: Any,
+    pos: np.ndarray | None,
+    boundaries: Any,
+    mode: str,
+    period_range: tuple[float, float],
+    duration: float,
 ) -> tuple[np.ndarray, str, str]:
-    """The motion events to land on beats: ``(events, mode used, note)``."""
+    """The motion events to land on beats: ``(events, mode used, note)``; ``pos``: the
+    motion's joint positions (None for angle tables)."""
     if boundaries is not None:
         s = check_times(boundaries, name="boundaries", duration=duration)
         if mode != "beats":
@@ -119,7 +125,7 @@ def _events(
                 )
             return s, "periods", ""
     if mode == "beats":
-        return _motion_beats(motion, "mode='beats'"), "beats", ""
+        return _motion_beats(motion, pos, "mode='beats'"), "beats", ""
     try:
         seg = motion_periods(motion, period_range=period_range)
     except NotPeriodicError as exc:  # bad settings or no motion stay errors
@@ -133,7 +139,7 @@ def _events(
             "dancer's own motion beats onto the music's beats (mode='beats')"
         )
         warn(note, stacklevel=3)
-        return _motion_beats(motion, "the fallback to motion beats"), "beats", note
+        return _motion_beats(motion, pos, "the fallback to motion beats"), "beats", note
     return np.asarray(seg.boundaries, dtype=np.float64), "periods", ""
 
 
@@ -194,9 +200,13 @@ def _opening_snap(pos: np.ndarray | None) -> int:
     return k
 
 
-def _motion_beats(motion: Any, what: str) -> np.ndarray:
-    try:
-        mb = kinematic_beats(motion)
+def _motion_beats(motion: Any, pos: np.ndarray | None, what: str) -> np.ndarray:
+    try:  # without positions, kinematic_beats says why
+        mb = (
+            kinematic_beats(motion)
+            if pos is None
+            else frames_to_time(kinematic_beat_frames(pos, fps=motion.fps), fps=motion.fps)
+        )
     except ParameterError as exc:
         raise ParameterError(
             f"{what} needs joint positions (a skeleton or markers): {exc}"
@@ -375,8 +385,10 @@ def synchronize(
             )
     duration = float(frames_to_time(n_frames - 1, fps=fps))  # sample_motion clips here
 
+    # the joint positions (None for angle tables): once for every step that uses them
+    positions = _positions_or_none(motion)
     events, used_mode, note = _events(
-        motion, boundaries, mode, period_range, float(motion.duration)
+        motion, positions, boundaries, mode, period_range, float(motion.duration)
     )
     intervals = np.diff(events)
     unit = float(np.median(intervals)) if used_mode == "beats" else float(intervals.mean())
@@ -405,6 +417,7 @@ def synchronize(
         "events": events,
         "counts": None if whole_dance else counts,
         "beats_mode": used_mode == "beats",
+        "land": land,
         "dance": dance if used_mode == "beats" else None,
         "bar": bar,
         "beats": beats,
@@ -416,14 +429,12 @@ def synchronize(
         "duration": duration,
         "song_end": song_end if fill == "loop" else None,
         "beat_period": beat_period,
-        # the joint positions (None for angle tables) and, in beats mode, their speed
-        # curve: once for both passes
-        "positions": _positions_or_none(motion),
+        "positions": positions,
     }
     # the output starts after a converter's reference pose, if the clip opens on one
     plan["start"] = _opening_snap(plan["positions"]) / fps
-    if whole_dance:
-        plan["speed_curve"] = speed_curve(plan["positions"], fps=fps)
+    if whole_dance:  # once for both passes of land="accents"
+        plan["speed_curve"] = speed_curve(positions, fps=fps)
     lag = 0.0
     res = _resample(plan, phase_offset)
     if land == "accents":
@@ -437,11 +448,6 @@ def synchronize(
         if beats[first_beat] - lag < 0:
             plan["first_beat"] = first_beat = first_beat + 1
         res = _resample(plan, -lag)
-        if res.report["landings_seen"] is not None:  # the accents are aimed at the beats
-            aim = np.asarray(res.report["target_beats_s"]) + lag
-            res.report["landings_seen"] = landing_figures(
-                motion_positions(res.motion), res.motion.fps, aim
-            )
     ratio = ideal / count.m
     if not whole_dance and (ratio > 2.0 or ratio < 0.5):
         warn(
@@ -561,7 +567,9 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             reach += int(np.ceil((plan["song_end"] - beats[-1]) / plan["beat_period"]))
         if plan["fill"] == "loop" and cum[-1] < reach:
             # enough repetitions that whole intervals reach it, plus one for the tail
-            a, b, angle, shift, dist, join = choose_loop(motion, events)
+            a, b, angle, shift, dist, join = choose_loop(
+                motion, events, positions=plan["positions"]
+            )
             per_rep = max(int(cum[b] - cum[a]), 1)
             need = b + 1 + -(-max(0, reach - int(cum[b])) // per_rep) * (b - a)
             looped = loop_events(
@@ -649,8 +657,11 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         ],
         "first_boundary_frame": int(time_to_frames(targets[0], fps=out_fps)),  # for trimming
     }
+    # where the landed motion beats should show: their targets, or with the accents
+    # aligned (landed early by the lag), the beats
+    aims = targets - phase_offset if plan["land"] == "accents" else targets
     args = (motion, out_motion, src_times, warp, used, targets, looped, placed, plan["positions"])
-    report.update(report_entries(*args, beats_mode=plan["beats_mode"]))
+    report.update(report_entries(*args, aims=aims if plan["beats_mode"] else None))
     if report["repetitions"] > 1 and motion.skeleton is None and not motion.is_positional:
         warn(
             f"a table without a skeleton is looped as it is: {report['repetitions'] - 1} "

@@ -211,12 +211,17 @@ def _root_floor_columns(motion: object) -> np.ndarray | None:
     return np.array([motion.channels.index(n) for n in names])
 
 
-def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
-    """Joint positions and the index of their vertical axis, or None (angle tables)."""
+def joint_positions(
+    motion: object, positions: np.ndarray | None = None
+) -> tuple[np.ndarray, int] | None:
+    """Joint positions and the index of their vertical axis, or None (angle tables);
+    ``positions``: the motion's, if already computed."""
     if motion.is_positional:
         return motion.values.reshape(motion.n_frames, -1, 3), 2
     if _root_floor_columns(motion) is None:
         return None
+    if positions is not None:
+        return positions, 1
     try:
         return motion_positions(motion), 1
     except ParameterError:
@@ -224,14 +229,20 @@ def joint_positions(motion: object) -> tuple[np.ndarray, int] | None:
 
 
 def choose_loop(
-    motion: object, events: np.ndarray, *, join: float = LOOP_BLEND_S, dance: int | None = None
+    motion: object,
+    events: np.ndarray,
+    *,
+    join: float = LOOP_BLEND_S,
+    dance: int | None = None,
+    positions: np.ndarray | None = None,
 ) -> tuple[int, int, float, np.ndarray | None, float, float]:
     """Where to loop a clip (see the module docstring): ``(a, b, angle, shift, distance,
     join)``, ``a < b`` indexing ``events``, the rest as in :class:`LoopedClip` (``join``
-    shortened only when the clip leaves no room for it)."""
+    shortened only when the clip leaves no room for it); ``positions``: the motion's
+    joint positions, if already computed."""
     p = events.size - 1
     duration = (motion.n_frames - 1) / motion.fps
-    got = joint_positions(motion)
+    got = joint_positions(motion, positions)
     half_t = 0.5 * join
     room = (events - half_t >= 0) & (events + half_t <= duration)
     idx = np.nonzero(room)[0]

@@ -44,7 +44,9 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
     # music to cover: to the last beat, or on to the song's end
     span_s = float(max(song[-1], plan["song_end"] or 0.0) - song[0])
     if plan["fill"] == "loop" and events[-1] - events[0] < LOOP_REACH * span_s:
-        a, b, angle, shift, dist, join = choose_loop(motion, events, dance=plan["dance"])
+        a, b, angle, shift, dist, join = choose_loop(
+            motion, events, dance=plan["dance"], positions=plan["positions"]
+        )
         length = events[b] - events[a]
         extra = max(0.0, LOOP_REACH * span_s - (events[b] - events[0]))
         need = b + int(np.ceil(extra / length)) * (b - a)
@@ -55,7 +57,7 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
             looped = None
         else:
             timeline, index = looped.events, looped.event_index
-    headroom = peak_headroom(motion, events)
+    headroom = peak_headroom(motion, events, plan["positions"])
     placed = plan_counts(
         timeline,
         song,
@@ -81,11 +83,13 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
     return looped, used, targets, end, info
 
 
-def peak_headroom(motion: Any, events: np.ndarray) -> np.ndarray | None:
+def peak_headroom(
+    motion: Any, events: np.ndarray, positions: np.ndarray | None = None
+) -> np.ndarray | None:
     """Per interval of ``events``: the dancer's peak joint speed over the interval's
     peak, the fastest playback that keeps its joints within the dancer's own peak
-    (None without joint positions)."""
-    got = joint_positions(motion)
+    (None without joint positions; ``positions``: the motion's, if already computed)."""
+    got = joint_positions(motion, positions)
     if got is None:
         return None
     v = np.linalg.norm(np.diff(got[0], axis=0), axis=-1).max(axis=1)  # per frame step

@@ -180,10 +180,11 @@ def fitting_tempo(median_speed: float, song_bpm: float, band=DEFAULT_SCALE_BOUND
 
 
 def report_entries(
-    motion, out_motion, src_times, warp, used, targets, looped, placed, pos_in, *, beats_mode
+    motion, out_motion, src_times, warp, used, targets, looped, placed, pos_in, *, aims
 ) -> dict:
     """Report entries computed from the output frames (see the module docstring);
-    ``pos_in``: the input's joint positions (None for angle tables)."""
+    ``pos_in``: the input's joint positions (None for angle tables); ``aims`` [s]: where
+    the landed motion beats should show (beats mode; None in periods mode)."""
     out_fps = float(out_motion.fps)
     counts, n = np.unique(np.asarray(placed["beats"], dtype=np.float64), return_counts=True)
     rep: dict[str, Any] = {
@@ -207,8 +208,8 @@ def report_entries(
             pos_in = interp_frames(pos_in, motion.fps, t)
         rep["kinematics"] = joint_kinematics(pos_in, out_fps, pos_out, out_fps)
     rep["landings_seen"] = None
-    if beats_mode and pos_out is not None:
-        rep["landings_seen"] = landing_figures(pos_out, out_fps, targets)
+    if aims is not None and pos_out is not None:
+        rep["landings_seen"] = landing_figures(pos_out, out_fps, aims)
     rep["loop"] = None
     rep["joins"] = []
     if looped is not None:
