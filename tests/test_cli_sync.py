@@ -275,6 +275,12 @@ BAD = [
       "--beats", "{d}/song.beats"], "--first-beat=500 but the music has only"),
     (["{d}/salsa.bvh", "{d}/song.wav", "-o", "{o}/x.bvh", "--beats-per-period", "0",
       "--beats", "{d}/song.beats"], "--beats-per-period=0 must be an integer >= 1"),
+    # a frame rate checked on the motion is named as the option too
+    (["{d}/dancer.json", "{d}/song.wav", "-o", "{o}/x.json", "--fps", "100000"],
+     "error: --fps=100000"),
+    # a frame rate 40 times too high squeezes the dance into a few tenths of a second
+    (["{d}/dancer.json", "{d}/song.wav", "-o", "{o}/x.json", "--fps", "1000"],
+     r"s at --fps=1000\); at least 2 are needed: .* frame rate wrong"),
 ]
 
 

@@ -121,7 +121,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _as_options(exc: BaseException, argv: Sequence[str]) -> BaseException:
     """Bad input checked by the library names its argument (``first_beat=-1``); said to
-    the command line, the option given for it (``--first-beat=-1``)."""
+    the command line, the option given for it (``--first-beat=-1``; ``motion.fps=0`` as
+    ``--fps=0``)."""
     from .errors import ParameterError
 
     if not isinstance(exc, ParameterError):
@@ -131,7 +132,7 @@ def _as_options(exc: BaseException, argv: Sequence[str]) -> BaseException:
     msg = str(exc)
     for opt in {a.split("=")[0] for a in argv if a.startswith("--")}:
         name = re.escape(opt[2:].replace("-", "_"))
-        msg = re.sub(rf"(?<![\w-]){name}=", f"{opt}=", msg)
+        msg = re.sub(rf"(?<![\w.-])(?:[a-z_]+\.)?{name}=", f"{opt}=", msg)
     return exc if msg == str(exc) else ParameterError(msg)
 
 

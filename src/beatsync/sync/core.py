@@ -213,8 +213,9 @@ def _motion_beats(motion: Any, pos: np.ndarray | None, what: str) -> np.ndarray:
         ) from None
     if mb.size < 2:
         raise ParameterError(
-            f"{what} found {mb.size} motion beat(s) in the dance; at least 2 are needed "
-            "(is the dancer standing still?)"
+            f"{what} found {mb.size} motion beat(s) in the dance ({motion.n_frames} frames, "
+            f"{motion.duration:.2f} s at fps={motion.fps:g}); at least 2 are needed: is the "
+            "dancer standing still, or is the frame rate wrong?"
         )
     return mb
 
