@@ -530,6 +530,20 @@ def test_fill_loop_of_a_real_walk_too_short_for_its_blend_window_walks_on(clip):
 
 
 @pytest.mark.parametrize("mode", ["periods", "beats"])
+def test_a_reference_pose_the_walk_opens_on_is_not_the_dancers_peak(mode):
+    # 007_12's first frame is a T-pose that snaps into the walk at 17 000 units/s, the
+    # walk's own steps peak at 710: the report compares the output with the walk, and
+    # beats mode keeps its joints within the walk's peak (x1.40 when the snap counted)
+    walk = datasets.load_walk("007_12")
+    beats = np.arange(0.3, 20.0, 0.712)
+    rep = synchronize(walk, None, beats, mode=mode, fill="loop", song_end=20.3).report
+    kin = rep["kinematics"]
+    assert kin["input"]["peak_joint_speed"] < 1.2 * kin["input"]["p99_joint_speed"]
+    if mode == "beats":
+        assert kin["ratio"]["peak_joint_speed"] <= 1.15
+
+
+@pytest.mark.parametrize("mode", ["periods", "beats"])
 def test_loop_reports_the_passes_it_plays(mode):
     # the looped timeline is built with room to spare; the report counts what is played
     walk = datasets.load_walk("007_01")

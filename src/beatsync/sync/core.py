@@ -661,7 +661,11 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     # where the landed motion beats should show: their targets, or with the accents
     # aligned (landed early by the lag), the beats
     aims = targets - phase_offset if plan["land"] == "accents" else targets
-    args = (motion, out_motion, src_times, warp, used, targets, looped, placed, plan["positions"])
+    # the input's figures leave out a reference pose it opens on, as the output does
+    pos_in = plan["positions"]
+    if pos_in is not None:
+        pos_in = pos_in[int(round(plan["start"] * plan["fps"])) :]
+    args = (motion, out_motion, src_times, warp, used, targets, looped, placed, pos_in)
     report.update(report_entries(*args, aims=aims if plan["beats_mode"] else None))
     if report["repetitions"] > 1 and motion.skeleton is None and not motion.is_positional:
         warn(

@@ -57,7 +57,8 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
             looped = None
         else:
             timeline, index = looped.events, looped.event_index
-    headroom = peak_headroom(motion, events, plan["positions"])
+    skip = int(round(plan["start"] * plan["fps"]))  # a reference pose the output never shows
+    headroom = peak_headroom(motion, events, plan["positions"], skip=skip)
     placed = plan_counts(
         timeline,
         song,
@@ -84,15 +85,17 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
 
 
 def peak_headroom(
-    motion: Any, events: np.ndarray, positions: np.ndarray | None = None
+    motion: Any, events: np.ndarray, positions: np.ndarray | None = None, *, skip: int = 0
 ) -> np.ndarray | None:
     """Per interval of ``events``: the dancer's peak joint speed over the interval's
     peak, the fastest playback that keeps its joints within the dancer's own peak
-    (None without joint positions; ``positions``: the motion's, if already computed)."""
+    (None without joint positions; ``positions``: the motion's, if already computed;
+    the first ``skip`` frames, a reference pose the clip opens on, are not the dancer's)."""
     got = joint_positions(motion, positions)
     if got is None:
         return None
     v = np.linalg.norm(np.diff(got[0], axis=0), axis=-1).max(axis=1)  # per frame step
+    v[:skip] = 0.0
     frames = np.clip(np.rint(events * motion.fps).astype(np.int64), 0, v.size)
     peak = np.array(
         [v[a:b].max() if b > a else 0.0 for a, b in zip(frames[:-1], frames[1:], strict=True)]

@@ -183,7 +183,8 @@ def report_entries(
     motion, out_motion, src_times, warp, used, targets, looped, placed, pos_in, *, aims
 ) -> dict:
     """Report entries computed from the output frames (see the module docstring);
-    ``pos_in``: the input's joint positions (None for angle tables); ``aims`` [s]: where
+    ``pos_in``: the input's joint positions (None for angle tables; from the first frame
+    the output can show, at the input's rate); ``aims`` [s]: where
     the landed motion beats should show (beats mode; None in periods mode)."""
     out_fps = float(out_motion.fps)
     counts, n = np.unique(np.asarray(placed["beats"], dtype=np.float64), return_counts=True)
@@ -204,7 +205,7 @@ def report_entries(
     if pos_in is not None:
         # finite differences depend on the frame rate: the input at the output's
         if out_fps != motion.fps:
-            t = np.arange(0.0, (motion.n_frames - 1) / motion.fps + 1e-9, 1.0 / out_fps)
+            t = np.arange(0.0, (pos_in.shape[0] - 1) / motion.fps + 1e-9, 1.0 / out_fps)
             pos_in = interp_frames(pos_in, motion.fps, t)
         rep["kinematics"] = joint_kinematics(pos_in, out_fps, pos_out, out_fps)
     rep["landings_seen"] = None
