@@ -532,15 +532,27 @@ def test_fill_loop_of_a_real_walk_too_short_for_its_blend_window_walks_on(clip):
 @pytest.mark.parametrize("mode", ["periods", "beats"])
 def test_a_reference_pose_the_walk_opens_on_is_not_the_dancers_peak(mode):
     # 007_12's first frame is a T-pose that snaps into the walk at 17 000 units/s, the
-    # walk's own steps peak at 710: the report compares the output with the walk, and
-    # beats mode keeps its joints within the walk's peak (x1.40 when the snap counted)
+    # walk's own steps peak at 710: the report compares the output with the walk
     walk = datasets.load_walk("007_12")
     beats = np.arange(0.3, 20.0, 0.712)
-    rep = synchronize(walk, None, beats, mode=mode, fill="loop", song_end=20.3).report
-    kin = rep["kinematics"]
+    kin = synchronize(walk, None, beats, mode=mode, fill="loop", song_end=20.3).report["kinematics"]
     assert kin["input"]["peak_joint_speed"] < 1.2 * kin["input"]["p99_joint_speed"]
-    if mode == "beats":
-        assert kin["ratio"]["peak_joint_speed"] <= 1.15
+
+
+def test_peak_headroom_leaves_out_the_reference_pose():
+    # the fastest playback of each interval that keeps the joints within the walk's own
+    # peak: against the T-pose's snap, every interval could play 20 times faster
+    from beatsync.motion_beats import kinematic_beats
+    from beatsync.sync.core import _opening_snap
+    from beatsync.sync.placement import peak_headroom
+
+    walk = datasets.load_walk("007_12")
+    events = kinematic_beats(walk)
+    skip = _opening_snap(walk.positions())
+    assert skip >= 1
+    assert peak_headroom(walk, events).min() > 10.0
+    room = peak_headroom(walk, events, skip=skip)
+    assert 1.0 <= room.min() and room.max() < 2.0
 
 
 @pytest.mark.parametrize("mode", ["periods", "beats"])
