@@ -38,6 +38,21 @@ def test_integrate_warp_holds_at_least_the_floor_at_every_boundary():
     np.testing.assert_allclose(w.to_target(s), b, atol=1e-9)  # still lands every beat
 
 
+def test_integrate_warp_holds_where_the_two_periods_meet():
+    # a short fast period between two slow ones: held at the geometric mean of the two
+    # rates at each of its ends (eq. 9's blend, reaching the further period, held 0.995, and
+    # the period's middle played at x1.49 for a mean of x1.18; now x1.42)
+    s = np.array([0.0, 1.0, 1.5, 2.5])
+    rates = np.array([1.1, 0.85, 1.1])
+    b = np.concatenate([[0.0], np.cumsum(np.diff(s) * rates)])
+    w = integrate_warp(s, b, hold=0.1)
+    for x in s[1:3]:
+        assert w.rate[np.searchsorted(w.src, x)] == pytest.approx(np.sqrt(1.1 * 0.85))
+    inside = (w.src > s[1]) & (w.src < s[2])
+    assert 1.0 / w.rate[inside].min() < 1.45
+    np.testing.assert_allclose(w.to_target(s), b, atol=1e-9)
+
+
 def test_within_shortens_a_move_that_leaves_the_band():
     targets = np.array([0.0, 1.0, 2.0])
     kept = np.array([0.0, 1.0, 2.0])

@@ -150,9 +150,10 @@ def integrate_warp(
 ) -> TimeWarp:
     """:func:`time_warp` on inputs already checked (float64, increasing, same length >= 2).
 
-    ``hold`` [s]: the rate stays at its boundary value this long on both sides of every
-    boundary (at most ``MAX_HOLD`` of a period), so that a speed minimum of the motion
-    there is neither moved nor erased by a change of rate; the bump corrects in between.
+    ``hold`` [s]: the rate stays at its boundary value, the geometric mean of the two
+    periods' rates there, this long on both sides of every boundary (at most
+    ``MAX_HOLD`` of a period), so that a speed minimum of the motion there is neither
+    moved nor erased by a change of rate; the bump corrects in between.
     ``floor`` (one per boundary): the lowest rate held at each boundary (ignored
     without ``hold``).
     """
@@ -175,6 +176,12 @@ def integrate_warp(
         v = np.clip((v - q) / (1.0 - 2.0 * q), 0.0, 1.0)
     h = np.broadcast_to(correction_bump(v), r.shape)
     if hold > 0:
+        # held at the rate where the two periods meet (their geometric mean): eq. 9's
+        # blend reaches further periods, and held at a slower neighbour's rate a short
+        # fast period would have to make the time up in its middle
+        log_r = np.log(rates)
+        joint = np.exp(np.concatenate([log_r[:1], 0.5 * (log_r[:-1] + log_r[1:]), log_r[-1:]]))
+        r[:, 0], r[:, -1] = joint[:-1], joint[1:]
         if floor is not None:
             r[:, 0] = np.maximum(r[:, 0], floor[:-1])
             r[:, -1] = np.maximum(r[:, -1], floor[1:])
