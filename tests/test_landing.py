@@ -9,7 +9,7 @@ import pytest
 
 from beatsync.errors import BeatsyncWarning
 from beatsync.sync import synchronize
-from beatsync.sync.landing import _within, dip_floor
+from beatsync.sync.landing import _within, dip_floor, release_floor
 from beatsync.sync.warp import integrate_warp
 
 
@@ -51,6 +51,27 @@ def test_integrate_warp_holds_where_the_two_periods_meet():
     inside = (w.src > s[1]) & (w.src < s[2])
     assert 1.0 / w.rate[inside].min() < 1.45
     np.testing.assert_allclose(w.to_target(s), b, atol=1e-9)
+
+
+def test_release_floor_gives_the_band_priority_over_a_dips_depth():
+    # a short fast interval (x1.18) between two slow ones (x0.91), its ends held at the
+    # slow rate: it races to x1.82 in its middle; released to its own rate there, it
+    # plays as without a floor (x1.42, the held geometric mean's own bump)
+    s = np.array([0.0, 1.0, 1.5, 2.5])
+    b = np.array([0.0, 1.1, 1.525, 2.625])
+    floor = np.array([0.0, 1.1, 1.1, 0.0])
+    w = integrate_warp(s, b, hold=0.1, floor=floor)
+    lower = release_floor(w, s, b, floor, np.full(3, 1.25))
+    np.testing.assert_allclose(lower, [0.0, 0.85, 0.85, 0.0])
+
+    def fastest(warp):
+        return 1.0 / warp.rate[(warp.src > s[1]) & (warp.src < s[2])].min()
+
+    released = integrate_warp(s, b, hold=0.1, floor=lower)
+    assert fastest(w) > 1.8
+    assert fastest(released) == pytest.approx(fastest(integrate_warp(s, b, hold=0.1)))
+    assert fastest(released) < 1.45
+    assert release_floor(w, s, b, floor, np.full(3, 2.0)) is None  # nothing races
 
 
 def test_within_shortens_a_move_that_leaves_the_band():

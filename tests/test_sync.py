@@ -555,6 +555,20 @@ def test_peak_headroom_leaves_out_the_reference_pose():
     assert 1.0 <= room.min() and room.max() < 2.0
 
 
+def test_a_walk_on_a_real_song_does_not_race_between_its_landings():
+    # CMU walk 005_02 in beats mode on the cha-cha dancer's song (125 BPM, tracked): one-beat
+    # intervals between two-beat ones. Held at the slow neighbours' rate at both ends, one
+    # raced to x1.58 in its middle, its joints to x1.34 the walk's own peak
+    from beatsync.beats import track_beats
+
+    y, sr = io.read_audio(datasets.path("motion/dance_with_melody/DANCE_C_4/audio.ogg"))
+    beats = np.asarray(track_beats(y, sr).beats)
+    walk = datasets.load_walk("005_02")
+    r = synchronize(walk, None, beats, mode="beats", fill="loop", song_end=y.size / sr).report
+    assert r["playback_speed"]["instantaneous"]["max"] < 1.45
+    assert r["kinematics"]["ratio"]["peak_joint_speed"] < 1.25
+
+
 @pytest.mark.parametrize("mode", ["periods", "beats"])
 def test_loop_reports_the_passes_it_plays(mode):
     # the looped timeline is built with room to spare; the report counts what is played

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import NotPeriodicError, ParameterError, silenced, warn
+from ..graph.timescale import DEFAULT_SCALE_BOUND
 from ..motion import segmentation_view
 from ..motion_beats import kinematic_beat_frames, kinematic_beats, motion_positions, speed_curve
 from ..rotations import sample_motion
@@ -29,8 +30,9 @@ from ..validation import (
     frames_to_time,
     time_to_frames,
 )
+from .counts import MARGIN
 from .fill import LoopedClip, choose_loop, loop_events, with_center
-from .landing import dip_floor, land_seen, position_view, source_speed
+from .landing import dip_floor, land_seen, position_view, release_floor, source_speed
 from .mapping import BeatCount, beats_per_unit, choose_count, count_or_none, lag_of
 from .placement import check_start, place_whole_dance
 from .positions import restore_bone_lengths
@@ -537,17 +539,16 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         speed_at = source_speed(plan["speed_curve"], fps, looped)
         pos_at = position_view(plan["positions"], 2 if motion.is_positional else 1, fps, looped)
 
+        # the fastest each interval may play anywhere: the band's top, or its peak headroom
+        top = np.minimum(DEFAULT_SCALE_BOUND[1], placed["speed_band"][1] * MARGIN)
+        held = {"start": plan["start"], "end": end, "delta": plan["delta"], "hold": LANDING_HOLD}
+
         def warp_of(pins: np.ndarray) -> TimeWarp:
             floor = dip_floor(speed_at, pins, targets)
-            warp = integrate_warp(
-                pins,
-                targets,
-                start=plan["start"],
-                end=end,
-                delta=plan["delta"],
-                hold=LANDING_HOLD,
-                floor=floor,
-            )
+            warp = integrate_warp(pins, targets, floor=floor, **held)
+            lower = release_floor(warp, pins, targets, floor, top)
+            if lower is not None:
+                warp = integrate_warp(pins, targets, floor=lower, **held)
             if end is None and plan["song_end"] is not None:
                 warp = _go_on(warp, plan["song_end"], last)  # the song's end: no offset
             return warp

@@ -11,6 +11,8 @@ per source time), so the warp can fill a minimum in or move it:
   ``V_min / r`` at the landing: the dip keeps a depth ratio of about ``P r / m``.
   :func:`dip_floor` holds ``r >= m / sqrt(P)`` on both sides, so about half of every
   dip's log depth stays (exactly, were the peak played at the interval's mean rate).
+  Where that makes an interval play faster than the band's top in its middle,
+  :func:`release_floor` gives the band priority.
 - **The smoothing reaches past the held rate** (``LANDING_HOLD`` is one sigma), so
   the output's minimum can sit a frame or two off its beat. :func:`land_seen` finds
   the output's motion beats (to a sub-frame, the parabola through the minimum and its
@@ -47,6 +49,7 @@ __all__ = [
     "source_speed",
     "position_view",
     "dip_floor",
+    "release_floor",
     "land_seen",
 ]
 
@@ -100,6 +103,27 @@ def dip_floor(
     floor[:-1] = m / np.sqrt(np.maximum(peak / low[:-1], 1.0))  # the interval after
     floor[1:] = np.maximum(floor[1:], m / np.sqrt(np.maximum(peak / low[1:], 1.0)))
     return floor
+
+
+def release_floor(
+    warp: Any, pins: np.ndarray, targets: np.ndarray, floor: np.ndarray, top: np.ndarray
+) -> np.ndarray | None:
+    """``floor`` lowered to an interval's own rate at both its ends wherever ``warp``
+    plays the interval faster than its ``top`` (per interval) somewhere: held at a slower
+    neighbour's rate, a landing makes the interval beside it make up its time in its
+    middle, and the speed band comes before a dip's depth. None when no interval does."""
+    k = np.searchsorted(pins, warp.src, side="right") - 1
+    inside = (k >= 0) & (k < pins.size - 1)
+    fastest = np.zeros(pins.size - 1)
+    np.maximum.at(fastest, k[inside], 1.0 / warp.rate[inside])
+    over = np.nonzero(fastest > top)[0]
+    if over.size == 0:
+        return None
+    rate = np.diff(targets) / np.diff(pins)
+    lower = floor.copy()
+    np.minimum.at(lower, over, rate[over])
+    np.minimum.at(lower, over + 1, rate[over])
+    return lower
 
 
 def _within(moved, kept, planned, targets, lo, hi):
