@@ -100,6 +100,13 @@ NOTES = [
     "others (lowest 97.7 %, was 96.6 %), peak joint speed x0.84-1.06 (x0.82-1.07); "
     "music-beat score -0.01 to +0.03, motion-beat score -0.02 to +0.06; landings found "
     "again +1 on one pair.",
+    "- Where a landing's held rate makes the interval beside it play faster than the "
+    "band's top (or its peak headroom) somewhere, the floor at its ends falls to that "
+    "interval's own rate (`beatsync.sync.landing.release_floor`: the band before a dip's "
+    "depth). Against the run before it, two pairs change: DANCE_W_5 on DANCE_R_3's song "
+    "plays at most x1.30 (x1.36), 97.9 % in band (97.7 %), music-beat score 0.32 (0.34), "
+    "landings found again 14 (15); DANCE_W_10 on DANCE_R_3's song at most x1.24 (x1.19), "
+    "motion-beat score +0.02.",
     "- The pair that misses the alignment target (DANCE_W_5 on DANCE_C_4's song) misses "
     "it on the music-beat score (BAS, averaged over music beats) only, by 0.002; the "
     "second table shows where it goes. A music beat scores when the output shows a motion "
