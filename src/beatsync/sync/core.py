@@ -541,21 +541,35 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
 
         # the fastest each interval may play anywhere: the band's top, or its peak headroom
         top = np.minimum(DEFAULT_SCALE_BOUND[1], placed["speed_band"][1] * MARGIN)
-        held = {"start": plan["start"], "end": end, "delta": plan["delta"], "hold": LANDING_HOLD}
 
-        def warp_of(pins: np.ndarray) -> TimeWarp:
-            floor = dip_floor(speed_at, pins, targets)
-            warp = integrate_warp(pins, targets, floor=floor, **held)
-            lower = release_floor(warp, pins, targets, floor, top)
+        def warp_of(pins: np.ndarray, part: tuple[int, int] | None = None) -> TimeWarp:
+            """The warp of ``pins``, or of the landings ``part`` (a, b) of them only
+            (eq. 9's width kept: the warp there is the whole warp's, away from its ends)."""
+            a, b = (0, pins.size) if part is None else part
+            tg = targets[a:b]
+            held = {
+                "start": plan["start"] if a == 0 else None,
+                "end": end if b == pins.size else None,
+                "delta": plan["delta"] or float(pins[-1] - pins[0]) / (pins.size - 1),
+                "hold": LANDING_HOLD,
+            }
+            pins = pins[a:b]
+            floor = dip_floor(speed_at, pins, tg)
+            warp = integrate_warp(pins, tg, floor=floor, **held)
+            lower = release_floor(warp, pins, tg, floor, top[a : b - 1])
             if lower is not None:
-                warp = integrate_warp(pins, targets, floor=lower, **held)
-            if end is None and plan["song_end"] is not None:
+                warp = integrate_warp(pins, tg, floor=lower, **held)
+            if held["end"] is None and b == targets.size and plan["song_end"] is not None:
                 warp = _go_on(warp, plan["song_end"], last)  # the song's end: no offset
             return warp
 
-        def view(pins: np.ndarray):
-            warp = warp_of(pins)
+        def view(pins: np.ndarray, span=None, part=None):
+            """Joint positions, output and source times of the output frames (within
+            ``span`` [s], if given) and the warp (of the landings ``part``)."""
+            warp = warp_of(pins, part)
             out_t = _output_times(warp, out_fps)
+            if span is not None:
+                out_t = out_t[(out_t >= span[0]) & (out_t <= span[1])]
             src_t = warp.to_source(out_t)
             return pos_at(src_t), out_t, src_t, warp
 

@@ -27,6 +27,13 @@ per source time), so the warp can fill a minimum in or move it:
   per interval, the lead-in and the run-on included), the one with the most minima
   within half a frame of their frames, then the best music-side alignment Gaussian
   (summed), wins.
+- **Neighbours on shallow dips push each other off.** Moving a landing onto its frame
+  can move its neighbour's minimum off, so the rounds stop there. Then each pin beside
+  a landing still off its frame tries moves of a half frame to ``REFINE_STEPS`` half
+  frames either way, one pin at a time, each kept when the output around it (eq. 9's
+  reach, ``REFINE_REACH`` widths, on the warp of the landings within it) scores better
+  with no more output off the band; the pins so moved are kept when the whole output
+  measures better too.
 
 The rounds are judged on a cheap view of the output, the source's joint positions
 sampled linearly (:func:`position_view`); the output itself is made once, at the end.
@@ -55,6 +62,15 @@ __all__ = [
 
 #: rounds of measuring the output's motion beats and moving the pins
 SEEN_ROUNDS = 2
+#: then each pin beside a landing still off its frame tries moves of up to this many
+#: half output frames either way, over at most ``REFINE_SWEEPS`` passes
+REFINE_STEPS = 4
+REFINE_SWEEPS = 3
+#: a move is measured on the output within this many of eq. 9's widths of the landings
+#: beside it (the blend's weights beyond are below 1.2 %) ...
+REFINE_REACH = 3.0
+#: ... and the motion-beat detector's reach [s] (its smoothing and prominence window)
+REFINE_EDGE = 0.5
 #: width of the landings' score [s]: the published alignment scores' (3 frames at 60 fps)
 SCORE_SIGMA = 0.05
 #: samples per interval when looking for its speed peak
@@ -217,5 +233,60 @@ def land_seen(
         err, _, off, warp = measure(mix)
         if off.sum() <= off0.sum():
             rounds.append((score(err), mix, warp))
-    _, pins, warp = max(rounds, key=lambda r: r[0])
+    chosen, pins, warp = max(rounds, key=lambda r: r[0])
+    refined = _refine(view, fps, pins, targets, warp.delta, score, off0.sum())
+    if refined is not None:  # measured on the whole output, as the rounds were
+        err, _, off, r_warp = measure(refined)
+        if off.sum() <= off0.sum() and score(err) > chosen:
+            return refined, r_warp
     return pins, warp
+
+
+def _refine(view, fps, pins, targets, delta, score, off_budget):
+    """The rounds' pins, each pin beside a landing still off its frame moved by
+    ``REFINE_STEPS`` half frames or fewer either way, one at a time, while its
+    neighbourhood measures better (minima on their frames, then the Gaussian) with no
+    more output off the band (None if no move helped). Moving a pin changes the warp
+    only within a few of eq. 9's widths of it, so each move is measured there."""
+
+    blend = REFINE_REACH * delta  # eq. 9's reach
+    reach = blend + REFINE_EDGE
+
+    def window(p, span):
+        """Score, output frames off the band and landing errors within ``span`` [s],
+        on the warp of the landings within the blend's reach of it."""
+        part = None
+        if span[0] > targets[0] - reach or span[1] < targets[-1] + reach:
+            a = max(int(np.searchsorted(targets, span[0] - blend)) - 1, 0)
+            b = min(int(np.searchsorted(targets, span[1] + blend, side="right")) + 1, p.size)
+            part = (a, b)
+        pos, out_t, src_t, warp = view(p, span, part)
+        inside = (targets >= span[0] + REFINE_EDGE) & (targets <= span[1] - REFINE_EDGE)
+        err, _ = seen_landings(pos, fps, targets[inside] - out_t[0])
+        speed = np.diff(src_t) * fps
+        live = (out_t[:-1] >= warp.tgt[0] - 1e-9) & (out_t[1:] <= warp.tgt[-1] + 1e-9)
+        off = (speed < DEFAULT_SCALE_BOUND[0]) | (speed > DEFAULT_SCALE_BOUND[1])
+        return score(err), int(np.count_nonzero(off & live)), err
+
+    whole = (-np.inf, np.inf)
+    steps = [k * 0.5 / fps for m in range(1, REFINE_STEPS + 1) for k in (-m, m)]
+    start = pins
+    for _ in range(REFINE_SWEEPS):
+        _, off, err = window(pins, whole)
+        spare, moved = off_budget - off, False
+        off_frame = np.nonzero(err > 0.5 / fps)[0]
+        for i in sorted({j for k in off_frame for j in (k - 1, k, k + 1) if 0 < j < pins.size}):
+            span = (targets[i - 1] - reach, targets[min(i + 1, targets.size - 1)] + reach)
+            base, base_off, _ = window(pins, span)
+            for step in steps:
+                p = pins.copy()
+                p[i] += step
+                if not np.all(np.diff(p) > 0):
+                    continue
+                got, got_off, _ = window(p, span)
+                if got > base and got_off - base_off <= spare:
+                    spare -= got_off - base_off
+                    pins, base, base_off, moved = p, got, got_off, True
+        if not moved:
+            break
+    return None if pins is start else pins
