@@ -74,6 +74,26 @@ def test_release_floor_gives_the_band_priority_over_a_dips_depth():
     assert release_floor(w, s, b, floor, np.full(3, 2.0)) is None  # nothing races
 
 
+def test_seen_landings_of_a_window_aim_at_the_whole_outputs_frames():
+    # a window of the output from an odd frame on: a beat exactly half-way between two
+    # frames is aimed at the frame the whole output aims at (np.rint rounds half frames
+    # to the even one; shifting the times by an odd number of frames moved them)
+    from beatsync.sync.quality import seen_landings
+
+    fps = 25.0
+    t = np.arange(200) / fps
+    speed = 1.5 + np.cos(2 * np.pi * (t - 2.02) / 1.6)  # minima at 2.82 s and 4.42 s
+    pos = np.zeros((t.size, 2, 3))
+    pos[:, :, 0] = np.cumsum(speed)[:, None] / fps
+    targets = np.array([2.82, 4.42])  # half-way between frames 70 and 71, 110 and 111
+    whole, _ = seen_landings(pos, fps, targets)
+    first = 31  # odd
+    part, _ = seen_landings(pos[first:], fps, targets, first)
+    np.testing.assert_allclose(part, whole, atol=1e-9)
+    shifted, _ = seen_landings(pos[first:], fps, targets - first / fps)
+    assert not np.allclose(shifted, whole, atol=1e-9)  # the times shifted instead
+
+
 def test_within_shortens_a_move_that_leaves_the_band():
     targets = np.array([0.0, 1.0, 2.0])
     kept = np.array([0.0, 1.0, 2.0])

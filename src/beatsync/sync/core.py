@@ -435,7 +435,8 @@ def synchronize(
         "positions": positions,
     }
     # the output starts after a converter's reference pose, if the clip opens on one
-    plan["start"] = _opening_snap(plan["positions"]) / fps
+    plan["start_frame"] = _opening_snap(plan["positions"])
+    plan["start"] = plan["start_frame"] / fps
     if whole_dance:  # once for both passes of land="accents"
         plan["speed_curve"] = speed_curve(positions, fps=fps)
     lag = 0.0
@@ -540,6 +541,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
         pos_at = position_view(plan["positions"], 2 if motion.is_positional else 1, fps, looped)
 
         # the fastest each interval may play anywhere: the band's top, or its peak headroom
+        # (the counts' band without the margin they aimed inside)
         top = np.minimum(DEFAULT_SCALE_BOUND[1], placed["speed_band"][1] * MARGIN)
 
         def warp_of(pins: np.ndarray, part: tuple[int, int] | None = None) -> TimeWarp:
@@ -547,7 +549,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             (eq. 9's width kept: the warp there is the whole warp's, away from its ends)."""
             a, b = (0, pins.size) if part is None else part
             tg = targets[a:b]
-            held = {
+            args = {
                 "start": plan["start"] if a == 0 else None,
                 "end": end if b == pins.size else None,
                 "delta": plan["delta"] or float(pins[-1] - pins[0]) / (pins.size - 1),
@@ -555,11 +557,11 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
             }
             pins = pins[a:b]
             floor = dip_floor(speed_at, pins, tg)
-            warp = integrate_warp(pins, tg, floor=floor, **held)
+            warp = integrate_warp(pins, tg, floor=floor, **args)
             lower = release_floor(warp, pins, tg, floor, top[a : b - 1])
             if lower is not None:
-                warp = integrate_warp(pins, tg, floor=lower, **held)
-            if held["end"] is None and b == targets.size and plan["song_end"] is not None:
+                warp = integrate_warp(pins, tg, floor=lower, **args)
+            if args["end"] is None and b == targets.size and plan["song_end"] is not None:
                 warp = _go_on(warp, plan["song_end"], last)  # the song's end: no offset
             return warp
 
@@ -679,7 +681,7 @@ def _resample(plan: dict[str, Any], phase_offset: float) -> SyncResult:
     # the input's figures leave out a reference pose it opens on, as the output does
     pos_in = plan["positions"]
     if pos_in is not None:
-        pos_in = pos_in[int(round(plan["start"] * plan["fps"])) :]
+        pos_in = pos_in[plan["start_frame"] :]
     args = (motion, out_motion, src_times, warp, used, targets, looped, placed, pos_in)
     report.update(report_entries(*args, aims=aims if plan["beats_mode"] else None))
     if report["repetitions"] > 1 and motion.skeleton is None and not motion.is_positional:

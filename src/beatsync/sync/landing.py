@@ -49,7 +49,7 @@ import numpy as np
 from ..graph.distance import ground_axes
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from .positions import interp_frames
-from .quality import live_steps, seen_landings
+from .quality import seen_landings
 
 __all__ = [
     "SEEN_ROUNDS",
@@ -174,9 +174,11 @@ def _within(moved, kept, planned, targets, lo, hi):
 def _off_band(view: tuple, fps: float, targets: np.ndarray) -> np.ndarray:
     """Output frames per interval between ``targets`` played outside the speed band,
     wherever the warp plays (its lead-in in the first interval, its run-on in the last;
-    ``view``: positions, output and source times, the warp)."""
+    ``view``: positions, output and source times of consecutive output frames, the
+    warp)."""
     _, out_times, src_times, warp = view
-    live = live_steps(src_times.size, fps, (warp.tgt[0], warp.tgt[-1]))
+    # the steps between frames within the warp's span (a held lead-in left out)
+    live = (out_times[:-1] >= warp.tgt[0] - 1e-9) & (out_times[1:] <= warp.tgt[-1] + 1e-9)
     speed = np.diff(src_times)[live] * fps
     off = (speed < DEFAULT_SCALE_BOUND[0]) | (speed > DEFAULT_SCALE_BOUND[1])
     k = np.clip(np.searchsorted(targets, out_times[1:][live]) - 1, 0, targets.size - 2)
@@ -184,16 +186,18 @@ def _off_band(view: tuple, fps: float, targets: np.ndarray) -> np.ndarray:
 
 
 def land_seen(
-    view: Callable[[np.ndarray], tuple],
+    view: Callable[..., tuple],
     fps: float,
     used: np.ndarray,
     targets: np.ndarray,
     band: tuple[float, np.ndarray],
 ) -> tuple[np.ndarray, Any]:
     """The landings' source pins (from ``used`` [s]) whose output shows its motion beats
-    on ``targets`` [s] (module docstring), and their warp. ``view(pins)`` returns the
-    output's joint positions, output times and source times at ``fps``, and the warp;
-    ``band`` the lowest and highest playback speed per interval the beat counts aimed at."""
+    on ``targets`` [s] (module docstring), and their warp. ``view(pins, span=None,
+    part=None)`` returns the output's joint positions, output times and source times at
+    ``fps`` (of the frames within ``span`` [s]), and the warp (of the landings ``part``,
+    ``(a, b)``, only); ``band`` the lowest and highest playback speed per interval the
+    beat counts aimed at."""
     speed = np.diff(used) / np.diff(targets)
     lo, hi = np.minimum(band[0], speed), np.maximum(band[1], speed)
 
@@ -243,50 +247,57 @@ def land_seen(
 
 
 def _refine(view, fps, pins, targets, delta, score, off_budget):
-    """The rounds' pins, each pin beside a landing still off its frame moved by
-    ``REFINE_STEPS`` half frames or fewer either way, one at a time, while its
-    neighbourhood measures better (minima on their frames, then the Gaussian) with no
-    more output off the band (None if no move helped). Moving a pin changes the warp
-    only within a few of eq. 9's widths of it, so each move is measured there."""
+    """The rounds' ``pins`` refined one at a time (module docstring): each pin of, or
+    beside, a landing still off its frame moves by a half frame, then a frame, ... up to
+    ``REFINE_STEPS`` half frames in one direction while each move measures better
+    (``score``: minima on their frames, then the Gaussian) with no more output off the
+    band than ``off_budget`` frames in all, then in the other; a direction is given up
+    when a whole frame brings nothing. None if no move helped.
 
-    blend = REFINE_REACH * delta  # eq. 9's reach
+    Moving a pin changes the warp only within a few of eq. 9's widths (``delta`` [s]) of
+    it, so each move is measured there, on the warp of the landings within as many widths
+    again (the whole output's, away from its ends)."""
+    blend = REFINE_REACH * delta
     reach = blend + REFINE_EDGE
+    half = 0.5 / fps
 
     def window(p, span):
-        """Score, output frames off the band and landing errors within ``span`` [s],
-        on the warp of the landings within the blend's reach of it."""
+        """Score, frames off the band and landing errors of the output within ``span``."""
         part = None
         if span[0] > targets[0] - reach or span[1] < targets[-1] + reach:
             a = max(int(np.searchsorted(targets, span[0] - blend)) - 1, 0)
             b = min(int(np.searchsorted(targets, span[1] + blend, side="right")) + 1, p.size)
             part = (a, b)
-        pos, out_t, src_t, warp = view(p, span, part)
+        look = view(p, span, part)
         inside = (targets >= span[0] + REFINE_EDGE) & (targets <= span[1] - REFINE_EDGE)
-        err, _ = seen_landings(pos, fps, targets[inside] - out_t[0])
-        speed = np.diff(src_t) * fps
-        live = (out_t[:-1] >= warp.tgt[0] - 1e-9) & (out_t[1:] <= warp.tgt[-1] + 1e-9)
-        off = (speed < DEFAULT_SCALE_BOUND[0]) | (speed > DEFAULT_SCALE_BOUND[1])
-        return score(err), int(np.count_nonzero(off & live)), err
+        first = int(round(look[1][0] * fps))
+        err, _ = seen_landings(look[0], fps, targets[inside], first)
+        return score(err), int(_off_band(look, fps, targets).sum()), err
 
-    whole = (-np.inf, np.inf)
-    steps = [k * 0.5 / fps for m in range(1, REFINE_STEPS + 1) for k in (-m, m)]
     start = pins
     for _ in range(REFINE_SWEEPS):
-        _, off, err = window(pins, whole)
+        _, off, err = window(pins, (-np.inf, np.inf))
         spare, moved = off_budget - off, False
-        off_frame = np.nonzero(err > 0.5 / fps)[0]
-        for i in sorted({j for k in off_frame for j in (k - 1, k, k + 1) if 0 < j < pins.size}):
-            span = (targets[i - 1] - reach, targets[min(i + 1, targets.size - 1)] + reach)
+        far = np.nonzero(err > half)[0]
+        for i in sorted({j for k in far for j in (k - 1, k, k + 1) if 0 <= j < pins.size}):
+            span = (targets[max(i - 1, 0)] - reach, targets[min(i + 1, pins.size - 1)] + reach)
             base, base_off, _ = window(pins, span)
-            for step in steps:
-                p = pins.copy()
-                p[i] += step
-                if not np.all(np.diff(p) > 0):
-                    continue
-                got, got_off, _ = window(p, span)
-                if got > base and got_off - base_off <= spare:
-                    spare -= got_off - base_off
-                    pins, base, base_off, moved = p, got, got_off, True
+            origin = pins[i]
+            for sign in (1.0, -1.0):
+                went = False
+                for m in range(1, REFINE_STEPS + 1):
+                    p = pins.copy()
+                    p[i] = origin + sign * m * half
+                    if not np.all(np.diff(p) > 0):
+                        break
+                    got, got_off, _ = window(p, span)
+                    if got > base and got_off - base_off <= spare:
+                        spare -= got_off - base_off
+                        pins, base, base_off, moved, went = p, got, got_off, True, True
+                    elif went or m >= 2:
+                        break
+                if went:
+                    break
         if not moved:
             break
     return None if pins is start else pins

@@ -57,8 +57,8 @@ def place_whole_dance(plan: dict[str, Any], phase_offset: float):
             looped = None
         else:
             timeline, index = looped.events, looped.event_index
-    skip = int(round(plan["start"] * plan["fps"]))  # a reference pose the output never shows
-    headroom = peak_headroom(motion, events, plan["positions"], skip=skip)
+    # a reference pose the clip opens on is not the dancer's (the output never shows it)
+    headroom = peak_headroom(motion, events, plan["positions"], skip=plan["start_frame"])
     placed = plan_counts(
         timeline,
         song,

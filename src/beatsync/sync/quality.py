@@ -66,14 +66,14 @@ def live_steps(n: int, out_fps: float, covered: tuple[float, float]) -> np.ndarr
 
 
 def seen_landings(
-    pos: np.ndarray, fps: float, targets: np.ndarray
+    pos: np.ndarray, fps: float, targets: np.ndarray, first_frame: int = 0
 ) -> tuple[np.ndarray, np.ndarray]:
     """For every beat in ``targets`` [s]: how far [s] the nearest motion beat of the
-    output's joint positions ``pos`` (at ``fps``; a speed minimum found to a sub-frame,
-    the parabola through it and its neighbours) lies from the output frame nearest the
-    beat, the frame a viewer can see it on (inf beyond ``SEEN_REACH``), and the same
-    signed (the minimum's time minus the frame's)."""
-    aim = np.rint(targets * fps) / fps
+    output's joint positions ``pos`` (at ``fps``, from output frame ``first_frame`` on;
+    a speed minimum found to a sub-frame, the parabola through it and its neighbours)
+    lies from the output frame nearest the beat, the frame a viewer can see it on (inf
+    beyond ``SEEN_REACH``), and the same signed (the minimum's time minus the frame's)."""
+    aim = (np.rint(targets * fps) - first_frame) / fps
     curve = speed_curve(pos, fps=fps)
     f = speed_minima(curve, fps)  # kinematic_beats' defaults
     if f.size == 0:
