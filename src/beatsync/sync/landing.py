@@ -28,12 +28,13 @@ per source time), so the warp can fill a minimum in or move it:
   within half a frame of their frames, then the best music-side alignment Gaussian
   (summed), wins.
 - **Neighbours on shallow dips push each other off.** Moving a landing onto its frame
-  can move its neighbour's minimum off, so the rounds stop there. Then each pin beside
-  a landing still off its frame tries moves of a half frame to ``REFINE_STEPS`` half
-  frames either way, one pin at a time, each kept when the output around it (eq. 9's
-  reach, ``REFINE_REACH`` widths, on the warp of the landings within it) scores better
-  with no more output off the band; the pins so moved are kept when the whole output
-  measures better too.
+  can move its neighbour's minimum off, so the rounds stop there. Then the pin of each
+  landing still off its frame, and its neighbours', move one at a time: a half frame,
+  then a frame, ... up to ``REFINE_STEPS`` half frames in one direction while each move
+  is better, then the other, each kept when the output around it (eq. 9's reach,
+  ``REFINE_REACH`` widths, on the warp of the landings within it) scores better with no
+  more output off the band; the pins so moved are kept when the whole output measures
+  better too.
 
 The rounds are judged on a cheap view of the output, the source's joint positions
 sampled linearly (:func:`position_view`); the output itself is made once, at the end.
