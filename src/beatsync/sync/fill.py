@@ -38,6 +38,7 @@ skeleton's root channels with y up (BVH).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -115,8 +116,9 @@ class LoopedClip:
                 rb = np.where(near, kk + 1.0, rb)
         return a, b, w, ra, rb
 
-    def _moves(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Rotation angles and floor translations of ``M^r`` for each repetition."""
+    @cached_property
+    def _pass_moves(self) -> tuple[np.ndarray, np.ndarray]:
+        """Rotation angle and floor translation of ``M^r``, per repetition ``r``."""
         n = self.repetitions
         ang = np.arange(n) * self.angle
         off = np.zeros((n, 2))
@@ -125,6 +127,11 @@ class LoopedClip:
             for r in range(1, n):  # M^r = M o M^(r-1): x -> R x + shift
                 x, y = off[r - 1]
                 off[r] = (c * x - s * y + self.shift[0], s * x + c * y + self.shift[1])
+        return ang, off
+
+    def _moves(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rotation angles and floor translations of ``M^r`` for each repetition."""
+        ang, off = self._pass_moves
         idx = reps.astype(np.int64)
         return ang[idx], off[idx]
 
