@@ -68,7 +68,9 @@ SEEN_ROUNDS = 2
 REFINE_STEPS = 4
 REFINE_SWEEPS = 3
 #: a move is measured on the output within this many of eq. 9's widths of the landings
-#: beside it (the blend's weights beyond are below 1.2 %) ...
+#: beside it, on the warp of the landings within as many again and one more on each
+#: side (the blend's weights three widths off are 1.1 % of its own; the widths are
+#: source seconds, taken here as music seconds) ...
 REFINE_REACH = 3.0
 #: ... and the motion-beat detector's reach [s] (its smoothing and prominence window)
 REFINE_EDGE = 0.5
