@@ -50,7 +50,7 @@ import numpy as np
 from ..graph.distance import ground_axes
 from ..graph.timescale import DEFAULT_SCALE_BOUND
 from .positions import interp_frames
-from .quality import seen_landings
+from .quality import live_steps, seen_landings
 
 __all__ = [
     "SEEN_ROUNDS",
@@ -67,10 +67,10 @@ SEEN_ROUNDS = 2
 #: half output frames either way, over at most ``REFINE_SWEEPS`` passes
 REFINE_STEPS = 4
 REFINE_SWEEPS = 3
-#: a move is measured on the output within this many of eq. 9's widths of the landings
+#: a move is judged on the output within this many of eq. 9's widths of the landings
 #: beside it, on the warp of the landings within as many again and one more on each
-#: side (the blend's weights three widths off are 1.1 % of its own; the widths are
-#: source seconds, taken here as music seconds) ...
+#: side: eq. 9's Gaussian weights fall below exp(-4.5) of their own there (the widths
+#: are source seconds, taken here as music seconds) ...
 REFINE_REACH = 3.0
 #: ... and the motion-beat detector's reach [s] (its smoothing and prominence window)
 REFINE_EDGE = 0.5
@@ -180,8 +180,7 @@ def _off_band(view: tuple, fps: float, targets: np.ndarray) -> np.ndarray:
     ``view``: positions, output and source times of consecutive output frames, the
     warp)."""
     _, out_times, src_times, warp = view
-    # the steps between frames within the warp's span (a held lead-in left out)
-    live = (out_times[:-1] >= warp.tgt[0] - 1e-9) & (out_times[1:] <= warp.tgt[-1] + 1e-9)
+    live = live_steps(out_times, (warp.tgt[0], warp.tgt[-1]))
     speed = np.diff(src_times)[live] * fps
     off = (speed < DEFAULT_SCALE_BOUND[0]) | (speed > DEFAULT_SCALE_BOUND[1])
     k = np.clip(np.searchsorted(targets, out_times[1:][live]) - 1, 0, targets.size - 2)
@@ -242,7 +241,7 @@ def land_seen(
             rounds.append((score(err), mix, warp))
     chosen, pins, warp = max(rounds, key=lambda r: r[0])
     refined = _refine(view, fps, pins, targets, warp.delta, score, off0.sum())
-    if refined is not None:  # measured on the whole output, as the rounds were
+    if refined is not None:  # the whole output decides, as it does for the rounds
         err, _, off, r_warp = measure(refined)
         if off.sum() <= off0.sum() and score(err) > chosen:
             return refined, r_warp

@@ -58,11 +58,10 @@ def _stats(s: np.ndarray, weight: np.ndarray, band: tuple[float, float]) -> dict
     }
 
 
-def live_steps(n: int, out_fps: float, covered: tuple[float, float]) -> np.ndarray:
-    """Which of the ``n - 1`` steps between consecutive output frames lie wholly within
+def live_steps(times: np.ndarray, covered: tuple[float, float]) -> np.ndarray:
+    """Which steps between consecutive output frames (at ``times`` [s]) lie wholly within
     ``covered`` [s], where the warp plays (a held lead-in, and the step out of it, left out)."""
-    t = np.arange(n) / out_fps
-    return (t[:-1] >= covered[0] - 1e-9) & (t[1:] <= covered[1] + 1e-9)
+    return (times[:-1] >= covered[0] - 1e-9) & (times[1:] <= covered[1] + 1e-9)
 
 
 def seen_landings(
@@ -105,7 +104,8 @@ def instantaneous_speed(
     src_times: np.ndarray, out_fps: float, covered: tuple[float, float]
 ) -> np.ndarray:
     """Source seconds per output second between output frames within ``covered`` [s]."""
-    return np.diff(src_times)[live_steps(src_times.size, out_fps, covered)] * out_fps
+    live = live_steps(np.arange(src_times.size) / out_fps, covered)
+    return np.diff(src_times)[live] * out_fps
 
 
 def speed_figures(
@@ -197,12 +197,10 @@ def report_entries(
             src_times, out_fps, (float(warp.tgt[0]), float(warp.tgt[-1])), used, targets
         ),
     }
-    pos_out = None
+    pos_out = rep["kinematics"] = None
     if pos_in is not None:  # angle tables have no joint speeds to report
         with silenced():
             pos_out = motion_positions(out_motion)
-    rep["kinematics"] = None
-    if pos_in is not None:
         # finite differences depend on the frame rate: the input at the output's
         if out_fps != motion.fps:
             t = np.arange(0.0, (pos_in.shape[0] - 1) / motion.fps + 1e-9, 1.0 / out_fps)
